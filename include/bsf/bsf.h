@@ -1,0 +1,15 @@
+/*
+ * bsf.h - umbrella header of the bsf library: include this one.
+ *
+ * bsf turns a 2D LIDAR scan into quadratic B-spline map features in fixed,
+ * caller-owned memory (no heap, no VLAs, no recursion).
+ */
+#ifndef BSF_H
+#define BSF_H
+
+#include "bsf_config.h"
+#include "bsf_common.h"
+#include "bsf_scan.h"
+#include "bsf_feature.h"
+
+#endif /* BSF_H */

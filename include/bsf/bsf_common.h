@@ -1,0 +1,53 @@
+/*
+ * bsf_common.h - status codes and basic types shared by every bsf module.
+ */
+#ifndef BSF_COMMON_H
+#define BSF_COMMON_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bsf_config.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Results that must not be ignored (a status that carries an error). */
+#if defined(__GNUC__) || defined(__clang__)
+#define BSF_NODISCARD __attribute__((warn_unused_result))
+#else
+#define BSF_NODISCARD
+#endif
+
+/**
+ * Status of a bsf call: BSF_OK (0) on success, a negative value on error.
+ * Functions that return a count return it as a non-negative value.
+ */
+typedef enum {
+    BSF_OK = 0,
+    BSF_ERR_ARG = -1,        /**< NULL pointer or an argument outside its domain */
+    BSF_ERR_CAPACITY = -2,   /**< input or output larger than a compile-time cap */
+    BSF_ERR_PARAM = -3,      /**< runtime parameter out of its documented range */
+    BSF_ERR_NUMERIC = -4,    /**< a solve failed (matrix not positive definite after one retry) */
+    BSF_ERR_DEGENERATE = -5, /**< too few or coincident points for the requested fit */
+    BSF_ERR_BUFFER = -6,     /**< caller's output buffer too small */
+    BSF_ERR_FORMAT = -7,     /**< malformed frame or field */
+    BSF_ERR_CRC = -8,        /**< frame check sequence mismatch */
+    BSF_ERR_VERSION = -9     /**< unsupported frame version or type */
+} bsf_status_t;
+
+/** A point in the sensor (or world) plane, metres. */
+typedef struct {
+    float x;
+    float y;
+} bsf_point_t;
+
+/** Short English name of a status code ("ok", "bad argument", ...); never NULL. */
+const char *bsf_status_str(bsf_status_t status);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BSF_COMMON_H */

@@ -1,0 +1,62 @@
+/*
+ * bsf_config.h - compile-time capacities of the bsf library.
+ *
+ * Every array the library uses lives in a caller-owned object whose size
+ * follows from the caps below, so sizeof() of that object is the whole RAM
+ * cost. Override any cap by defining it before this header is read, either
+ * on the compiler command line (-DBSF_MAX_POINTS=361) or in a header of your
+ * own named by BSF_CONFIG_HEADER (-DBSF_CONFIG_HEADER='"my_bsf_config.h"'),
+ * which is included first. The library and every translation unit that uses
+ * its headers must see the same values.
+ */
+#ifndef BSF_CONFIG_H
+#define BSF_CONFIG_H
+
+#ifdef BSF_CONFIG_HEADER
+#include BSF_CONFIG_HEADER
+#endif
+
+/** Largest number of beams in one scan (index space, valid or not). */
+#ifndef BSF_MAX_POINTS
+#define BSF_MAX_POINTS 1081
+#endif
+
+/** Largest number of interest points (corners) kept for one scan. */
+#ifndef BSF_MAX_KEYPOINTS
+#define BSF_MAX_KEYPOINTS 64
+#endif
+
+/** Largest number of kept (not wasted) segments, hence features, per scan. */
+#ifndef BSF_MAX_SEGMENTS
+#define BSF_MAX_SEGMENTS 128
+#endif
+
+/** Largest number of stored control points of one feature (a vertex counts twice). */
+#ifndef BSF_MAX_CTRL_PER_FEATURE
+#define BSF_MAX_CTRL_PER_FEATURE 32
+#endif
+
+/** Largest number of stored control points of one scan, all features together. */
+#ifndef BSF_MAX_CTRL_POINTS
+#define BSF_MAX_CTRL_POINTS 512
+#endif
+
+/* Range checks: a bad value stops the build here rather than corrupting
+ * memory at run time. Beam indices are stored as uint16_t. */
+#if BSF_MAX_POINTS < 8 || BSF_MAX_POINTS > 65535
+#error "BSF_MAX_POINTS must be in [8, 65535]"
+#endif
+#if BSF_MAX_KEYPOINTS < 1 || BSF_MAX_KEYPOINTS > BSF_MAX_POINTS
+#error "BSF_MAX_KEYPOINTS must be in [1, BSF_MAX_POINTS]"
+#endif
+#if BSF_MAX_SEGMENTS < 1 || BSF_MAX_SEGMENTS > BSF_MAX_POINTS
+#error "BSF_MAX_SEGMENTS must be in [1, BSF_MAX_POINTS]"
+#endif
+#if BSF_MAX_CTRL_PER_FEATURE < 4 || BSF_MAX_CTRL_PER_FEATURE > 64
+#error "BSF_MAX_CTRL_PER_FEATURE must be in [4, 64]"
+#endif
+#if BSF_MAX_CTRL_POINTS < BSF_MAX_CTRL_PER_FEATURE || BSF_MAX_CTRL_POINTS > 65535
+#error "BSF_MAX_CTRL_POINTS must be in [BSF_MAX_CTRL_PER_FEATURE, 65535]"
+#endif
+
+#endif /* BSF_CONFIG_H */

@@ -1,0 +1,72 @@
+/*
+ * bsf_feature.h - what extraction produces: B-spline features of one scan
+ * and the scan's statistics. The stream encoder and the metrics consume it.
+ */
+#ifndef BSF_FEATURE_H
+#define BSF_FEATURE_H
+
+#include "bsf_common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Kind of a feature (paper section 5): with or without a vertex (corner). */
+typedef enum {
+    BSF_FEATURE_BLEAK = 0,    /**< no interest point inside: a smooth curve */
+    BSF_FEATURE_AUXILIARY = 1 /**< at least one interest point inside: has vertices */
+} bsf_feature_kind_t;
+
+/**
+ * One B-spline feature: a clamped uniform quadratic B-spline whose control
+ * points are result->ctrl[ctrl_first .. ctrl_first + n_ctrl - 1].
+ * A vertex control point has multiplicity 2: it is stored twice, in two
+ * consecutive slots, both flagged in result->ctrl_is_vertex, and counts twice
+ * in n_ctrl (as in the paper's compactness metric).
+ */
+typedef struct {
+    uint16_t first_beam; /**< first beam index covered (inclusive) */
+    uint16_t last_beam;  /**< last beam index covered (inclusive) */
+    uint16_t n_points;   /**< valid points assigned to the feature */
+    uint16_t ctrl_first; /**< index of the first control point in the result pool */
+    uint8_t n_ctrl;      /**< stored control points, 3..BSF_MAX_CTRL_PER_FEATURE */
+    uint8_t kind;        /**< a bsf_feature_kind_t */
+    float e_curve;       /**< RMS distance of its points to the curve, metres */
+} bsf_feature_t;
+
+/** Pipeline stages whose time is measured when a clock is given. */
+typedef enum {
+    BSF_STAGE_POINTS = 0,
+    BSF_STAGE_CORNERS = 1,
+    BSF_STAGE_SEGMENTS = 2,
+    BSF_STAGE_FIT = 3,
+    BSF_STAGE_COUNT = 4
+} bsf_stage_t;
+
+/** Per-scan statistics (paper section 6.1 metrics are computed from these). */
+typedef struct {
+    uint32_t n_valid;       /**< N: valid readings in the scan */
+    uint32_t n_in_features; /**< points in kept features (numerator of retrievability) */
+    uint32_t n_ctrl;        /**< stored control points of all features */
+    uint32_t n_features;    /**< kept features */
+    uint32_t n_keypoints;   /**< interest points found by the corner stage */
+    uint32_t n_unfitted;    /**< segments whose fit failed (counted as wasted) */
+    uint32_t time_ns;       /**< whole extraction time, ns; 0 when no clock is set */
+    uint32_t stage_ns[BSF_STAGE_COUNT]; /**< per-stage time, ns; 0 when no clock */
+} bsf_stats_t;
+
+/** All features of one scan. Fixed size; lives in caller memory. */
+typedef struct {
+    bsf_feature_t features[BSF_MAX_SEGMENTS];
+    bsf_point_t ctrl[BSF_MAX_CTRL_POINTS];       /**< control points, sensor frame, metres */
+    uint8_t ctrl_is_vertex[BSF_MAX_CTRL_POINTS]; /**< 1 for both copies of a vertex */
+    uint16_t n_features;
+    uint16_t n_ctrl;
+    bsf_stats_t stats;
+} bsf_result_t;
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BSF_FEATURE_H */
