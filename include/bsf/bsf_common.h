@@ -43,6 +43,19 @@ typedef struct {
     float y;
 } bsf_point_t;
 
+/**
+ * An interest point (corner) found by a corner detector (FALKO or BID).
+ * The beam index is what segmentation and fitting use; the other fields
+ * describe the keypoint for users who want it as a landmark.
+ */
+typedef struct {
+    uint16_t index;    /**< beam index of the keypoint */
+    bsf_point_t point; /**< position, sensor frame, metres (sub-beam refined when enabled) */
+    float orientation; /**< FALKO orientation, radians (0 for BID) */
+    float radius;      /**< neighbourhood radius used, metres */
+    float score;       /**< FALKO: raw integer score (lower = more corner-like); BID: N_q */
+} bsf_keypoint_t;
+
 /** Short English name of a status code ("ok", "bad argument", ...); never NULL. */
 const char *bsf_status_str(bsf_status_t status);
 
