@@ -14,6 +14,7 @@ typedef struct {
     size_t close;    /* window when radius >= range: floor(asin(0.8) / inc) */
 } window_ctx_t;
 
+/* floor(w) for w >= 0 (truncation; floorf may be a library call), clamped. */
 static size_t clamp_window(float w)
 {
     if (!(w >= 0.0f)) {
@@ -31,7 +32,7 @@ static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
     /* asin(s) < inc, hence window 0, whenever s < sin(inc); the margin keeps
      * rounding on the safe side. */
     c.far_ratio = sinf(c.inc) * 0.999f;
-    c.close = clamp_window(floorf(BSF_ASIN_0_8 / c.inc));
+    c.close = clamp_window(BSF_ASIN_0_8 / c.inc);
     return c;
 }
 
@@ -40,7 +41,8 @@ static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
  * the same integer, that is the window and asinf is not needed. */
 static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t *c)
 {
-    float s, lo, hi;
+    float s;
+    size_t lo, hi;
     if (!pts->valid[i]) {
         return 0u;
     }
@@ -51,12 +53,12 @@ static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t 
         return 0u;
     }
     s = c->radius / pts->range[i];
-    lo = floorf(s * c->inv_inc * (1.0f - 1e-5f));
-    hi = floorf(s / sqrtf(1.0f - s * s) * c->inv_inc * (1.0f + 1e-5f));
+    lo = clamp_window(s * c->inv_inc * (1.0f - 1e-5f));
+    hi = clamp_window(s / sqrtf(1.0f - s * s) * c->inv_inc * (1.0f + 1e-5f));
     if (lo == hi) {
-        return clamp_window(lo);
+        return lo;
     }
-    return clamp_window(floorf(asinf(s) / c->inc));
+    return clamp_window(asinf(s) / c->inc);
 }
 
 size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius)
