@@ -132,7 +132,8 @@ static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv
 {
     const float rho = pts->range[i];
     const float a = r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
-    return (a < (float)pts->count) ? (size_t)a : pts->count;
+    /* a >= 0; BSF_MAX_POINTS fits int, and int conversion is one instruction */
+    return (a < (float)BSF_MAX_POINTS) ? (size_t)(int)a : (size_t)BSF_MAX_POINTS;
 }
 
 static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, neigh_t *nb)
@@ -242,7 +243,12 @@ static int sector_of(bsf_point_t q, bsf_point_t c, float theta, float sector_wid
     } else if (ang <= -FALKO_PI) {
         ang = -FALKO_ANGLE_LIMIT;
     }
-    return (int)floorf((ang + FALKO_PI - theta) / sector_width);
+    {
+        /* floor without a library call: |x| < 2 pi / sector_width + 1 */
+        const float x = (ang + FALKO_PI - theta) / sector_width;
+        const int k = (int)x;
+        return ((float)k > x) ? k - 1 : k;
+    }
 }
 
 /* Step 8: FALKOLib's sector distance (truncating %), or the true circular one. */

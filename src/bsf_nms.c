@@ -20,7 +20,8 @@ static size_t clamp_window(float w)
     if (!(w >= 0.0f)) {
         return 0u;
     }
-    return (w > (float)BSF_MAX_POINTS) ? (size_t)BSF_MAX_POINTS : (size_t)w;
+    /* BSF_MAX_POINTS fits int (and uint16_t); int conversion is one instruction */
+    return (w > (float)BSF_MAX_POINTS) ? (size_t)BSF_MAX_POINTS : (size_t)(int)w;
 }
 
 static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
@@ -81,8 +82,15 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
     size_t imax = 0;
     size_t k, i2, n_peak, run;
 
+    /* All windows first, in a loop whose latencies overlap, into peak[]:
+     * the candidate list written below stays at or behind the beam being
+     * read (n_cand <= i), so one array serves both. */
+    for (i = 0; i < n; ++i) {
+        peak[i] = (uint16_t)half_window(pts, i, &ctx);
+    }
+    i = 0;
     while (i < n) {
-        const size_t win = half_window(pts, i, &ctx);
+        const size_t win = peak[i];
         size_t j, jbeg, jend;
         size_t jmax = i;
 
