@@ -80,6 +80,7 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
     size_t n_cand = 0;
     size_t i = 0;
     size_t imax = 0;
+    size_t run_end = 0; /* end (exclusive) of the run of equal scores from i */
     size_t k, i2, n_peak, run;
 
     /* All windows first, in a loop whose latencies overlap, into peak[]:
@@ -93,6 +94,24 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
         const size_t win = peak[i];
         size_t j, jbeg, jend;
         size_t jmax = i;
+
+        /* Fast path, same outcome as the general step below: the previous
+         * beam is the running maximum, and the whole window [i, i + win]
+         * holds its score, which does not pass the threshold. Then nothing
+         * beats beam i, it becomes imax, is no candidate, and i moves on.
+         * Most beams of a scan (rejected ones) go this way. */
+        if (run_end <= i) {
+            run_end = i + 1u;
+            while (run_end < n && score[run_end] == score[i]) {
+                ++run_end;
+            }
+        }
+        if (i > 0u && imax == i - 1u && score[imax] == score[i] && i + win < run_end &&
+            !(sign * score[i] > min_val)) {
+            imax = i;
+            ++i;
+            continue;
+        }
 
         /* Search the left part of the window only when the running maximum
          * imax lies outside it; otherwise it has already been seen. */
