@@ -121,11 +121,13 @@ typedef struct {
     float sum_lx, sum_ly, sum_rx, sum_ry; /* sums of p - p_apex per side */
 } neigh_t;
 
-/* Beam window [i - alpha, i + alpha + 1], alpha = floor(asin(r / rho) / inc)
- * (the reference's one extra beam on the right, clamped to the scan instead
- * of read past its end). Any larger window gives the same neighbours: a beam
- * at angle phi from the apex is at least rho sin(phi) > r away when
- * phi > asin(r / rho). So alpha comes from a bound that costs one division,
+/* The reference's beam window is [i - alpha, i + alpha + 1] with
+ * alpha = floor(asin(r / rho) / inc) (and it reads one element past the end
+ * of the scan there). Any window holding the beams within asin(r / rho) of
+ * the apex gives the same neighbours: a beam at angle phi from the apex is at
+ * least rho sin(phi) > r away when phi > asin(r / rho); that also makes the
+ * reference's extra right beam irrelevant. So this window is [i - A, i + A],
+ * clamped to the scan, with A >= alpha from a bound that costs one division,
  * asin(s) <= s / sqrt(1 - s^2) <= s / (1 - s^2) = r rho / (rho^2 - r^2)
  * (r <= 0.8 rho keeps the denominator positive), with a rounding margin. */
 static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
@@ -139,7 +141,7 @@ static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv
 static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, neigh_t *nb)
 {
     nb->beg = (i >= alpha) ? i - alpha : 0u;
-    nb->end = (i + alpha + 1u < pts->count) ? i + alpha + 1u : pts->count - 1u;
+    nb->end = (i + alpha < pts->count) ? i + alpha : pts->count - 1u;
 }
 
 /* The outermost neighbours on each side; 0 when a side has none. */
