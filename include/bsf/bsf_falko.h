@@ -74,6 +74,10 @@ typedef struct {
  * Only valid beams (pts->valid) are used, as apexes and as neighbours. For
  * non-maxima suppression an invalid beam counts as a beam far away (window
  * 0), which is how FALKOLib treats the datasets' no-return codes (81.83 m).
+ * FALKOLib uses every reading as a neighbour, also those beyond max_range;
+ * to match it exactly, build the points with a range_max above
+ * max_range + r(max_range) (e.g. 81 m, just below the no-return code), not
+ * with range_max = max_range.
  * The angle increment may be negative (clockwise scans); its magnitude is used.
  *
  * @param pts     scan points (bsf_scan_to_points); count <= BSF_MAX_POINTS
