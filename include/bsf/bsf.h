@@ -12,5 +12,6 @@
 #include "bsf_scan.h"
 #include "bsf_feature.h"
 #include "bsf_metrics.h"
+#include "bsf_segment.h"
 
 #endif /* BSF_H */
