@@ -13,5 +13,6 @@
 #include "bsf_feature.h"
 #include "bsf_metrics.h"
 #include "bsf_segment.h"
+#include "bsf_falko.h"
 
 #endif /* BSF_H */
