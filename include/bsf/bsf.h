@@ -11,5 +11,7 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 #include "bsf_feature.h"
+#include "bsf_bspline.h"
+#include "bsf_fit.h"
 
 #endif /* BSF_H */
