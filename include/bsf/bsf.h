@@ -14,5 +14,7 @@
 #include "bsf_metrics.h"
 #include "bsf_segment.h"
 #include "bsf_falko.h"
+#include "bsf_bspline.h"
+#include "bsf_fit.h"
 
 #endif /* BSF_H */
