@@ -11,5 +11,6 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 #include "bsf_feature.h"
+#include "bsf_stream.h"
 
 #endif /* BSF_H */
