@@ -86,8 +86,8 @@ static int sink_close(seg_sink_t *sink, size_t first, size_t last, size_t n_poin
 }
 
 /* Common argument checks of both segmenters; on success fills the sink. */
-static bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out, size_t cap,
-                          size_t *n_out, size_t *n_wasted_points, seg_sink_t *sink)
+static bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out, size_t cap, size_t *n_out,
+                          size_t *n_wasted_points, seg_sink_t *sink)
 {
     if (n_out != NULL) {
         *n_out = 0;
@@ -335,9 +335,9 @@ bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_point
         size_t w1 = 0;
         /* Inner interest points lie strictly between the second valid point
          * (v1) and the last-but-one valid point (w1). */
-        if (next_valid(pts, first, last, &v0) && v0 < last &&
-            next_valid(pts, v0 + 1u, last, &v1) && prev_valid(pts, first, last, &w0) &&
-            w0 > first && prev_valid(pts, first, w0 - 1u, &w1) && v1 < w1) {
+        if (next_valid(pts, first, last, &v0) && v0 < last && next_valid(pts, v0 + 1u, last, &v1) &&
+            prev_valid(pts, first, last, &w0) && w0 > first &&
+            prev_valid(pts, first, w0 - 1u, &w1) && v1 < w1) {
             size_t j = upper_bound(interest_beams, n_interest, v1);
             for (; j < n_interest && (size_t)interest_beams[j] < w1; ++j) {
                 if (pts->valid[interest_beams[j]]) {

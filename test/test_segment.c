@@ -113,8 +113,8 @@ static void test_sved_keeps_a_smooth_noisy_wall_in_one_segment(void)
     for (seed = 1u; seed <= 5u; ++seed) {
         bsf_scene_rng_seed(&rng, seed);
         shoot(&l, &rng);
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS,
-                                                       &n_segs, &n_wasted));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
         TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
         TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
         TEST_ASSERT_EQUAL_UINT16(0u, segs[0].first);
@@ -136,12 +136,12 @@ static void test_sved_breaks_at_depth_jump_exactly_when_larger_than_r_of_rho(voi
         double r;
         bsf_scene_init(&scene);
         TEST_ASSERT_EQUAL_INT(0, bsf_scene_add_segment(&scene, 2.0, -10.0, 2.0, 0.0));
-        TEST_ASSERT_EQUAL_INT(1, bsf_scene_add_segment(&scene, 2.0 + jumps[j], 0.0,
-                                                       2.0 + jumps[j], 10.0));
+        TEST_ASSERT_EQUAL_INT(
+            1, bsf_scene_add_segment(&scene, 2.0 + jumps[j], 0.0, 2.0 + jumps[j], 10.0));
         shoot(&l, NULL);
         TEST_ASSERT_EQUAL_UINT32(180u, (uint32_t)points.n_valid);
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS,
-                                                       &n_segs, &n_wasted));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
         check_partition();
         d = step(89u, 90u);
         r = sved_threshold(90u);
@@ -190,11 +190,11 @@ static void test_sved_steps_inside_segments_pass_and_breaks_fail_the_distance_te
     int have_prev = 0;
     l.noise_sigma = 0.03;
     bsf_scene_rng_seed(&rng, 99u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_room_with_pillar(&scene, -4.0, -3.0, 6.0, 5.0,
-                                                                 1.5, 0.5, 0.4));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_room_with_pillar(&scene, -4.0, -3.0, 6.0, 5.0, 1.5, 0.5, 0.4));
     shoot(&l, &rng);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_TRUE(n_segs >= 2u); /* the pillar stands in front of the walls */
     k = 0;
@@ -226,12 +226,12 @@ static void test_sved_invalid_beams_do_not_break_a_segment(void)
     for (i = 0; i < 40u; ++i) {
         ranges[i] = 3.0f;
     }
-    ranges[15] = NAN;   /* a gap of two beams: 3 steps of 5 cm = 0.16 m < r(3 m) */
+    ranges[15] = NAN;    /* a gap of two beams: 3 steps of 5 cm = 0.16 m < r(3 m) */
     ranges[16] = 81.83f; /* no-return code */
     points_from_ranges(40u);
     TEST_ASSERT_EQUAL_UINT32(38u, (uint32_t)points.n_valid);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT16(0u, segs[0].first);
     TEST_ASSERT_EQUAL_UINT16(39u, segs[0].last);
@@ -240,8 +240,8 @@ static void test_sved_invalid_beams_do_not_break_a_segment(void)
     ranges[0] = NAN;
     ranges[39] = 0.0f;
     points_from_ranges(40u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT16(1u, segs[0].first);
     TEST_ASSERT_EQUAL_UINT16(38u, segs[0].last);
@@ -268,8 +268,8 @@ static size_t wall_object_wall(size_t n_object)
 static void test_sved_wastes_a_four_point_segment_and_keeps_a_five_point_one(void)
 {
     wall_object_wall(4u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n_wasted);
@@ -277,8 +277,8 @@ static void test_sved_wastes_a_four_point_segment_and_keeps_a_five_point_one(voi
     TEST_ASSERT_EQUAL_UINT16(24u, segs[1].first);
 
     wall_object_wall(5u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(3u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
@@ -292,13 +292,13 @@ static void test_sved_min_segment_points_is_configurable(void)
     bsf_sved_params_t p = bsf_sved_params_default();
     wall_object_wall(5u);
     p.min_segment_points = 6u;
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_segment_sved(&points, &p, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, &p, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(5u, (uint32_t)n_wasted);
     p.min_segment_points = 21u;
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_segment_sved(&points, &p, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, &p, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(45u, (uint32_t)n_wasted);
 }
@@ -320,16 +320,16 @@ static void test_rpos_breaks_at_a_right_angle_corner_and_keeps_the_corner_point_
     TEST_ASSERT_EQUAL_INT(100, c.beam);
     shoot(&l, NULL);
     TEST_ASSERT_EQUAL_UINT32(181u, (uint32_t)points.n_valid);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
     TEST_ASSERT_EQUAL_UINT16(100u, segs[0].last);
     TEST_ASSERT_EQUAL_UINT16(101u, segs[1].first);
     /* SVED does not break there: corners are found by the corner detector. */
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
 }
 
@@ -350,23 +350,23 @@ static void bent_line(double turn_deg)
 static void test_rpos_breaks_on_turns_above_alpha_max_only(void)
 {
     bent_line(40.0);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     bent_line(-40.0);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     bent_line(50.0);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT16(10u, segs[0].last);
     TEST_ASSERT_EQUAL_UINT16(11u, segs[1].first);
     bent_line(-120.0);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
 }
 
@@ -389,8 +389,8 @@ static void test_rpos_breaks_on_spacing_jumps_beyond_eta(void)
     size_t j;
     for (j = 0; j < sizeof factors / sizeof factors[0]; ++j) {
         spacing_jump(factors[j]);
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS,
-                                                       &n_segs, &n_wasted));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
         check_partition();
         TEST_ASSERT_EQUAL_UINT32(expected[j], (uint32_t)n_segs);
         if (expected[j] == 2u) {
@@ -405,8 +405,8 @@ static void test_rpos_breaks_at_a_depth_discontinuity_in_a_scene(void)
     TEST_ASSERT_EQUAL_INT(0, bsf_scene_add_segment(&scene, 2.0, -10.0, 2.0, 0.0));
     TEST_ASSERT_EQUAL_INT(1, bsf_scene_add_segment(&scene, 3.0, 0.0, 3.0, 10.0));
     shoot(&l, NULL);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT16(89u, segs[0].last);
@@ -421,16 +421,16 @@ static void test_rpos_outlier_drags_its_neighbour_into_waste(void)
     }
     ranges[20] = 1.0f;
     points_from_ranges(40u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_wasted); /* the outlier and beam 21 */
     TEST_ASSERT_EQUAL_UINT16(19u, segs[0].last);
     TEST_ASSERT_EQUAL_UINT16(22u, segs[1].first);
     /* SVED only loses the outlier itself. */
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_wasted);
 }
@@ -443,8 +443,8 @@ static void test_rpos_skips_invalid_beams_and_measures_spacing_across_the_gap(vo
     }
     ranges[20] = NAN; /* doubles the spacing between beams 19 and 21 */
     points_from_ranges(40u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
@@ -456,14 +456,14 @@ static void test_rpos_wastes_four_points_and_keeps_five(void)
 {
     /* Object 4 beams: its break rule leaves 19+1 | 4 | ... Count only. */
     wall_object_wall(4u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n_wasted);
     wall_object_wall(5u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_EQUAL_UINT32(3u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
@@ -563,14 +563,14 @@ static void test_classify_marks_the_room_corner_segment_auxiliary(void)
     bsf_scene_corner_t c;
     size_t n_c = 0;
     uint16_t beam;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 2.0, 0.2, 0.75 * PI_D, 4.0,
-                                                       -0.75 * PI_D, 4.0));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_corner(&scene, 2.0, 0.2, 0.75 * PI_D, 4.0, -0.75 * PI_D, 4.0));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, &c, 1u, &n_c));
     TEST_ASSERT_TRUE(c.beam > 0);
     beam = (uint16_t)c.beam;
     shoot(&l, NULL);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_classify(segs, n_segs, &points, &beam, 1u));
     TEST_ASSERT_EQUAL_UINT8(BSF_FEATURE_AUXILIARY, segs[0].kind);
@@ -603,8 +603,8 @@ static void test_empty_and_all_invalid_scans_give_no_segments(void)
 {
     size_t i;
     points_from_ranges(0u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
     for (i = 0; i < 100u; ++i) {
@@ -612,8 +612,8 @@ static void test_empty_and_all_invalid_scans_give_no_segments(void)
     }
     points_from_ranges(100u);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)points.n_valid);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
     n_segs = 7u;
@@ -632,24 +632,24 @@ static void test_single_valid_beam_is_wasted_or_kept_with_min_one(void)
     }
     ranges[33] = 2.0f;
     points_from_ranges(50u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_wasted);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_wasted);
     sp.min_segment_points = 1u;
     rp.min_segment_points = 1u;
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_segment_sved(&points, &sp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, &sp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT16(33u, segs[0].first);
     TEST_ASSERT_EQUAL_UINT16(33u, segs[0].last);
     TEST_ASSERT_EQUAL_UINT16(1u, segs[0].n_points);
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_segment_rpos(&points, &rp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, &rp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_wasted);
 }
@@ -692,8 +692,8 @@ static void test_bad_parameters_are_refused(void)
     sp = sd;
     sp.a = 0.0f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM,
-                          bsf_segment_sved(&points, &sp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_ERR_PARAM, bsf_segment_sved(&points, &sp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     sp = sd;
     sp.a = NAN;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
@@ -710,8 +710,8 @@ static void test_bad_parameters_are_refused(void)
     rp = rd;
     rp.alpha_max = 0.0f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_rpos_params_check(&rp));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM,
-                          bsf_segment_rpos(&points, &rp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_ERR_PARAM, bsf_segment_rpos(&points, &rp, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     rp = rd;
     rp.alpha_max = 3.2f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_rpos_params_check(&rp));
@@ -737,12 +737,12 @@ static void test_nan_coordinates_in_hand_made_points_do_not_join(void)
     }
     points.pt[15].x = NAN;
     points.range[15] = NAN;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n_segs);
     TEST_ASSERT_EQUAL_UINT32(30u, (uint32_t)(segs[0].n_points + segs[1].n_points + n_wasted));
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     TEST_ASSERT_TRUE(n_segs >= 1u);
     TEST_ASSERT_TRUE(segs[0].last < 15u);
 }
@@ -787,13 +787,13 @@ static void test_full_scan_at_max_points_segments_and_overflowing_segments_error
     TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 2.0, -1.0, 0.3) >= 0);
     shoot(&l, &rng);
     TEST_ASSERT_EQUAL_UINT32(BSF_MAX_POINTS, (uint32_t)points.count);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     TEST_ASSERT_TRUE(n_segs >= 2u);
     TEST_ASSERT_TRUE(n_wasted < points.n_valid / 20u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs,
-                                                   &n_wasted));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
     check_partition();
     /* 1081 beams in blocks of 5: 217 kept segments do not fit in BSF_MAX_SEGMENTS. */
     alternating_blocks(BSF_MAX_POINTS, 5u);

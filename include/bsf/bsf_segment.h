@@ -133,8 +133,7 @@ BSF_NODISCARD bsf_status_t bsf_segment_rpos(const bsf_points_t *pts,
  */
 BSF_NODISCARD bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n,
                                                 const bsf_points_t *pts,
-                                                const uint16_t *interest_beams,
-                                                size_t n_interest);
+                                                const uint16_t *interest_beams, size_t n_interest);
 
 #ifdef __cplusplus
 }
