@@ -290,7 +290,7 @@ static void test_bad_input_is_refused_with_an_error(void)
     int k;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(NULL, 0.0, 0.0, 1.0, 0.0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(&scene, 0.0, 0.0, 0.0, 0.0));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(&scene, NAN, 0.0, 1.0, 0.0));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(&scene, (double)NAN, 0.0, 1.0, 0.0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_circle(&scene, 0.0, 0.0, 0.0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_polyline(&scene, xy, 2u, 0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_l_room(&scene, 0.0, 0.0, 2.0, 2.0, 2.0, 1.0));
