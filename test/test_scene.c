@@ -166,8 +166,8 @@ static void test_corner_reports_right_angle_and_the_beam_where_walls_change(void
     bsf_scene_corner_t c[4];
     size_t n = 0;
     int k;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 2.0, 0.3, 0.75 * PI_D, 3.0,
-                                                       -0.75 * PI_D, 3.0));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_corner(&scene, 2.0, 0.3, 0.75 * PI_D, 3.0, -0.75 * PI_D, 3.0));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, c, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
     ASSERT_NEAR_D(1e-9, 0.5 * PI_D, c[0].angle);
@@ -180,7 +180,7 @@ static void test_corner_reports_right_angle_and_the_beam_where_walls_change(void
     /* The nearest beam is within half a step of the vertex, and the walls
      * change between its neighbours. */
     ASSERT_NEAR_D(0.5 * l.angle_increment + 1e-12, c[0].bearing,
-                              l.angle_min + (double)k * l.angle_increment);
+                  l.angle_min + (double)k * l.angle_increment);
     TEST_ASSERT_NOT_EQUAL(hits[k - 1], hits[k + 1]);
     TEST_ASSERT_TRUE(hits[k - 1] >= 0 && hits[k + 1] >= 0);
     /* The vertex is the farthest point of a concave corner seen from inside. */
@@ -195,8 +195,8 @@ static void test_room_corners_are_found_and_occlusion_is_reported(void)
     size_t i;
     l.angle_min = -PI_D;
     l.angle_increment = 2.0 * PI_D / 720.0;
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_scene_add_room_with_pillar(&scene, -5.0, -5.0, 5.0, 5.0, 2.5, 2.5, 0.5));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_room_with_pillar(&scene, -5.0, -5.0, 5.0, 5.0, 2.5, 2.5, 0.5));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, c, 8u, &n));
     TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n);
     for (i = 0; i < n; ++i) {
@@ -240,8 +240,8 @@ static void test_scan_points_lie_on_the_surfaces_in_the_world(void)
     bsf_lidar_t l = bsf_lidar_default(1.0, -0.5, 0.7, 361u, 1.5 * PI_D);
     bsf_scan_t s;
     size_t i;
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_scene_add_room_with_pillar(&scene, -4.0, -3.0, 6.0, 5.0, 3.0, 1.0, 0.4));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_room_with_pillar(&scene, -4.0, -3.0, 6.0, 5.0, 3.0, 1.0, 0.4));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, NULL, ranges, hits, BSF_MAX_POINTS));
     s = bsf_scene_lidar_scan(&l, ranges);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
@@ -290,7 +290,7 @@ static void test_bad_input_is_refused_with_an_error(void)
     int k;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(NULL, 0.0, 0.0, 1.0, 0.0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(&scene, 0.0, 0.0, 0.0, 0.0));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(&scene, NAN, 0.0, 1.0, 0.0));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_segment(&scene, (double)NAN, 0.0, 1.0, 0.0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_circle(&scene, 0.0, 0.0, 0.0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_polyline(&scene, xy, 2u, 0));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_scene_add_l_room(&scene, 0.0, 0.0, 2.0, 2.0, 2.0, 1.0));

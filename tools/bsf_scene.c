@@ -97,8 +97,7 @@ bsf_status_t bsf_scene_add_polyline(bsf_scene_t *scene, const double *xy, size_t
     return BSF_OK;
 }
 
-bsf_status_t bsf_scene_add_rect_room(bsf_scene_t *scene, double x0, double y0, double x1,
-                                     double y1)
+bsf_status_t bsf_scene_add_rect_room(bsf_scene_t *scene, double x0, double y0, double x1, double y1)
 {
     double xy[8];
     if (!(x0 != x1) || !(y0 != y1)) {
@@ -328,8 +327,7 @@ bsf_status_t bsf_scene_scan(const bsf_scene_t *scene, const bsf_lidar_t *lidar,
         return BSF_ERR_CAPACITY;
     }
     for (i = 0; i < lidar->n_beams; ++i) {
-        const double a =
-            lidar->pose.theta + lidar->angle_min + (double)i * lidar->angle_increment;
+        const double a = lidar->pose.theta + lidar->angle_min + (double)i * lidar->angle_increment;
         int shape = -1;
         double t = bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, a, &shape);
         if (t < 0.0 || t > lidar->range_max) {
