@@ -11,7 +11,11 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 #include "bsf_feature.h"
+#include "bsf_metrics.h"
+#include "bsf_segment.h"
+#include "bsf_falko.h"
 #include "bsf_bspline.h"
 #include "bsf_fit.h"
+#include "bsf_extract.h"
 
 #endif /* BSF_H */
