@@ -177,6 +177,9 @@ float bsf_footpoint_refine(const bsf_point_t *ctrl, size_t n_ctrl, bsf_point_t p
     bsf_point_t c;
     bsf_point_t cu;
     bsf_point_t cuu;
+    bsf_point_t cn;
+    bsf_point_t cun;
+    bsf_point_t cuun;
     float u;
     float t_cur = *t;
     float best;
@@ -196,33 +199,49 @@ float bsf_footpoint_refine(const bsf_point_t *ctrl, size_t n_ctrl, bsf_point_t p
         const float gn = cu.x * cu.x + cu.y * cu.y;
         float h = gn + ex * cuu.x + ey * cuu.y;
         float t_new;
-        float d;
+        float delta;
+        float d = best;
+        unsigned halving;
 
-        if (!(h > 0.0f)) {
-            h = gn; /* curvature makes Newton go uphill: Gauss-Newton step */
+        if (!(h >= 0.5f * gn)) {
+            /* Curvature makes the Newton step huge or uphill: take the
+             * Gauss-Newton step instead. */
+            h = gn;
         }
         if (!(h > 0.0f)) {
             break;
         }
         /* A step in u is a step of du / n_span in t; the new t may fall in a
-         * neighbouring span, which is then evaluated with its own closed form. */
-        t_new = t_cur - g / (h * n_span);
-        t_new = t_new < 0.0f ? 0.0f : (t_new > 1.0f ? 1.0f : t_new);
-        if (!(fabsf(t_new - t_cur) > 1e-7f)) {
-            break;
-        }
-        span = bsf_bspline_span(n_ctrl, t_new, &u);
-        bsf_bspline_eval_u(ctrl, n_ctrl, span, u, &c, &cu, &cuu);
-        {
-            const float fx = c.x - p.x;
-            const float fy = c.y - p.y;
-            d = fx * fx + fy * fy;
+         * neighbouring span, which is then evaluated with its own closed form.
+         * A step that does not bring the curve closer is halved (twice at
+         * most): far from the curve the distance is not quadratic in t. */
+        delta = -g / (h * n_span);
+        for (halving = 0; halving < 3u; ++halving) {
+            t_new = t_cur + delta;
+            t_new = t_new < 0.0f ? 0.0f : (t_new > 1.0f ? 1.0f : t_new);
+            if (!(fabsf(t_new - t_cur) > 1e-7f)) {
+                break;
+            }
+            span = bsf_bspline_span(n_ctrl, t_new, &u);
+            bsf_bspline_eval_u(ctrl, n_ctrl, span, u, &cn, &cun, &cuun);
+            {
+                const float fx = cn.x - p.x;
+                const float fy = cn.y - p.y;
+                d = fx * fx + fy * fy;
+            }
+            if (d < best) {
+                break;
+            }
+            delta *= 0.5f;
         }
         if (!(d < best)) {
             break; /* never accept a worse footpoint */
         }
         best = d;
         t_cur = t_new;
+        c = cn;
+        cu = cun;
+        cuu = cuun;
     }
     *t = t_cur;
     return best;

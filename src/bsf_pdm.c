@@ -9,6 +9,8 @@
 #include <string.h>
 
 #define NO_FRAGMENT 0xFFFFu
+/* Newton steps of the first projection onto the start curve. */
+#define PDM_INIT_STEPS 6u
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -106,18 +108,39 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
     s->n_unknown = unknown;
 }
 
-/* Start parameters: arc length along each fragment's points mapped onto the
- * fragment's knot range, so a vertex point starts exactly at its vertex. */
-static void init_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0,
-                            const float *t1)
+/* Greville abscissa of stored control point k: the parameter a control point
+ * "belongs" to (the mean of its two inner knots). */
+static float greville(size_t k, size_t n_span)
 {
+    const float fs = (float)n_span;
+    const float a = k >= 1u ? (float)(k - 1u) / fs : 0.0f;
+    const float b = (float)k / fs;
+    return 0.5f * ((a > 1.0f ? 1.0f : a) + (b > 1.0f ? 1.0f : b));
+}
+
+/* Start of a fit: boundary control points on the end points, vertices on
+ * their interest points, precision points on the fragment's polyline at the
+ * arc-length fraction of their Greville abscissa inside the fragment (evenly
+ * spread, so the start curve follows the points with a parameter roughly
+ * proportional to arc length). Each point's parameter starts at its
+ * arc-length fraction of the fragment's knot range; the caller then projects
+ * it onto the start curve. */
+static void init_fit(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0, const float *t1)
+{
+    const size_t n_span = s->n_ctrl - 2u;
+    size_t stored = 0;
     size_t f;
     size_t i;
+
+    w->ctrl[stored++] = rel_point(s, 0u);
     for (f = 0; f < s->n_frag; ++f) {
         const size_t a = w->frag_first[f];
         const size_t b = w->frag_last[f];
+        const float range = t1[f] - t0[f];
         float len = 0.0f;
         float acc = 0.0f;
+        size_t k;
+        size_t seg = a; /* polyline piece [seg, seg + 1] holding the walk */
         for (i = a + 1u; i <= b; ++i) {
             len += dist(s->pts[i - 1u], s->pts[i]);
         }
@@ -128,12 +151,34 @@ static void init_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const float
             }
             /* Coincident points: fall back to even spacing by index. */
             frac = len > 0.0f ? acc / len : (float)(i - a) / (float)(b - a);
-            if (frac > 1.0f) {
-                frac = 1.0f;
+            w->t[i] = t0[f] + (frac > 1.0f ? 1.0f : frac) * range;
+        }
+        acc = 0.0f;
+        for (k = 0; k < w->frag_precision[f]; ++k) {
+            const float want = (greville(stored, n_span) - t0[f]) / range * len;
+            bsf_point_t q = rel_point(s, b);
+            while (seg < b) {
+                const float piece = dist(s->pts[seg], s->pts[seg + 1u]);
+                if (acc + piece >= want && piece > 0.0f) {
+                    const float r = (want - acc) / piece;
+                    const bsf_point_t p0 = rel_point(s, seg);
+                    const bsf_point_t p1 = rel_point(s, seg + 1u);
+                    q.x = p0.x + r * (p1.x - p0.x);
+                    q.y = p0.y + r * (p1.y - p0.y);
+                    break;
+                }
+                acc += piece;
+                ++seg;
             }
-            w->t[i] = t0[f] + frac * (t1[f] - t0[f]);
+            w->ctrl[stored++] = q;
+        }
+        if (f + 1u < s->n_frag) {
+            const bsf_point_t v = rel_point(s, b);
+            w->ctrl[stored++] = v;
+            w->ctrl[stored++] = v;
         }
     }
+    w->ctrl[stored] = rel_point(s, s->n - 1u);
 }
 
 /* Step (a): control points for fixed footpoint parameters. */
@@ -189,13 +234,17 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
  * (a vertex point belongs to both of its fragments) and overall. */
 static void update_footpoints(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
 {
+    const size_t last = s->n - 1u;
     float total = 0.0f;
     float frag_sum = 0.0f;
     size_t f = 0;
     size_t i;
 
     for (i = 0; i < s->n; ++i) {
-        const float d = bsf_footpoint_refine(w->ctrl, s->n_ctrl, rel_point(s, i), &w->t[i], steps);
+        /* The end points keep their parameters 0 and 1: they anchor the curve's
+         * ends, which would otherwise drift past (or short of) the data. */
+        const unsigned n_steps = (i == 0u || i == last) ? 0u : steps;
+        const float d = bsf_footpoint_refine(w->ctrl, s->n_ctrl, rel_point(s, i), &w->t[i], n_steps);
         total += d;
         frag_sum += d;
         if (i == w->frag_last[f]) {
@@ -385,7 +434,8 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
         }
     }
     build_layout(&s, work, t0, t1);
-    init_parameters(&s, work, t0, t1);
+    init_fit(&s, work, t0, t1);
+    update_footpoints(&s, work, PDM_INIT_STEPS);
     st = run_pdm(&s, work, p, &info.iterations);
     if (st != BSF_OK) {
         return st;

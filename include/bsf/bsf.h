@@ -17,5 +17,6 @@
 #include "bsf_bspline.h"
 #include "bsf_fit.h"
 #include "bsf_extract.h"
+#include "bsf_stream.h"
 
 #endif /* BSF_H */

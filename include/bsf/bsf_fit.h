@@ -22,7 +22,7 @@ extern "C" {
 #define BSF_FIT_MAX_COORD 1.0e6f
 
 /** Hard cap on PDM iterations per solve (size of the RMS history). */
-#define BSF_PDM_MAX_ITERATIONS 32
+#define BSF_PDM_MAX_ITERATIONS 128
 
 /** Most vertices one PDM feature can hold (each is stored twice, plus two boundary points). */
 #define BSF_PDM_MAX_VERTICES ((BSF_MAX_CTRL_PER_FEATURE - 2) / 2)
