@@ -30,6 +30,10 @@
  * (81.83, 81.91; genuine outdoor returns reach ~81.8 m). */
 #define NO_RETURN_FLOOR 81.8f
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 static const char *g_cmd = TOOL_NAME;
 
 static void fail_msg(const char *fmt, ...)
@@ -238,7 +242,7 @@ static int decode_stream(FILE *in, const char *name, frame_cb on_frame, void *ct
         size_t off = 0;
         while (off < got) {
             size_t used = 0;
-            const int r = bsf_decoder_feed(&g_dec, buf + off, got - off, &g_frame, &used);
+            const int r = bsf_decoder_feed(&g_dec, buf + off, got - off, &used, &g_frame);
             if (r < 0) {
                 fail_msg("%s: decoder error (%s)", name, bsf_status_str((bsf_status_t)r));
                 return -1;
@@ -274,7 +278,7 @@ static int decode_stream(FILE *in, const char *name, frame_cb on_frame, void *ct
     {
         static const uint8_t zero = 0u;
         size_t used = 0;
-        const int r = bsf_decoder_feed(&g_dec, &zero, 1u, &g_frame, &used);
+        const int r = bsf_decoder_feed(&g_dec, &zero, 1u, &used, &g_frame);
         if (r == 1 && on_frame != NULL) {
             /* a frame complete but for its delimiter is intact: use it */
             if (on_frame(ctx, &g_frame, total + 1u - frame_start_bytes) != 0) {
