@@ -201,6 +201,17 @@ static void progress_end(progress_t *p)
     }
 }
 
+static carmen_reader_t *open_log(const char *path)
+{
+    carmen_reader_t *rd;
+    errno = 0;
+    rd = carmen_open(path, stderr);
+    if (rd == NULL) {
+        fail_msg("cannot open log %s: %s", path, errno ? strerror(errno) : "unreadable");
+    }
+    return rd;
+}
+
 /* ---- decoded stream in memory ------------------------------------------------ */
 
 typedef struct {
@@ -504,7 +515,7 @@ static int run_extract(const extract_opts_t *o)
     if (init_extractor(o->method) != 0) {
         return EXIT_FAIL;
     }
-    rd = carmen_open(o->log, stderr);
+    rd = open_log(o->log);
     if (rd == NULL) {
         return EXIT_FAIL;
     }
@@ -926,7 +937,7 @@ static int in_range(uint32_t seq, long lo, long hi)
 static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
                            const frame_list_t *l, bsf_bounds_t *bounds)
 {
-    carmen_reader_t *rd = carmen_open(log, stderr);
+    carmen_reader_t *rd = open_log(log);
     carmen_scan_t rec;
     unsigned long index = 0;
     int r;
@@ -1214,7 +1225,7 @@ static int run_dataset(const char *path, bsf_method_t method, long max_scans, ru
     if (init_extractor(method) != 0) {
         return -1;
     }
-    rd = carmen_open(path, stderr);
+    rd = open_log(path);
     if (rd == NULL) {
         return -1;
     }
