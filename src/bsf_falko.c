@@ -1,0 +1,438 @@
+/*
+ * FALKO keypoints, following FALKOLib's FALKOExtractor::extract step by step
+ * (design brief section 4), in float and in caller-owned memory.
+ *
+ * Float versus the reference's double. The decisions that pick keypoints are
+ * comparisons: neighbour distance <= r, the triangle base and height against
+ * r / b_ratio, the sector floor((angle + pi - theta) / (2 pi / S)), and the
+ * integer score threshold. The last one is exact here (integer arithmetic;
+ * scores below 2^24 are exact in float). The others can flip when the double
+ * value lies within float rounding (about 1e-7 relative) of the boundary.
+ * The window alpha = floor(asin(r / rho) / dtheta) cannot change a result on
+ * its own: a beam more than asin(r / rho) away from the apex is farther than r
+ * from it (distance >= rho sin(angle)), so the distance test rejects it anyway.
+ */
+#include "bsf/bsf_falko.h"
+
+#include <math.h>
+
+#include "bsf_nms.h"
+
+#define FALKO_PI 3.14159265358979f
+/* FALKOLib clamps atan2 results to just inside +-pi (by 1e-6 rad). */
+#define FALKO_ANGLE_LIMIT (FALKO_PI - 0.000001f)
+/* Scores are kept in float: integers up to 2^24 are exact. */
+#define FALKO_SCORE_LIMIT 16777216L
+#define FALKO_REJECTED (-1.0f)
+
+bsf_falko_params_t bsf_falko_params_default(void)
+{
+    bsf_falko_params_t p;
+    p.min_score_th = 50;
+    p.min_range = 0.0f;
+    p.max_range = 30.0f;
+    p.subbeam = 1;
+    p.nms_radius = 0.1f;
+    p.neigh_a = 0.1f;
+    p.neigh_b = 0.07f;
+    p.neigh_min_points = 2;
+    p.b_ratio = 2.5f;
+    p.grid_sectors = 16;
+    p.circular_sector_distance = 0;
+    return p;
+}
+
+static int finite_f(float v)
+{
+    return v == v && fabsf(v) <= 3.402823466e38f;
+}
+
+bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p)
+{
+    if (p == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (p->min_score_th < 0 || p->min_score_th > 100 || !finite_f(p->min_range) ||
+        p->min_range < 0.0f || !finite_f(p->max_range) || !(p->max_range > p->min_range) ||
+        !finite_f(p->nms_radius) || p->nms_radius < 0.0f || !finite_f(p->neigh_a) ||
+        !(p->neigh_a > 0.0f) || !finite_f(p->neigh_b) || p->neigh_b < 0.0f ||
+        p->neigh_min_points < 1 || !finite_f(p->b_ratio) || !(p->b_ratio > 0.0f) ||
+        p->grid_sectors < 2 || p->grid_sectors > 64) {
+        return BSF_ERR_PARAM;
+    }
+    return BSF_OK;
+}
+
+/* Neighbourhood radius of a beam at range rho (step 2). */
+static float neigh_radius(const bsf_falko_params_t *p, float rho)
+{
+    const float r = p->neigh_a * expf(p->neigh_b * rho);
+    return (r >= rho) ? 0.8f * rho : r;
+}
+
+/* The disc of radius r around an apex c, with the squared-distance band
+ * outside which the test sqrtf(d2) <= r is decided without sqrtf: below
+ * lo it is certainly true, above hi certainly false (the band is wider than
+ * the rounding of sqrtf and of r * r), so results equal the sqrtf test. */
+typedef struct {
+    bsf_point_t c;
+    float r;
+    float lo;
+    float hi;
+} ball_t;
+
+static ball_t make_ball(bsf_point_t c, float r)
+{
+    ball_t b;
+    const float r2 = r * r;
+    b.c = c;
+    b.r = r;
+    b.lo = r2 * (1.0f - 1e-6f);
+    b.hi = r2 * (1.0f + 1e-6f);
+    return b;
+}
+
+/* Is beam j a neighbour: valid and within distance r of the apex (step 3)? */
+static int in_ball(const bsf_points_t *pts, size_t j, const ball_t *b)
+{
+    float dx, dy, d2;
+    if (!pts->valid[j]) {
+        return 0;
+    }
+    dx = b->c.x - pts->pt[j].x;
+    dy = b->c.y - pts->pt[j].y;
+    d2 = dx * dx + dy * dy;
+    if (d2 <= b->lo) {
+        return 1;
+    }
+    if (d2 > b->hi) {
+        return 0;
+    }
+    return sqrtf(d2) <= b->r;
+}
+
+/* A neighbourhood (steps 3, 4 and 6). */
+typedef struct {
+    size_t beg, end; /* beam window, inclusive, clamped to the scan */
+    size_t first;    /* first kept beam (left of the apex) */
+    size_t last;     /* last kept beam (right of the apex) */
+    int n_left;      /* kept neighbours before the apex */
+    int n_right;     /* kept neighbours after the apex */
+    float sum_lx, sum_ly, sum_rx, sum_ry; /* sums of p - p_apex per side */
+} neigh_t;
+
+/* Beam window [i - alpha, i + alpha + 1], alpha = floor(asin(r / rho) / inc)
+ * (the reference's one extra beam on the right, clamped to the scan instead
+ * of read past its end). Any larger window gives the same neighbours: a beam
+ * at angle phi from the apex is at least rho sin(phi) > r away when
+ * phi > asin(r / rho). So alpha comes from the cheap upper bound
+ * asin(s) <= s / sqrt(1 - s^2), with a margin for rounding. */
+static void neigh_window(const bsf_points_t *pts, size_t i, float r, float inv_inc, neigh_t *nb)
+{
+    const float s = r / pts->range[i];
+    const float a = s / sqrtf(1.0f - s * s) * inv_inc * (1.0f + 1e-5f);
+    size_t alpha = (a < (float)pts->count) ? (size_t)a : pts->count; /* s <= 0.8: a >= 0 */
+    nb->beg = (i >= alpha) ? i - alpha : 0u;
+    nb->end = (i + alpha + 1u < pts->count) ? i + alpha + 1u : pts->count - 1u;
+}
+
+/* The outermost neighbours on each side; 0 when a side has none. */
+static int find_ends(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t *nb)
+{
+    size_t j = nb->beg;
+    while (j < i && !in_ball(pts, j, b)) {
+        ++j;
+    }
+    if (j == i) {
+        return 0;
+    }
+    nb->first = j;
+    j = nb->end;
+    while (j > i && !in_ball(pts, j, b)) {
+        --j;
+    }
+    if (j == i) {
+        return 0;
+    }
+    nb->last = j;
+    return 1;
+}
+
+/* Counts and sums of both sides, between the ends found by find_ends. */
+static void count_sides(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t *nb)
+{
+    const bsf_point_t c = b->c;
+    size_t j;
+    nb->n_left = 0;
+    nb->n_right = 0;
+    nb->sum_lx = 0.0f;
+    nb->sum_ly = 0.0f;
+    nb->sum_rx = 0.0f;
+    nb->sum_ry = 0.0f;
+    for (j = nb->first; j < i; ++j) {
+        if (in_ball(pts, j, b)) {
+            ++nb->n_left;
+            nb->sum_lx += pts->pt[j].x - c.x;
+            nb->sum_ly += pts->pt[j].y - c.y;
+        }
+    }
+    for (j = i + 1u; j <= nb->last; ++j) {
+        if (in_ball(pts, j, b)) {
+            ++nb->n_right;
+            nb->sum_rx += pts->pt[j].x - c.x;
+            nb->sum_ry += pts->pt[j].y - c.y;
+        }
+    }
+}
+
+/* Step 5: the triangle apex - first - last must be wide and tall enough. */
+static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r,
+                       float b_ratio)
+{
+    const bsf_point_t a = pts->pt[i];
+    const bsf_point_t f = pts->pt[nb->first];
+    const bsf_point_t l = pts->pt[nb->last];
+    const float lim = r / b_ratio;
+    const float bx = l.x - f.x;
+    const float by = l.y - f.y;
+    const float base = sqrtf(bx * bx + by * by);
+    float area2;
+    if (base < lim) {
+        return 0;
+    }
+    /* Twice the signed area of (a, f, l), written as the reference does. */
+    area2 = by * a.x - bx * a.y + l.x * f.y - l.y * f.x;
+    return !(fabsf(area2) / base < lim);
+}
+
+/* Steps 3-5 and the sums of step 6 for apex i; 0 when rejected. All
+ * rejections are alike, so the cheap ends-and-triangle test runs first and
+ * the full count only for its survivors. */
+static int neighbourhood(const bsf_points_t *pts, size_t i, float r, float inv_inc,
+                         const bsf_falko_params_t *p, neigh_t *nb)
+{
+    const ball_t b = make_ball(pts->pt[i], r);
+    neigh_window(pts, i, r, inv_inc, nb);
+    if (!find_ends(pts, i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
+        return 0;
+    }
+    count_sides(pts, i, &b, nb);
+    return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
+}
+
+/* Step 6: orientation of the corner (mean left vector + mean right vector). */
+static float corner_orientation(const neigh_t *nb)
+{
+    const float x = nb->sum_lx / (float)nb->n_left + nb->sum_rx / (float)nb->n_right;
+    const float y = nb->sum_ly / (float)nb->n_left + nb->sum_ry / (float)nb->n_right;
+    return atan2f(y, x);
+}
+
+/* Step 7: sector of neighbour q seen from the apex c, not wrapped. */
+static int sector_of(bsf_point_t q, bsf_point_t c, float theta, float sector_width)
+{
+    float ang = atan2f(c.y - q.y, c.x - q.x);
+    if (ang >= FALKO_PI) {
+        ang = FALKO_ANGLE_LIMIT;
+    } else if (ang <= -FALKO_PI) {
+        ang = -FALKO_ANGLE_LIMIT;
+    }
+    return (int)floorf((ang + FALKO_PI - theta) / sector_width);
+}
+
+/* Step 8: FALKOLib's sector distance (truncating %), or the true circular one. */
+static int sector_distance(int a, int b, int sectors, int circular)
+{
+    if (circular) {
+        int m = (a - b) % sectors;
+        if (m < 0) {
+            m += sectors;
+        }
+        return (m < sectors - m) ? m : sectors - m;
+    } else {
+        const int half = sectors / 2;
+        const int d = ((a - b) + half) % sectors - half;
+        return (d < 0) ? -d : d;
+    }
+}
+
+/* Steps 7-9 for an apex that passed steps 1-6: the raw integer score. */
+static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r,
+                         float theta, const bsf_falko_params_t *p, int8_t *sector)
+{
+    const ball_t ball = make_ball(pts->pt[i], r);
+    const bsf_point_t c = ball.c;
+    const float width = 2.0f * FALKO_PI / (float)p->grid_sectors;
+    const int nl = nb->n_left;
+    const int nr = nb->n_right;
+    int k = 0;
+    int a, b;
+    long score = 0;
+    size_t j;
+
+    /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
+    for (j = nb->first; j <= nb->last; ++j) {
+        if (j != i && in_ball(pts, j, &ball)) {
+            sector[k++] = (int8_t)sector_of(pts->pt[j], c, theta, width);
+        }
+    }
+    /* Ordered pairs: the first of each pair is the one nearer the apex. */
+    for (a = nl - 1; a >= 0; --a) {
+        for (b = a - 1; b >= 0; --b) {
+            score += sector_distance(sector[a], sector[b], p->grid_sectors,
+                                     p->circular_sector_distance);
+        }
+    }
+    for (a = 0; a < nr; ++a) {
+        for (b = a + 1; b < nr; ++b) {
+            score += sector_distance(sector[nl + a], sector[nl + b], p->grid_sectors,
+                                     p->circular_sector_distance);
+        }
+    }
+    return score;
+}
+
+/* Total-least-squares line through beams [from, to] that are neighbours of
+ * apex c: unit normal n and offset d with n . x = d. */
+static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball_t *ball,
+                     float *nx, float *ny, float *d)
+{
+    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, syy = 0.0f, sxy = 0.0f;
+    float mx, my, t;
+    int n = 0;
+    size_t j;
+    for (j = from; j <= to; ++j) {
+        if (in_ball(pts, j, ball)) {
+            sx += pts->pt[j].x;
+            sy += pts->pt[j].y;
+            ++n;
+        }
+    }
+    mx = sx / (float)n;
+    my = sy / (float)n;
+    /* Centred moments: no cancellation in float. */
+    for (j = from; j <= to; ++j) {
+        if (in_ball(pts, j, ball)) {
+            const float dx = pts->pt[j].x - mx;
+            const float dy = pts->pt[j].y - my;
+            sxx += dx * dx;
+            syy += dy * dy;
+            sxy += dx * dy;
+        }
+    }
+    /* Direction of largest spread, then the normal a quarter turn away. */
+    t = 0.5f * atan2f(2.0f * sxy, sxx - syy) + 0.5f * FALKO_PI;
+    *nx = cosf(t);
+    *ny = sinf(t);
+    *d = *nx * mx + *ny * my;
+}
+
+/* Step 11: intersect the lines fitted to each side (apex in both). */
+static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r)
+{
+    const ball_t ball = make_ball(pts->pt[i], r);
+    const bsf_point_t c = ball.c;
+    float n1x, n1y, d1, n2x, n2y, d2, det;
+    bsf_point_t q;
+    fit_line(pts, nb->first, i, &ball, &n1x, &n1y, &d1);
+    fit_line(pts, i, nb->last, &ball, &n2x, &n2y, &d2);
+    det = n1x * n2y - n1y * n2x;
+    if (fabsf(det) < 1e-7f) {
+        return c;
+    }
+    q.x = (d1 * n2y - n1y * d2) / det;
+    q.y = (n1x * d2 - d1 * n2x) / det;
+    if (!finite_f(q.x) || !finite_f(q.y) ||
+        !(sqrtf((q.x - c.x) * (q.x - c.x) + (q.y - c.y) * (q.y - c.y)) < 0.20f)) {
+        return c;
+    }
+    return q;
+}
+
+/* Steps 1-9 for beam i: its raw score, or FALKO_REJECTED. */
+static float beam_score(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p,
+                        float inv_inc, int8_t *sector)
+{
+    const float rho = pts->range[i];
+    float r, theta;
+    neigh_t nb;
+
+    if (!pts->valid[i] || !(rho >= p->min_range && rho <= p->max_range)) {
+        return FALKO_REJECTED;
+    }
+    r = neigh_radius(p, rho);
+    if (!neighbourhood(pts, i, r, inv_inc, p, &nb)) {
+        return FALKO_REJECTED;
+    }
+    theta = corner_orientation(&nb);
+    return (float)corner_score(pts, i, &nb, r, theta, p, sector);
+}
+
+bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
+                              bsf_falko_work_t *work, bsf_keypoint_t *out, size_t out_cap,
+                              size_t *n_out)
+{
+    size_t i, k, n_peak;
+    float inc;
+    long score_max = 0;
+    long min_val;
+    bsf_status_t st;
+
+    if (n_out != NULL) {
+        *n_out = 0;
+    }
+    if (pts == NULL || p == NULL || work == NULL || n_out == NULL ||
+        (out == NULL && out_cap > 0u)) {
+        return BSF_ERR_ARG;
+    }
+    st = bsf_falko_params_check(p);
+    if (st != BSF_OK) {
+        return st;
+    }
+    if (pts->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    inc = fabsf(pts->angle_increment);
+    if (!finite_f(inc) || inc == 0.0f) {
+        return BSF_ERR_ARG;
+    }
+
+    for (i = 0; i < pts->count; ++i) {
+        const float s = beam_score(pts, i, p, 1.0f / inc, work->sector);
+        work->score[i] = s;
+        if (s > (float)score_max) {
+            if (s > (float)FALKO_SCORE_LIMIT) {
+                return BSF_ERR_CAPACITY;
+            }
+            score_max = (long)s;
+        }
+    }
+    if (score_max == 0) {
+        /* Every strength would be 0 and the threshold >= 0: nothing passes. */
+        return BSF_OK;
+    }
+
+    /* Strength = scoreMax - raw (rejected beams: 0); candidates need a
+     * strength above int(scoreMax * th / 100), computed exactly in integers. */
+    for (i = 0; i < pts->count; ++i) {
+        const float s = work->score[i];
+        work->score[i] = (s < 0.0f) ? 0.0f : (float)score_max - s;
+    }
+    min_val = score_max * (long)p->min_score_th / 100L;
+    n_peak = bsf_nms_beams(pts, work->score, BSF_NMS_HIGHER_IS_BETTER, (float)min_val,
+                           p->nms_radius, work->peak);
+
+    *n_out = n_peak;
+    for (k = 0; k < n_peak && k < out_cap; ++k) {
+        const size_t b = work->peak[k];
+        const float r = neigh_radius(p, pts->range[b]);
+        neigh_t nb;
+        (void)neighbourhood(pts, b, r, 1.0f / inc, p, &nb); /* passed before */
+        out[k].index = (uint16_t)b;
+        out[k].orientation = corner_orientation(&nb);
+        out[k].radius = r;
+        out[k].score = (float)score_max - work->score[b];
+        out[k].point = p->subbeam ? subbeam_corner(pts, b, &nb, r) : pts->pt[b];
+    }
+    return (n_peak > out_cap) ? BSF_ERR_CAPACITY : BSF_OK;
+}

@@ -1,0 +1,133 @@
+#include "bsf_nms.h"
+
+#include <math.h>
+
+/* asin(0.8): the reference's window angle when the radius reaches the range. */
+#define BSF_ASIN_0_8 0.927295218f
+
+/* What every window of one scan shares. */
+typedef struct {
+    float radius;    /* suppression radius, metres */
+    float inc;       /* |angle increment|, radians */
+    float inv_inc;   /* 1 / inc */
+    float far_ratio; /* radius / range below this: window certainly 0 */
+    size_t close;    /* window when radius >= range: floor(asin(0.8) / inc) */
+} window_ctx_t;
+
+static size_t clamp_window(float w)
+{
+    if (!(w >= 0.0f)) {
+        return 0u;
+    }
+    return (w > (float)BSF_MAX_POINTS) ? (size_t)BSF_MAX_POINTS : (size_t)w;
+}
+
+static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
+{
+    window_ctx_t c;
+    c.radius = radius;
+    c.inc = fabsf(pts->angle_increment);
+    c.inv_inc = 1.0f / c.inc;
+    /* asin(s) < inc, hence window 0, whenever s < sin(inc); the margin keeps
+     * rounding on the safe side. */
+    c.far_ratio = sinf(c.inc) * 0.999f;
+    c.close = clamp_window(floorf(BSF_ASIN_0_8 / c.inc));
+    return c;
+}
+
+/* floor(asin(s) / inc) for s = radius / range. asin(s) lies between s and
+ * s / sqrt(1 - s^2); when both bounds (widened by a rounding margin) floor to
+ * the same integer, that is the window and asinf is not needed. */
+static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t *c)
+{
+    float s, lo, hi;
+    if (!pts->valid[i]) {
+        return 0u;
+    }
+    if (c->radius >= pts->range[i]) {
+        return c->close;
+    }
+    if (c->radius < c->far_ratio * pts->range[i]) {
+        return 0u;
+    }
+    s = c->radius / pts->range[i];
+    lo = floorf(s * c->inv_inc * (1.0f - 1e-5f));
+    hi = floorf(s / sqrtf(1.0f - s * s) * c->inv_inc * (1.0f + 1e-5f));
+    if (lo == hi) {
+        return clamp_window(lo);
+    }
+    return clamp_window(floorf(asinf(s) / c->inc));
+}
+
+size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius)
+{
+    const window_ctx_t c = window_ctx(pts, radius);
+    return half_window(pts, i, &c);
+}
+
+size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_t order,
+                     float threshold, float radius, uint16_t *peak)
+{
+    /* Comparing sign * score turns "lower is better" into "higher is better"
+     * exactly (negation is exact in floating point). */
+    const float sign = (order == BSF_NMS_LOWER_IS_BETTER) ? -1.0f : 1.0f;
+    const size_t n = pts->count;
+    const float min_val = sign * threshold;
+    const window_ctx_t ctx = window_ctx(pts, radius);
+    size_t n_cand = 0;
+    size_t i = 0;
+    size_t imax = 0;
+    size_t k, i2, n_peak, run;
+
+    while (i < n) {
+        const size_t win = half_window(pts, i, &ctx);
+        size_t j, jbeg, jend;
+        size_t jmax = i;
+
+        /* Search the left part of the window only when the running maximum
+         * imax lies outside it; otherwise it has already been seen. */
+        if (imax + win < i) {
+            jbeg = i - win;
+            imax = i;
+        } else {
+            jbeg = i;
+        }
+        jend = (i + win + 1u < n) ? i + win + 1u : n;
+        for (j = jbeg; j < jend; ++j) {
+            if (sign * score[j] > sign * score[jmax]) {
+                jmax = j;
+            }
+        }
+        if (sign * score[jmax] >= sign * score[imax]) {
+            imax = jmax;
+        }
+        if (i == imax && sign * score[i] > min_val) {
+            peak[n_cand++] = (uint16_t)i;
+        }
+        i = (jmax > i) ? jmax : i + 1u;
+    }
+
+    /* Plateau merge, in place (a peak is written at or before the candidate
+     * it comes from, and later reads are further right): within a run of
+     * consecutive candidates with equal scores, the kept index i2 advances
+     * every other step, ending near the middle of the run. */
+    n_peak = 0;
+    i2 = 0;
+    run = 0;
+    for (k = 0; k < n_cand; ++k) {
+        if (score[peak[i2]] == score[peak[k]]) {
+            ++run;
+            if (2u * (k - i2) > run) {
+                ++i2;
+            }
+        } else {
+            peak[n_peak++] = peak[i2];
+            i2 = k;
+            run = 0;
+        }
+    }
+    if (n_cand > 0u) {
+        peak[n_peak++] = peak[i2];
+    }
+    return n_peak;
+}

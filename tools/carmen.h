@@ -1,0 +1,82 @@
+/*
+ * carmen.h - streaming reader of CARMEN log files (host only, not part of the
+ * library). Reads plain or gzip-compressed logs (zlib's gzopen reads both)
+ * one laser message at a time.
+ *
+ * Understood: FLASER and ROBOTLASER1. Skipped: every other message type
+ * (ODOM, PARAM, VERTEX2, EDGE2, NEFF, ...), comment lines (starting with #)
+ * and blank lines. A malformed FLASER/ROBOTLASER1 line is reported as
+ * "file:line: message" to the error stream given at open, counted, and
+ * skipped; reading goes on with the next line.
+ */
+#ifndef BSF_TOOLS_CARMEN_H
+#define BSF_TOOLS_CARMEN_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+/** Largest beam count accepted on one line; more is reported as malformed. */
+#define CARMEN_MAX_BEAMS 8192
+
+/** Kind of laser message a record came from. */
+typedef enum {
+    CARMEN_FLASER = 1,     /**< old front-laser message, geometry by convention */
+    CARMEN_ROBOTLASER1 = 2 /**< geometry given on the line */
+} carmen_msg_t;
+
+/** A planar pose in the world frame: metres, metres, radians. */
+typedef struct {
+    double x;
+    double y;
+    double theta;
+} carmen_pose_t;
+
+/**
+ * One laser scan. `ranges` points into the reader's storage and stays valid
+ * until the next carmen_next or carmen_close on the same reader.
+ *
+ * Geometry: beam i points at angle_min + i * angle_increment (radians, CCW).
+ *  - ROBOTLASER1: angle_min = start, angle_increment = res from the line
+ *    (the fov field is ignored); max_range = the line's maxrange.
+ *  - FLASER (CARMEN's readlog convention): angle_min = -pi/2; increment
+ *    1 deg for 180 or 181 beams, 0.5 deg for 360 or 361 beams; any other
+ *    count N >= 2 spreads the beams over exactly 180 deg (pi / (N - 1)), and
+ *    a single beam gets increment pi. max_range = 80 m (CARMEN's assumption).
+ *    laser_pose = the line's x y theta, robot_pose = its odometry pose.
+ */
+typedef struct {
+    carmen_msg_t type;
+    const float *ranges;       /**< count readings, metres, as written */
+    size_t count;              /**< number of beams (may change from line to line) */
+    float angle_min;           /**< radians */
+    float angle_increment;     /**< radians */
+    float max_range;           /**< declared maximum range, metres */
+    carmen_pose_t laser_pose;  /**< lx ly ltheta (FLASER: x y theta) */
+    carmen_pose_t robot_pose;  /**< rx ry rtheta (FLASER: odom_x odom_y odom_theta) */
+    double timestamp;          /**< ipc_time, seconds */
+    unsigned long line;        /**< 1-based line number in the file */
+} carmen_scan_t;
+
+typedef struct carmen_reader carmen_reader_t;
+
+/**
+ * Open a log. `err` receives the reports of malformed lines (NULL: silent).
+ * Returns NULL when the file cannot be opened (errno tells why) or memory
+ * runs out.
+ */
+carmen_reader_t *carmen_open(const char *path, FILE *err);
+
+/**
+ * Read the next laser message into *scan.
+ * @return 1 when a scan was read, 0 at end of file, -1 on a read error
+ *         (reported to the error stream).
+ */
+int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan);
+
+/** Number of malformed laser lines skipped so far. */
+unsigned long carmen_malformed_count(const carmen_reader_t *reader);
+
+/** Close the reader and free its storage; NULL is allowed. */
+void carmen_close(carmen_reader_t *reader);
+
+#endif /* BSF_TOOLS_CARMEN_H */
