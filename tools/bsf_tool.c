@@ -36,6 +36,15 @@
 
 static const char *g_cmd = TOOL_NAME;
 
+#if defined(__GNUC__) || defined(__clang__)
+#define BSF_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#else
+#define BSF_PRINTF_LIKE(f, a)
+#endif
+
+static void fail_msg(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
+static int usage_error(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
+
 static void fail_msg(const char *fmt, ...)
 {
     va_list ap;
@@ -590,7 +599,7 @@ static int cmd_extract(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.method = BSF_METHOD_FALKO_SVED_PDM;
     o.count = -1;
-    o.quant = BSF_QUANT_STEP_DEFAULT;
+    o.quant = (double)BSF_QUANT_STEP_DEFAULT;
     o.out = "-";
     for (i = 1; i < argc; ++i) {
         const char *v;
@@ -615,7 +624,7 @@ static int cmd_extract(int argc, char **argv)
                 return usage_error("--range-max needs metres > 0, got '%s'", v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--quant", &err)) != NULL) {
-            if (parse_float(v, BSF_QUANT_STEP_MIN, BSF_QUANT_STEP_MAX, &o.quant) != 0) {
+            if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) != 0) {
                 return usage_error("--quant needs metres in [%g, %g], got '%s'",
                                    (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, v);
             }
