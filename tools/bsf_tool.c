@@ -26,9 +26,6 @@
 #define EXIT_USAGE 2
 #define EXIT_FAIL 1
 
-/* Readings at or above this are no-return codes in every CARMEN log we know
- * (81.83, 81.91; genuine outdoor returns reach ~81.8 m). */
-#define NO_RETURN_FLOOR 81.8f
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -472,12 +469,7 @@ typedef struct {
 
 static float scan_range_max(const carmen_scan_t *s, double opt)
 {
-    float rmax;
-    if (opt > 0.0) {
-        return (float)opt;
-    }
-    rmax = (s->max_range > 0.0f && isfinite(s->max_range)) ? s->max_range : 80.0f;
-    return rmax < NO_RETURN_FLOOR ? rmax : NO_RETURN_FLOOR;
+    return opt > 0.0 ? (float)opt : carmen_valid_range_max(s);
 }
 
 static bsf_scan_t scan_of_record(const carmen_scan_t *s, double range_max_opt)
