@@ -11,6 +11,12 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 #include "bsf_feature.h"
+#include "bsf_metrics.h"
+#include "bsf_segment.h"
 #include "bsf_falko.h"
+#include "bsf_bspline.h"
+#include "bsf_fit.h"
+#include "bsf_extract.h"
+#include "bsf_stream.h"
 
 #endif /* BSF_H */

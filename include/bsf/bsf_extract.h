@@ -1,0 +1,115 @@
+/*
+ * bsf_extract.h - the whole pipeline in one call: scan -> points -> corners
+ * -> segments -> B-spline features, for the three methods of the paper.
+ *
+ *   static bsf_extractor_t ex;               // all working memory, no heap
+ *   static bsf_result_t res;
+ *   bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
+ *   if (bsf_extractor_init(&ex, &p) != BSF_OK) { ... }
+ *   if (bsf_extract(&ex, &scan, &res) == BSF_OK) { ... res.features ... }
+ *
+ * Each stage is also callable on its own (bsf_scan.h, bsf_falko.h,
+ * bsf_bid.h, bsf_segment.h, bsf_fit.h).
+ */
+#ifndef BSF_EXTRACT_H
+#define BSF_EXTRACT_H
+
+#include "bsf_common.h"
+#include "bsf_scan.h"
+#include "bsf_feature.h"
+#include "bsf_falko.h"
+#include "bsf_segment.h"
+#include "bsf_fit.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** The extraction methods of the paper's Table 1. */
+typedef enum {
+    BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM (default) */
+    BSF_METHOD_BID_SVED_PDM = 1,   /**< baseline: B-spline interest points (slow), SVED, PDM */
+    BSF_METHOD_RPOS_LSBA = 2,      /**< baseline: RPOS segments, 4-point least squares, no corners */
+    BSF_METHOD_COUNT = 3
+} bsf_method_t;
+
+/**
+ * A clock for the time metric: returns a free-running 32-bit tick count
+ * (only differences are used, so it may wrap). NULL: no timing, no cost.
+ * Ready-made hooks are in port/bsf_port_clock.h.
+ */
+typedef uint32_t (*bsf_clock_fn)(void *user);
+
+/** Runtime parameters; start from bsf_params_default(method). */
+typedef struct {
+    bsf_method_t method;
+    bsf_falko_params_t falko; /**< used by FALKO-SVED-PDM */
+    bsf_sved_params_t sved;   /**< used by the two SVED methods */
+    bsf_rpos_params_t rpos;   /**< used by RPOS-LSBA */
+    bsf_pdm_params_t pdm;     /**< used by the two PDM methods */
+    bsf_clock_fn clock;       /**< optional, see bsf_clock_fn */
+    void *clock_user;         /**< passed to clock */
+    uint32_t clock_hz;        /**< ticks per second of clock (> 0 when clock is set) */
+} bsf_params_t;
+
+/** Defaults for a method (the parameters the paper and design brief name).
+ *  An unknown method gives the FALKO-SVED-PDM defaults with that method
+ *  stored, which bsf_extractor_init then refuses. */
+bsf_params_t bsf_params_default(bsf_method_t method);
+
+/** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
+ *  NULL, BSF_ERR_PARAM for an unknown method or a value out of range. */
+BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
+
+/**
+ * All working memory of the pipeline, owned by the caller. Statically
+ * allocatable; its size follows from the caps in bsf_config.h (see the
+ * README's table). Fields are private: use the functions.
+ */
+typedef struct {
+    bsf_params_t params;
+    bsf_points_t points;
+    union {
+        bsf_falko_work_t falko;
+    } corner_work;
+    bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
+    uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
+    bsf_segment_t segments[BSF_MAX_SEGMENTS];
+    bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points, gathered */
+    uint16_t vertex_pos[BSF_MAX_KEYPOINTS];  /**< its vertices, as positions in seg_points */
+    bsf_pdm_work_t pdm;
+    size_t n_keypoints;
+    size_t n_segments;
+    uint32_t ready; /**< set by a successful init */
+} bsf_extractor_t;
+
+/**
+ * Validate params and prepare ex (copies params; no other work).
+ * @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM for bad params. On
+ *         error ex is marked not ready, and bsf_extract refuses it.
+ */
+BSF_NODISCARD bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params);
+
+/**
+ * Extract one scan's features into *result (overwritten whole).
+ * A segment whose fit fails numerically is dropped and counted in
+ * result->stats.n_unfitted (its points are wasted), never output with NaN.
+ * @return BSF_OK; BSF_ERR_ARG for NULL or an extractor not initialised, or a
+ *         scan refused by bsf_scan_to_points; BSF_ERR_CAPACITY when the scan,
+ *         its keypoints, segments or control points exceed a cap. On error
+ *         result holds no features (n_features 0) and zero stats.
+ */
+BSF_NODISCARD bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan,
+                                       bsf_result_t *result);
+
+/** Name of a method as the tool spells it ("falko-sved-pdm", ...), or NULL. */
+const char *bsf_method_name(bsf_method_t method);
+
+/** Method from its name; returns BSF_METHOD_COUNT for an unknown name. */
+bsf_method_t bsf_method_from_name(const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BSF_EXTRACT_H */

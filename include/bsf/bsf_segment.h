@@ -1,0 +1,142 @@
+/*
+ * bsf_segment.h - split a scan's points into segments (runs of beams that
+ * belong to one surface), drop the short ones as wasted, and classify the
+ * kept ones as auxiliary (a corner inside) or bleak (smooth).
+ *
+ * Two methods (design section 6):
+ *  - SVED (default): a point joins the current segment when its distance to
+ *    the segment's last point is at most r(rho) = a * exp(b * rho), rho the
+ *    range of the new point. Invalid beams never break a segment by
+ *    themselves: only the distance test does.
+ *  - RPOS (baseline of the paper): consecutive VALID points q[i-1], q[i],
+ *    q[i+1] stay together while the turn between q[i]-q[i-1] and q[i+1]-q[i]
+ *    is at most alpha_max and the two spacings differ by at most a factor eta.
+ *
+ * Both keep segments of at least min_segment_points valid points; points of
+ * shorter segments are wasted (paper section 5.3.1: fewer than five points).
+ * Both make one pass over the beams, use no square root and no heap.
+ */
+#ifndef BSF_SEGMENT_H
+#define BSF_SEGMENT_H
+
+#include "bsf_common.h"
+#include "bsf_feature.h"
+#include "bsf_scan.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** One kept segment: a run of beams, both ends valid beams. */
+typedef struct {
+    uint16_t first;     /**< beam index of the first valid point (inclusive) */
+    uint16_t last;      /**< beam index of the last valid point (inclusive) */
+    uint16_t n_points;  /**< valid points in the segment (invalid beams inside are not counted) */
+    uint8_t kind;       /**< a bsf_feature_kind_t, set by bsf_segment_classify (BLEAK before) */
+    uint8_t n_interest; /**< inner interest points (see bsf_segment_classify), saturates at 255 */
+} bsf_segment_t;
+
+/** SVED parameters. */
+typedef struct {
+    float a;                     /**< distance threshold at range 0, metres, finite, > 0 */
+    float b;                     /**< growth of the threshold with range, 1/metre, finite, >= 0 */
+    uint16_t min_segment_points; /**< shortest kept segment, points, 1..BSF_MAX_POINTS */
+} bsf_sved_params_t;
+
+/** RPOS parameters. */
+typedef struct {
+    float alpha_max;             /**< largest turn between successive steps, radians, (0, pi] */
+    float eta;                   /**< largest ratio of successive spacings, 1..1e6 */
+    uint16_t min_segment_points; /**< shortest kept segment, points, 1..BSF_MAX_POINTS */
+} bsf_rpos_params_t;
+
+/** SVED defaults of the paper: a = 0.2 m, b = 0.07 /m, min_segment_points = 5. */
+bsf_sved_params_t bsf_sved_params_default(void);
+
+/** RPOS defaults of the paper: alpha_max = pi/4, eta = 1.5, min_segment_points = 5. */
+bsf_rpos_params_t bsf_rpos_params_default(void);
+
+/**
+ * Check SVED parameters against the ranges documented on bsf_sved_params_t.
+ * @return BSF_OK; BSF_ERR_ARG when p is NULL; BSF_ERR_PARAM when a value is out
+ *         of range (NaN included).
+ */
+BSF_NODISCARD bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p);
+
+/**
+ * Check RPOS parameters against the ranges documented on bsf_rpos_params_t.
+ * @return BSF_OK; BSF_ERR_ARG when p is NULL; BSF_ERR_PARAM when a value is out
+ *         of range (NaN included).
+ */
+BSF_NODISCARD bsf_status_t bsf_rpos_params_check(const bsf_rpos_params_t *p);
+
+/**
+ * SVED segmentation. Walks the beams in order; each valid point joins the
+ * current segment when its distance to the segment's last point is at most
+ * a * exp(b * rho) (rho: its range, metres), else it starts a new segment.
+ * Segments with fewer than min_segment_points points are not output; their
+ * points are counted as wasted. Kept segments come out in beam order, with
+ * kind BSF_FEATURE_BLEAK and n_interest 0 (see bsf_segment_classify).
+ *
+ * @param pts     points of one scan (bsf_scan_to_points)
+ * @param params  parameters; NULL means the defaults
+ * @param out     kept segments (cap entries; may be NULL when cap is 0)
+ * @param cap     length of out
+ * @param n_out   number of kept segments written
+ * @param n_wasted_points  valid points in dropped segments (may be NULL);
+ *                always pts->n_valid minus the points of the kept segments
+ * @return BSF_OK (an empty or all-invalid scan gives 0 segments, and a single
+ *         valid point 0 segments and 1 wasted point with the defaults);
+ *         BSF_ERR_ARG for a NULL pts or n_out, or out NULL with cap > 0;
+ *         BSF_ERR_PARAM for bad params; BSF_ERR_CAPACITY when pts->count
+ *         exceeds BSF_MAX_POINTS or more than cap segments are kept. On any
+ *         error *n_out and *n_wasted_points are 0 and out is unspecified.
+ */
+BSF_NODISCARD bsf_status_t bsf_segment_sved(const bsf_points_t *pts,
+                                            const bsf_sved_params_t *params, bsf_segment_t *out,
+                                            size_t cap, size_t *n_out, size_t *n_wasted_points);
+
+/**
+ * RPOS segmentation over consecutive VALID points: invalid beams are
+ * skipped, so across a gap the spacing is the distance between the valid
+ * points on either side (a gap of one beam on a wall doubles the spacing and
+ * therefore breaks by the eta test; SVED is the method that bridges gaps).
+ * A segment's first two
+ * points always go together; each further point q[i+1] joins while, at the
+ * segment's last point q[i], the turn |alpha_i| between q[i]-q[i-1] and
+ * q[i+1]-q[i] is <= alpha_max and max(p_i, p_(i+1)) <= eta * min(p_i, p_(i+1))
+ * with p_i = |q[i] - q[i-1]|. Otherwise the segment ends at q[i] and a new
+ * one starts at q[i+1]: a corner point stays with the segment before it, and
+ * an isolated outlier drags its next neighbour into a two-point (wasted)
+ * segment, as in the paper. Output, waste rule, parameters and return codes
+ * as bsf_segment_sved.
+ */
+BSF_NODISCARD bsf_status_t bsf_segment_rpos(const bsf_points_t *pts,
+                                            const bsf_rpos_params_t *params, bsf_segment_t *out,
+                                            size_t cap, size_t *n_out, size_t *n_wasted_points);
+
+/**
+ * Classify segments against interest points (corner beam indices).
+ * A segment is BSF_FEATURE_AUXILIARY when at least one interest beam is a
+ * valid beam of the segment other than its first two or last two valid
+ * points; otherwise BSF_FEATURE_BLEAK. n_interest gets the number of such
+ * inner interest points (saturating at 255). Segments may come in any order.
+ *
+ * @param segs            segments to update (n entries; may be NULL when n is 0)
+ * @param pts             the points the segments were made from
+ * @param interest_beams  beam indices, strictly ascending (may be NULL when
+ *                        n_interest is 0); indices outside the scan are never inside a segment
+ * @return BSF_OK; BSF_ERR_ARG for NULL pointers (as above), interest beams not
+ *         strictly ascending, or a segment with first > last or last >=
+ *         pts->count; BSF_ERR_CAPACITY when pts->count exceeds BSF_MAX_POINTS.
+ *         On error no segment is changed.
+ */
+BSF_NODISCARD bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n,
+                                                const bsf_points_t *pts,
+                                                const uint16_t *interest_beams, size_t n_interest);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BSF_SEGMENT_H */

@@ -1,0 +1,323 @@
+#include "bsf/bsf_extract.h"
+
+#include <string.h>
+
+#define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
+
+static const char *const method_names[BSF_METHOD_COUNT] = {
+    "falko-sved-pdm",
+    "bid-sved-pdm",
+    "rpos-lsba",
+};
+
+const char *bsf_method_name(bsf_method_t method)
+{
+    if ((unsigned)method >= (unsigned)BSF_METHOD_COUNT) {
+        return NULL;
+    }
+    return method_names[method];
+}
+
+bsf_method_t bsf_method_from_name(const char *name)
+{
+    unsigned m;
+    if (name == NULL) {
+        return BSF_METHOD_COUNT;
+    }
+    for (m = 0; m < (unsigned)BSF_METHOD_COUNT; ++m) {
+        if (strcmp(name, method_names[m]) == 0) {
+            return (bsf_method_t)m;
+        }
+    }
+    return BSF_METHOD_COUNT;
+}
+
+bsf_params_t bsf_params_default(bsf_method_t method)
+{
+    bsf_params_t p;
+    memset(&p, 0, sizeof p);
+    p.method = method;
+    p.falko = bsf_falko_params_default();
+    p.sved = bsf_sved_params_default();
+    p.rpos = bsf_rpos_params_default();
+    bsf_pdm_params_default(&p.pdm);
+    p.clock = NULL;
+    p.clock_user = NULL;
+    p.clock_hz = 0u;
+    return p;
+}
+
+bsf_status_t bsf_params_check(const bsf_params_t *p)
+{
+    bsf_status_t st = BSF_OK;
+    if (p == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (p->clock != NULL && p->clock_hz == 0u) {
+        return BSF_ERR_PARAM;
+    }
+    switch (p->method) {
+    case BSF_METHOD_FALKO_SVED_PDM:
+        st = bsf_falko_params_check(&p->falko);
+        if (st == BSF_OK) {
+            st = bsf_sved_params_check(&p->sved);
+        }
+        if (st == BSF_OK) {
+            st = bsf_pdm_params_check(&p->pdm);
+        }
+        break;
+    case BSF_METHOD_BID_SVED_PDM:
+        st = BSF_ERR_PARAM; /* BID lands with the B-spline detector */
+        break;
+    case BSF_METHOD_RPOS_LSBA:
+        st = bsf_rpos_params_check(&p->rpos);
+        break;
+    case BSF_METHOD_COUNT:
+    default:
+        return BSF_ERR_PARAM;
+    }
+    /* A NULL inside a valid struct cannot happen, so any failure is a value. */
+    return st == BSF_OK ? BSF_OK : BSF_ERR_PARAM;
+}
+
+bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params)
+{
+    bsf_status_t st;
+    if (ex == NULL || params == NULL) {
+        return BSF_ERR_ARG;
+    }
+    ex->ready = 0u;
+    st = bsf_params_check(params);
+    if (st != BSF_OK) {
+        return st;
+    }
+    ex->params = *params;
+    ex->n_keypoints = 0u;
+    ex->n_segments = 0u;
+    ex->ready = BSF_EXTRACTOR_READY;
+    return BSF_OK;
+}
+
+/* Tick difference to nanoseconds, saturating at 2^32 - 1 ns. */
+static uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
+{
+    const float ns = (float)ticks * (1.0e9f / (float)hz);
+    if (!(ns < 4294967040.0f)) {
+        return 0xFFFFFFFFu;
+    }
+    return (uint32_t)ns;
+}
+
+typedef struct {
+    const bsf_params_t *p;
+    uint32_t start;
+    uint32_t last;
+} stage_clock_t;
+
+static void clock_start(stage_clock_t *c, const bsf_params_t *p)
+{
+    c->p = p;
+    c->start = c->last = (p->clock != NULL) ? p->clock(p->clock_user) : 0u;
+}
+
+static void clock_stage(stage_clock_t *c, bsf_stats_t *stats, bsf_stage_t stage)
+{
+    uint32_t now;
+    if (c->p->clock == NULL) {
+        return;
+    }
+    now = c->p->clock(c->p->clock_user);
+    stats->stage_ns[stage] = ticks_to_ns(now - c->last, c->p->clock_hz);
+    stats->time_ns = ticks_to_ns(now - c->start, c->p->clock_hz);
+    c->last = now;
+}
+
+static bsf_status_t detect_corners(bsf_extractor_t *ex)
+{
+    bsf_status_t st = BSF_OK;
+    size_t i;
+    ex->n_keypoints = 0u;
+    switch (ex->params.method) {
+    case BSF_METHOD_FALKO_SVED_PDM:
+        st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->corner_work.falko,
+                              ex->keypoints, BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+        break;
+    case BSF_METHOD_BID_SVED_PDM:
+        break;
+    case BSF_METHOD_RPOS_LSBA:
+    case BSF_METHOD_COUNT:
+    default:
+        break;
+    }
+    if (st != BSF_OK) {
+        ex->n_keypoints = 0u;
+        return st;
+    }
+    /* Detectors return keypoints ascending by beam; keep that as a checked
+     * invariant, since classification relies on it. */
+    for (i = 0; i < ex->n_keypoints; ++i) {
+        ex->interest[i] = ex->keypoints[i].index;
+        if (i > 0u && ex->interest[i] <= ex->interest[i - 1u]) {
+            return BSF_ERR_ARG;
+        }
+    }
+    return BSF_OK;
+}
+
+static bsf_status_t segment(bsf_extractor_t *ex)
+{
+    bsf_status_t st;
+    ex->n_segments = 0u;
+    if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
+        return bsf_segment_rpos(&ex->points, &ex->params.rpos, ex->segments, BSF_MAX_SEGMENTS,
+                                &ex->n_segments, NULL);
+    }
+    st = bsf_segment_sved(&ex->points, &ex->params.sved, ex->segments, BSF_MAX_SEGMENTS,
+                          &ex->n_segments, NULL);
+    if (st != BSF_OK) {
+        return st;
+    }
+    return bsf_segment_classify(ex->segments, ex->n_segments, &ex->points, ex->interest,
+                                ex->n_keypoints);
+}
+
+/* Gather a segment's valid points into ex->seg_points and the positions of
+ * its vertices into ex->vertex_pos: interest beams inside the segment that
+ * are not among its first two or last two points (the rule of
+ * bsf_segment_classify). Returns the number of points. */
+static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
+{
+    size_t n = 0u;
+    size_t nv = 0u;
+    size_t k = 0u;
+    size_t b;
+    size_t i;
+
+    while (k < ex->n_keypoints && ex->interest[k] < s->first) {
+        ++k;
+    }
+    for (b = s->first; b <= s->last; ++b) {
+        if (!ex->points.valid[b]) {
+            continue;
+        }
+        while (k < ex->n_keypoints && ex->interest[k] < b) {
+            ++k; /* an interest beam on an invalid reading is no vertex */
+        }
+        if (k < ex->n_keypoints && ex->interest[k] == b) {
+            ex->vertex_pos[nv++] = (uint16_t)n;
+            ++k;
+        }
+        ex->seg_points[n++] = ex->points.pt[b];
+    }
+    *n_vertex = 0u;
+    for (i = 0; i < nv; ++i) {
+        if (ex->vertex_pos[i] >= 2u && (size_t)ex->vertex_pos[i] + 3u <= n) {
+            ex->vertex_pos[(*n_vertex)++] = ex->vertex_pos[i];
+        }
+    }
+    return n;
+}
+
+static bsf_status_t fit_features(bsf_extractor_t *ex, bsf_result_t *res)
+{
+    size_t si;
+
+    for (si = 0; si < ex->n_segments; ++si) {
+        const bsf_segment_t *s = &ex->segments[si];
+        bsf_feature_t *f;
+        size_t n_vertex = 0u;
+        size_t n_ctrl = 0u;
+        size_t room;
+        float e_curve = 0.0f;
+        bsf_status_t st;
+        const size_t n = gather_segment(ex, s, &n_vertex);
+
+        if (res->n_features >= BSF_MAX_SEGMENTS) {
+            return BSF_ERR_CAPACITY;
+        }
+        room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
+        if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
+            if (room < 4u) {
+                return BSF_ERR_CAPACITY;
+            }
+            st = bsf_lsba_fit(ex->seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
+            if (st == BSF_OK) {
+                n_ctrl = 4u;
+                memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
+            }
+        } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
+            st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
+        } else {
+            st = bsf_pdm_fit(ex->seg_points, n, ex->vertex_pos, n_vertex, &ex->params.pdm, &ex->pdm,
+                             &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl], room,
+                             &n_ctrl, &e_curve, NULL);
+            if (st == BSF_ERR_BUFFER) {
+                return BSF_ERR_CAPACITY; /* the scan's control-point pool is full */
+            }
+        }
+        if (st != BSF_OK) {
+            /* Not fitted: its points count as wasted (design 7). */
+            res->stats.n_unfitted++;
+            continue;
+        }
+        f = &res->features[res->n_features++];
+        f->first_beam = s->first;
+        f->last_beam = s->last;
+        f->n_points = s->n_points;
+        f->ctrl_first = res->n_ctrl;
+        f->n_ctrl = (uint8_t)n_ctrl;
+        f->kind = s->kind;
+        f->e_curve = e_curve;
+        res->n_ctrl = (uint16_t)(res->n_ctrl + n_ctrl);
+        res->stats.n_in_features += s->n_points;
+        res->stats.n_ctrl += (uint32_t)n_ctrl;
+    }
+    res->stats.n_features = res->n_features;
+    return BSF_OK;
+}
+
+static void clear_result(bsf_result_t *res)
+{
+    res->n_features = 0u;
+    res->n_ctrl = 0u;
+    memset(&res->stats, 0, sizeof res->stats);
+}
+
+bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan, bsf_result_t *res)
+{
+    stage_clock_t clk;
+    bsf_status_t st;
+
+    if (ex == NULL || scan == NULL || res == NULL) {
+        return BSF_ERR_ARG;
+    }
+    clear_result(res);
+    if (ex->ready != BSF_EXTRACTOR_READY) {
+        return BSF_ERR_ARG;
+    }
+    clock_start(&clk, &ex->params);
+
+    st = bsf_scan_to_points(scan, &ex->points);
+    if (st != BSF_OK) {
+        return st;
+    }
+    res->stats.n_valid = (uint32_t)ex->points.n_valid;
+    clock_stage(&clk, &res->stats, BSF_STAGE_POINTS);
+
+    st = detect_corners(ex);
+    if (st == BSF_OK) {
+        res->stats.n_keypoints = (uint32_t)ex->n_keypoints;
+        clock_stage(&clk, &res->stats, BSF_STAGE_CORNERS);
+        st = segment(ex);
+    }
+    if (st == BSF_OK) {
+        clock_stage(&clk, &res->stats, BSF_STAGE_SEGMENTS);
+        st = fit_features(ex, res);
+    }
+    if (st != BSF_OK) {
+        clear_result(res);
+        return st;
+    }
+    clock_stage(&clk, &res->stats, BSF_STAGE_FIT);
+    return BSF_OK;
+}

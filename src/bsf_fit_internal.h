@@ -1,0 +1,36 @@
+/*
+ * bsf_fit_internal.h - helpers shared by the spline fitters (not public).
+ */
+#ifndef BSF_FIT_INTERNAL_H
+#define BSF_FIT_INTERNAL_H
+
+#include "bsf/bsf_common.h"
+
+/* Basis of span `span` of a curve with n_span spans at local u, with first
+ * and second derivatives with respect to u. All three arrays are required. */
+void bsf_bspline_basis_u(size_t n_span, size_t span, float u, float b[3], float du[3],
+                         float ddu[3]);
+
+/* Point and u-derivatives of span `span` at local u (n_ctrl >= 3, span valid). */
+void bsf_bspline_eval_u(const bsf_point_t *ctrl, size_t n_ctrl, size_t span, float u,
+                        bsf_point_t *c, bsf_point_t *cu, bsf_point_t *cuu);
+
+/* Move *t towards the footpoint of p (the nearest curve point) with at most
+ * max_steps Newton steps; a step may land in a neighbouring span and is only
+ * accepted when it brings the curve closer. Returns the squared distance at
+ * the final *t, never larger than at the initial *t. */
+float bsf_footpoint_refine(const bsf_point_t *ctrl, size_t n_ctrl, bsf_point_t p, float *t,
+                           unsigned max_steps);
+
+/* Add weight * w w^T to a lower band matrix of half-bandwidth 2 (stride 3)
+ * and weight * w * (px, py) to the right-hand sides (when rx is not NULL),
+ * where w holds three coefficients for the non-decreasing unknowns unk[0..2];
+ * coefficients of a repeated unknown (a vertex stored twice) are summed. */
+void bsf_fit_accumulate(float *band, float *rx, float *ry, const uint8_t unk[3], const float w[3],
+                        float weight, float px, float py);
+
+/* BSF_OK when all n points are finite with |x|, |y| <= BSF_FIT_MAX_COORD,
+ * else BSF_ERR_ARG. */
+bsf_status_t bsf_fit_check_points(const bsf_point_t *pts, size_t n);
+
+#endif /* BSF_FIT_INTERNAL_H */

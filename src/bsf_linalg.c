@@ -1,0 +1,122 @@
+#include "bsf_linalg.h"
+
+#include <math.h>
+
+static int finite_f(float v)
+{
+    return v == v && fabsf(v) <= 3.402823466e38f;
+}
+
+/* In-place banded Cholesky of factor (holding A + loading * I). Returns 0 on
+ * a bad pivot. */
+static int band_cholesky(float *f, size_t m, size_t bw, float loading)
+{
+    const size_t w = bw + 1u;
+    size_t i;
+    size_t j;
+    size_t k;
+
+    for (i = 0; i < m; ++i) {
+        const size_t j0 = i > bw ? i - bw : 0u;
+        f[i * w] += loading;
+        for (j = j0; j <= i; ++j) {
+            float sum = f[i * w + (i - j)];
+            for (k = j0; k < j; ++k) {
+                sum -= f[i * w + (i - k)] * f[j * w + (j - k)];
+            }
+            if (j < i) {
+                f[i * w + (i - j)] = sum / f[j * w];
+            } else {
+                const float diag = f[i * w];
+                /* f[i*w] still holds A[i][i] + loading here */
+                if (!(sum > BSF_LINALG_PIVOT_REL * diag) || !finite_f(sum)) {
+                    return 0;
+                }
+                f[i * w] = sqrtf(sum);
+            }
+        }
+    }
+    return 1;
+}
+
+bsf_status_t bsf_spd_band_solve2(const float *band, size_t m, size_t bw, float *factor, float *rx,
+                                 float *ry, int *loaded)
+{
+    const size_t w = bw + 1u;
+    size_t i;
+    size_t k;
+    int attempt;
+    int ok = 0;
+    float max_diag = 0.0f;
+
+    if (band == NULL || factor == NULL || rx == NULL || ry == NULL || m == 0u || bw >= m) {
+        return BSF_ERR_ARG;
+    }
+    if (m > (size_t)BSF_LINALG_MAX_M) {
+        return BSF_ERR_CAPACITY;
+    }
+    for (i = 0; i < m; ++i) {
+        const float d = band[i * w];
+        if (!finite_f(d) || !finite_f(rx[i]) || !finite_f(ry[i])) {
+            return BSF_ERR_NUMERIC;
+        }
+        if (d > max_diag) {
+            max_diag = d;
+        }
+    }
+    if (!(max_diag > 0.0f)) {
+        return BSF_ERR_NUMERIC;
+    }
+    for (attempt = 0; attempt < 2 && !ok; ++attempt) {
+        const float loading = attempt == 0 ? 0.0f : BSF_LINALG_LOADING_REL * max_diag;
+        for (i = 0; i < m * w; ++i) {
+            factor[i] = band[i];
+        }
+        ok = band_cholesky(factor, m, bw, loading);
+        if (loaded != NULL) {
+            *loaded = attempt;
+        }
+    }
+    if (!ok) {
+        return BSF_ERR_NUMERIC;
+    }
+    {
+        /* Forward substitution L z = b, then back substitution L^T x = z,
+         * both right-hand sides in the same sweep. The results go to the
+         * caller only when every value is finite. */
+        float zx[BSF_LINALG_MAX_M];
+        float zy[BSF_LINALG_MAX_M];
+        for (i = 0; i < m; ++i) {
+            const size_t k0 = i > bw ? i - bw : 0u;
+            float sx = rx[i];
+            float sy = ry[i];
+            for (k = k0; k < i; ++k) {
+                const float l = factor[i * w + (i - k)];
+                sx -= l * zx[k];
+                sy -= l * zy[k];
+            }
+            zx[i] = sx / factor[i * w];
+            zy[i] = sy / factor[i * w];
+        }
+        for (i = m; i-- > 0u;) {
+            const size_t k1 = i + bw < m - 1u ? i + bw : m - 1u;
+            float sx = zx[i];
+            float sy = zy[i];
+            for (k = i + 1u; k <= k1; ++k) {
+                const float l = factor[k * w + (k - i)];
+                sx -= l * zx[k];
+                sy -= l * zy[k];
+            }
+            zx[i] = sx / factor[i * w];
+            zy[i] = sy / factor[i * w];
+            if (!finite_f(zx[i]) || !finite_f(zy[i])) {
+                return BSF_ERR_NUMERIC;
+            }
+        }
+        for (i = 0; i < m; ++i) {
+            rx[i] = zx[i];
+            ry[i] = zy[i];
+        }
+    }
+    return BSF_OK;
+}

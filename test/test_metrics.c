@@ -1,0 +1,136 @@
+/* Metrics: per-scan definitions, undefined cases, dataset means and quantiles. */
+#include <math.h>
+#include <string.h>
+
+#include "bsf/bsf.h"
+#include "unity.h"
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+static bsf_scan_counts_t counts(uint32_t n_valid, uint32_t in_feat, uint32_t ctrl, uint32_t feats,
+                                float sum_e, float t)
+{
+    bsf_scan_counts_t c;
+    c.n_valid = n_valid;
+    c.n_in_features = in_feat;
+    c.n_ctrl = ctrl;
+    c.n_features = feats;
+    c.sum_e_curve = sum_e;
+    c.time_s = t;
+    return c;
+}
+
+static void test_scan_metrics_follow_the_paper_definitions(void)
+{
+    bsf_scan_metrics_t m;
+    bsf_scan_counts_t c = counts(180u, 166u, 43u, 5u, 0.05f, 0.0019f);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_scan(&c, &m));
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, 166.0f / 180.0f, m.retrievability);
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, 43.0f / 166.0f, m.compactness);
+    TEST_ASSERT_FLOAT_WITHIN(1e-7f, 0.01f, m.accuracy);
+    TEST_ASSERT_FLOAT_WITHIN(1e-9f, 0.0019f, m.time_s);
+    TEST_ASSERT_TRUE(m.has_retrievability && m.has_compactness && m.has_accuracy && m.has_time);
+}
+
+static void test_undefined_metrics_are_flagged_not_nan(void)
+{
+    bsf_scan_metrics_t m;
+    bsf_scan_counts_t c = counts(0u, 0u, 0u, 0u, 0.0f, -1.0f);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_scan(&c, &m));
+    TEST_ASSERT_FALSE(m.has_retrievability);
+    TEST_ASSERT_FALSE(m.has_compactness);
+    TEST_ASSERT_FALSE(m.has_accuracy);
+    TEST_ASSERT_FALSE(m.has_time);
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, m.compactness);
+    c = counts(100u, 0u, 0u, 0u, 0.0f, 1e-5f);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_scan(&c, &m));
+    TEST_ASSERT_TRUE(m.has_retrievability);
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, m.retrievability);
+    TEST_ASSERT_FALSE(m.has_compactness);
+}
+
+static void test_inconsistent_counts_are_refused(void)
+{
+    bsf_scan_metrics_t m;
+    bsf_scan_counts_t c = counts(10u, 11u, 4u, 1u, 0.0f, 0.0f);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_scan(&c, &m));
+    c = counts(10u, 5u, 4u, 1u, NAN, 0.0f);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_scan(&c, &m));
+    c = counts(10u, 5u, 4u, 0u, 0.0f, 0.0f);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_scan(&c, &m));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_scan(NULL, &m));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_scan(&c, NULL));
+}
+
+static void test_dataset_means_skip_undefined_scans(void)
+{
+    bsf_metrics_acc_t acc;
+    bsf_metrics_summary_t s;
+    bsf_scan_counts_t a = counts(100u, 80u, 20u, 4u, 0.04f, 0.001f);
+    bsf_scan_counts_t b = counts(100u, 60u, 12u, 2u, 0.02f, 0.003f);
+    bsf_scan_counts_t empty = counts(50u, 0u, 0u, 0u, 0.0f, 0.002f);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &a));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &b));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &empty));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_summary(&acc, &s));
+    TEST_ASSERT_EQUAL_UINT32(3u, s.n_scans);
+    TEST_ASSERT_EQUAL_UINT32(3u, s.n_retrievability);
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, (0.8f + 0.6f + 0.0f) / 3.0f, s.retrievability);
+    TEST_ASSERT_EQUAL_UINT32(2u, s.n_compactness);
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, (0.25f + 0.2f) / 2.0f, s.compactness);
+    TEST_ASSERT_FLOAT_WITHIN(1e-7f, 0.01f, s.accuracy);
+    TEST_ASSERT_FLOAT_WITHIN(1e-8f, 0.002f, s.time_mean_s);
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, 2.0f, s.features_per_scan);
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, s.time_median_s);
+}
+
+static void test_time_quantiles_are_nearest_rank(void)
+{
+    static float samples[200];
+    bsf_metrics_acc_t acc;
+    bsf_metrics_summary_t s;
+    uint32_t i;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, samples, 200u));
+    for (i = 0; i < 200u; ++i) {
+        /* 1..200 microseconds, added in a scrambled order */
+        const uint32_t v = (i * 73u) % 200u + 1u;
+        bsf_scan_counts_t c = counts(10u, 5u, 3u, 1u, 0.001f, (float)v * 1e-6f);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_summary(&acc, &s));
+    TEST_ASSERT_FLOAT_WITHIN(1e-9f, 100e-6f, s.time_median_s);
+    TEST_ASSERT_FLOAT_WITHIN(1e-9f, 198e-6f, s.time_p99_s);
+    TEST_ASSERT_FLOAT_WITHIN(1e-8f, 100.5e-6f, s.time_mean_s);
+}
+
+static void test_time_array_overflow_is_an_error_not_a_truncation(void)
+{
+    float samples[2];
+    bsf_metrics_acc_t acc;
+    bsf_scan_counts_t c = counts(10u, 5u, 3u, 1u, 0.001f, 1e-5f);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, samples, 2u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_metrics_acc_add(&acc, &c));
+    TEST_ASSERT_EQUAL_UINT32(2u, acc.n_scans);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_acc_init(&acc, NULL, 3u));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_scan_metrics_follow_the_paper_definitions);
+    RUN_TEST(test_undefined_metrics_are_flagged_not_nan);
+    RUN_TEST(test_inconsistent_counts_are_refused);
+    RUN_TEST(test_dataset_means_skip_undefined_scans);
+    RUN_TEST(test_time_quantiles_are_nearest_rank);
+    RUN_TEST(test_time_array_overflow_is_an_error_not_a_truncation);
+    return UNITY_END();
+}

@@ -1,0 +1,561 @@
+#include "bsf_scene.h"
+
+#include <math.h>
+#include <string.h>
+
+#define SCENE_PI 3.14159265358979323846
+/* Rays start this far out so a sensor standing on a surface does not hit it. */
+#define SCENE_T_MIN 1e-9
+/* Endpoints closer than this are the same vertex (a corner). */
+#define SCENE_JOIN_EPS 1e-9
+/* Angles within this of pi are collinear joints, not corners. */
+#define SCENE_COLLINEAR_EPS 1e-6
+#define SCENE_FAR 1e300
+/* Angle either side of a vertex at which its two walls must be seen, radians. */
+#define SCENE_SIDE_EPS 1e-6
+
+static int finite_d(double v)
+{
+    return v == v && fabs(v) <= 1.7976931348623157e308;
+}
+
+void bsf_scene_init(bsf_scene_t *scene)
+{
+    if (scene != NULL) {
+        memset(scene, 0, sizeof *scene);
+    }
+}
+
+int bsf_scene_add_segment(bsf_scene_t *scene, double x0, double y0, double x1, double y1)
+{
+    bsf_shape_t *s;
+    if (scene == NULL || !finite_d(x0) || !finite_d(y0) || !finite_d(x1) || !finite_d(y1) ||
+        (x0 == x1 && y0 == y1)) {
+        return BSF_ERR_ARG;
+    }
+    if (scene->n_shapes >= BSF_SCENE_MAX_SHAPES) {
+        return BSF_ERR_CAPACITY;
+    }
+    s = &scene->shape[scene->n_shapes];
+    s->kind = BSF_SHAPE_SEGMENT;
+    s->x0 = x0;
+    s->y0 = y0;
+    s->x1 = x1;
+    s->y1 = y1;
+    s->r = 0.0;
+    return (int)scene->n_shapes++;
+}
+
+int bsf_scene_add_circle(bsf_scene_t *scene, double cx, double cy, double r)
+{
+    bsf_shape_t *s;
+    if (scene == NULL || !finite_d(cx) || !finite_d(cy) || !finite_d(r) || !(r > 0.0)) {
+        return BSF_ERR_ARG;
+    }
+    if (scene->n_shapes >= BSF_SCENE_MAX_SHAPES) {
+        return BSF_ERR_CAPACITY;
+    }
+    s = &scene->shape[scene->n_shapes];
+    s->kind = BSF_SHAPE_CIRCLE;
+    s->x0 = cx;
+    s->y0 = cy;
+    s->x1 = cx;
+    s->y1 = cy;
+    s->r = r;
+    return (int)scene->n_shapes++;
+}
+
+bsf_status_t bsf_scene_add_polyline(bsf_scene_t *scene, const double *xy, size_t n_vertices,
+                                    int closed)
+{
+    size_t n_edges;
+    size_t k;
+    if (scene == NULL || xy == NULL || n_vertices < 2u || (closed && n_vertices < 3u)) {
+        return BSF_ERR_ARG;
+    }
+    n_edges = closed ? n_vertices : n_vertices - 1u;
+    for (k = 0; k < n_vertices; ++k) {
+        if (!finite_d(xy[2u * k]) || !finite_d(xy[2u * k + 1u])) {
+            return BSF_ERR_ARG;
+        }
+    }
+    for (k = 0; k < n_edges; ++k) {
+        const size_t a = k;
+        const size_t b = (k + 1u) % n_vertices;
+        if (xy[2u * a] == xy[2u * b] && xy[2u * a + 1u] == xy[2u * b + 1u]) {
+            return BSF_ERR_ARG;
+        }
+    }
+    if (n_edges > BSF_SCENE_MAX_SHAPES - scene->n_shapes) {
+        return BSF_ERR_CAPACITY;
+    }
+    for (k = 0; k < n_edges; ++k) {
+        const size_t a = k;
+        const size_t b = (k + 1u) % n_vertices;
+        /* Cannot fail: inputs and room were checked above. */
+        (void)bsf_scene_add_segment(scene, xy[2u * a], xy[2u * a + 1u], xy[2u * b],
+                                    xy[2u * b + 1u]);
+    }
+    return BSF_OK;
+}
+
+bsf_status_t bsf_scene_add_rect_room(bsf_scene_t *scene, double x0, double y0, double x1, double y1)
+{
+    double xy[8];
+    if (!(x0 != x1) || !(y0 != y1)) {
+        return BSF_ERR_ARG;
+    }
+    xy[0] = x0;
+    xy[1] = y0;
+    xy[2] = x1;
+    xy[3] = y0;
+    xy[4] = x1;
+    xy[5] = y1;
+    xy[6] = x0;
+    xy[7] = y1;
+    return bsf_scene_add_polyline(scene, xy, 4u, 1);
+}
+
+bsf_status_t bsf_scene_add_corner(bsf_scene_t *scene, double vx, double vy, double heading_a,
+                                  double len_a, double heading_b, double len_b)
+{
+    double xy[6];
+    if (!finite_d(heading_a) || !finite_d(heading_b) || !(len_a > 0.0) || !(len_b > 0.0) ||
+        !finite_d(len_a) || !finite_d(len_b)) {
+        return BSF_ERR_ARG;
+    }
+    /* Walk from the end of wall a through the vertex to the end of wall b. */
+    xy[0] = vx + len_a * cos(heading_a);
+    xy[1] = vy + len_a * sin(heading_a);
+    xy[2] = vx;
+    xy[3] = vy;
+    xy[4] = vx + len_b * cos(heading_b);
+    xy[5] = vy + len_b * sin(heading_b);
+    return bsf_scene_add_polyline(scene, xy, 3u, 0);
+}
+
+bsf_status_t bsf_scene_add_l_room(bsf_scene_t *scene, double x0, double y0, double w, double h,
+                                  double notch_w, double notch_h)
+{
+    double xy[12];
+    if (!(notch_w > 0.0) || !(notch_w < w) || !(notch_h > 0.0) || !(notch_h < h)) {
+        return BSF_ERR_ARG;
+    }
+    xy[0] = x0;
+    xy[1] = y0;
+    xy[2] = x0 + w;
+    xy[3] = y0;
+    xy[4] = x0 + w;
+    xy[5] = y0 + h - notch_h;
+    xy[6] = x0 + w - notch_w; /* the reflex corner */
+    xy[7] = y0 + h - notch_h;
+    xy[8] = x0 + w - notch_w;
+    xy[9] = y0 + h;
+    xy[10] = x0;
+    xy[11] = y0 + h;
+    return bsf_scene_add_polyline(scene, xy, 6u, 1);
+}
+
+bsf_status_t bsf_scene_add_room_with_pillar(bsf_scene_t *scene, double x0, double y0, double x1,
+                                            double y1, double pcx, double pcy, double pillar_r)
+{
+    bsf_status_t st;
+    int idx;
+    if (scene == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (scene->n_shapes + 5u > BSF_SCENE_MAX_SHAPES) {
+        return BSF_ERR_CAPACITY;
+    }
+    if (!finite_d(pcx) || !finite_d(pcy) || !finite_d(pillar_r) || !(pillar_r > 0.0)) {
+        return BSF_ERR_ARG;
+    }
+    st = bsf_scene_add_rect_room(scene, x0, y0, x1, y1);
+    if (st != BSF_OK) {
+        return st;
+    }
+    idx = bsf_scene_add_circle(scene, pcx, pcy, pillar_r);
+    return idx < 0 ? (bsf_status_t)idx : BSF_OK;
+}
+
+bsf_lidar_t bsf_lidar_default(double x, double y, double theta, size_t n_beams, double fov)
+{
+    bsf_lidar_t l;
+    memset(&l, 0, sizeof l);
+    if (n_beams < 2u) {
+        return l;
+    }
+    l.pose.x = x;
+    l.pose.y = y;
+    l.pose.theta = theta;
+    l.n_beams = n_beams;
+    l.angle_min = -0.5 * fov;
+    l.angle_increment = fov / (double)(n_beams - 1u);
+    l.range_max = 30.0;
+    l.noise_sigma = 0.0;
+    l.no_return = (float)(l.range_max + 1.0);
+    return l;
+}
+
+/* ---- random numbers ------------------------------------------------------- */
+
+void bsf_scene_rng_seed(bsf_scene_rng_t *rng, uint64_t seed)
+{
+    /* splitmix64 scrambles the seed; xorshift needs a non-zero state. */
+    uint64_t z = seed + 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    rng->state = z != 0u ? z : 0x2545F4914F6CDD1Dull;
+    rng->spare = 0.0;
+    rng->has_spare = 0;
+}
+
+uint64_t bsf_scene_rng_next(bsf_scene_rng_t *rng)
+{
+    uint64_t x = rng->state;
+    x ^= x >> 12;
+    x ^= x << 25;
+    x ^= x >> 27;
+    rng->state = x;
+    return x * 0x2545F4914F6CDD1Dull;
+}
+
+double bsf_scene_rng_uniform(bsf_scene_rng_t *rng)
+{
+    /* 53 random bits, shifted by one so 0 never occurs (log(0) in Box-Muller). */
+    const uint64_t bits = bsf_scene_rng_next(rng) >> 11;
+    return ((double)bits + 1.0) * (1.0 / 9007199254740992.0);
+}
+
+double bsf_scene_rng_gauss(bsf_scene_rng_t *rng)
+{
+    double u1;
+    double u2;
+    double mag;
+    if (rng->has_spare) {
+        rng->has_spare = 0;
+        return rng->spare;
+    }
+    u1 = bsf_scene_rng_uniform(rng);
+    u2 = bsf_scene_rng_uniform(rng);
+    mag = sqrt(-2.0 * log(u1));
+    rng->spare = mag * sin(2.0 * SCENE_PI * u2);
+    rng->has_spare = 1;
+    return mag * cos(2.0 * SCENE_PI * u2);
+}
+
+/* ---- ray casting ---------------------------------------------------------- */
+
+/* Distance along the unit ray (ox,oy)+(dx,dy)t to shape s, or -1 when missed. */
+static double ray_hit(const bsf_shape_t *s, double ox, double oy, double dx, double dy)
+{
+    if (s->kind == BSF_SHAPE_SEGMENT) {
+        const double ex = s->x1 - s->x0;
+        const double ey = s->y1 - s->y0;
+        const double px = s->x0 - ox;
+        const double py = s->y0 - oy;
+        const double denom = dx * ey - dy * ex;
+        double t;
+        double u;
+        if (denom == 0.0) {
+            return -1.0; /* parallel: a grazing ray sees no wall */
+        }
+        t = (px * ey - py * ex) / denom;
+        u = (px * dy - py * dx) / denom;
+        if (t > SCENE_T_MIN && u >= 0.0 && u <= 1.0) {
+            return t;
+        }
+        return -1.0;
+    } else {
+        const double fx = ox - s->x0;
+        const double fy = oy - s->y0;
+        const double b = fx * dx + fy * dy;
+        const double c = fx * fx + fy * fy - s->r * s->r;
+        const double disc = b * b - c;
+        double q;
+        if (disc < 0.0) {
+            return -1.0;
+        }
+        q = sqrt(disc);
+        if (-b - q > SCENE_T_MIN) {
+            return -b - q;
+        }
+        if (-b + q > SCENE_T_MIN) {
+            return -b + q; /* sensor inside the circle: its far side */
+        }
+        return -1.0;
+    }
+}
+
+double bsf_scene_raycast(const bsf_scene_t *scene, double ox, double oy, double angle,
+                         int *hit_shape)
+{
+    const double dx = cos(angle);
+    const double dy = sin(angle);
+    double best = -1.0;
+    int best_shape = -1;
+    size_t k;
+    if (scene != NULL) {
+        for (k = 0; k < scene->n_shapes; ++k) {
+            const double t = ray_hit(&scene->shape[k], ox, oy, dx, dy);
+            if (t > 0.0 && (best < 0.0 || t < best)) {
+                best = t;
+                best_shape = (int)k;
+            }
+        }
+    }
+    if (hit_shape != NULL) {
+        *hit_shape = best_shape;
+    }
+    return best;
+}
+
+bsf_status_t bsf_scene_scan(const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                            bsf_scene_rng_t *rng, float *ranges, int16_t *hit_shape, size_t cap)
+{
+    size_t i;
+    if (scene == NULL || lidar == NULL || ranges == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (!finite_d(lidar->angle_min) || !finite_d(lidar->angle_increment) ||
+        lidar->angle_increment == 0.0 || !(lidar->range_max > 0.0) ||
+        !finite_d(lidar->noise_sigma) || lidar->noise_sigma < 0.0 ||
+        (lidar->noise_sigma > 0.0 && rng == NULL) || !finite_d(lidar->pose.x) ||
+        !finite_d(lidar->pose.y) || !finite_d(lidar->pose.theta)) {
+        return BSF_ERR_ARG;
+    }
+    if (lidar->n_beams == 0u || lidar->n_beams > cap || lidar->n_beams > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    for (i = 0; i < lidar->n_beams; ++i) {
+        const double a = lidar->pose.theta + lidar->angle_min + (double)i * lidar->angle_increment;
+        int shape = -1;
+        double t = bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, a, &shape);
+        if (t < 0.0 || t > lidar->range_max) {
+            ranges[i] = lidar->no_return;
+            shape = -1;
+        } else {
+            if (lidar->noise_sigma > 0.0) {
+                t += lidar->noise_sigma * bsf_scene_rng_gauss(rng);
+                if (t < 0.0) {
+                    t = 0.0;
+                }
+            }
+            ranges[i] = (float)t;
+        }
+        if (hit_shape != NULL) {
+            hit_shape[i] = (int16_t)shape;
+        }
+    }
+    return BSF_OK;
+}
+
+bsf_scan_t bsf_scene_lidar_scan(const bsf_lidar_t *lidar, const float *ranges)
+{
+    bsf_scan_t s;
+    memset(&s, 0, sizeof s);
+    if (lidar == NULL) {
+        return s;
+    }
+    s.ranges = ranges;
+    s.count = lidar->n_beams;
+    s.angle_min = (float)lidar->angle_min;
+    s.angle_increment = (float)lidar->angle_increment;
+    s.range_min = 0.0f;
+    s.range_max = (float)lidar->range_max;
+    return s;
+}
+
+/* ---- ground truth --------------------------------------------------------- */
+
+void bsf_scene_sensor_to_world(const bsf_scene_pose_t *pose, double sx, double sy, double *wx,
+                               double *wy)
+{
+    const double c = cos(pose->theta);
+    const double s = sin(pose->theta);
+    *wx = pose->x + c * sx - s * sy;
+    *wy = pose->y + s * sx + c * sy;
+}
+
+void bsf_scene_world_to_sensor(const bsf_scene_pose_t *pose, double wx, double wy, double *sx,
+                               double *sy)
+{
+    const double c = cos(pose->theta);
+    const double s = sin(pose->theta);
+    const double dx = wx - pose->x;
+    const double dy = wy - pose->y;
+    *sx = c * dx + s * dy;
+    *sy = -s * dx + c * dy;
+}
+
+int bsf_scene_beam_of_bearing(const bsf_lidar_t *lidar, double bearing)
+{
+    int m;
+    if (lidar == NULL || lidar->n_beams == 0u || lidar->angle_increment == 0.0 ||
+        !finite_d(bearing)) {
+        return -1;
+    }
+    /* The field of view may straddle +-pi: try the bearing one turn either way. */
+    for (m = -2; m <= 2; ++m) {
+        const double k =
+            (bearing + (double)m * 2.0 * SCENE_PI - lidar->angle_min) / lidar->angle_increment;
+        if (k >= -0.5 && k <= (double)lidar->n_beams - 0.5) {
+            long idx = (long)floor(k + 0.5);
+            if (idx > (long)lidar->n_beams - 1) {
+                idx = (long)lidar->n_beams - 1;
+            }
+            if (idx < 0) {
+                idx = 0;
+            }
+            return (int)idx;
+        }
+    }
+    return -1;
+}
+
+static int same_point(double ax, double ay, double bx, double by)
+{
+    return fabs(ax - bx) <= SCENE_JOIN_EPS && fabs(ay - by) <= SCENE_JOIN_EPS;
+}
+
+/* Unit-free direction of the wall from its endpoint (vx,vy) into the wall. */
+static void wall_direction(const bsf_shape_t *s, double vx, double vy, double *ux, double *uy)
+{
+    if (same_point(s->x0, s->y0, vx, vy)) {
+        *ux = s->x1 - s->x0;
+        *uy = s->y1 - s->y0;
+    } else {
+        *ux = s->x0 - s->x1;
+        *uy = s->y0 - s->y1;
+    }
+}
+
+/* Fills a corner record; returns 0 when the joint is collinear (no corner). */
+static int make_corner(const bsf_scene_t *scene, const bsf_lidar_t *lidar, size_t a, size_t b,
+                       double vx, double vy, bsf_scene_corner_t *c)
+{
+    double ax, ay, bx, by;
+    double angle;
+    double sx, sy;
+    double t;
+    int shape;
+    wall_direction(&scene->shape[a], vx, vy, &ax, &ay);
+    wall_direction(&scene->shape[b], vx, vy, &bx, &by);
+    angle = atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
+    if (angle > SCENE_PI - SCENE_COLLINEAR_EPS) {
+        return 0;
+    }
+    bsf_scene_world_to_sensor(&lidar->pose, vx, vy, &sx, &sy);
+    c->x = sx;
+    c->y = sy;
+    c->wx = vx;
+    c->wy = vy;
+    c->range = sqrt(sx * sx + sy * sy);
+    c->bearing = atan2(sy, sx);
+    c->angle = angle;
+    c->beam = bsf_scene_beam_of_bearing(lidar, c->bearing);
+    c->shape_a = (uint16_t)a;
+    c->shape_b = (uint16_t)b;
+    c->visible = 0;
+    if (c->beam >= 0 && c->range <= lidar->range_max && c->range > 0.0) {
+        const double dir = atan2(vy - lidar->pose.y, vx - lidar->pose.x);
+        int left = -1;
+        int right = -1;
+        /* Occluded when a surface lies clearly before the vertex on its line
+         * of sight. Seen as a corner only when rays just either side of the
+         * vertex hit its two walls, one each: with one wall hidden behind
+         * the vertex (or seen edge-on) it is a jump edge, not a corner. */
+        t = bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, dir, &shape);
+        if (t < 0.0 || t >= c->range - 1e-6) {
+            (void)bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, dir + SCENE_SIDE_EPS,
+                                    &left);
+            (void)bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, dir - SCENE_SIDE_EPS,
+                                    &right);
+            c->visible =
+                ((left == (int)a && right == (int)b) || (left == (int)b && right == (int)a)) ? 1
+                                                                                             : 0;
+        }
+    }
+    return 1;
+}
+
+bsf_status_t bsf_scene_corners(const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                               bsf_scene_corner_t *out, size_t cap, size_t *n_out)
+{
+    size_t a;
+    size_t b;
+    size_t n = 0;
+    if (scene == NULL || lidar == NULL || n_out == NULL || (out == NULL && cap > 0u)) {
+        return BSF_ERR_ARG;
+    }
+    for (a = 0; a < scene->n_shapes; ++a) {
+        const bsf_shape_t *sa = &scene->shape[a];
+        if (sa->kind != BSF_SHAPE_SEGMENT) {
+            continue;
+        }
+        for (b = a + 1u; b < scene->n_shapes; ++b) {
+            const bsf_shape_t *sb = &scene->shape[b];
+            double vx;
+            double vy;
+            bsf_scene_corner_t c;
+            int end;
+            if (sb->kind != BSF_SHAPE_SEGMENT) {
+                continue;
+            }
+            /* Each of a's two endpoints may touch one of b's. */
+            for (end = 0; end < 2; ++end) {
+                vx = end == 0 ? sa->x0 : sa->x1;
+                vy = end == 0 ? sa->y0 : sa->y1;
+                if (!same_point(vx, vy, sb->x0, sb->y0) && !same_point(vx, vy, sb->x1, sb->y1)) {
+                    continue;
+                }
+                if (!make_corner(scene, lidar, a, b, vx, vy, &c)) {
+                    continue;
+                }
+                if (n < cap) {
+                    out[n] = c;
+                }
+                ++n;
+            }
+        }
+    }
+    *n_out = n;
+    return n > cap ? BSF_ERR_CAPACITY : BSF_OK;
+}
+
+double bsf_scene_distance_to_surface(const bsf_scene_t *scene, double wx, double wy, int *shape)
+{
+    double best = SCENE_FAR;
+    int best_shape = -1;
+    size_t k;
+    if (scene != NULL) {
+        for (k = 0; k < scene->n_shapes; ++k) {
+            const bsf_shape_t *s = &scene->shape[k];
+            double d;
+            if (s->kind == BSF_SHAPE_SEGMENT) {
+                const double ex = s->x1 - s->x0;
+                const double ey = s->y1 - s->y0;
+                double u = ((wx - s->x0) * ex + (wy - s->y0) * ey) / (ex * ex + ey * ey);
+                double px;
+                double py;
+                u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+                px = s->x0 + u * ex - wx;
+                py = s->y0 + u * ey - wy;
+                d = sqrt(px * px + py * py);
+            } else {
+                const double cx = wx - s->x0;
+                const double cy = wy - s->y0;
+                d = fabs(sqrt(cx * cx + cy * cy) - s->r);
+            }
+            if (d < best) {
+                best = d;
+                best_shape = (int)k;
+            }
+        }
+    }
+    if (shape != NULL) {
+        *shape = best_shape;
+    }
+    return best;
+}
