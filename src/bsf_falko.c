@@ -134,11 +134,11 @@ static int in_ball(const bsf_points_t *pts, size_t j, const ball_t *b)
 
 /* A neighbourhood (steps 3, 4 and 6). */
 typedef struct {
-    size_t beg, end; /* beam window, inclusive, clamped to the scan */
-    size_t first;    /* first kept beam (left of the apex) */
-    size_t last;     /* last kept beam (right of the apex) */
-    int n_left;      /* kept neighbours before the apex */
-    int n_right;     /* kept neighbours after the apex */
+    size_t beg, end;                      /* beam window, inclusive, clamped to the scan */
+    size_t first;                         /* first kept beam (left of the apex) */
+    size_t last;                          /* last kept beam (right of the apex) */
+    int n_left;                           /* kept neighbours before the apex */
+    int n_right;                          /* kept neighbours after the apex */
     float sum_lx, sum_ly, sum_rx, sum_ry; /* sums of p - p_apex per side */
 } neigh_t;
 
@@ -215,8 +215,7 @@ static void count_sides(const bsf_points_t *pts, size_t i, const ball_t *b, neig
 }
 
 /* Step 5: the triangle apex - first - last must be wide and tall enough. */
-static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r,
-                       float b_ratio)
+static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float b_ratio)
 {
     const bsf_point_t a = pts->pt[i];
     const bsf_point_t f = pts->pt[nb->first];
@@ -291,8 +290,8 @@ static int sector_distance(int a, int b, int sectors, int circular)
 }
 
 /* Steps 7-9 for an apex that passed steps 1-6: the raw integer score. */
-static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r,
-                         float theta, const bsf_falko_params_t *p, int8_t *sector)
+static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float theta,
+                         const bsf_falko_params_t *p, int8_t *sector)
 {
     const ball_t ball = make_ball(pts->pt[i], r);
     const bsf_point_t c = ball.c;
@@ -313,8 +312,8 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
     /* Ordered pairs: the first of each pair is the one nearer the apex. */
     for (a = nl - 1; a >= 0; --a) {
         for (b = a - 1; b >= 0; --b) {
-            score += sector_distance(sector[a], sector[b], p->grid_sectors,
-                                     p->circular_sector_distance);
+            score +=
+                sector_distance(sector[a], sector[b], p->grid_sectors, p->circular_sector_distance);
         }
     }
     for (a = 0; a < nr; ++a) {
@@ -328,8 +327,8 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
 
 /* Total-least-squares line through beams [from, to] that are neighbours of
  * apex c: unit normal n and offset d with n . x = d. */
-static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball_t *ball,
-                     float *nx, float *ny, float *d)
+static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball_t *ball, float *nx,
+                     float *ny, float *d)
 {
     float sx = 0.0f, sy = 0.0f, sxx = 0.0f, syy = 0.0f, sxy = 0.0f;
     float mx, my, t;
@@ -448,8 +447,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     }
     for (i = 0; i < pts->count; ++i) {
         const float r = work->score[i];
-        const float s = (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], p, work->sector)
-                                   : FALKO_REJECTED;
+        const float s =
+            (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], p, work->sector) : FALKO_REJECTED;
         work->score[i] = s;
         if (s > (float)score_max) {
             if (s > (float)FALKO_SCORE_LIMIT) {
