@@ -687,3 +687,63 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     }
     return BSF_OK;
 }
+
+bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
+                               const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                               bsf_point_t *ctrl_out, float *e_curve_out, uint32_t *iterations)
+{
+    pdm_state_t s;
+    float t0[1];
+    float t1[1];
+    float length = 0.0f;
+    float acc = 0.0f;
+    size_t i;
+    bsf_status_t st;
+
+    if (pts == NULL || p == NULL || work == NULL || ctrl_out == NULL || iterations == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (n > (size_t)BSF_MAX_POINTS || n_ctrl > (size_t)BSF_MAX_CTRL_PER_FEATURE) {
+        return BSF_ERR_CAPACITY;
+    }
+    if (n < 3u || n_ctrl < 3u) {
+        return BSF_ERR_DEGENERATE;
+    }
+    for (i = 1; i < n; ++i) {
+        length += dist(pts[i - 1u], pts[i]);
+    }
+    if (!(length > 0.0f)) {
+        return BSF_ERR_DEGENERATE;
+    }
+    memset(&s, 0, sizeof s);
+    s.pts = pts;
+    s.n = n;
+    s.origin = pts[0];
+    s.n_frag = 1u;
+    s.lambda = p->lambda_per_metre * length;
+    work->frag_first[0] = 0u;
+    work->frag_last[0] = (uint16_t)(n - 1u);
+    work->frag_precision[0] = (uint8_t)(n_ctrl - 2u);
+    work->n_fragments = 1u;
+    work->last_refined = (uint16_t)NO_FRAGMENT;
+    build_layout(&s, work, t0, t1);
+    for (i = 0; i < n; ++i) {
+        if (i > 0u) {
+            acc += dist(pts[i - 1u], pts[i]);
+        }
+        work->t[i] = acc / length;
+    }
+    assemble(&s, work);
+    st = run_pdm(&s, work, p, iterations);
+    if (st != BSF_OK) {
+        return st;
+    }
+    for (i = 0; i < n_ctrl; ++i) {
+        ctrl_out[i].x = work->ctrl[i].x + s.origin.x;
+        ctrl_out[i].y = work->ctrl[i].y + s.origin.y;
+    }
+    if (e_curve_out != NULL) {
+        *e_curve_out = s.rms;
+    }
+    return BSF_OK;
+}
