@@ -52,9 +52,9 @@ bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
     if (!(p->precision_spacing > 0.0f && p->precision_spacing <= BSF_FIT_MAX_COORD) ||
         !(p->lambda_per_metre >= 0.0f && p->lambda_per_metre <= 1.0f) ||
         !(p->rel_tol > 0.0f && p->rel_tol < 1.0f) ||
-        !(p->target_rms > 0.0f && p->target_rms <= BSF_FIT_MAX_COORD) ||
-        p->max_iterations < 1u || p->max_iterations > BSF_PDM_MAX_ITERATIONS ||
-        p->max_ctrl < 3u || p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
+        !(p->target_rms > 0.0f && p->target_rms <= BSF_FIT_MAX_COORD) || p->max_iterations < 1u ||
+        p->max_iterations > BSF_PDM_MAX_ITERATIONS || p->max_ctrl < 3u ||
+        p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
         p->footpoint_steps > 8u || p->refine > 1u) {
         return BSF_ERR_PARAM;
     }
@@ -246,8 +246,7 @@ static void eval_span(const bsf_point_t *ctrl, size_t n_span, size_t span, float
 /* Add one point with basis (b0, 1 - b0 - b2, b2) on `span` to the normal
  * equations. The common case (three distinct unknowns) is written out; a
  * span touching a vertex goes through the general merge. */
-static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2, float px,
-                             float py)
+static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2, float px, float py)
 {
     const uint8_t *unk = &w->unknown_of[span];
     const float b1 = 1.0f - b0 - b2;

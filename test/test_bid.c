@@ -29,8 +29,7 @@ static size_t detect(const bsf_scene_t *scene, bsf_lidar_t *lidar, uint64_t seed
     bsf_scan_t scan;
     size_t n_kp = 99u;
     bsf_scene_rng_seed(&rng, seed);
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_scene_scan(scene, lidar, &rng, ranges, NULL, BSF_MAX_POINTS));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(scene, lidar, &rng, ranges, NULL, BSF_MAX_POINTS));
     scan = bsf_scene_lidar_scan(lidar, ranges);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
     TEST_ASSERT_EQUAL_INT(BSF_OK,
@@ -51,8 +50,9 @@ static void check_corner_found(double opening, double d, double lateral, uint64_
     const double to_sensor = atan2(-lateral, -d);
     lidar.noise_sigma = 0.005;
     bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, d, lateral, to_sensor + opening / 2.0,
-                                                       1.5, to_sensor - opening / 2.0, 1.5));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, d, lateral, to_sensor + opening / 2.0, 1.5,
+                                               to_sensor - opening / 2.0, 1.5));
     n_kp = detect(&scene, &lidar, seed);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &lidar, c, 2u, &n_c));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_c);

@@ -78,8 +78,8 @@ int main(int argc, char **argv)
                     const double vy = dists[d] * sin(turns[t]);
                     const double to_sensor = atan2(-vy, -vx);
                     const double mid = convex ? to_sensor + PI : to_sensor;
-                    const double half = convex ? (PI - angles[a]) / 2.0 + angles[a] / 2.0
-                                               : angles[a] / 2.0;
+                    const double half =
+                        convex ? (PI - angles[a]) / 2.0 + angles[a] / 2.0 : angles[a] / 2.0;
                     int n_kp;
                     float s;
                     lidar.noise_sigma = sigma;
@@ -121,8 +121,8 @@ int main(int argc, char **argv)
                                         cx + 4.0 * sin(ang), 4.0 * cos(ang));
             n_kp = scan_scene(&scene, &lidar, seed++);
             s = min_score(0u, points.count - 1u);
-            printf("wall d %.0f tilt %+.1f: min N_q %.3f, keypoints %d\n", dists[d], ang,
-                   (double)s, n_kp);
+            printf("wall d %.0f tilt %+.1f: min N_q %.3f, keypoints %d\n", dists[d], ang, (double)s,
+                   n_kp);
             best_wall = s < best_wall ? s : best_wall;
         }
     }

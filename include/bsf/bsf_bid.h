@@ -34,13 +34,14 @@ extern "C" {
 
 /** BID parameters; start from bsf_bid_params_default(). */
 typedef struct {
-    float neigh_a;       /**< neighbourhood radius r = neigh_a * exp(neigh_b * range), metres (0.2) */
-    float neigh_b;       /**< see neigh_a, 1/metres (0.07) */
-    float t_th;          /**< N_q threshold, in (0, 1) (0.3, calibrated: see bsf_bid.c) */
-    float nms_radius;    /**< non-maxima suppression radius, metres, >= 0 (0.1) */
+    float neigh_a;    /**< neighbourhood radius r = neigh_a * exp(neigh_b * range), metres (0.2) */
+    float neigh_b;    /**< see neigh_a, 1/metres (0.07) */
+    float t_th;       /**< N_q threshold, in (0, 1) (0.3, calibrated: see bsf_bid.c) */
+    float nms_radius; /**< non-maxima suppression radius, metres, >= 0 (0.1) */
     uint16_t min_side_points; /**< neighbours needed on each side of q, >= 1 (2) */
-    uint16_t max_iterations;  /**< PDM iterations per neighbourhood, 1..BSF_PDM_MAX_ITERATIONS (10) */
-    float rel_tol;       /**< PDM relative RMS improvement to stop, in (0, 1) (0.01) */
+    uint16_t
+        max_iterations; /**< PDM iterations per neighbourhood, 1..BSF_PDM_MAX_ITERATIONS (10) */
+    float rel_tol;      /**< PDM relative RMS improvement to stop, in (0, 1) (0.01) */
 } bsf_bid_params_t;
 
 /** The defaults listed beside each field of bsf_bid_params_t. */
@@ -53,15 +54,15 @@ bsf_bid_params_t bsf_bid_params_default(void);
 BSF_NODISCARD bsf_status_t bsf_bid_params_check(const bsf_bid_params_t *p);
 
 /**
- * Scratch memory of bsf_bid_detect, owned by the caller; about 28 KiB at
+ * Scratch memory of bsf_bid_detect, owned by the caller; 26080 bytes at
  * BSF_MAX_POINTS = 1081. After a call, score[] holds N_q per beam (+inf
  * where none was computed).
  */
 typedef struct {
-    float score[BSF_MAX_POINTS];        /**< N_q per beam */
-    uint16_t peak[BSF_MAX_POINTS];      /**< NMS output */
-    bsf_point_t neigh[BSF_MAX_POINTS];  /**< one neighbourhood, beam order */
-    bsf_pdm_work_t pdm;                 /**< PDM working memory */
+    float score[BSF_MAX_POINTS];       /**< N_q per beam */
+    uint16_t peak[BSF_MAX_POINTS];     /**< NMS output */
+    bsf_point_t neigh[BSF_MAX_POINTS]; /**< one neighbourhood, beam order */
+    bsf_pdm_work_t pdm;                /**< PDM working memory */
 } bsf_bid_work_t;
 
 /**
@@ -83,8 +84,8 @@ typedef struct {
  *         a candidate.
  */
 BSF_NODISCARD bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid_params_t *p,
-                                          bsf_bid_work_t *work, bsf_keypoint_t *out,
-                                          size_t out_cap, size_t *n_out);
+                                          bsf_bid_work_t *work, bsf_keypoint_t *out, size_t out_cap,
+                                          size_t *n_out);
 
 #ifdef __cplusplus
 }

@@ -87,26 +87,27 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
 
 /**
  * Working memory of bsf_pdm_fit, owned by the caller (static or on a task's
- * stack it does not overflow: about 5 KiB at the default caps). Its content
+ * stack it does not overflow: 10944 bytes at the default caps). Its content
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {
-    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
-    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
+    float t[BSF_MAX_POINTS];                    /**< footpoint parameter of each point */
+    float t_prev[BSF_MAX_POINTS];               /**< parameters before the current iteration */
     float band[BSF_MAX_CTRL_PER_FEATURE * 3];   /**< normal matrix, lower band (bw 2) */
     float factor[BSF_MAX_CTRL_PER_FEATURE * 3]; /**< its Cholesky factor */
     float rhs_x[BSF_MAX_CTRL_PER_FEATURE];      /**< right-hand sides, then solutions */
     float rhs_y[BSF_MAX_CTRL_PER_FEATURE];
     bsf_point_t ctrl[BSF_MAX_CTRL_PER_FEATURE];      /**< stored control points, relative */
     bsf_point_t ctrl_prev[BSF_MAX_CTRL_PER_FEATURE]; /**< before the current iteration */
-    uint8_t unknown_of[BSF_MAX_CTRL_PER_FEATURE];   /**< unknown index of each stored one */
-    uint16_t frag_first[BSF_PDM_MAX_FRAGMENTS];     /**< first point of each fragment */
-    uint16_t frag_last[BSF_PDM_MAX_FRAGMENTS];      /**< last point of each fragment */
-    uint8_t frag_precision[BSF_PDM_MAX_FRAGMENTS];  /**< precision points per fragment */
-    float frag_rms[BSF_PDM_MAX_FRAGMENTS];          /**< RMS per fragment, metres */
-    float frag_rms_prev[BSF_PDM_MAX_FRAGMENTS];     /**< before the current iteration */
-    float rms_history[BSF_PDM_MAX_ITERATIONS]; /**< RMS after each accepted iteration of the last solve */
-    uint16_t n_history;                             /**< entries in rms_history */
+    uint8_t unknown_of[BSF_MAX_CTRL_PER_FEATURE];    /**< unknown index of each stored one */
+    uint16_t frag_first[BSF_PDM_MAX_FRAGMENTS];      /**< first point of each fragment */
+    uint16_t frag_last[BSF_PDM_MAX_FRAGMENTS];       /**< last point of each fragment */
+    uint8_t frag_precision[BSF_PDM_MAX_FRAGMENTS];   /**< precision points per fragment */
+    float frag_rms[BSF_PDM_MAX_FRAGMENTS];           /**< RMS per fragment, metres */
+    float frag_rms_prev[BSF_PDM_MAX_FRAGMENTS];      /**< before the current iteration */
+    float rms_history[BSF_PDM_MAX_ITERATIONS]; /**< RMS after each accepted iteration of the last
+                                                  solve */
+    uint16_t n_history;                        /**< entries in rms_history */
     uint16_t n_fragments;
     uint16_t last_refined; /**< fragment that received the last refinement point, or 0xFFFF */
 } bsf_pdm_work_t;
@@ -144,7 +145,8 @@ typedef struct {
  * @param is_vertex_out 1 for both copies of a vertex, 0 otherwise; may be NULL
  * @param ctrl_cap      room in ctrl_out (and is_vertex_out)
  * @param n_ctrl_out    number of stored control points out
- * @param e_curve_out   RMS distance of the points to the curve at their footpoints, metres; may be NULL
+ * @param e_curve_out   RMS distance of the points to the curve at their footpoints, metres; may be
+ * NULL
  * @param info_out      iteration counts; may be NULL
  * @return BSF_OK; BSF_ERR_ARG for NULL required pointers, a non-finite or
  *         too large coordinate, or bad vertex positions; BSF_ERR_PARAM for bad
@@ -158,9 +160,8 @@ typedef struct {
 BSF_NODISCARD bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *vertex_pos,
                                        size_t n_vertex, const bsf_pdm_params_t *p,
                                        bsf_pdm_work_t *work, bsf_point_t *ctrl_out,
-                                       uint8_t *is_vertex_out, size_t ctrl_cap,
-                                       size_t *n_ctrl_out, float *e_curve_out,
-                                       bsf_pdm_info_t *info_out);
+                                       uint8_t *is_vertex_out, size_t ctrl_cap, size_t *n_ctrl_out,
+                                       float *e_curve_out, bsf_pdm_info_t *info_out);
 
 #ifdef __cplusplus
 }
