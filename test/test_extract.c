@@ -164,24 +164,53 @@ static void curve_to_truth(const bsf_lidar_t *l, double *rms, double *max_d)
     *rms = sqrt(sum / (double)n);
 }
 
+/* An office: an L-shaped outline, a partition wall with a doorway, a
+ * cabinet and a round pillar. */
+static void build_office(void)
+{
+    static const double outline[] = {0.0, 0.0, 14.0, 0.0, 14.0, 6.0, 9.0, 6.0, 9.0, 10.0,
+                                     0.0, 10.0};
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 6u, 1));
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 5.0, 0.0, 5.0, 3.0) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 5.0, 4.2, 5.0, 7.0) >= 0);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, 2.0, 7.5, 3.5, 8.3));
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 10.5, 3.0, 0.45) >= 0);
+}
+
 static void test_curves_stay_close_to_the_true_walls_for_each_noise_level(void)
 {
     static const double sigmas[3] = {0.0, 0.005, 0.01};
+    static const double poses[3][3] = {{3.0, 3.6, 0.3}, {7.0, 2.0, 2.0}, {11.0, 3.6, 3.0}};
     static const bsf_method_t methods[2] = {BSF_METHOD_FALKO_SVED_PDM, BSF_METHOD_RPOS_LSBA};
-    size_t si, mi;
+    size_t si, mi, pi;
     for (mi = 0; mi < 2u; ++mi) {
-        for (si = 0; si < 3u; ++si) {
-            const bsf_lidar_t l = make_lidar(2.0, 2.0, 0.4, sigmas[si]);
-            double rms, max_d;
-            build_l_room();
-            extract_with(methods[mi], &l, 11u + si);
-            curve_to_truth(&l, &rms, &max_d);
-            /* The fit averages the noise, so the curve is closer to the wall
-             * than the points are: RMS within sigma (+1 mm for float and
-             * range quantisation), worst sample within 4 sigma + 1 cm (the
-             * ends of a feature sit on noisy end points). */
-            TEST_ASSERT_TRUE_MESSAGE(rms <= sigmas[si] + 0.001, "curve RMS to true walls too large");
-            TEST_ASSERT_TRUE_MESSAGE(max_d <= 4.0 * sigmas[si] + 0.01, "curve strays from the walls");
+        for (pi = 0; pi < 3u; ++pi) {
+            for (si = 0; si < 3u; ++si) {
+                const bsf_lidar_t l = make_lidar(poses[pi][0], poses[pi][1], poses[pi][2],
+                                                 sigmas[si]);
+                const double target = (double)bsf_params_default(methods[mi]).pdm.target_rms;
+                double rms, max_d;
+                build_office();
+                extract_with(methods[mi], &l, 11u + si);
+                curve_to_truth(&l, &rms, &max_d);
+                if (methods[mi] == BSF_METHOD_RPOS_LSBA) {
+                    /* RPOS cuts at every corner, so each curve spans one wall
+                     * and the fit averages the noise away: within sigma of the
+                     * walls in RMS, worst sample within 3 sigma. RPOS keeps a
+                     * corner point with the wall before it, which bends a curve
+                     * end by up to about 1 cm: +2 mm RMS, +1.5 cm worst. */
+                    TEST_ASSERT_TRUE_MESSAGE(rms <= sigmas[si] + 0.002, "LSBA curve RMS too large");
+                    TEST_ASSERT_TRUE_MESSAGE(max_d <= 3.0 * sigmas[si] + 0.015,
+                                             "LSBA curve strays from the walls");
+                } else {
+                    /* PDM refines each fragment to target_rms against the
+                     * points; a corner FALKO misses is rounded within that
+                     * budget. So the curve stays within target_rms + sigma of
+                     * the true walls in RMS. */
+                    TEST_ASSERT_TRUE_MESSAGE(rms <= target + sigmas[si], "PDM curve RMS too large");
+                }
+            }
         }
     }
 }
