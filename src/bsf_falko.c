@@ -70,79 +70,125 @@ static float neigh_radius(const bsf_falko_params_t *p, float rho)
     return (r >= rho) ? 0.8f * rho : r;
 }
 
-/* What pass 1 over a neighbourhood learns (steps 3, 4 and 6). */
+/* The disc of radius r around an apex c, with the squared-distance band
+ * outside which the test sqrtf(d2) <= r is decided without sqrtf: below
+ * lo it is certainly true, above hi certainly false (the band is wider than
+ * the rounding of sqrtf and of r * r), so results equal the sqrtf test. */
 typedef struct {
-    size_t beg, end;   /* beam window, inclusive, clamped to the scan */
-    int n_left;        /* kept neighbours before the apex */
-    int n_right;       /* kept neighbours after the apex */
-    size_t first;      /* first kept beam */
-    size_t last;       /* last kept beam */
+    bsf_point_t c;
+    float r;
+    float lo;
+    float hi;
+} ball_t;
+
+static ball_t make_ball(bsf_point_t c, float r)
+{
+    ball_t b;
+    const float r2 = r * r;
+    b.c = c;
+    b.r = r;
+    b.lo = r2 * (1.0f - 1e-6f);
+    b.hi = r2 * (1.0f + 1e-6f);
+    return b;
+}
+
+/* Is beam j a neighbour: valid and within distance r of the apex (step 3)? */
+static int in_ball(const bsf_points_t *pts, size_t j, const ball_t *b)
+{
+    float dx, dy, d2;
+    if (!pts->valid[j]) {
+        return 0;
+    }
+    dx = b->c.x - pts->pt[j].x;
+    dy = b->c.y - pts->pt[j].y;
+    d2 = dx * dx + dy * dy;
+    if (d2 <= b->lo) {
+        return 1;
+    }
+    if (d2 > b->hi) {
+        return 0;
+    }
+    return sqrtf(d2) <= b->r;
+}
+
+/* A neighbourhood (steps 3, 4 and 6). */
+typedef struct {
+    size_t beg, end; /* beam window, inclusive, clamped to the scan */
+    size_t first;    /* first kept beam (left of the apex) */
+    size_t last;     /* last kept beam (right of the apex) */
+    int n_left;      /* kept neighbours before the apex */
+    int n_right;     /* kept neighbours after the apex */
     float sum_lx, sum_ly, sum_rx, sum_ry; /* sums of p - p_apex per side */
 } neigh_t;
 
-/* Beam window [i - alpha, i + alpha + 1] (the reference's one extra beam on
- * the right, clamped to the scan instead of read past its end). */
-static void neigh_window(const bsf_points_t *pts, size_t i, float r, float inc, neigh_t *nb)
+/* Beam window [i - alpha, i + alpha + 1], alpha = floor(asin(r / rho) / inc)
+ * (the reference's one extra beam on the right, clamped to the scan instead
+ * of read past its end). Any larger window gives the same neighbours: a beam
+ * at angle phi from the apex is at least rho sin(phi) > r away when
+ * phi > asin(r / rho). So alpha comes from a bound that costs one division,
+ * asin(s) <= s / sqrt(1 - s^2) <= s / (1 - s^2) = r rho / (rho^2 - r^2)
+ * (r <= 0.8 rho keeps the denominator positive), with a rounding margin. */
+static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
 {
-    const float a = floorf(asinf(r / pts->range[i]) / inc);
-    size_t alpha = (a > 0.0f) ? (size_t)a : 0u;
-    if (alpha > pts->count) {
-        alpha = pts->count;
-    }
+    const float rho = pts->range[i];
+    const float a = r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
+    /* a >= 0; BSF_MAX_POINTS fits int, and int conversion is one instruction */
+    return (a < (float)BSF_MAX_POINTS) ? (size_t)(int)a : (size_t)BSF_MAX_POINTS;
+}
+
+static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, neigh_t *nb)
+{
     nb->beg = (i >= alpha) ? i - alpha : 0u;
     nb->end = (i + alpha + 1u < pts->count) ? i + alpha + 1u : pts->count - 1u;
 }
 
-static int is_neighbour(const bsf_points_t *pts, size_t j, bsf_point_t c, float r)
+/* The outermost neighbours on each side; 0 when a side has none. */
+static int find_ends(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t *nb)
 {
-    float dx, dy;
-    if (!pts->valid[j]) {
+    size_t j = nb->beg;
+    while (j < i && !in_ball(pts, j, b)) {
+        ++j;
+    }
+    if (j == i) {
         return 0;
     }
-    dx = c.x - pts->pt[j].x;
-    dy = c.y - pts->pt[j].y;
-    return sqrtf(dx * dx + dy * dy) <= r;
+    nb->first = j;
+    j = nb->end;
+    while (j > i && !in_ball(pts, j, b)) {
+        --j;
+    }
+    if (j == i) {
+        return 0;
+    }
+    nb->last = j;
+    return 1;
 }
 
-/* Pass 1 over the left side only; returns 0 when it already fails step 4. */
-static int scan_left(const bsf_points_t *pts, size_t i, float r, int min_pts, neigh_t *nb)
+/* Counts and sums of both sides, between the ends found by find_ends. */
+static void count_sides(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t *nb)
 {
-    const bsf_point_t c = pts->pt[i];
+    const bsf_point_t c = b->c;
     size_t j;
     nb->n_left = 0;
-    nb->first = i;
+    nb->n_right = 0;
     nb->sum_lx = 0.0f;
     nb->sum_ly = 0.0f;
-    for (j = nb->beg; j < i; ++j) {
-        if (is_neighbour(pts, j, c, r)) {
-            if (nb->n_left == 0) {
-                nb->first = j;
-            }
+    nb->sum_rx = 0.0f;
+    nb->sum_ry = 0.0f;
+    for (j = nb->first; j < i; ++j) {
+        if (in_ball(pts, j, b)) {
             ++nb->n_left;
             nb->sum_lx += pts->pt[j].x - c.x;
             nb->sum_ly += pts->pt[j].y - c.y;
         }
     }
-    return nb->n_left >= min_pts;
-}
-
-static int scan_right(const bsf_points_t *pts, size_t i, float r, int min_pts, neigh_t *nb)
-{
-    const bsf_point_t c = pts->pt[i];
-    size_t j;
-    nb->n_right = 0;
-    nb->last = i;
-    nb->sum_rx = 0.0f;
-    nb->sum_ry = 0.0f;
-    for (j = i + 1u; j <= nb->end; ++j) {
-        if (is_neighbour(pts, j, c, r)) {
-            nb->last = j;
+    for (j = i + 1u; j <= nb->last; ++j) {
+        if (in_ball(pts, j, b)) {
             ++nb->n_right;
             nb->sum_rx += pts->pt[j].x - c.x;
             nb->sum_ry += pts->pt[j].y - c.y;
         }
     }
-    return nb->n_right >= min_pts;
 }
 
 /* Step 5: the triangle apex - first - last must be wide and tall enough. */
@@ -165,6 +211,21 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
     return !(fabsf(area2) / base < lim);
 }
 
+/* Steps 3-5 and the sums of step 6 for apex i; 0 when rejected. All
+ * rejections are alike, so the cheap ends-and-triangle test runs first and
+ * the full count only for its survivors. */
+static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alpha,
+                         const bsf_falko_params_t *p, neigh_t *nb)
+{
+    const ball_t b = make_ball(pts->pt[i], r);
+    neigh_window(pts, i, alpha, nb);
+    if (!find_ends(pts, i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
+        return 0;
+    }
+    count_sides(pts, i, &b, nb);
+    return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
+}
+
 /* Step 6: orientation of the corner (mean left vector + mean right vector). */
 static float corner_orientation(const neigh_t *nb)
 {
@@ -182,7 +243,12 @@ static int sector_of(bsf_point_t q, bsf_point_t c, float theta, float sector_wid
     } else if (ang <= -FALKO_PI) {
         ang = -FALKO_ANGLE_LIMIT;
     }
-    return (int)floorf((ang + FALKO_PI - theta) / sector_width);
+    {
+        /* floor without a library call: |x| < 2 pi / sector_width + 1 */
+        const float x = (ang + FALKO_PI - theta) / sector_width;
+        const int k = (int)x;
+        return ((float)k > x) ? k - 1 : k;
+    }
 }
 
 /* Step 8: FALKOLib's sector distance (truncating %), or the true circular one. */
@@ -205,7 +271,8 @@ static int sector_distance(int a, int b, int sectors, int circular)
 static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r,
                          float theta, const bsf_falko_params_t *p, int8_t *sector)
 {
-    const bsf_point_t c = pts->pt[i];
+    const ball_t ball = make_ball(pts->pt[i], r);
+    const bsf_point_t c = ball.c;
     const float width = 2.0f * FALKO_PI / (float)p->grid_sectors;
     const int nl = nb->n_left;
     const int nr = nb->n_right;
@@ -215,8 +282,8 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
     size_t j;
 
     /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
-    for (j = nb->beg; j <= nb->end; ++j) {
-        if (j != i && is_neighbour(pts, j, c, r)) {
+    for (j = nb->first; j <= nb->last; ++j) {
+        if (j != i && in_ball(pts, j, &ball)) {
             sector[k++] = (int8_t)sector_of(pts->pt[j], c, theta, width);
         }
     }
@@ -238,7 +305,7 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
 
 /* Total-least-squares line through beams [from, to] that are neighbours of
  * apex c: unit normal n and offset d with n . x = d. */
-static void fit_line(const bsf_points_t *pts, size_t from, size_t to, bsf_point_t c, float r,
+static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball_t *ball,
                      float *nx, float *ny, float *d)
 {
     float sx = 0.0f, sy = 0.0f, sxx = 0.0f, syy = 0.0f, sxy = 0.0f;
@@ -246,7 +313,7 @@ static void fit_line(const bsf_points_t *pts, size_t from, size_t to, bsf_point_
     int n = 0;
     size_t j;
     for (j = from; j <= to; ++j) {
-        if (is_neighbour(pts, j, c, r)) {
+        if (in_ball(pts, j, ball)) {
             sx += pts->pt[j].x;
             sy += pts->pt[j].y;
             ++n;
@@ -256,7 +323,7 @@ static void fit_line(const bsf_points_t *pts, size_t from, size_t to, bsf_point_
     my = sy / (float)n;
     /* Centred moments: no cancellation in float. */
     for (j = from; j <= to; ++j) {
-        if (is_neighbour(pts, j, c, r)) {
+        if (in_ball(pts, j, ball)) {
             const float dx = pts->pt[j].x - mx;
             const float dy = pts->pt[j].y - my;
             sxx += dx * dx;
@@ -274,11 +341,12 @@ static void fit_line(const bsf_points_t *pts, size_t from, size_t to, bsf_point_
 /* Step 11: intersect the lines fitted to each side (apex in both). */
 static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r)
 {
-    const bsf_point_t c = pts->pt[i];
+    const ball_t ball = make_ball(pts->pt[i], r);
+    const bsf_point_t c = ball.c;
     float n1x, n1y, d1, n2x, n2y, d2, det;
     bsf_point_t q;
-    fit_line(pts, nb->beg, i, c, r, &n1x, &n1y, &d1);
-    fit_line(pts, i, nb->end, c, r, &n2x, &n2y, &d2);
+    fit_line(pts, nb->first, i, &ball, &n1x, &n1y, &d1);
+    fit_line(pts, i, nb->last, &ball, &n2x, &n2y, &d2);
     det = n1x * n2y - n1y * n2x;
     if (fabsf(det) < 1e-7f) {
         return c;
@@ -292,22 +360,21 @@ static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh
     return q;
 }
 
-/* Steps 1-9 for beam i: its raw score, or FALKO_REJECTED. */
-static float beam_score(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p, float inc,
-                        int8_t *sector)
+/* Is beam i an apex candidate at all (step 1)? */
+static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p)
 {
     const float rho = pts->range[i];
-    float r, theta;
-    neigh_t nb;
+    return pts->valid[i] && rho >= p->min_range && rho <= p->max_range;
+}
 
-    if (!pts->valid[i] || !(rho >= p->min_range && rho <= p->max_range)) {
-        return FALKO_REJECTED;
-    }
-    r = neigh_radius(p, rho);
-    neigh_window(pts, i, r, inc, &nb);
-    if (!scan_left(pts, i, r, p->neigh_min_points, &nb) ||
-        !scan_right(pts, i, r, p->neigh_min_points, &nb) ||
-        !triangle_ok(pts, i, &nb, r, p->b_ratio)) {
+/* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
+ * FALKO_REJECTED. */
+static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha,
+                        const bsf_falko_params_t *p, int8_t *sector)
+{
+    float theta;
+    neigh_t nb;
+    if (!neighbourhood(pts, i, r, alpha, p, &nb)) {
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
@@ -343,8 +410,23 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         return BSF_ERR_ARG;
     }
 
+    /* Radius and window of every apex first, in a loop without hard branches
+     * (the exp, division and conversion latencies of successive beams
+     * overlap): r in score[], alpha in peak[]; 0 marks a beam that is no apex. */
     for (i = 0; i < pts->count; ++i) {
-        const float s = beam_score(pts, i, p, inc, work->sector);
+        float r = 0.0f;
+        size_t alpha = 0;
+        if (in_extraction_range(pts, i, p)) {
+            r = neigh_radius(p, pts->range[i]);
+            alpha = window_alpha(pts, i, r, 1.0f / inc);
+        }
+        work->score[i] = r;
+        work->peak[i] = (uint16_t)alpha;
+    }
+    for (i = 0; i < pts->count; ++i) {
+        const float r = work->score[i];
+        const float s = (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], p, work->sector)
+                                   : FALKO_REJECTED;
         work->score[i] = s;
         if (s > (float)score_max) {
             if (s > (float)FALKO_SCORE_LIMIT) {
@@ -373,9 +455,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        neigh_window(pts, b, r, inc, &nb);
-        (void)scan_left(pts, b, r, p->neigh_min_points, &nb);
-        (void)scan_right(pts, b, r, p->neigh_min_points, &nb);
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, 1.0f / inc), p,
+                            &nb); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);
         out[k].radius = r;

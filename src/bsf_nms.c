@@ -5,44 +5,67 @@
 /* asin(0.8): the reference's window angle when the radius reaches the range. */
 #define BSF_ASIN_0_8 0.927295218f
 
-/* far_ratio: below this radius/range ratio the window is certainly 0. */
-static size_t half_window(const bsf_points_t *pts, size_t i, float radius, float inc,
-                          float far_ratio)
-{
-    float w;
+/* What every window of one scan shares. */
+typedef struct {
+    float radius;    /* suppression radius, metres */
+    float inc;       /* |angle increment|, radians */
+    float inv_inc;   /* 1 / inc */
+    float far_ratio; /* radius / range below this: window certainly 0 */
+    size_t close;    /* window when radius >= range: floor(asin(0.8) / inc) */
+} window_ctx_t;
 
-    if (!pts->valid[i]) {
-        return 0u;
-    }
-    if (radius >= pts->range[i]) {
-        w = floorf(BSF_ASIN_0_8 / inc);
-    } else {
-        const float s = radius / pts->range[i];
-        if (s < far_ratio) {
-            return 0u;
-        }
-        w = floorf(asinf(s) / inc);
-    }
+/* floor(w) for w >= 0 (truncation; floorf may be a library call), clamped. */
+static size_t clamp_window(float w)
+{
     if (!(w >= 0.0f)) {
         return 0u;
     }
-    if (w > (float)BSF_MAX_POINTS) {
-        return (size_t)BSF_MAX_POINTS;
-    }
-    return (size_t)w;
+    /* BSF_MAX_POINTS fits int (and uint16_t); int conversion is one instruction */
+    return (w > (float)BSF_MAX_POINTS) ? (size_t)BSF_MAX_POINTS : (size_t)(int)w;
 }
 
-/* asin(s) < inc, hence window 0, whenever s < sin(inc): a margin below that
- * lets far beams (most of them) skip asinf without changing any window. */
-static float far_ratio_of(float inc)
+static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
 {
-    return sinf(inc) * 0.999f;
+    window_ctx_t c;
+    c.radius = radius;
+    c.inc = fabsf(pts->angle_increment);
+    c.inv_inc = 1.0f / c.inc;
+    /* asin(s) < inc, hence window 0, whenever s < sin(inc); the margin keeps
+     * rounding on the safe side. */
+    c.far_ratio = sinf(c.inc) * 0.999f;
+    c.close = clamp_window(BSF_ASIN_0_8 / c.inc);
+    return c;
+}
+
+/* floor(asin(s) / inc) for s = radius / range. asin(s) lies between s and
+ * s / sqrt(1 - s^2); when both bounds (widened by a rounding margin) floor to
+ * the same integer, that is the window and asinf is not needed. */
+static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t *c)
+{
+    float s;
+    size_t lo, hi;
+    if (!pts->valid[i]) {
+        return 0u;
+    }
+    if (c->radius >= pts->range[i]) {
+        return c->close;
+    }
+    if (c->radius < c->far_ratio * pts->range[i]) {
+        return 0u;
+    }
+    s = c->radius / pts->range[i];
+    lo = clamp_window(s * c->inv_inc * (1.0f - 1e-5f));
+    hi = clamp_window(s / sqrtf(1.0f - s * s) * c->inv_inc * (1.0f + 1e-5f));
+    if (lo == hi) {
+        return lo;
+    }
+    return clamp_window(asinf(s) / c->inc);
 }
 
 size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius)
 {
-    const float inc = fabsf(pts->angle_increment);
-    return half_window(pts, i, radius, inc, far_ratio_of(inc));
+    const window_ctx_t c = window_ctx(pts, radius);
+    return half_window(pts, i, &c);
 }
 
 size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_t order,
@@ -53,17 +76,42 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
     const float sign = (order == BSF_NMS_LOWER_IS_BETTER) ? -1.0f : 1.0f;
     const size_t n = pts->count;
     const float min_val = sign * threshold;
-    const float inc = fabsf(pts->angle_increment);
-    const float far_ratio = far_ratio_of(inc);
+    const window_ctx_t ctx = window_ctx(pts, radius);
     size_t n_cand = 0;
     size_t i = 0;
     size_t imax = 0;
+    size_t run_end = 0; /* end (exclusive) of the run of equal scores from i */
     size_t k, i2, n_peak, run;
 
+    /* All windows first, in a loop whose latencies overlap, into peak[]:
+     * the candidate list written below stays at or behind the beam being
+     * read (n_cand <= i), so one array serves both. */
+    for (i = 0; i < n; ++i) {
+        peak[i] = (uint16_t)half_window(pts, i, &ctx);
+    }
+    i = 0;
     while (i < n) {
-        const size_t win = half_window(pts, i, radius, inc, far_ratio);
+        const size_t win = peak[i];
         size_t j, jbeg, jend;
         size_t jmax = i;
+
+        /* Fast path, same outcome as the general step below: the previous
+         * beam is the running maximum, and the whole window [i, i + win]
+         * holds its score, which does not pass the threshold. Then nothing
+         * beats beam i, it becomes imax, is no candidate, and i moves on.
+         * Most beams of a scan (rejected ones) go this way. */
+        if (run_end <= i) {
+            run_end = i + 1u;
+            while (run_end < n && score[run_end] == score[i]) {
+                ++run_end;
+            }
+        }
+        if (i > 0u && imax == i - 1u && score[imax] == score[i] && i + win < run_end &&
+            !(sign * score[i] > min_val)) {
+            imax = i;
+            ++i;
+            continue;
+        }
 
         /* Search the left part of the window only when the running maximum
          * imax lies outside it; otherwise it has already been seen. */

@@ -50,7 +50,7 @@ bsf_status_t bsf_rpos_params_check(const bsf_rpos_params_t *p)
         return BSF_ERR_ARG;
     }
     if (!(p->alpha_max > 0.0f) || !(p->alpha_max <= BSF_SEG_PI_F) || !is_finite_f(p->eta) ||
-        !(p->eta >= 1.0f) || !min_points_ok(p->min_segment_points)) {
+        !(p->eta >= 1.0f) || !(p->eta <= 1e6f) || !min_points_ok(p->min_segment_points)) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -86,8 +86,8 @@ static int sink_close(seg_sink_t *sink, size_t first, size_t last, size_t n_poin
 }
 
 /* Common argument checks of both segmenters; on success fills the sink. */
-static bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out, size_t cap,
-                          size_t *n_out, size_t *n_wasted_points, seg_sink_t *sink)
+static bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out, size_t cap, size_t *n_out,
+                          size_t *n_wasted_points, seg_sink_t *sink)
 {
     if (n_out != NULL) {
         *n_out = 0;
@@ -115,6 +115,12 @@ static bsf_status_t finish(const seg_sink_t *sink, size_t *n_out, size_t *n_wast
         *n_wasted_points = sink->n_wasted;
     }
     return BSF_OK;
+}
+
+/* 1 + x + x^2/2 + x^3/6 + x^4/24: a lower bound of exp(x) for x >= 0. */
+static float exp_lower_bound(float x)
+{
+    return 1.0f + x * (1.0f + x * (0.5f + x * (0.16666667f + x * 0.041666668f)));
 }
 
 bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *params,
@@ -146,32 +152,44 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
     a2 = p->a * p->a;
     two_b = 2.0f * p->b;
 
-    for (i = 0; i < pts->count; ++i) {
+    /* The first valid point opens the first segment; then one pass. */
+    for (i = 0; i < pts->count && !pts->valid[i]; ++i) {
+    }
+    if (i == pts->count) {
+        return finish(&sink, n_out, n_wasted_points);
+    }
+    first = i;
+    last = i;
+    prev = pts->pt[i];
+    n_cur = 1;
+    for (++i; i < pts->count; ++i) {
         const bsf_point_t q = pts->pt[i];
+        float dx;
+        float dy;
+        float d2;
         if (!pts->valid[i]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
-        if (n_cur > 0u) {
-            const float dx = q.x - prev.x;
-            const float dy = q.y - prev.y;
-            const float d2 = dx * dx + dy * dy;
-            /* r(rho) >= a for b >= 0, so the exponential is only needed for
-             * steps longer than a: rare on a wall, hence cheap. NaN breaks. */
-            if (!(d2 <= a2) && !(d2 <= a2 * expf(two_b * pts->range[i]))) {
-                if (!sink_close(&sink, first, last, n_cur)) {
-                    return BSF_ERR_CAPACITY;
-                }
-                n_cur = 0;
+        dx = q.x - prev.x;
+        dy = q.y - prev.y;
+        d2 = dx * dx + dy * dy;
+        /* Decide without expf where possible: r(rho) >= a, and the Taylor
+         * polynomial of exp to degree 4 never exceeds exp for x >= 0, so
+         * steps within a^2 * poly(x) join. expf is left for the few steps
+         * near or beyond the threshold. NaN breaks. */
+        if (!(d2 <= a2) && !(d2 <= a2 * exp_lower_bound(two_b * pts->range[i])) &&
+            !(d2 <= a2 * expf(two_b * pts->range[i]))) {
+            if (!sink_close(&sink, first, last, n_cur)) {
+                return BSF_ERR_CAPACITY;
             }
-        }
-        if (n_cur == 0u) {
             first = i;
+            n_cur = 0;
         }
         ++n_cur;
         last = i;
         prev = q;
     }
-    if (n_cur > 0u && !sink_close(&sink, first, last, n_cur)) {
+    if (!sink_close(&sink, first, last, n_cur)) {
         return BSF_ERR_CAPACITY;
     }
     return finish(&sink, n_out, n_wasted_points);
@@ -182,9 +200,9 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
 static int turn_ok(float dot, float uu_vv, float cos_max, float cos_max2)
 {
     if (cos_max >= 0.0f) {
-        return dot >= 0.0f && dot * dot >= cos_max2 * uu_vv;
+        return (dot >= 0.0f) & (dot * dot >= cos_max2 * uu_vv);
     }
-    return dot >= 0.0f || dot * dot <= cos_max2 * uu_vv;
+    return (dot >= 0.0f) | (dot * dot <= cos_max2 * uu_vv);
 }
 
 bsf_status_t bsf_segment_rpos(const bsf_points_t *pts, const bsf_rpos_params_t *params,
@@ -220,32 +238,40 @@ bsf_status_t bsf_segment_rpos(const bsf_points_t *pts, const bsf_rpos_params_t *
     cos_max2 = cos_max * cos_max;
     eta2 = p->eta * p->eta;
 
-    for (i = 0; i < pts->count; ++i) {
+    /* The first valid point opens the first segment; then one pass. */
+    for (i = 0; i < pts->count && !pts->valid[i]; ++i) {
+    }
+    if (i == pts->count) {
+        return finish(&sink, n_out, n_wasted_points);
+    }
+    first = i;
+    last = i;
+    prev = pts->pt[i];
+    n_cur = 1;
+    for (++i; i < pts->count; ++i) {
         const bsf_point_t q = pts->pt[i];
         float vx;
         float vy;
         float vv;
+        float dot;
+        int spacing_ok;
         if (!pts->valid[i]) {
             continue; /* RPOS works on consecutive valid points */
         }
         vx = q.x - prev.x;
         vy = q.y - prev.y;
         vv = vx * vx + vy * vy;
-        if (n_cur >= 2u) {
-            const float dot = ux * vx + uy * vy;
-            const float lo = uu < vv ? uu : vv;
-            const float hi = uu < vv ? vv : uu;
-            /* max(p_i, p_i+1) <= eta * min(p_i, p_i+1), squared. NaN fails. */
-            const int spacing_ok = hi <= eta2 * lo;
-            if (!spacing_ok || !turn_ok(dot, uu * vv, cos_max, cos_max2)) {
-                if (!sink_close(&sink, first, last, n_cur)) {
-                    return BSF_ERR_CAPACITY;
-                }
-                n_cur = 0;
+        dot = ux * vx + uy * vy;
+        /* max(p_i, p_i+1) <= eta * min(p_i, p_i+1), squared, as two
+         * comparisons joined by & (no data-dependent branch). NaN fails.
+         * A one-point segment takes its second point unconditionally. */
+        spacing_ok = (uu <= eta2 * vv) & (vv <= eta2 * uu);
+        if (n_cur >= 2u && !(spacing_ok & turn_ok(dot, uu * vv, cos_max, cos_max2))) {
+            if (!sink_close(&sink, first, last, n_cur)) {
+                return BSF_ERR_CAPACITY;
             }
-        }
-        if (n_cur == 0u) {
             first = i;
+            n_cur = 0;
         } else {
             ux = vx;
             uy = vy;
@@ -255,7 +281,7 @@ bsf_status_t bsf_segment_rpos(const bsf_points_t *pts, const bsf_rpos_params_t *
         last = i;
         prev = q;
     }
-    if (n_cur > 0u && !sink_close(&sink, first, last, n_cur)) {
+    if (!sink_close(&sink, first, last, n_cur)) {
         return BSF_ERR_CAPACITY;
     }
     return finish(&sink, n_out, n_wasted_points);
@@ -335,9 +361,9 @@ bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_point
         size_t w1 = 0;
         /* Inner interest points lie strictly between the second valid point
          * (v1) and the last-but-one valid point (w1). */
-        if (next_valid(pts, first, last, &v0) && v0 < last &&
-            next_valid(pts, v0 + 1u, last, &v1) && prev_valid(pts, first, last, &w0) &&
-            w0 > first && prev_valid(pts, first, w0 - 1u, &w1) && v1 < w1) {
+        if (next_valid(pts, first, last, &v0) && v0 < last && next_valid(pts, v0 + 1u, last, &v1) &&
+            prev_valid(pts, first, last, &w0) && w0 > first &&
+            prev_valid(pts, first, w0 - 1u, &w1) && v1 < w1) {
             size_t j = upper_bound(interest_beams, n_interest, v1);
             for (; j < n_interest && (size_t)interest_beams[j] < w1; ++j) {
                 if (pts->valid[interest_beams[j]]) {

@@ -78,19 +78,20 @@ typedef struct {
 /** Deterministic pseudo-random generator (xorshift64*) with a Gaussian cache. */
 typedef struct {
     uint64_t state;
-    double spare;   /**< second Box-Muller value, used when has_spare */
+    double spare; /**< second Box-Muller value, used when has_spare */
     int has_spare;
 } bsf_scene_rng_t;
 
 /** A true corner: two segments of the scene sharing an endpoint. */
 typedef struct {
-    double x, y;     /**< vertex in the sensor frame, metres */
-    double wx, wy;   /**< vertex in the world frame, metres */
-    double range;    /**< distance from the sensor, metres */
-    double bearing;  /**< direction in the sensor frame, radians, in [-pi, pi] */
-    double angle;    /**< angle between the two walls at the vertex, radians, (0, pi) */
-    int beam;        /**< nearest beam index, -1 when outside the field of view */
-    int visible;     /**< 1 when in the field of view, within range_max and not occluded */
+    double x, y;      /**< vertex in the sensor frame, metres */
+    double wx, wy;    /**< vertex in the world frame, metres */
+    double range;     /**< distance from the sensor, metres */
+    double bearing;   /**< direction in the sensor frame, radians, in [-pi, pi] */
+    double angle;     /**< angle between the two walls at the vertex, radians, (0, pi) */
+    int beam;         /**< nearest beam index, -1 when outside the field of view */
+    int visible;      /**< 1 when in the field of view, within range_max, not occluded,
+                           and both walls are seen next to the vertex (else a jump edge) */
     uint16_t shape_a; /**< index of the first segment */
     uint16_t shape_b; /**< index of the second segment */
 } bsf_scene_corner_t;

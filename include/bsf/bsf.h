@@ -18,5 +18,6 @@
 #include "bsf_fit.h"
 #include "bsf_bid.h"
 #include "bsf_extract.h"
+#include "bsf_stream.h"
 
 #endif /* BSF_H */

@@ -46,7 +46,7 @@ typedef struct {
 /** RPOS parameters. */
 typedef struct {
     float alpha_max;             /**< largest turn between successive steps, radians, (0, pi] */
-    float eta;                   /**< largest ratio of successive spacings, finite, >= 1 */
+    float eta;                   /**< largest ratio of successive spacings, 1..1e6 */
     uint16_t min_segment_points; /**< shortest kept segment, points, 1..BSF_MAX_POINTS */
 } bsf_rpos_params_t;
 
@@ -97,8 +97,11 @@ BSF_NODISCARD bsf_status_t bsf_segment_sved(const bsf_points_t *pts,
                                             size_t cap, size_t *n_out, size_t *n_wasted_points);
 
 /**
- * RPOS segmentation over consecutive VALID points (invalid beams are
- * skipped: they neither break nor join a segment). A segment's first two
+ * RPOS segmentation over consecutive VALID points: invalid beams are
+ * skipped, so across a gap the spacing is the distance between the valid
+ * points on either side (a gap of one beam on a wall doubles the spacing and
+ * therefore breaks by the eta test; SVED is the method that bridges gaps).
+ * A segment's first two
  * points always go together; each further point q[i+1] joins while, at the
  * segment's last point q[i], the turn |alpha_i| between q[i]-q[i-1] and
  * q[i+1]-q[i] is <= alpha_max and max(p_i, p_(i+1)) <= eta * min(p_i, p_(i+1))
@@ -130,8 +133,7 @@ BSF_NODISCARD bsf_status_t bsf_segment_rpos(const bsf_points_t *pts,
  */
 BSF_NODISCARD bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n,
                                                 const bsf_points_t *pts,
-                                                const uint16_t *interest_beams,
-                                                size_t n_interest);
+                                                const uint16_t *interest_beams, size_t n_interest);
 
 #ifdef __cplusplus
 }

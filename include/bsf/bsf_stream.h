@@ -1,0 +1,259 @@
+/*
+ * bsf_stream.h - the serial wire format (docs/FORMAT.md is the normative
+ * spec): one frame per scan, COBS-framed with a 0x00 delimiter and checked
+ * by CRC-32C, so a receiver that loses bytes resynchronises at the next 0x00.
+ *
+ * Encoder: a bsf_result_t plus a bsf_frame_info_t (sequence number,
+ * timestamp, optional pose, quantisation step) become one frame, written to
+ * a caller buffer or handed to a sink callback in chunks of at most 256
+ * bytes. Decoder: bytes fed in arbitrary chunks come out as whole, fully
+ * validated frames; damaged frames are dropped and counted.
+ *
+ * Every byte from the link is untrusted: the decoder checks every field
+ * before a frame is delivered and never writes beyond its fixed buffers.
+ */
+#ifndef BSF_STREAM_H
+#define BSF_STREAM_H
+
+#include "bsf_common.h"
+#include "bsf_feature.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- Format constants ---------------------------------------------------- */
+
+/** Format version written by this encoder (upper nibble of payload byte 0). */
+#define BSF_FORMAT_VERSION 1u
+/** Frame type "features of one scan" (lower nibble of payload byte 0). */
+#define BSF_FRAME_TYPE_FEATURES 1u
+
+/** Quantisation step of control points: unit on the wire is 0.1 mm. */
+#define BSF_QUANT_STEP_UNIT 0.0001f
+/** Smallest and largest quantisation step, metres (wire codes 1..10000). */
+#define BSF_QUANT_STEP_MIN 0.0001f
+#define BSF_QUANT_STEP_MAX 1.0f
+/** Default quantisation step, metres (adds at most 1 mm per coordinate). */
+#define BSF_QUANT_STEP_DEFAULT 0.002f
+/** Largest |coordinate| / step a control point may have (2^23 - 1). */
+#define BSF_QUANT_MAX_STEPS 8388607L
+/** Largest |pose x|, |pose y| that can be sent, metres (int32 millimetres). */
+#define BSF_POSE_XY_MAX 2000000.0f
+/** Largest |pose theta| accepted, radians (wrapped into [-pi, pi) on the wire). */
+#define BSF_POSE_THETA_MAX 25.0f
+/** Largest E_curve that can be sent, metres (wire unit 0.1 mm). */
+#define BSF_E_CURVE_MAX 1000.0f
+
+/* ---- Worst-case sizes (depend only on the caps in bsf_config.h) ---------- */
+
+/** COBS-encoded length of n bytes, worst case (delimiter not included). */
+#define BSF_COBS_MAX_SIZE(n) ((n) + (n) / 254u + 1u)
+
+/** Largest fixed frame header (version/type, flags, seq, time stamp, pose,
+ * step, N, extraction time, feature count), bytes. */
+#define BSF_FRAME_HEADER_MAX_SIZE 42u
+/** Largest per-feature header (descriptor, beams, E_curve, vertex mask), bytes. */
+#define BSF_FRAME_FEATURE_MAX_SIZE 25u
+/** Largest size of one control point on the wire (two 4-byte varints), bytes. */
+#define BSF_FRAME_CTRL_MAX_SIZE 8u
+/** Size of the CRC-32C trailer, bytes. */
+#define BSF_FRAME_CRC_SIZE 4u
+
+/** Largest payload + CRC ("frame body", before COBS), bytes, for the caps. */
+#define BSF_FRAME_BODY_MAX_SIZE                                                                    \
+    (BSF_FRAME_HEADER_MAX_SIZE + BSF_FRAME_FEATURE_MAX_SIZE * (unsigned)BSF_MAX_SEGMENTS +         \
+     BSF_FRAME_CTRL_MAX_SIZE * (unsigned)BSF_MAX_CTRL_POINTS + BSF_FRAME_CRC_SIZE)
+
+/** Largest encoded frame on the wire (COBS body + 0x00 delimiter), bytes. */
+#define BSF_FRAME_MAX_SIZE (BSF_COBS_MAX_SIZE(BSF_FRAME_BODY_MAX_SIZE) + 1u)
+
+/* ---- Building blocks ----------------------------------------------------- */
+
+/**
+ * CRC-32C (Castagnoli): reflected polynomial 0x82F63B78, init 0xFFFFFFFF,
+ * reflected in and out, xor-out 0xFFFFFFFF; check value of "123456789" is
+ * 0xE3069283. Start with crc = 0 and pass each result back in to continue
+ * over several pieces. data may be NULL only when len is 0.
+ *
+ * @return the CRC of everything processed so far.
+ */
+uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len);
+
+/**
+ * COBS-encode len bytes (no delimiter is appended).
+ *
+ * @param out      destination, cap bytes; must not overlap in.
+ * @param out_len  receives the encoded length (at most BSF_COBS_MAX_SIZE(len)).
+ * @return BSF_OK; BSF_ERR_ARG when in (with len > 0), out or out_len is NULL;
+ *         BSF_ERR_BUFFER when cap is too small (*out_len is then the size needed).
+ */
+BSF_NODISCARD bsf_status_t bsf_cobs_encode(const uint8_t *in, size_t len, uint8_t *out, size_t cap,
+                                           size_t *out_len);
+
+/**
+ * Decode one COBS block sequence (without its 0x00 delimiter).
+ *
+ * @return BSF_OK; BSF_ERR_ARG for NULL pointers; BSF_ERR_FORMAT when the
+ *         input holds a 0x00 or ends inside a block; BSF_ERR_BUFFER when the
+ *         decoded data exceed cap. Decoded length is at most len - 1.
+ */
+BSF_NODISCARD bsf_status_t bsf_cobs_decode(const uint8_t *in, size_t len, uint8_t *out, size_t cap,
+                                           size_t *out_len);
+
+/* ---- Encoder -------------------------------------------------------------- */
+
+/** What a frame carries besides the features. */
+typedef struct {
+    uint32_t seq;          /**< sequence number (wraps), for loss detection */
+    uint64_t timestamp_ms; /**< scan time, milliseconds since the sender's epoch */
+    uint8_t has_pose;      /**< 1: pose_* are sent (laser pose in the world frame) */
+    float pose_x;          /**< metres, |x| <= BSF_POSE_XY_MAX, sent in 1 mm units */
+    float pose_y;          /**< metres, |y| <= BSF_POSE_XY_MAX, sent in 1 mm units */
+    float pose_theta;      /**< radians, |theta| <= BSF_POSE_THETA_MAX, sent in 2*pi/65536 units */
+    float quant_step;      /**< control point step, metres, [BSF_QUANT_STEP_MIN, _MAX],
+                                rounded to 0.1 mm */
+} bsf_frame_info_t;
+
+/** Fill info with zeros, no pose and quant_step = BSF_QUANT_STEP_DEFAULT. */
+void bsf_frame_info_init(bsf_frame_info_t *info);
+
+/**
+ * Encode one scan's result into a complete frame: COBS(payload || CRC) || 0x00.
+ * Only the first result->n_features features are read; each one's control
+ * points are result->ctrl[ctrl_first .. ctrl_first + n_ctrl - 1]. A vertex
+ * (two consecutive flagged slots whose values quantise alike) travels once.
+ *
+ * @param buf      destination, or NULL to only compute the size.
+ * @param cap      size of buf in bytes (ignored when buf is NULL).
+ * @param out_len  receives the exact frame size in bytes (also when buf is
+ *                 NULL, and on BSF_ERR_BUFFER: the size needed).
+ * @return BSF_OK; BSF_ERR_ARG when info, result or out_len is NULL, or a value
+ *         cannot be represented: non-finite or out-of-range control point
+ *         (|coordinate| / step > BSF_QUANT_MAX_STEPS), pose, quant_step or
+ *         E_curve; n_ctrl < 3 or > BSF_MAX_CTRL_PER_FEATURE; control points
+ *         outside result->n_ctrl; a flagged vertex slot without an equal
+ *         partner; beams out of order within a feature, >= BSF_MAX_POINTS, or
+ *         n_points > last - first + 1; kind > 1; stats.n_valid >
+ *         BSF_MAX_POINTS or smaller than the points in features;
+ *         BSF_ERR_CAPACITY when n_features > BSF_MAX_SEGMENTS or n_ctrl >
+ *         BSF_MAX_CTRL_POINTS; BSF_ERR_BUFFER when buf is not NULL and cap is
+ *         smaller than the frame (nothing is claimed written). The input is
+ *         fully validated before the first byte is written.
+ */
+BSF_NODISCARD bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info,
+                                            const bsf_result_t *result, uint8_t *buf, size_t cap,
+                                            size_t *out_len);
+
+/**
+ * Receives encoded bytes from bsf_frame_encode_sink(), in order.
+ * @return 0 when the bytes were taken, non-zero to abort the frame.
+ */
+typedef int (*bsf_sink_fn)(void *ctx, const uint8_t *data, size_t len);
+
+/** Working memory of bsf_frame_encode_sink(): one COBS block (no state kept between calls). */
+typedef struct {
+    uint8_t block[256];
+} bsf_encoder_t;
+
+/**
+ * Encode like bsf_frame_encode() but hand the bytes to sink, one COBS block
+ * (at most 256 bytes, the last one ending with the 0x00 delimiter) per call,
+ * so a UART or DMA queue can drain them as they come.
+ *
+ * @param work     caller-owned working memory.
+ * @param written  optional (may be NULL): receives the bytes given to sink.
+ * @return BSF_OK; the same BSF_ERR_ARG / BSF_ERR_CAPACITY as
+ *         bsf_frame_encode() (then sink is never called); BSF_ERR_ARG for a
+ *         NULL work or sink; BSF_ERR_BUFFER when sink returned non-zero: the
+ *         frame was cut short and a receiver drops it (send a 0x00 before the
+ *         next frame so that it does not swallow it).
+ */
+BSF_NODISCARD bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,
+                                                 const bsf_result_t *result, bsf_sink_fn sink,
+                                                 void *ctx, size_t *written);
+
+/* ---- Decoder -------------------------------------------------------------- */
+
+/**
+ * One decoded frame. `result` holds the features as the encoder saw them:
+ * control points dequantised (within half a step of the originals),
+ * vertices expanded to two flagged copies, ctrl_first the running sum of
+ * n_ctrl, E_curve in 0.1 mm steps; result.stats carries n_valid,
+ * n_in_features, n_ctrl, n_features and time_ns (= time_us * 1000), the
+ * other stats are 0 (they do not travel).
+ */
+typedef struct {
+    uint8_t version;       /**< format version (BSF_FORMAT_VERSION) */
+    uint8_t type;          /**< frame type (BSF_FRAME_TYPE_FEATURES) */
+    uint32_t seq;          /**< sequence number */
+    uint64_t timestamp_ms; /**< milliseconds since the sender's epoch */
+    uint8_t has_pose;      /**< 1 when pose_* are valid */
+    float pose_x;          /**< metres (1 mm resolution) */
+    float pose_y;          /**< metres (1 mm resolution) */
+    float pose_theta;      /**< radians in [-pi, pi) (2*pi/65536 resolution) */
+    float quant_step;      /**< metres */
+    uint32_t time_us;      /**< extraction time, microseconds */
+    bsf_result_t result;   /**< features, control points, vertex flags, stats */
+} bsf_frame_t;
+
+/**
+ * Decode one frame body (payload || CRC, i.e. the COBS-decoded bytes between
+ * two delimiters) into out. out is written only when the whole frame is valid.
+ *
+ * @return BSF_OK; BSF_ERR_ARG for NULL pointers; BSF_ERR_CRC when the CRC
+ *         does not match (or len < 5); BSF_ERR_VERSION for a version other
+ *         than BSF_FORMAT_VERSION or an unknown frame type; BSF_ERR_FORMAT for
+ *         any malformed or out-of-range field, non-minimal varint or trailing
+ *         byte; BSF_ERR_CAPACITY when the frame exceeds this build's caps.
+ */
+BSF_NODISCARD bsf_status_t bsf_frame_decode(const uint8_t *body, size_t len, bsf_frame_t *out);
+
+/** Decoder counters; they only grow (wrapping at 2^32) until bsf_decoder_init(). */
+typedef struct {
+    uint32_t frames_ok;           /**< frames delivered */
+    uint32_t bad_crc;             /**< dropped: CRC mismatch or shorter than 5 bytes */
+    uint32_t malformed;           /**< dropped: COBS error, malformed field, over the caps */
+    uint32_t unsupported_version; /**< dropped: version this decoder does not know */
+    uint32_t unknown_type;        /**< skipped: known version, unknown frame type */
+    uint32_t oversize;            /**< dropped: longer than BSF_FRAME_BODY_MAX_SIZE */
+    uint32_t bytes_skipped;       /**< bytes of all dropped frames (delimiters excluded) */
+} bsf_decoder_stats_t;
+
+/** Stream decoder state: the body of the frame being received and counters. */
+typedef struct {
+    uint8_t body[BSF_FRAME_BODY_MAX_SIZE]; /**< COBS-decoded bytes of the current frame */
+    size_t len;                            /**< bytes in body */
+    size_t raw_len;                        /**< wire bytes of the current frame so far */
+    uint32_t crc;                          /**< running CRC-32C over body */
+    uint8_t block_left;                    /**< data bytes left in the current COBS block */
+    uint8_t block_code;                    /**< code of the current block (0: none yet) */
+    uint8_t overflow;                      /**< 1: current frame too long, skipping it */
+    bsf_decoder_stats_t stats;
+} bsf_decoder_t;
+
+/** Reset dec to "between frames" with zero counters. dec must not be NULL. */
+void bsf_decoder_init(bsf_decoder_t *dec);
+
+/**
+ * Feed received bytes. Consumes bytes until a valid frame is complete (it is
+ * then written to *out and 1 is returned) or data is exhausted (0). Call it
+ * again with data + *consumed to continue. Work is O(1) per byte, plus one
+ * parse of the frame (O(frame size)) at its delimiter. The stream start
+ * counts as a frame boundary; a 0x00 always ends a frame, so after garbage
+ * or lost bytes the decoder is back in step at the next delimiter. Empty
+ * frames (0x00 0x00) are ignored. *out is written only for a delivered frame.
+ *
+ * @param consumed receives the number of bytes of data used (<= len).
+ * @return 1 when a frame was delivered into *out, 0 when all of data was
+ *         consumed without completing one, BSF_ERR_ARG for NULL pointers
+ *         (data may be NULL when len is 0).
+ */
+BSF_NODISCARD int bsf_decoder_feed(bsf_decoder_t *dec, const uint8_t *data, size_t len,
+                                   size_t *consumed, bsf_frame_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BSF_STREAM_H */
