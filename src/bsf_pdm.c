@@ -37,9 +37,10 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     p->lambda_per_metre = 1e-6f;
     p->rel_tol = 0.01f;
     p->target_rms = 0.015f;
-    p->max_iterations = 8u;
+    p->max_iterations = 2u;
+    p->refine_iterations = 1u;
     p->max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE;
-    p->footpoint_steps = 2u;
+    p->footpoint_steps = 1u;
     p->refine = 1u;
 }
 
@@ -53,7 +54,8 @@ bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
         !(p->lambda_per_metre >= 0.0f && p->lambda_per_metre <= 1.0f) ||
         !(p->rel_tol > 0.0f && p->rel_tol < 1.0f) ||
         !(p->target_rms > 0.0f && p->target_rms <= BSF_FIT_MAX_COORD) || p->max_iterations < 1u ||
-        p->max_iterations > BSF_PDM_MAX_ITERATIONS || p->max_ctrl < 3u ||
+        p->max_iterations > BSF_PDM_MAX_ITERATIONS || p->refine_iterations < 1u ||
+        p->refine_iterations > BSF_PDM_MAX_ITERATIONS || p->max_ctrl < 3u ||
         p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
         p->footpoint_steps > 8u || p->refine > 1u) {
         return BSF_ERR_PARAM;
@@ -449,13 +451,13 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
  * control points and fragment RMS restored) and ends the solve, so the
  * accepted RMS sequence never increases. */
 static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_params_t *p,
-                            uint32_t *iterations)
+                            size_t max_iterations, uint32_t *iterations)
 {
     float prev = 0.0f;
     size_t it;
 
     w->n_history = 0u;
-    for (it = 0; it < p->max_iterations; ++it) {
+    for (it = 0; it < max_iterations; ++it) {
         bsf_status_t st;
         if (it > 0u) {
             memcpy(w->t_prev, w->t, s->n * sizeof w->t[0]);
@@ -638,7 +640,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     /* The start curve follows the points with known parameters (see
      * init_fit): the first solve needs no projection onto it. */
     assemble(&s, work);
-    st = run_pdm(&s, work, p, &info.iterations);
+    st = run_pdm(&s, work, p, p->max_iterations, &info.iterations);
     if (st != BSF_OK) {
         return st;
     }
@@ -658,7 +660,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
         build_layout(&s, work, t0, t1);
         remap_parameters(&s, work, old_t0, old_t1, t0, t1);
         assemble(&s, work);
-        st = run_pdm(&s, work, p, &info.iterations);
+        st = run_pdm(&s, work, p, p->refine_iterations, &info.iterations);
         if (st != BSF_OK) {
             return st;
         }
@@ -733,7 +735,7 @@ bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
         work->t[i] = acc / length;
     }
     assemble(&s, work);
-    st = run_pdm(&s, work, p, iterations);
+    st = run_pdm(&s, work, p, p->max_iterations, iterations);
     if (st != BSF_OK) {
         return st;
     }
