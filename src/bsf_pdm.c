@@ -245,6 +245,21 @@ static void eval_span(const bsf_point_t *ctrl, size_t n_span, size_t span, float
     e->uuy = 2.0f * (k0 * ay + k2 * by);
 }
 
+/* Only the point and the basis of eval_span (after the last Newton step no
+ * derivative is needed). */
+static void eval_span_point(const bsf_point_t *ctrl, size_t n_span, size_t span, float u,
+                            span_eval_t *e)
+{
+    const bsf_point_t *p = ctrl + span;
+    const float k0 = span == 0u ? 1.0f : 0.5f;
+    const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
+    const float v = 1.0f - u;
+    e->b0 = k0 * v * v;
+    e->b2 = k2 * u * u;
+    e->cx = p[1].x + e->b0 * (p[0].x - p[1].x) + e->b2 * (p[2].x - p[1].x);
+    e->cy = p[1].y + e->b0 * (p[0].y - p[1].y) + e->b2 * (p[2].y - p[1].y);
+}
+
 /* Add one point with basis (b0, 1 - b0 - b2, b2) on `span` to the normal
  * equations. The common case (three distinct unknowns) is written out; a
  * span touching a vertex goes through the general merge. */
@@ -409,7 +424,11 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
                     break;
                 }
                 span_new = span_of(t_new, fs, n_span, &un);
-                eval_span(w->ctrl, n_span, span_new, un, &en);
+                if (step + 1u < n_steps) {
+                    eval_span(w->ctrl, n_span, span_new, un, &en);
+                } else {
+                    eval_span_point(w->ctrl, n_span, span_new, un, &en);
+                }
                 {
                     const float fx = en.cx - q.x;
                     const float fy = en.cy - q.y;
