@@ -121,7 +121,8 @@ typedef struct {
 
 /** Outcome details of one bsf_pdm_fit call. */
 typedef struct {
-    uint32_t iterations;  /**< PDM iterations over all refinement rounds */
+    uint32_t
+        iterations; /**< PDM iterations run over all refinement rounds (an undone one counts) */
     uint32_t refinements; /**< precision control points added by refinement */
     uint32_t loaded;      /**< solves that needed the diagonal-loading retry */
 } bsf_pdm_info_t;
@@ -132,12 +133,20 @@ typedef struct {
  * The stored control polygon is: boundary point, the first fragment's
  * precision points, vertex (twice), the next fragment's precision points,
  * ..., boundary point. Both copies of a vertex are one unknown, so the curve
- * passes through it with a straight span on each side. Iterations alternate
- * a least-squares solve (with bending weight lambda) and a footpoint update,
- * until the RMS improves by less than rel_tol or max_iterations is reached.
+ * passes through it with a straight span on each side. The first solve uses
+ * start parameters from arc length along each fragment (corrected for the
+ * non-uniform speed of straight spans at a vertex). Iterations alternate a
+ * least-squares solve (with bending weight lambda) and a footpoint update
+ * (Newton on the span, clamped to [0, 1], free to move into the neighbouring
+ * span, never accepted when it moves the curve away; the first and last
+ * points keep parameters 0 and 1 so the ends cannot drift past the data),
+ * until the RMS improves by less than rel_tol or max_iterations is reached;
+ * an iteration that raises the RMS (possible through the bending term) is
+ * undone and ends the solve, so the RMS never increases.
  * With refinement, the worst fragment whose RMS exceeds target_rms (and whose
  * cap of one precision point per 4 of its points, and the control-point cap,
- * allow it) receives one more precision point and the fit is warm-started;
+ * allow it) receives one more precision point and the fit is warm-started
+ * (parameters remapped fragment by fragment, refine_iterations iterations);
  * this repeats until every fragment meets the target or none can grow. A
  * result above target_rms is therefore not an error: compare e_curve_out.
  *
@@ -152,8 +161,8 @@ typedef struct {
  * @param is_vertex_out 1 for both copies of a vertex, 0 otherwise; may be NULL
  * @param ctrl_cap      room in ctrl_out (and is_vertex_out)
  * @param n_ctrl_out    number of stored control points out
- * @param e_curve_out   RMS distance of the points to the curve at their footpoints, metres; may be
- * NULL
+ * @param e_curve_out   E_curve: RMS distance of the points to the curve at
+ *                      their footpoints, metres; may be NULL
  * @param info_out      iteration counts; may be NULL
  * @return BSF_OK; BSF_ERR_ARG for NULL required pointers, a non-finite or
  *         too large coordinate, or bad vertex positions; BSF_ERR_PARAM for bad
