@@ -263,32 +263,41 @@ static void eval_span_point(const bsf_point_t *ctrl, size_t n_span, size_t span,
 /* Add one point with basis (b0, 1 - b0 - b2, b2) on `span` to the normal
  * equations. The common case (three distinct unknowns) is written out; a
  * span touching a vertex goes through the general merge. */
-static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2, float px, float py)
+static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2, float px,
+                             float py)
 {
     const uint8_t *unk = &w->unknown_of[span];
+    const size_t a = unk[0];
     const float b1 = 1.0f - b0 - b2;
-    if (unk[0] != unk[1] && unk[1] != unk[2]) {
-        float *r0 = &w->band[(size_t)unk[0] * 3u];
-        float *r1 = r0 + 3;
-        float *r2 = r0 + 6;
+    float *r0 = &w->band[a * 3u];
+    float *rx = &w->rhs_x[a];
+    float *ry = &w->rhs_y[a];
+    if (unk[1] != a && unk[2] != unk[1]) {
+        /* Three distinct unknowns a, a + 1, a + 2 (rows of stride 3). */
         r0[0] += b0 * b0;
-        r1[0] += b1 * b1;
-        r1[1] += b1 * b0;
-        r2[0] += b2 * b2;
-        r2[1] += b2 * b1;
-        r2[2] += b2 * b0;
-        w->rhs_x[unk[0]] += b0 * px;
-        w->rhs_y[unk[0]] += b0 * py;
-        w->rhs_x[unk[1]] += b1 * px;
-        w->rhs_y[unk[1]] += b1 * py;
-        w->rhs_x[unk[2]] += b2 * px;
-        w->rhs_y[unk[2]] += b2 * py;
+        r0[3] += b1 * b1;
+        r0[4] += b1 * b0;
+        r0[6] += b2 * b2;
+        r0[7] += b2 * b1;
+        r0[8] += b2 * b0;
+        rx[0] += b0 * px;
+        ry[0] += b0 * py;
+        rx[1] += b1 * px;
+        ry[1] += b1 * py;
+        rx[2] += b2 * px;
+        ry[2] += b2 * py;
     } else {
-        float b[3];
-        b[0] = b0;
-        b[1] = b1;
-        b[2] = b2;
-        bsf_fit_accumulate(w->band, w->rhs_x, w->rhs_y, unk, b, 1.0f, px, py);
+        /* A span at a vertex: its two copies share one unknown, so the span
+         * touches two unknowns a, a + 1 with summed weights. */
+        const float w0 = unk[1] == a ? b0 + b1 : b0;
+        const float w1 = unk[1] == a ? b2 : b1 + b2;
+        r0[0] += w0 * w0;
+        r0[3] += w1 * w1;
+        r0[4] += w1 * w0;
+        rx[0] += w0 * px;
+        ry[0] += w0 * py;
+        rx[1] += w1 * px;
+        ry[1] += w1 * py;
     }
 }
 
