@@ -906,10 +906,64 @@ static void for_each_curve_sample(const bsf_frame_t *fr, sample_fn fn, void *ctx
     }
 }
 
+/* Curve samples gathered for robust map bounds: a few stray features (a
+ * reflection, a bad pose) must not shrink the whole map to a corner. */
+typedef struct {
+    double *x, *y;
+    size_t n, cap;
+    int oom;
+} samples_t;
+
 static void bounds_sample(void *ctx, int new_curve, double wx, double wy)
 {
+    samples_t *s = (samples_t *)ctx;
     (void)new_curve;
-    bsf_bounds_add((bsf_bounds_t *)ctx, wx, wy);
+    if (s->oom) {
+        return;
+    }
+    if (s->n == s->cap) {
+        const size_t cap = s->cap ? 2u * s->cap : 4096u;
+        double *nx = (double *)realloc(s->x, cap * sizeof *nx);
+        double *ny = nx ? (double *)realloc(s->y, cap * sizeof *ny) : NULL;
+        if (nx != NULL) {
+            s->x = nx;
+        }
+        if (ny == NULL) {
+            s->oom = 1;
+            return;
+        }
+        s->y = ny;
+        s->cap = cap;
+    }
+    s->x[s->n] = wx;
+    s->y[s->n] = wy;
+    s->n++;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a;
+    const double y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Bounds holding the central 99 % of the samples in x and in y, widened by
+ * 5 %; all of them when there are few. */
+static void robust_bounds(samples_t *s, bsf_bounds_t *b)
+{
+    size_t lo, hi;
+    double mx, my;
+    if (s->n == 0) {
+        return;
+    }
+    qsort(s->x, s->n, sizeof *s->x, cmp_double);
+    qsort(s->y, s->n, sizeof *s->y, cmp_double);
+    lo = s->n >= 1000u ? s->n / 200u : 0u;
+    hi = s->n - 1u - lo;
+    mx = 0.05 * (s->x[hi] - s->x[lo]);
+    my = 0.05 * (s->y[hi] - s->y[lo]);
+    bsf_bounds_add(b, s->x[lo] - mx, s->y[lo] - my);
+    bsf_bounds_add(b, s->x[hi] + mx, s->y[hi] + my);
 }
 
 typedef struct {
@@ -1051,12 +1105,23 @@ static int write_map_svg(const char *out_path, const frame_list_t *l, long lo, l
     char legend[160];
 
     bsf_bounds_init(&b);
-    for (i = 0; i < l->n; ++i) {
-        if (in_range(l->frames[i].seq, lo, hi)) {
-            for_each_curve_sample(&l->frames[i], bounds_sample, &b);
+    {
+        samples_t smp;
+        memset(&smp, 0, sizeof smp);
+        for (i = 0; i < l->n; ++i) {
+            if (in_range(l->frames[i].seq, lo, hi)) {
+                for_each_curve_sample(&l->frames[i], bounds_sample, &smp);
+            }
+        }
+        robust_bounds(&smp, &b);
+        free(smp.x);
+        free(smp.y);
+        if (smp.oom) {
+            fail_msg("out of memory");
+            return -1;
         }
     }
-    if (points_log != NULL && draw_log_points(NULL, points_log, lo, hi, l, &b) != 0) {
+    if (b.empty && points_log != NULL && draw_log_points(NULL, points_log, lo, hi, l, &b) != 0) {
         return -1;
     }
     if (scene != NULL) {
