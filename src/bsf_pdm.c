@@ -9,6 +9,16 @@
 #include <string.h>
 
 #define NO_FRAGMENT 0xFFFFu
+/* A fragment whose RMS is above this multiple of target_rms is "far" from
+ * the target: a solve stops after its first iteration (refinement follows
+ * anyway), and refinement grows such fragments by several points at once
+ * and restarts the fit from arc length (design brief section 7, measured on
+ * the four datasets: fewer refits and no warm start stuck on a corner the
+ * vertices miss). */
+#define PDM_FAR_RATIO 2.0f
+/* A warm-started refinement that lowered the refined fragment's RMS by less
+ * than this fraction also tries a restart from arc length. */
+#define PDM_COLD_GAIN 0.1f
 /* Footpoint steps shorter than this fraction of a span are not taken. */
 #define PDM_STEP_EPS 1e-6f
 /* Failed footpoint steps longer than this fraction of a span are halved and
@@ -201,104 +211,105 @@ static void init_fit(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0, c
 }
 
 /* Span of t and its local coordinate (t in [0, 1]). */
-static size_t span_of(float t, float fs, size_t n_span, float *u)
+static inline size_t span_of(float t, float fs, size_t n_span, float *u)
 {
+    /* t is in [0, 1], so x is small and non-negative: a signed conversion
+     * is exact and much cheaper than one to size_t on 64-bit targets. */
     const float x = t * fs;
-    size_t span = (size_t)x;
-    if (span >= n_span) {
-        span = n_span - 1u;
+    int32_t span = (int32_t)x;
+    if (span >= (int32_t)n_span) {
+        span = (int32_t)n_span - 1;
     }
     *u = x - (float)span;
-    return span;
+    return (size_t)span;
 }
 
-/* One span evaluated at u, written around the middle control point:
- * C = P1 + b0 (P0 - P1) + b2 (P2 - P1), with the end-span factors k0, k2
- * (2 on a clamped end, else 1); the u-derivatives follow the same pattern.
- * This is the closed form of the design's Appendix with b1 = 1 - b0 - b2. */
+/* One span's control points written around the middle one: on the span,
+ * C(u) = P1 + b0 (P0 - P1) + b2 (P2 - P1) with b0 = k0 (1 - u)^2 and
+ * b2 = k2 u^2, k0 and k2 being 1 on a clamped end and 1/2 inside. This is the
+ * closed form of the design's Appendix with b1 = 1 - b0 - b2. Points arrive in
+ * scan order, so consecutive ones mostly share a span: the coefficients are
+ * loaded once per span change. */
 typedef struct {
-    float b0, b2;   /* basis of the outer control points (b1 = 1 - b0 - b2) */
-    float cx, cy;   /* curve point */
-    float ux, uy;   /* first u-derivative */
-    float uux, uuy; /* second u-derivative */
-} span_eval_t;
+    size_t span;
+    float k0, k2;
+    float p1x, p1y;
+    float ax, ay;   /* P0 - P1 */
+    float bx, by;   /* P2 - P1 */
+    float uux, uuy; /* second u-derivative (constant on a span) */
+} span_coef_t;
 
-static void eval_span(const bsf_point_t *ctrl, size_t n_span, size_t span, float u, span_eval_t *e)
+static inline void load_span(const bsf_point_t *ctrl, size_t n_span, size_t span, span_coef_t *c)
 {
     const bsf_point_t *p = ctrl + span;
-    const float k0 = span == 0u ? 1.0f : 0.5f;
-    const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
-    const float v = 1.0f - u;
-    const float ax = p[0].x - p[1].x;
-    const float ay = p[0].y - p[1].y;
-    const float bx = p[2].x - p[1].x;
-    const float by = p[2].y - p[1].y;
-    const float d0 = -2.0f * k0 * v;
-    const float d2 = 2.0f * k2 * u;
-    e->b0 = k0 * v * v;
-    e->b2 = k2 * u * u;
-    e->cx = p[1].x + e->b0 * ax + e->b2 * bx;
-    e->cy = p[1].y + e->b0 * ay + e->b2 * by;
-    e->ux = d0 * ax + d2 * bx;
-    e->uy = d0 * ay + d2 * by;
-    e->uux = 2.0f * (k0 * ax + k2 * bx);
-    e->uuy = 2.0f * (k0 * ay + k2 * by);
+    c->span = span;
+    c->k0 = span == 0u ? 1.0f : 0.5f;
+    c->k2 = span + 1u == n_span ? 1.0f : 0.5f;
+    c->p1x = p[1].x;
+    c->p1y = p[1].y;
+    c->ax = p[0].x - p[1].x;
+    c->ay = p[0].y - p[1].y;
+    c->bx = p[2].x - p[1].x;
+    c->by = p[2].y - p[1].y;
+    c->uux = 2.0f * (c->k0 * c->ax + c->k2 * c->bx);
+    c->uuy = 2.0f * (c->k0 * c->ay + c->k2 * c->by);
 }
 
-/* Only the point and the basis of eval_span (after the last Newton step no
- * derivative is needed). */
-static void eval_span_point(const bsf_point_t *ctrl, size_t n_span, size_t span, float u,
-                            span_eval_t *e)
+/* Sums of one span's basis products and basis-weighted coordinates over the
+ * points that fall on it, added to the normal equations once per span
+ * change instead of once per point. */
+typedef struct {
+    size_t span;
+    float s00, s10, s11, s20, s21, s22;
+    float x0, x1, x2, y0, y1, y2;
+} span_sums_t;
+
+static inline void sums_reset(span_sums_t *a, size_t span)
 {
-    const bsf_point_t *p = ctrl + span;
-    const float k0 = span == 0u ? 1.0f : 0.5f;
-    const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
-    const float v = 1.0f - u;
-    e->b0 = k0 * v * v;
-    e->b2 = k2 * u * u;
-    e->cx = p[1].x + e->b0 * (p[0].x - p[1].x) + e->b2 * (p[2].x - p[1].x);
-    e->cy = p[1].y + e->b0 * (p[0].y - p[1].y) + e->b2 * (p[2].y - p[1].y);
+    memset(a, 0, sizeof *a);
+    a->span = span;
 }
 
-/* Add one point with basis (b0, 1 - b0 - b2, b2) on `span` to the normal
- * equations. The common case (three distinct unknowns) is written out; a
- * span touching a vertex goes through the general merge. */
-static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2, float px,
-                             float py)
+static inline void sums_add(span_sums_t *a, float b0, float b2, float px, float py)
 {
-    const uint8_t *unk = &w->unknown_of[span];
-    const size_t a = unk[0];
     const float b1 = 1.0f - b0 - b2;
-    float *r0 = &w->band[a * 3u];
-    float *rx = &w->rhs_x[a];
-    float *ry = &w->rhs_y[a];
-    if (unk[1] != a && unk[2] != unk[1]) {
-        /* Three distinct unknowns a, a + 1, a + 2 (rows of stride 3). */
-        r0[0] += b0 * b0;
-        r0[3] += b1 * b1;
-        r0[4] += b1 * b0;
-        r0[6] += b2 * b2;
-        r0[7] += b2 * b1;
-        r0[8] += b2 * b0;
-        rx[0] += b0 * px;
-        ry[0] += b0 * py;
-        rx[1] += b1 * px;
-        ry[1] += b1 * py;
-        rx[2] += b2 * px;
-        ry[2] += b2 * py;
-    } else {
-        /* A span at a vertex: its two copies share one unknown, so the span
-         * touches two unknowns a, a + 1 with summed weights. */
-        const float w0 = unk[1] == a ? b0 + b1 : b0;
-        const float w1 = unk[1] == a ? b2 : b1 + b2;
-        r0[0] += w0 * w0;
-        r0[3] += w1 * w1;
-        r0[4] += w1 * w0;
-        rx[0] += w0 * px;
-        ry[0] += w0 * py;
-        rx[1] += w1 * px;
-        ry[1] += w1 * py;
-    }
+    a->s00 += b0 * b0;
+    a->s10 += b1 * b0;
+    a->s11 += b1 * b1;
+    a->s20 += b2 * b0;
+    a->s21 += b2 * b1;
+    a->s22 += b2 * b2;
+    a->x0 += b0 * px;
+    a->x1 += b1 * px;
+    a->x2 += b2 * px;
+    a->y0 += b0 * py;
+    a->y1 += b1 * py;
+    a->y2 += b2 * py;
+}
+
+/* Add a span's sums to the lower band (stride 3) and right-hand sides. Its
+ * three stored control points map to non-decreasing unknowns; at a vertex
+ * two of them are one unknown, whose weight is the sum of both basis values,
+ * so the cross product of the two copies lands twice on its diagonal. */
+static void sums_flush(bsf_pdm_work_t *w, const span_sums_t *a)
+{
+    const uint8_t *unk = &w->unknown_of[a->span];
+    const size_t u0 = unk[0];
+    const size_t u1 = unk[1];
+    const size_t u2 = unk[2];
+    float *band = w->band;
+    band[u0 * 3u] += a->s00;
+    band[u1 * 3u] += a->s11;
+    band[u2 * 3u] += a->s22;
+    band[u1 * 3u + (u1 - u0)] += (u1 == u0 ? 2.0f : 1.0f) * a->s10;
+    band[u2 * 3u + (u2 - u0)] += (u2 == u0 ? 2.0f : 1.0f) * a->s20;
+    band[u2 * 3u + (u2 - u1)] += (u2 == u1 ? 2.0f : 1.0f) * a->s21;
+    w->rhs_x[u0] += a->x0;
+    w->rhs_x[u1] += a->x1;
+    w->rhs_x[u2] += a->x2;
+    w->rhs_y[u0] += a->y0;
+    w->rhs_y[u1] += a->y1;
+    w->rhs_y[u2] += a->y2;
 }
 
 static void clear_normal_equations(const pdm_state_t *s, bsf_pdm_work_t *w)
@@ -314,16 +325,25 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
 {
     const size_t n_span = s->n_ctrl - 2u;
     const float fs = (float)n_span;
+    const float ox = s->origin.x;
+    const float oy = s->origin.y;
+    span_sums_t acc;
     size_t i;
     clear_normal_equations(s, w);
+    sums_reset(&acc, 0u);
     for (i = 0; i < s->n; ++i) {
         float u;
         const size_t span = span_of(w->t[i], fs, n_span, &u);
         const float k0 = span == 0u ? 1.0f : 0.5f;
         const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
-        const bsf_point_t q = rel_point(s, i);
-        accumulate_point(w, span, k0 * (1.0f - u) * (1.0f - u), k2 * u * u, q.x, q.y);
+        const float v = 1.0f - u;
+        if (span != acc.span) {
+            sums_flush(w, &acc);
+            sums_reset(&acc, span);
+        }
+        sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
     }
+    sums_flush(w, &acc);
 }
 
 /* Step (a): add the bending term to the assembled normal equations and solve
@@ -377,41 +397,63 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
     const float fs = (float)n_span;
     const float inv_fs = 1.0f / fs;
     const size_t last = s->n - 1u;
+    const float ox = s->origin.x;
+    const float oy = s->origin.y;
+    span_coef_t c;
+    span_coef_t cn;
+    span_sums_t acc;
     float total = 0.0f;
     float frag_sum = 0.0f;
+    size_t frag_end = w->frag_last[0];
     size_t f = 0;
     size_t i;
 
     clear_normal_equations(s, w);
+    sums_reset(&acc, 0u);
+    load_span(w->ctrl, n_span, 0u, &c);
+    cn = c;
     for (i = 0; i < s->n; ++i) {
-        const bsf_point_t q = rel_point(s, i);
+        const float qx = s->pts[i].x - ox;
+        const float qy = s->pts[i].y - oy;
         const unsigned n_steps = (i == 0u || i == last) ? 0u : steps;
-        span_eval_t e;
         float t = w->t[i];
         float u;
         size_t span = span_of(t, fs, n_span, &u);
+        float b0;
+        float b2;
+        float ex;
+        float ey;
         float best;
         unsigned step;
 
-        eval_span(w->ctrl, n_span, span, u, &e);
-        {
-            const float ex = e.cx - q.x;
-            const float ey = e.cy - q.y;
-            best = ex * ex + ey * ey;
+        if (span != c.span) {
+            load_span(w->ctrl, n_span, span, &c);
         }
+        b0 = c.k0 * (1.0f - u) * (1.0f - u);
+        b2 = c.k2 * u * u;
+        ex = c.p1x + b0 * c.ax + b2 * c.bx - qx;
+        ey = c.p1y + b0 * c.ay + b2 * c.by - qy;
+        best = ex * ex + ey * ey;
         for (step = 0; step < n_steps; ++step) {
-            const float ex = e.cx - q.x;
-            const float ey = e.cy - q.y;
-            const float g = ex * e.ux + ey * e.uy;
-            const float gn = e.ux * e.ux + e.uy * e.uy;
-            float h = gn + ex * e.uux + ey * e.uuy;
+            /* Derivatives at the current u of span c. */
+            const float d0 = -2.0f * c.k0 * (1.0f - u);
+            const float d2 = 2.0f * c.k2 * u;
+            const float ux = d0 * c.ax + d2 * c.bx;
+            const float uy = d0 * c.ay + d2 * c.by;
+            const float g = ex * ux + ey * uy;
+            const float gn = ux * ux + uy * uy;
+            float h = gn + ex * c.uux + ey * c.uuy;
             float delta;
             float t_new = t;
+            float u_new = u;
             float d = best;
+            float nb0 = b0;
+            float nb2 = b2;
+            float nex = ex;
+            float ney = ey;
             unsigned halving;
             unsigned n_try;
-            span_eval_t en = e;
-            size_t span_new = span;
+            size_t span_new = c.span;
 
             if (!(h >= 0.5f * gn)) {
                 h = gn;
@@ -426,23 +468,25 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
             n_try = fabsf(delta) > PDM_HALVE_MIN ? 3u : 1u;
             delta *= inv_fs;
             for (halving = 0; halving < n_try; ++halving) {
-                float un;
                 t_new = t + delta;
                 t_new = t_new < 0.0f ? 0.0f : (t_new > 1.0f ? 1.0f : t_new);
                 if (!(fabsf(t_new - t) > 1e-7f)) {
                     break;
                 }
-                span_new = span_of(t_new, fs, n_span, &un);
-                if (step + 1u < n_steps) {
-                    eval_span(w->ctrl, n_span, span_new, un, &en);
+                span_new = span_of(t_new, fs, n_span, &u_new);
+                if (span_new == c.span) {
+                    nb0 = c.k0 * (1.0f - u_new) * (1.0f - u_new);
+                    nb2 = c.k2 * u_new * u_new;
+                    nex = c.p1x + nb0 * c.ax + nb2 * c.bx - qx;
+                    ney = c.p1y + nb0 * c.ay + nb2 * c.by - qy;
                 } else {
-                    eval_span_point(w->ctrl, n_span, span_new, un, &en);
+                    load_span(w->ctrl, n_span, span_new, &cn);
+                    nb0 = cn.k0 * (1.0f - u_new) * (1.0f - u_new);
+                    nb2 = cn.k2 * u_new * u_new;
+                    nex = cn.p1x + nb0 * cn.ax + nb2 * cn.bx - qx;
+                    ney = cn.p1y + nb0 * cn.ay + nb2 * cn.by - qy;
                 }
-                {
-                    const float fx = en.cx - q.x;
-                    const float fy = en.cy - q.y;
-                    d = fx * fx + fy * fy;
-                }
+                d = nex * nex + ney * ney;
                 if (d < best) {
                     break;
                 }
@@ -453,23 +497,45 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
             }
             best = d;
             t = t_new;
-            span = span_new;
-            e = en;
+            u = u_new;
+            b0 = nb0;
+            b2 = nb2;
+            ex = nex;
+            ey = ney;
+            if (span_new != c.span) {
+                c = cn;
+            }
         }
         w->t[i] = t;
-        accumulate_point(w, span, e.b0, e.b2, q.x, q.y);
+        if (c.span != acc.span) {
+            sums_flush(w, &acc);
+            sums_reset(&acc, c.span);
+        }
+        sums_add(&acc, b0, b2, qx, qy);
         total += best;
         frag_sum += best;
-        if (i == w->frag_last[f]) {
-            const size_t count = (size_t)w->frag_last[f] - w->frag_first[f] + 1u;
+        if (i == frag_end) {
+            const size_t count = frag_end - w->frag_first[f] + 1u;
             w->frag_rms[f] = sqrtf(frag_sum / (float)count);
             frag_sum = best; /* the vertex point opens the next fragment */
             if (f + 1u < s->n_frag) {
                 ++f;
+                frag_end = w->frag_last[f];
             }
         }
     }
+    sums_flush(w, &acc);
     s->rms = sqrtf(total / (float)s->n);
+}
+
+static float worst_fragment(const pdm_state_t *s, const bsf_pdm_work_t *w)
+{
+    float worst = 0.0f;
+    size_t f;
+    for (f = 0; f < s->n_frag; ++f) {
+        worst = w->frag_rms[f] > worst ? w->frag_rms[f] : worst;
+    }
+    return worst;
 }
 
 /* Alternate (a) and (b) until the RMS stops improving by rel_tol. The normal
@@ -477,9 +543,17 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
  * bending term means a solve minimises RMS plus bending, so in rare cases an
  * iteration raises the RMS slightly: such an iteration is undone (parameters,
  * control points and fragment RMS restored) and ends the solve, so the
- * accepted RMS sequence never increases. */
+ * accepted RMS sequence never increases. With stop_below > 0 (refinement on,
+ * stop_below = target_rms) the solve also ends as soon as every fragment
+ * meets it (more iterations would only polish a finished fit), and with
+ * stop_when_far when the worst fragment is still far above it (refinement
+ * will change the layout anyway, so polishing this one is wasted; not on the
+ * first solve, whose second iteration settles the vertices and keeps
+ * straight fragments from looking far). */
+
 static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_params_t *p,
-                            size_t max_iterations, uint32_t *iterations)
+                            size_t max_iterations, float stop_below, int stop_when_far,
+                            uint32_t *iterations)
 {
     float prev = 0.0f;
     size_t it;
@@ -506,7 +580,10 @@ static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_par
             break;
         }
         w->rms_history[w->n_history++] = s->rms;
-        if (!(s->rms > 0.0f) || (it > 0u && prev - s->rms < p->rel_tol * prev)) {
+        if (!(s->rms > 0.0f) || (it > 0u && prev - s->rms < p->rel_tol * prev) ||
+            (stop_below > 0.0f &&
+             (worst_fragment(s, w) <= stop_below ||
+              (stop_when_far && worst_fragment(s, w) > PDM_FAR_RATIO * stop_below)))) {
             break;
         }
         prev = s->rms;
@@ -557,6 +634,61 @@ static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const floa
         t = t0[f] + (t - old_t0[f]) * (t1[f] - t0[f]) / (old_t1[f] - old_t0[f]);
         w->t[i] = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
     }
+}
+
+/* Precision points to add to fragment f, whose RMS is above PDM_FAR_RATIO *
+ * target: as many as an h^3 error law (quadratic splines on a smooth shape)
+ * predicts to bring it down to that level, at least one, within the
+ * fragment's cap and the control-point cap. The law errs low on a corner the
+ * vertices miss (its error falls more slowly), so a fragment is rarely grown
+ * past need, and the last points before the target are always added one at
+ * a time. Only the worst fragment grows: a neighbour's error may only be the
+ * pull of the worst one on their shared vertex. */
+static size_t far_growth(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f, float target,
+                         size_t max_ctrl)
+{
+    const size_t room = max_ctrl - s->n_ctrl;
+    const float ratio = w->frag_rms[f] / (PDM_FAR_RATIO * target);
+    const size_t k = w->frag_precision[f];
+    const size_t cap = precision_cap(w, f);
+    const float now = (float)(k + 1u);
+    size_t add = 0u;
+    do {
+        const float next = (float)(k + add + 2u);
+        ++add;
+        if (next * next * next >= ratio * now * now * now) {
+            break;
+        }
+    } while (k + add < cap && add < room);
+    return add;
+}
+
+/* After a warm-started refinement that gained little: the footpoints may be
+ * stuck on the wrong side of a corner the vertices miss. Fit the layout from
+ * arc length too and keep whichever fit has the lower RMS (the warm one is
+ * parked in the *_prev buffers, which run_pdm only uses from its second
+ * iteration on). */
+static bsf_status_t try_cold_start(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_params_t *p,
+                                   const float *t0, const float *t1, uint32_t *iterations)
+{
+    const float warm = s->rms;
+    bsf_status_t st;
+    memcpy(w->t_prev, w->t, s->n * sizeof w->t[0]);
+    memcpy(w->ctrl_prev, w->ctrl, s->n_ctrl * sizeof w->ctrl[0]);
+    memcpy(w->frag_rms_prev, w->frag_rms, s->n_frag * sizeof w->frag_rms[0]);
+    init_fit(s, w, t0, t1);
+    assemble(s, w);
+    st = run_pdm(s, w, p, 1u, p->target_rms, 1, iterations);
+    if (st != BSF_OK) {
+        return st;
+    }
+    if (!(s->rms < warm)) {
+        memcpy(w->t, w->t_prev, s->n * sizeof w->t[0]);
+        memcpy(w->ctrl, w->ctrl_prev, s->n_ctrl * sizeof w->ctrl[0]);
+        memcpy(w->frag_rms, w->frag_rms_prev, s->n_frag * sizeof w->frag_rms[0]);
+        s->rms = warm;
+    }
+    return BSF_OK;
 }
 
 static bsf_status_t check_vertices(const uint16_t *vertex_pos, size_t n_vertex, size_t n)
@@ -668,7 +800,8 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     /* The start curve follows the points with known parameters (see
      * init_fit): the first solve needs no projection onto it. */
     assemble(&s, work);
-    st = run_pdm(&s, work, p, p->max_iterations, &info.iterations);
+    st = run_pdm(&s, work, p, p->max_iterations, p->refine ? p->target_rms : 0.0f, 0,
+                 &info.iterations);
     if (st != BSF_OK) {
         return st;
     }
@@ -677,20 +810,44 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
         float old_t0[BSF_PDM_MAX_FRAGMENTS];
         float old_t1[BSF_PDM_MAX_FRAGMENTS];
         const size_t pick = pick_fragment(&s, work, p->target_rms, max_ctrl);
+        float before;
         if (pick == NO_FRAGMENT) {
             break;
         }
+        before = work->frag_rms[pick];
+        work->last_refined = (uint16_t)pick;
+        if (before > PDM_FAR_RATIO * p->target_rms) {
+            /* Far from the target: several points at once, then a fresh
+             * fit of the new layout from arc length. */
+            const size_t add = far_growth(&s, work, pick, p->target_rms, max_ctrl);
+            work->frag_precision[pick] = (uint8_t)(work->frag_precision[pick] + add);
+            info.refinements += (uint32_t)add;
+            build_layout(&s, work, t0, t1);
+            init_fit(&s, work, t0, t1);
+            assemble(&s, work);
+            st = run_pdm(&s, work, p, p->refine_iterations, p->target_rms, 1, &info.iterations);
+            if (st != BSF_OK) {
+                return st;
+            }
+            continue;
+        }
+        /* Near the target: one point on the worst fragment, warm start. */
         memcpy(old_t0, t0, s.n_frag * sizeof t0[0]);
         memcpy(old_t1, t1, s.n_frag * sizeof t1[0]);
         work->frag_precision[pick]++;
-        work->last_refined = (uint16_t)pick;
         ++info.refinements;
         build_layout(&s, work, t0, t1);
         remap_parameters(&s, work, old_t0, old_t1, t0, t1);
         assemble(&s, work);
-        st = run_pdm(&s, work, p, p->refine_iterations, &info.iterations);
+        st = run_pdm(&s, work, p, p->refine_iterations, p->target_rms, 1, &info.iterations);
         if (st != BSF_OK) {
             return st;
+        }
+        if (!(work->frag_rms[pick] < (1.0f - PDM_COLD_GAIN) * before)) {
+            st = try_cold_start(&s, work, p, t0, t1, &info.iterations);
+            if (st != BSF_OK) {
+                return st;
+            }
         }
     }
 
@@ -763,7 +920,7 @@ bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
         work->t[i] = acc / length;
     }
     assemble(&s, work);
-    st = run_pdm(&s, work, p, p->max_iterations, iterations);
+    st = run_pdm(&s, work, p, p->max_iterations, 0.0f, 0, iterations);
     if (st != BSF_OK) {
         return st;
     }
