@@ -36,6 +36,7 @@ typedef struct {
     float lambda;
     float rms;
     uint32_t loaded;
+    float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* polyline length of each fragment */
 } pdm_state_t;
 
 void bsf_pdm_params_default(bsf_pdm_params_t *p)
@@ -80,14 +81,6 @@ static float dist(bsf_point_t a, bsf_point_t b)
     return sqrtf(dx * dx + dy * dy);
 }
 
-static bsf_point_t rel_point(const pdm_state_t *s, size_t i)
-{
-    bsf_point_t q;
-    q.x = s->pts[i].x - s->origin.x;
-    q.y = s->pts[i].y - s->origin.y;
-    return q;
-}
-
 /* Control polygon for the current precision counts: unknown index of every
  * stored control point and the knot range [t0, t1] of every fragment. A vertex
  * whose first copy is stored at index j sits at the knot j / n_span. */
@@ -121,93 +114,6 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
     t1[s->n_frag - 1u] = 1.0f;
     s->n_ctrl = stored;
     s->n_unknown = unknown;
-}
-
-/* Greville abscissa of stored control point k: the parameter a control point
- * "belongs" to (the mean of its two inner knots). */
-static float greville(size_t k, size_t n_span)
-{
-    const float fs = (float)n_span;
-    const float a = k >= 1u ? (float)(k - 1u) / fs : 0.0f;
-    const float b = (float)k / fs;
-    return 0.5f * ((a > 1.0f ? 1.0f : a) + (b > 1.0f ? 1.0f : b));
-}
-
-/* Start of a fit: boundary control points on the end points, vertices on
- * their interest points, precision points on the fragment's polyline at the
- * arc-length fraction of their Greville abscissa inside the fragment (evenly
- * spread, so the start curve follows the points with a parameter roughly
- * proportional to arc length). Each point's parameter starts at its
- * arc-length fraction of the fragment's knot range, corrected for the
- * non-uniform speed of the straight spans at a vertex. */
-static void init_fit(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0, const float *t1)
-{
-    const size_t n_span = s->n_ctrl - 2u;
-    size_t stored = 0;
-    size_t f;
-    size_t i;
-
-    w->ctrl[stored++] = rel_point(s, 0u);
-    for (f = 0; f < s->n_frag; ++f) {
-        const size_t a = w->frag_first[f];
-        const size_t b = w->frag_last[f];
-        const float range = t1[f] - t0[f];
-        float len = 0.0f;
-        float acc = 0.0f;
-        size_t k;
-        size_t seg = a; /* polyline piece [seg, seg + 1] holding the walk */
-        for (i = a + 1u; i <= b; ++i) {
-            len += dist(s->pts[i - 1u], s->pts[i]);
-        }
-        for (i = a; i <= b; ++i) {
-            float frac;
-            if (i > a) {
-                acc += dist(s->pts[i - 1u], s->pts[i]);
-            }
-            /* Coincident points: fall back to even spacing by index. */
-            frac = len > 0.0f ? acc / len : (float)(i - a) / (float)(b - a);
-            frac = frac > 1.0f ? 1.0f : frac;
-            if (w->frag_precision[f] == 0u) {
-                /* A straight fragment at a vertex is not traversed at constant
-                 * speed: boundary-vertex runs as 1 - (1 - u)^2, vertex-boundary
-                 * as u^2, vertex-vertex as 2u^2 then 1 - 2(1 - u)^2. Invert it
-                 * so the start parameters are the footpoints already. */
-                if (f == 0u) {
-                    frac = 1.0f - sqrtf(1.0f - frac);
-                } else if (f + 1u == s->n_frag) {
-                    frac = sqrtf(frac);
-                } else {
-                    frac = frac <= 0.5f ? sqrtf(0.5f * frac) : 1.0f - sqrtf(0.5f * (1.0f - frac));
-                }
-            }
-            w->t[i] = t0[f] + frac * range;
-        }
-        acc = 0.0f;
-        for (k = 0; k < w->frag_precision[f]; ++k) {
-            const float want = (greville(stored, n_span) - t0[f]) / range * len;
-            bsf_point_t q = rel_point(s, b);
-            while (seg < b) {
-                const float piece = dist(s->pts[seg], s->pts[seg + 1u]);
-                if (acc + piece >= want && piece > 0.0f) {
-                    const float r = (want - acc) / piece;
-                    const bsf_point_t p0 = rel_point(s, seg);
-                    const bsf_point_t p1 = rel_point(s, seg + 1u);
-                    q.x = p0.x + r * (p1.x - p0.x);
-                    q.y = p0.y + r * (p1.y - p0.y);
-                    break;
-                }
-                acc += piece;
-                ++seg;
-            }
-            w->ctrl[stored++] = q;
-        }
-        if (f + 1u < s->n_frag) {
-            const bsf_point_t v = rel_point(s, b);
-            w->ctrl[stored++] = v;
-            w->ctrl[stored++] = v;
-        }
-    }
-    w->ctrl[stored] = rel_point(s, s->n - 1u);
 }
 
 /* Span of t and its local coordinate (t in [0, 1]). */
@@ -346,6 +252,78 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
     sums_flush(w, &acc);
 }
 
+/* Start of a fit (a new layout, or a restart): each point's parameter is
+ * its arc-length fraction of its fragment's knot range, corrected for the
+ * non-uniform speed of the straight spans at a vertex, and the normal
+ * equations are assembled at these parameters in the same sweep. No start
+ * curve is needed: the first solve computes the control points from the
+ * parameters alone. */
+static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0,
+                                  const float *t1)
+{
+    const size_t n_span = s->n_ctrl - 2u;
+    const float fs = (float)n_span;
+    const float ox = s->origin.x;
+    const float oy = s->origin.y;
+    span_sums_t acc;
+    size_t f;
+    size_t i = 0;
+
+    clear_normal_equations(s, w);
+    sums_reset(&acc, 0u);
+    for (f = 0; f < s->n_frag; ++f) {
+        const size_t a = w->frag_first[f];
+        const size_t b = w->frag_last[f];
+        const float len = s->frag_len[f];
+        const float range = t1[f] - t0[f];
+        const unsigned straight = w->frag_precision[f] == 0u;
+        const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
+        float arc = 0.0f;
+        /* The vertex point closing fragment f opens fragment f + 1: it is
+         * accumulated once, by the fragment it closes. */
+        for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
+            float frac;
+            float u;
+            float t;
+            size_t span;
+            if (i > a) {
+                arc += dist(s->pts[i - 1u], s->pts[i]);
+            }
+            /* Coincident points: fall back to even spacing by index. */
+            frac = len > 0.0f ? arc / len : (float)(i - a) / (float)(b - a);
+            frac = frac > 1.0f ? 1.0f : frac;
+            if (straight) {
+                /* A straight fragment at a vertex is not traversed at
+                 * constant speed: boundary-vertex runs as 1 - (1 - u)^2,
+                 * vertex-boundary as u^2, vertex-vertex as 2u^2 then
+                 * 1 - 2(1 - u)^2. Invert it so the start parameters are the
+                 * footpoints already. */
+                if (shape == 0u) {
+                    frac = 1.0f - sqrtf(1.0f - frac);
+                } else if (shape == 1u) {
+                    frac = sqrtf(frac);
+                } else {
+                    frac = frac <= 0.5f ? sqrtf(0.5f * frac) : 1.0f - sqrtf(0.5f * (1.0f - frac));
+                }
+            }
+            t = t0[f] + frac * range;
+            w->t[i] = t;
+            span = span_of(t, fs, n_span, &u);
+            if (span != acc.span) {
+                sums_flush(w, &acc);
+                sums_reset(&acc, span);
+            }
+            {
+                const float k0 = span == 0u ? 1.0f : 0.5f;
+                const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
+                const float v = 1.0f - u;
+                sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
+            }
+        }
+    }
+    sums_flush(w, &acc);
+}
+
 /* Step (a): add the bending term to the assembled normal equations and solve
  * for the control points. */
 static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
@@ -362,11 +340,20 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
         const float fs = (float)n_span;
         const float weight = s->lambda * fs * fs * fs;
         for (k = 0; k < n_span; ++k) {
-            float b[3];
-            float du[3];
-            float ddu[3];
-            bsf_bspline_basis_u(n_span, k, 0.5f, b, du, ddu);
-            bsf_fit_accumulate(w->band, NULL, NULL, &w->unknown_of[k], ddu, weight, 0.0f, 0.0f);
+            /* c_s = 2 (k0, -(k0 + k2), k2): the Appendix's (1, -2, 1),
+             * (2, -3, 1), (1, -3, 2) or (2, -4, 2). */
+            const float c0 = k == 0u ? 2.0f : 1.0f;
+            const float c2 = k + 1u == n_span ? 2.0f : 1.0f;
+            const float c1 = -(c0 + c2);
+            span_sums_t r;
+            sums_reset(&r, k);
+            r.s00 = weight * c0 * c0;
+            r.s10 = weight * c1 * c0;
+            r.s11 = weight * c1 * c1;
+            r.s20 = weight * c2 * c0;
+            r.s21 = weight * c2 * c1;
+            r.s22 = weight * c2 * c2;
+            sums_flush(w, &r);
         }
     }
     st = bsf_spd_band_solve2(w->band, m, m > 2u ? 2u : m - 1u, w->factor, w->rhs_x, w->rhs_y,
@@ -676,8 +663,7 @@ static bsf_status_t try_cold_start(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_
     memcpy(w->t_prev, w->t, s->n * sizeof w->t[0]);
     memcpy(w->ctrl_prev, w->ctrl, s->n_ctrl * sizeof w->ctrl[0]);
     memcpy(w->frag_rms_prev, w->frag_rms, s->n_frag * sizeof w->frag_rms[0]);
-    init_fit(s, w, t0, t1);
-    assemble(s, w);
+    start_from_arc_length(s, w, t0, t1);
     st = run_pdm(s, w, p, 1u, p->target_rms, 1, iterations);
     if (st != BSF_OK) {
         return st;
@@ -750,14 +736,19 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     if (st != BSF_OK) {
         return st;
     }
-    for (i = 1; i < n; ++i) {
-        length += dist(pts[i - 1u], pts[i]);
+    memset(&s, 0, sizeof s);
+    for (i = 1, f = 0; i < n; ++i) {
+        const float d = dist(pts[i - 1u], pts[i]);
+        s.frag_len[f] += d;
+        length += d;
+        if (f < n_vertex && i == vertex_pos[f]) {
+            ++f; /* the vertex closes fragment f */
+        }
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;
     }
 
-    memset(&s, 0, sizeof s);
     memset(&info, 0, sizeof info);
     s.pts = pts;
     s.n = n;
@@ -796,10 +787,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
         }
     }
     build_layout(&s, work, t0, t1);
-    init_fit(&s, work, t0, t1);
-    /* The start curve follows the points with known parameters (see
-     * init_fit): the first solve needs no projection onto it. */
-    assemble(&s, work);
+    start_from_arc_length(&s, work, t0, t1);
     st = run_pdm(&s, work, p, p->max_iterations, p->refine ? p->target_rms : 0.0f, 0,
                  &info.iterations);
     if (st != BSF_OK) {
@@ -823,8 +811,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
             work->frag_precision[pick] = (uint8_t)(work->frag_precision[pick] + add);
             info.refinements += (uint32_t)add;
             build_layout(&s, work, t0, t1);
-            init_fit(&s, work, t0, t1);
-            assemble(&s, work);
+            start_from_arc_length(&s, work, t0, t1);
             st = run_pdm(&s, work, p, p->refine_iterations, p->target_rms, 1, &info.iterations);
             if (st != BSF_OK) {
                 return st;
