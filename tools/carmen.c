@@ -359,3 +359,12 @@ int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan)
         }
     }
 }
+
+float carmen_valid_range_max(const carmen_scan_t *scan)
+{
+    const float declared = scan->max_range;
+    if (!(declared > 0.0f) || !(declared < CARMEN_NO_RETURN_FLOOR)) {
+        return CARMEN_NO_RETURN_FLOOR; /* also for NaN and infinity */
+    }
+    return declared;
+}
