@@ -35,8 +35,6 @@
 #include "bsf_scene.h"
 #include "carmen.h"
 
-/* Below the no-return codes 81.83 / 81.91 of the logs (as the host tool). */
-#define NO_RETURN_FLOOR 81.8f
 #define N_ROWS 6 /* 4 stages, whole (stats), call (outer timer) */
 #define ROW_WHOLE 4
 #define ROW_CALL 5
@@ -105,7 +103,6 @@ static int load_log(const char *path, size_t max_scans, scan_set_t *set)
     }
     while ((max_scans == 0u || set->n < max_scans) && carmen_next(rd, &rec) == 1) {
         stored_scan_t *st;
-        float rmax;
         if (rec.count > BSF_MAX_POINTS) {
             fprintf(stderr, "bench_extract: %s:%lu: %zu beams > BSF_MAX_POINTS, skipped\n", path,
                     rec.line, rec.count);
@@ -124,13 +121,12 @@ static int load_log(const char *path, size_t max_scans, scan_set_t *set)
         st = &set->scans[set->n];
         st->ranges = xmalloc(rec.count * sizeof(float));
         memcpy(st->ranges, rec.ranges, rec.count * sizeof(float));
-        rmax = (rec.max_range > 0.0f && isfinite(rec.max_range)) ? rec.max_range : 80.0f;
         st->scan.ranges = st->ranges;
         st->scan.count = rec.count;
         st->scan.angle_min = rec.angle_min;
         st->scan.angle_increment = rec.angle_increment;
         st->scan.range_min = 0.0f;
-        st->scan.range_max = rmax < NO_RETURN_FLOOR ? rmax : NO_RETURN_FLOOR;
+        st->scan.range_max = carmen_valid_range_max(&rec);
         ++set->n;
     }
     carmen_close(rd);
