@@ -14,6 +14,9 @@
  * handler adds about 10 instructions per 655 k). These are instruction counts, not cycles:
  * QEMU models no pipeline, flash wait states or FPU latencies.
  *
+ * Also the stack high-water mark of the calls (painted stack, bytes below
+ * the caller's frame; libm included, unlike tools/stack_report.py).
+ *
  * Prints numbers, judges none; fails only if an extraction fails. Run:
  *   ctest --test-dir build-m4 -R bench_m4_icount -V
  */
@@ -47,6 +50,7 @@ static uint32_t g_stage[BSF_STAGE_COUNT][MAX_SCANS];
 static uint32_t g_sorted[MAX_SCANS];
 
 static double g_ticks_per_instr;
+static uint32_t g_stack_bytes;
 
 /* SysTick counts down through 24 bits; its interrupt counts the wraps, so a
  * count of any length is exact. The interrupt runs through a vector table of
@@ -132,6 +136,38 @@ static uint32_t to_instr(uint32_t ticks)
     return (uint32_t)((double)ticks / g_ticks_per_instr + 0.5);
 }
 
+/* Stack high-water mark: paint the free stack below the caller's frame,
+ * run, then find the deepest word overwritten. Counts everything bsf_extract
+ * uses, libm included. */
+#define PAINT_BYTES 8192u
+#define PAINT_WORD 0xDEADBEEFu
+
+static uint32_t *paint_base(void)
+{
+    uint32_t sp;
+    __asm volatile("mov %0, sp" : "=r"(sp));
+    return (uint32_t *)(uintptr_t)((sp - PAINT_BYTES - 256u) & ~7u);
+}
+
+static void __attribute__((noinline)) stack_paint(void)
+{
+    volatile uint32_t *p = paint_base();
+    uint32_t i;
+    for (i = 0; i < PAINT_BYTES / 4u; ++i) {
+        p[i] = PAINT_WORD;
+    }
+}
+
+/* Bytes used below the paint top (the painting function's own frame is above it). */
+static uint32_t __attribute__((noinline)) stack_used(uint32_t *base)
+{
+    uint32_t i = 0;
+    while (i < PAINT_BYTES / 4u && base[i] == PAINT_WORD) {
+        ++i;
+    }
+    return PAINT_BYTES - 4u * i;
+}
+
 static int cmp_u32(const void *a, const void *b)
 {
     const uint32_t x = *(const uint32_t *)a;
@@ -168,6 +204,11 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
         printf("  %-15s SKIPPED: not available in this build\n", bsf_method_name(method));
         return 0;
     }
+    uint32_t *painted = paint_base();
+    uint32_t stack_top_used;
+    stack_paint();
+    /* What the measuring itself leaves below the paint top (subtracted). */
+    stack_top_used = stack_used(painted);
     for (i = 0; i < src->n; ++i) {
         bsf_scan_t tmp;
         const bsf_scan_t *scan = src->get(i, &tmp);
@@ -186,6 +227,7 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
         mean += (double)g_whole[i];
         feats += g_res.stats.n_features;
     }
+    g_stack_bytes = stack_used(painted) - stack_top_used;
     /* Per-stage split with the hook (a few instructions more per stage). */
     p.clock = hook_ticks;
     p.clock_user = NULL;
@@ -209,7 +251,7 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
     for (s = 0; s < BSF_STAGE_COUNT; ++s) {
         printf(" %8lu", (unsigned long)median_of(g_stage[s], src->n, NULL));
     }
-    printf(" | %5.2f\n", (double)feats / (double)src->n);
+    printf(" | %5.2f | %5lu\n", (double)feats / (double)src->n, (unsigned long)g_stack_bytes);
     return 0;
 }
 
@@ -217,8 +259,8 @@ static int run_source(const scan_source_t *src)
 {
     int m, rc = 0;
     printf("\n%s: %u scans\n", src->name, (unsigned)src->n);
-    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %5s\n", "instructions", "median", "mean",
-           "max", "points", "corners", "segment", "fit", "feat");
+    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %5s | %5s\n", "instructions", "median",
+           "mean", "max", "points", "corners", "segment", "fit", "feat", "stack");
     printf("  %-15s %29s | %35s |\n", "", "whole bsf_extract per scan",
            "median per stage (with clock hook)");
     for (m = 0; m < BSF_METHOD_COUNT; ++m) {
