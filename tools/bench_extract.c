@@ -152,6 +152,7 @@ typedef struct {
 /* What one method did on one set of scans. */
 typedef struct {
     summary_t whole;       /* whole-extraction us per scan */
+    double row_median[N_ROWS]; /* median us per scan of each row */
     double features;       /* per scan */
     double in_features;    /* share of valid points kept in features */
 } method_result_t;
@@ -249,6 +250,7 @@ static int bench_method(const scan_set_t *set, bsf_method_t method, int passes, 
                 printf("    %-16s %10.2f %10.2f %10.2f %10.2f\n", row_name[r], s.mean, s.median,
                        s.p99, s.max);
             }
+            out->row_median[r] = s.median;
             if (r == ROW_WHOLE) {
                 out->whole = s;
             }
@@ -301,6 +303,7 @@ static int bench_scaling(const int *methods, int passes)
     static double median_us[BSF_METHOD_COUNT][N_SCALE];
     static double feats[BSF_METHOD_COUNT][N_SCALE];
     static double kept[BSF_METHOD_COUNT][N_SCALE];
+    static double stage_us[BSF_METHOD_COUNT][BSF_STAGE_COUNT][N_SCALE];
     stored_scan_t stored[SCALE_POSES];
     bsf_scene_t scene;
     bsf_scene_rng_t rng;
@@ -357,6 +360,9 @@ static int bench_scaling(const int *methods, int passes)
                 median_us[m][b] = res.whole.median;
                 feats[m][b] = res.features;
                 kept[m][b] = res.in_features;
+                for (i = 0; i < BSF_STAGE_COUNT; ++i) {
+                    stage_us[m][i][b] = res.row_median[i];
+                }
             }
         }
         if (median_us[m][0] < 0.0) {
@@ -380,6 +386,13 @@ static int bench_scaling(const int *methods, int passes)
             printf(" %9.3f", median_us[m][b] < 0.0 ? 0.0 : kept[m][b]);
         }
         printf("  share of valid points in features\n");
+        for (i = 0; i < BSF_STAGE_COUNT; ++i) {
+            printf("  %-16s", row_name[i]);
+            for (b = 0; b < N_SCALE; ++b) {
+                printf(" %9.1f", median_us[m][b] < 0.0 ? 0.0 : stage_us[m][i][b]);
+            }
+            printf("  us/scan (median of the stage)\n");
+        }
     }
     for (m = 0; m < BSF_METHOD_COUNT; ++m) {
         if (!methods[m]) {
