@@ -36,7 +36,7 @@
 #define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define SYST_MASK 0x00FFFFFFu
 
-#define MAX_SCANS 512
+#define MAX_SCANS 4096
 #define N_SYNTH_SCENES 3
 #define N_SYNTH_POSES 2
 
