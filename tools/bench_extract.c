@@ -3,7 +3,7 @@
  * dataset and per method, then how the time grows with the beam count.
  *
  *   bench_extract [--passes N] [--method NAME|all] [--max-scans N]
- *                 [--no-scaling] [--scaling-only] [LOG ...]
+ *                 [--no-scaling] [--scaling-only] [--beams N] [LOG ...]
  *
  * Without LOG: the four logs in ../shared/data (BSF_SHARED_DIR overrides the
  * shared directory): intel, mit-csail, fr079 and the first 1000 scans of
@@ -22,6 +22,7 @@
  * to 4000 beams over 270 degrees; it needs a library built with
  * BSF_MAX_POINTS >= 4000 (target bench_extract links bsf_big, 4096 beams;
  * bench_extract_default links the default library and skips larger sizes).
+ * --beams N runs only that size of the scaling list (for profiling).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -297,7 +298,7 @@ static int bench_log(const char *path, size_t max_scans, const int *methods, int
 static const size_t scale_beams[] = {180, 250, 500, 1000, 2000, 4000};
 #define N_SCALE (sizeof scale_beams / sizeof scale_beams[0])
 
-static int bench_scaling(const int *methods, int passes)
+static int bench_scaling(const int *methods, int passes, size_t only_beams)
 {
     static float ranges[SCALE_POSES][BSF_MAX_POINTS];
     static double median_us[BSF_METHOD_COUNT][N_SCALE];
@@ -335,7 +336,8 @@ static int bench_scaling(const int *methods, int passes)
             method_result_t res;
             int st;
             median_us[m][b] = -1.0;
-            if (scale_beams[b] > BSF_MAX_POINTS) {
+            if (scale_beams[b] > BSF_MAX_POINTS ||
+                (only_beams != 0u && scale_beams[b] != only_beams)) {
                 continue;
             }
             bsf_scene_rng_seed(&rng, 2022u + b);
@@ -365,7 +367,7 @@ static int bench_scaling(const int *methods, int passes)
                 }
             }
         }
-        if (median_us[m][0] < 0.0) {
+        if (only_beams == 0u && median_us[m][0] < 0.0) {
             printf("  %-16s SKIPPED: not available in this build\n", bsf_method_name((bsf_method_t)m));
             continue;
         }
@@ -416,7 +418,7 @@ static int bench_scaling(const int *methods, int passes)
 static void usage(void)
 {
     fprintf(stderr, "usage: bench_extract [--passes N] [--method NAME|all] [--max-scans N]\n"
-                    "                     [--no-scaling] [--scaling-only] [LOG ...]\n");
+                    "                     [--no-scaling] [--scaling-only] [--beams N] [LOG ...]\n");
 }
 
 int main(int argc, char **argv)
@@ -427,7 +429,7 @@ int main(int argc, char **argv)
     const char *shared = getenv("BSF_SHARED_DIR");
     int methods[BSF_METHOD_COUNT] = {1, 1, 1};
     int passes = 5, scaling = 1, logs = 1, n_paths = 0, a, rc = 0;
-    long max_scans = 0;
+    long max_scans = 0, only_beams = 0;
     const char **paths = xmalloc((size_t)argc * sizeof *paths);
 
     for (a = 1; a < argc; ++a) {
@@ -446,6 +448,8 @@ int main(int argc, char **argv)
                 memset(methods, 0, sizeof methods);
                 methods[m] = 1;
             }
+        } else if (strcmp(argv[a], "--beams") == 0 && a + 1 < argc) {
+            only_beams = atol(argv[++a]);
         } else if (strcmp(argv[a], "--no-scaling") == 0) {
             scaling = 0;
         } else if (strcmp(argv[a], "--scaling-only") == 0) {
@@ -457,7 +461,7 @@ int main(int argc, char **argv)
             paths[n_paths++] = argv[a];
         }
     }
-    if (passes < 1 || max_scans < 0) {
+    if (passes < 1 || max_scans < 0 || only_beams < 0) {
         usage();
         return 2;
     }
@@ -479,7 +483,7 @@ int main(int argc, char **argv)
         }
     }
     if (scaling) {
-        rc |= bench_scaling(methods, passes);
+        rc |= bench_scaling(methods, passes, (size_t)only_beams);
     }
     free(paths);
     return rc;
