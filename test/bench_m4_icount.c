@@ -259,8 +259,8 @@ static int run_source(const scan_source_t *src)
 {
     int m, rc = 0;
     printf("\n%s: %u scans\n", src->name, (unsigned)src->n);
-    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %5s | %5s\n", "instructions", "median",
-           "mean", "max", "points", "corners", "segment", "fit", "feat", "stack");
+    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %5s | %5s\n", "instructions", "median", "mean",
+           "max", "points", "corners", "segment", "fit", "feat", "stack");
     printf("  %-15s %29s | %35s |\n", "", "whole bsf_extract per scan",
            "median per stage (with clock hook)");
     for (m = 0; m < BSF_METHOD_COUNT; ++m) {
@@ -301,8 +301,9 @@ static int make_synthetic(size_t *n_out)
         for (pose = 0; pose < N_SYNTH_POSES; ++pose) {
             for (res = 0; res < 2u; ++res) {
                 const size_t beams = res == 0u ? 180u : 361u;
-                bsf_lidar_t l = bsf_lidar_default(-1.0 + 0.5 * (double)pose, -0.5 + 0.3 * (double)pose,
-                                                  0.7 * (double)pose, beams, 3.14159265358979);
+                bsf_lidar_t l =
+                    bsf_lidar_default(-1.0 + 0.5 * (double)pose, -0.5 + 0.3 * (double)pose,
+                                      0.7 * (double)pose, beams, 3.14159265358979);
                 l.noise_sigma = 0.01;
                 if (bsf_scene_scan(&scene, &l, &rng, g_synth_ranges[n], NULL, 361u) != BSF_OK) {
                     return 1;

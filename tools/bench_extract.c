@@ -40,8 +40,8 @@
 #define ROW_WHOLE 4
 #define ROW_CALL 5
 
-static const char *const row_name[N_ROWS] = {"points", "corners", "segmentation",
-                                             "fitting", "whole", "call (no hook)"};
+static const char *const row_name[N_ROWS] = {"points",  "corners", "segmentation",
+                                             "fitting", "whole",   "call (no hook)"};
 
 typedef struct {
     float *ranges;
@@ -152,10 +152,10 @@ typedef struct {
 
 /* What one method did on one set of scans. */
 typedef struct {
-    summary_t whole;       /* whole-extraction us per scan */
+    summary_t whole;           /* whole-extraction us per scan */
     double row_median[N_ROWS]; /* median us per scan of each row */
-    double features;       /* per scan */
-    double in_features;    /* share of valid points kept in features */
+    double features;           /* per scan */
+    double in_features;        /* share of valid points kept in features */
 } method_result_t;
 
 /* samples[scan * passes + pass] -> per-scan medians (sorted in place) -> summary. */
@@ -368,7 +368,8 @@ static int bench_scaling(const int *methods, int passes, size_t only_beams)
             }
         }
         if (only_beams == 0u && median_us[m][0] < 0.0) {
-            printf("  %-16s SKIPPED: not available in this build\n", bsf_method_name((bsf_method_t)m));
+            printf("  %-16s SKIPPED: not available in this build\n",
+                   bsf_method_name((bsf_method_t)m));
             continue;
         }
         printf("  %-16s", bsf_method_name((bsf_method_t)m));
@@ -423,8 +424,8 @@ static void usage(void)
 
 int main(int argc, char **argv)
 {
-    static const char *const default_logs[] = {"intel.log.gz", "mit-csail.log.gz",
-                                               "fr079.log.gz", "fr-clinic.log.gz"};
+    static const char *const default_logs[] = {"intel.log.gz", "mit-csail.log.gz", "fr079.log.gz",
+                                               "fr-clinic.log.gz"};
     static const size_t default_max[] = {0, 0, 0, 1000};
     const char *shared = getenv("BSF_SHARED_DIR");
     int methods[BSF_METHOD_COUNT] = {1, 1, 1};
