@@ -565,7 +565,7 @@ static void test_malformed_fields_are_dropped_and_counted(void)
     uint8_t payload[72];
     const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, base);
     unsigned c;
-    /* Payload of example 1: 11 00 00 00 14 14 00 01 | 08 14 13 32 | e8 07 f4 03 e8 07 f4 03 00 32 */
+    /* Payload of example 1: 11 00 00 00 32 14 00 01 | 08 14 13 32 | 90 03 c8 01 90 03 c8 01 00 14 */
     for (c = 0; c < 10u; ++c) {
         size_t plen = len;
         size_t n;
