@@ -22,9 +22,9 @@ static uint8_t body[BSF_FRAME_BODY_MAX_SIZE + 16u];
 static uint8_t scratch[BSF_FRAME_MAX_SIZE + 16u];
 
 /* docs/FORMAT.md, example 1 and example 2 (byte for byte). */
-static const uint8_t golden_minimal[] = {
-    0x02, 0x11, 0x01, 0x01, 0x03, 0x32, 0x14, 0x0e, 0x01, 0x08, 0x14, 0x13, 0x32, 0x90, 0x03,
-    0xc8, 0x01, 0x90, 0x03, 0xc8, 0x01, 0x06, 0x14, 0x2d, 0xdc, 0x7d, 0xa3, 0x00};
+static const uint8_t golden_minimal[] = {0x02, 0x11, 0x01, 0x01, 0x03, 0x32, 0x14, 0x0e, 0x01, 0x08,
+                                         0x14, 0x13, 0x32, 0x90, 0x03, 0xc8, 0x01, 0x90, 0x03, 0xc8,
+                                         0x01, 0x06, 0x14, 0x2d, 0xdc, 0x7d, 0xa3, 0x00};
 static const uint8_t golden_typical[] = {
     0x22, 0x11, 0x01, 0xd2, 0x09, 0x8e, 0xe0, 0x2a, 0xcc, 0x4a, 0xab, 0x5b, 0xa2, 0xc6, 0x32,
     0xb0, 0x01, 0x90, 0x07, 0x06, 0x14, 0x06, 0x23, 0x01, 0x3a, 0x26, 0xcf, 0x05, 0xf2, 0x04,
@@ -71,7 +71,8 @@ static unsigned feed_all(const uint8_t *data, size_t len, size_t chunk)
 static size_t golden_payload(const uint8_t *golden, size_t len, uint8_t *out)
 {
     size_t n = 0;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(golden, len - 1u, out, BSF_FRAME_BODY_MAX_SIZE, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_cobs_decode(golden, len - 1u, out, BSF_FRAME_BODY_MAX_SIZE, &n));
     return n - 4u;
 }
 
@@ -125,7 +126,8 @@ static void assert_round_trip(const bsf_frame_info_t *info, const bsf_result_t *
         TEST_ASSERT_EQUAL_UINT8(a->kind, b->kind);
         TEST_ASSERT_FLOAT_WITHIN(0.00005f + 1e-6f, a->e_curve, b->e_curve);
         for (k = a->ctrl_first; k < a->ctrl_first + a->n_ctrl; ++k) {
-            const float tol = 0.5f * step * 1.0001f + 4e-7f * (fabsf(in->ctrl[k].x) + fabsf(in->ctrl[k].y));
+            const float tol =
+                0.5f * step * 1.0001f + 4e-7f * (fabsf(in->ctrl[k].x) + fabsf(in->ctrl[k].y));
             TEST_ASSERT_FLOAT_WITHIN(tol, in->ctrl[k].x, out->result.ctrl[k].x);
             TEST_ASSERT_FLOAT_WITHIN(tol, in->ctrl[k].y, out->result.ctrl[k].y);
             TEST_ASSERT_EQUAL_UINT8(in->ctrl_is_vertex[k] != 0u, out->result.ctrl_is_vertex[k]);
@@ -198,7 +200,8 @@ static void test_cobs_refuses_zero_bytes_truncation_and_small_buffers(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_cobs_decode(truncated, 3, body, sizeof body, &n));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_cobs_encode(in, 3, buf, 3, &n));
     TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_cobs_decode(golden_minimal, sizeof golden_minimal - 1u, body, 3, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_cobs_decode(golden_minimal, sizeof golden_minimal - 1u, body, 3, &n));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_cobs_encode(NULL, 3, buf, sizeof buf, &n));
 }
 
@@ -245,7 +248,8 @@ static void test_one_shot_decode_reads_golden_body(void)
     bsf_frame_info_t info;
     size_t n = 0;
     fx_example_typical(&info, &res);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(golden_typical, sizeof golden_typical - 1u, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_cobs_decode(golden_typical, sizeof golden_typical - 1u, body, sizeof body, &n));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, n, &frame));
     assert_round_trip(&info, &res, &frame);
     body[7] ^= 0x40u;
@@ -282,7 +286,8 @@ static void test_too_small_buffer_is_refused_without_writing(void)
     size_t n = 0;
     fx_example_typical(&info, &res);
     memset(buf, 0xEE, sizeof buf);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode(&info, &res, buf, sizeof golden_typical - 1u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_frame_encode(&info, &res, buf, sizeof golden_typical - 1u, &n));
     TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical, (uint32_t)n);
     TEST_ASSERT_EACH_EQUAL_HEX8(0xEE, buf, sizeof golden_typical);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof golden_typical, &n));
@@ -327,7 +332,8 @@ static void test_sink_gets_the_same_bytes_in_blocks_of_at_most_256(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
     TEST_ASSERT_TRUE(n > 600u);
     memset(&log, 0, sizeof log);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
     TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)written);
     TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)log.len);
     TEST_ASSERT_EQUAL_HEX8_ARRAY(buf, scratch, n);
@@ -336,9 +342,11 @@ static void test_sink_gets_the_same_bytes_in_blocks_of_at_most_256(void)
 
     memset(&log, 0, sizeof log);
     log.fail_after = 2u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
     TEST_ASSERT_TRUE(written < n);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&work, &info, &res, NULL, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_frame_encode_sink(&work, &info, &res, NULL, &log, &written));
 }
 
 static void test_random_results_round_trip_within_half_a_step(void)
@@ -400,7 +408,7 @@ static void test_encoder_rejects_values_it_cannot_represent(void)
         case 6: info.pose_theta = NAN; break;
         case 7: info.pose_x = 3e6f; break;
         case 8: res.ctrl_is_vertex[6] = 0u; break; /* vertex without its copy */
-        case 9: res.ctrl[6].x += 0.01f; break;      /* copies differ */
+        case 9: res.ctrl[6].x += 0.01f; break;     /* copies differ */
         case 10: res.features[2].n_ctrl = 2u; break;
         case 11: res.features[5].n_ctrl = 5u; break; /* beyond result->n_ctrl */
         case 12: res.features[1].last_beam = 40u; break;
@@ -408,10 +416,14 @@ static void test_encoder_rejects_values_it_cannot_represent(void)
         case 14: res.features[1].kind = 2u; break;
         case 15: res.stats.n_valid = 100u; break; /* fewer than the points in features */
         case 16: res.features[0].e_curve = -0.001f; break;
-        case 17: res.n_features = BSF_MAX_SEGMENTS + 1u; want = BSF_ERR_CAPACITY; break;
+        case 17:
+            res.n_features = BSF_MAX_SEGMENTS + 1u;
+            want = BSF_ERR_CAPACITY;
+            break;
         default: res.features[5].last_beam = BSF_MAX_POINTS; break;
         }
-        TEST_ASSERT_EQUAL_INT_MESSAGE(want, bsf_frame_encode(&info, &res, buf, sizeof buf, &n), "case");
+        TEST_ASSERT_EQUAL_INT_MESSAGE(want, bsf_frame_encode(&info, &res, buf, sizeof buf, &n),
+                                      "case");
         TEST_ASSERT_EQUAL_INT(want, bsf_frame_encode(&info, &res, NULL, 0u, &n));
     }
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(NULL, &res, buf, sizeof buf, &n));
@@ -494,8 +506,7 @@ static void test_truncated_frames_are_never_delivered(void)
     }
     TEST_ASSERT_EQUAL_UINT32(0u, delivered);
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.frames_ok);
-    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical - 2u,
-                             dec.stats.bad_crc + dec.stats.malformed);
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical - 2u, dec.stats.bad_crc + dec.stats.malformed);
     /* Back in step right away. */
     TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_typical, sizeof golden_typical, 9u));
 }
@@ -508,7 +519,8 @@ static void test_oversized_frame_is_skipped_and_counted(void)
         scratch[i] = (uint8_t)(1u + i % 200u);
     }
     delivered += feed_all(scratch, sizeof scratch, 1000u);
-    delivered += feed_all(golden_minimal, sizeof golden_minimal, 1000u); /* its 0x00 ends the junk */
+    delivered +=
+        feed_all(golden_minimal, sizeof golden_minimal, 1000u); /* its 0x00 ends the junk */
     delivered += feed_all(golden_minimal, sizeof golden_minimal, 1000u);
     TEST_ASSERT_EQUAL_UINT32(1u, delivered);
     TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.oversize);
@@ -565,29 +577,34 @@ static void test_malformed_fields_are_dropped_and_counted(void)
     uint8_t payload[72];
     const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, base);
     unsigned c;
-    /* Payload of example 1: 11 00 00 00 32 14 00 01 | 08 14 13 32 | 90 03 c8 01 90 03 c8 01 00 14 */
+    /* Payload of example 1: 11 00 00 00 32 14 00 01 | 08 14 13 32 | 90 03 c8 01 90 03 c8 01 00 14
+     */
     for (c = 0; c < 10u; ++c) {
         size_t plen = len;
         size_t n;
         memcpy(payload, base, len);
         switch (c) {
-        case 0: payload[1] = 0x02; break;             /* reserved flag bit */
-        case 1: payload[plen++] = 0x00; break;        /* trailing byte */
-        case 2: plen -= 1u; break;                    /* field cut short */
-        case 3: payload[4] = 0x00; break;             /* quantisation step 0 */
-        case 4: payload[7] = 0x02; break;             /* 2 features announced, 1 sent */
-        case 5: payload[8] = 0x00; break;             /* 2 control points */
-        case 6: payload[10] = 0xFF; payload[11] = 0x7F; break; /* last beam beyond the caps */
-        case 7: payload[5] = 0x05; break;             /* N smaller than points in features */
-        case 8: /* non-minimal varint: seq as 0x80 0x00 */
+        case 0: payload[1] = 0x02; break;      /* reserved flag bit */
+        case 1: payload[plen++] = 0x00; break; /* trailing byte */
+        case 2: plen -= 1u; break;             /* field cut short */
+        case 3: payload[4] = 0x00; break;      /* quantisation step 0 */
+        case 4: payload[7] = 0x02; break;      /* 2 features announced, 1 sent */
+        case 5: payload[8] = 0x00; break;      /* 2 control points */
+        case 6:
+            payload[10] = 0xFF;
+            payload[11] = 0x7F;
+            break;                        /* last beam beyond the caps */
+        case 7: payload[5] = 0x05; break; /* N smaller than points in features */
+        case 8:                           /* non-minimal varint: seq as 0x80 0x00 */
             memmove(payload + 3, payload + 2, len - 2u);
             payload[2] = 0x80;
             ++plen;
             break;
-        default: payload[8] = 0x0A; break;            /* vertex flag without a mask */
+        default: payload[8] = 0x0A; break; /* vertex flag without a mask */
         }
         n = reframe(payload, plen, scratch);
-        TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u), "malformed frame delivered");
+        TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u),
+                                         "malformed frame delivered");
         TEST_ASSERT_EQUAL_UINT32(c + 1u, dec.stats.malformed);
     }
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.bad_crc);
