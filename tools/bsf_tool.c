@@ -449,7 +449,7 @@ static const char extract_help[] =
     "  --count N        process at most N scans (default: all)\n"
     "  --range-max M    readings >= M metres are invalid (default: the log's declared\n"
     "                   maximum range, capped below the 81.83/81.91 no-return codes)\n"
-    "  --quant STEP     control point quantisation step in metres (default 0.002)\n"
+    "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
