@@ -453,6 +453,7 @@ static const char extract_help[] =
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
+    "Frames carry the laser pose and the time in ms since the log's first scan.\n"
     "A malformed log line is reported as FILE:LINE and skipped. The summary goes to\n"
     "stderr; progress too, when stderr is a terminal.\n";
 
@@ -508,6 +509,8 @@ static int run_extract(const extract_opts_t *o)
     FILE *out;
     progress_t prog;
     unsigned long index = 0, done = 0, failed = 0, malformed;
+    double t0 = 0.0;
+    int have_t0 = 0;
     unsigned long long bytes = 0;
     bsf_frame_info_t info;
     int r;
@@ -548,7 +551,14 @@ static int run_extract(const extract_opts_t *o)
             continue;
         }
         info.seq = (uint32_t)index;
-        info.timestamp_ms = (rec.timestamp > 0.0) ? (uint64_t)llround(rec.timestamp * 1000.0) : 0u;
+        /* ms since the log's first scan: small numbers travel in fewer
+         * bytes, and the metrics never need absolute time. */
+        if (!have_t0) {
+            t0 = rec.timestamp;
+            have_t0 = 1;
+        }
+        info.timestamp_ms =
+            (rec.timestamp > t0) ? (uint64_t)llround((rec.timestamp - t0) * 1000.0) : 0u;
         info.has_pose = 1u;
         info.pose_x = (float)rec.laser_pose.x;
         info.pose_y = (float)rec.laser_pose.y;
