@@ -76,12 +76,9 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
             st = bsf_pdm_params_check(&p->pdm);
         }
         break;
-    case BSF_METHOD_RPOS_LSBA:
-        st = bsf_rpos_params_check(&p->rpos);
-        break;
+    case BSF_METHOD_RPOS_LSBA: st = bsf_rpos_params_check(&p->rpos); break;
     case BSF_METHOD_COUNT:
-    default:
-        return BSF_ERR_PARAM;
+    default: return BSF_ERR_PARAM;
     }
     /* A NULL inside a valid struct cannot happen, so any failure is a value. */
     return st == BSF_OK ? BSF_OK : BSF_ERR_PARAM;
@@ -146,8 +143,8 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex)
     ex->n_keypoints = 0u;
     switch (ex->params.method) {
     case BSF_METHOD_FALKO_SVED_PDM:
-        st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->scratch.falko,
-                              ex->keypoints, BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+        st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->scratch.falko, ex->keypoints,
+                              BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
     case BSF_METHOD_BID_SVED_PDM:
         st = bsf_bid_detect(&ex->points, &ex->params.bid, &ex->scratch.bid, ex->keypoints,
@@ -155,8 +152,7 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex)
         break;
     case BSF_METHOD_RPOS_LSBA:
     case BSF_METHOD_COUNT:
-    default:
-        break;
+    default: break;
     }
     if (st != BSF_OK) {
         ex->n_keypoints = 0u;
@@ -220,7 +216,8 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     }
     *n_vertex = 0u;
     for (i = 0; i < nv; ++i) {
-        if (ex->scratch.fit.vertex_pos[i] >= 2u && (size_t)ex->scratch.fit.vertex_pos[i] + 3u <= n) {
+        if (ex->scratch.fit.vertex_pos[i] >= 2u &&
+            (size_t)ex->scratch.fit.vertex_pos[i] + 3u <= n) {
             ex->scratch.fit.vertex_pos[(*n_vertex)++] = ex->scratch.fit.vertex_pos[i];
         }
     }
@@ -257,9 +254,9 @@ static bsf_status_t fit_features(bsf_extractor_t *ex, bsf_result_t *res)
         } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
             st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
         } else {
-            st = bsf_pdm_fit(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos, n_vertex, &ex->params.pdm, &ex->scratch.fit.pdm,
-                             &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl], room,
-                             &n_ctrl, &e_curve, NULL);
+            st = bsf_pdm_fit(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos, n_vertex,
+                             &ex->params.pdm, &ex->scratch.fit.pdm, &res->ctrl[res->n_ctrl],
+                             &res->ctrl_is_vertex[res->n_ctrl], room, &n_ctrl, &e_curve, NULL);
             if (st == BSF_ERR_BUFFER) {
                 return BSF_ERR_CAPACITY; /* the scan's control-point pool is full */
             }

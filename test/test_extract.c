@@ -189,8 +189,8 @@ static void curve_to_truth(const bsf_lidar_t *l, double *rms, double *max_d)
  * cabinet and a round pillar. */
 static void build_office(void)
 {
-    static const double outline[] = {0.0, 0.0, 14.0, 0.0, 14.0, 6.0, 9.0, 6.0, 9.0, 10.0,
-                                     0.0, 10.0};
+    static const double outline[] = {0.0, 0.0, 14.0, 0.0,  14.0, 6.0,
+                                     9.0, 6.0, 9.0,  10.0, 0.0,  10.0};
     bsf_scene_init(&scene);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 6u, 1));
     TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 5.0, 0.0, 5.0, 3.0) >= 0);
@@ -208,8 +208,8 @@ static void test_curves_stay_close_to_the_true_walls_for_each_noise_level(void)
     for (mi = 0; mi < 2u; ++mi) {
         for (pi = 0; pi < 3u; ++pi) {
             for (si = 0; si < 3u; ++si) {
-                const bsf_lidar_t l = make_lidar(poses[pi][0], poses[pi][1], poses[pi][2],
-                                                 sigmas[si]);
+                const bsf_lidar_t l =
+                    make_lidar(poses[pi][0], poses[pi][1], poses[pi][2], sigmas[si]);
                 const double target = (double)bsf_params_default(methods[mi]).pdm.target_rms;
                 double rms, max_d;
                 build_office();
@@ -251,11 +251,11 @@ static void test_retrievability_and_compactness_equal_hand_counts(void)
         ranges[i] = 2.0f / cosf(a);
     }
     ranges[20] = NAN;
-    ranges[21] = 6.0f;  /* isolated */
+    ranges[21] = 6.0f; /* isolated */
     ranges[22] = -1.0f;
     ranges[23] = 12.0f; /* isolated */
     ranges[24] = 0.0f;
-    ranges[25] = 3.0f;  /* isolated */
+    ranges[25] = 3.0f; /* isolated */
     ranges[26] = INFINITY;
     s.ranges = ranges;
     s.count = 27u;

@@ -30,7 +30,7 @@ extern "C" {
 typedef enum {
     BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM (default) */
     BSF_METHOD_BID_SVED_PDM = 1,   /**< baseline: B-spline interest points (slow), SVED, PDM */
-    BSF_METHOD_RPOS_LSBA = 2,      /**< baseline: RPOS segments, 4-point least squares, no corners */
+    BSF_METHOD_RPOS_LSBA = 2, /**< baseline: RPOS segments, 4-point least squares, no corners */
     BSF_METHOD_COUNT = 3
 } bsf_method_t;
 
@@ -81,7 +81,7 @@ typedef struct {
         bsf_bid_work_t bid;
         struct {
             bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
-            uint16_t vertex_pos[BSF_MAX_KEYPOINTS];  /**< its vertices, positions in seg_points */
+            uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, positions in seg_points */
             bsf_pdm_work_t pdm;
         } fit;
     } scratch;
