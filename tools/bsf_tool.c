@@ -354,19 +354,14 @@ static unsigned long frames_dropped(const bsf_decoder_stats_t *s)
 
 /* ---- metrics ------------------------------------------------------------------ */
 
-static bsf_scan_counts_t counts_of_result(const bsf_result_t *r, double time_s)
+/* A result's metric counts; the library's own definition (time from the
+ * result's stats: for a decoded frame, the extraction time it carries). */
+static bsf_scan_counts_t counts_of_result(const bsf_result_t *r)
 {
     bsf_scan_counts_t c;
-    size_t i;
-    memset(&c, 0, sizeof c);
-    c.n_valid = r->stats.n_valid;
-    c.n_features = r->n_features;
-    for (i = 0; i < r->n_features; ++i) {
-        c.n_in_features += r->features[i].n_points;
-        c.n_ctrl += r->features[i].n_ctrl;
-        c.sum_e_curve += r->features[i].e_curve;
+    if (bsf_metrics_counts(r, &c) != BSF_OK) {
+        memset(&c, 0, sizeof c);
     }
-    c.time_s = (float)time_s;
     return c;
 }
 
@@ -418,7 +413,7 @@ static int metrics_of_frames(const frame_list_t *l, dataset_metrics_t *out)
     }
     for (i = 0; i < l->n && rc == 0; ++i) {
         const bsf_frame_t *f = &l->frames[i];
-        const bsf_scan_counts_t c = counts_of_result(&f->result, 1e-6 * (double)f->time_us);
+        const bsf_scan_counts_t c = counts_of_result(&f->result);
         if (bsf_metrics_acc_add(&acc, &c) != BSF_OK) {
             fail_msg("frame seq %lu has inconsistent counts", (unsigned long)f->seq);
             rc = -1;
@@ -677,7 +672,7 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
 {
     decode_ctx_t *ctx = (decode_ctx_t *)vctx;
     const bsf_result_t *r = &fr->result;
-    const bsf_scan_counts_t c = counts_of_result(r, 1e-6 * (double)fr->time_us);
+    const bsf_scan_counts_t c = counts_of_result(r);
     size_t i, k;
     if (!ctx->json) {
         fprintf(ctx->out, "seq=%lu t=%.3f pose=", (unsigned long)fr->seq,
@@ -1359,7 +1354,7 @@ static int run_dataset(const char *path, bsf_method_t method, long max_scans, ru
             out->failed++;
             continue;
         }
-        counts[n] = counts_of_result(&g_res, 1e-9 * (double)g_res.stats.time_ns);
+        counts[n] = counts_of_result(&g_res);
         bytes[n] = len;
         ++n;
         progress_tick(&prog, n, path);

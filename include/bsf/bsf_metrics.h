@@ -16,6 +16,7 @@
 #define BSF_METRICS_H
 
 #include "bsf_common.h"
+#include "bsf_feature.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -30,6 +31,14 @@ typedef struct {
     float sum_e_curve;      /**< sum of E_curve over the features, metres */
     float time_s;           /**< extraction time, seconds; negative when not measured */
 } bsf_scan_counts_t;
+
+/**
+ * The counts of one extraction result: N from its stats, the sums over its
+ * features, and the time from stats.time_ns (-1, "not measured", when it is 0,
+ * which means no clock was set). Works as well on a decoded frame's result.
+ * @return BSF_OK; BSF_ERR_ARG for NULL.
+ */
+BSF_NODISCARD bsf_status_t bsf_metrics_counts(const bsf_result_t *result, bsf_scan_counts_t *out);
 
 /** Per-scan metrics. A `has_*` flag is 0 where the value is undefined (then the value is 0). */
 typedef struct {
