@@ -629,6 +629,19 @@ static void test_bspline_span_and_basis_clamp_bad_arguments(void)
     TEST_ASSERT_FLOAT_WITHIN(1e-6f, 1.0f, b[0] + b[1] + b[2]);
 }
 
+/* KNOWN BUG (src/bsf_bspline.c, bsf_bspline_span): for a huge n_ctrl,
+ * (float)(n_ctrl - 2) rounds up past SIZE_MAX and the float-to-size_t
+ * conversion of t * n_span overflows (undefined behaviour; UBSan flags it).
+ * The header promises a span in [0, n_ctrl - 3] for any n_ctrl >= 3. */
+static void test_bspline_span_stays_in_range_for_huge_control_point_counts(void)
+{
+    float u = -1.0f;
+    const size_t n = (size_t)-1;
+    TEST_ASSERT_TRUE(bsf_bspline_span(n, 1.0f, &u) == n - 3u);
+    TEST_ASSERT_TRUE(u >= 0.0f && u <= 1.0f);
+    TEST_ASSERT_TRUE(bsf_bspline_span(n, 0.999f, &u) <= n - 3u);
+}
+
 static void test_bspline_eval_refuses_bad_arguments_untouched(void)
 {
     bsf_point_t c[BSF_MAX_CTRL_PER_FEATURE + 1];
@@ -1425,6 +1438,7 @@ int main(void)
     RUN_TEST(test_falko_detect_degenerate_scans_give_finite_keypoints_or_none);
     RUN_TEST(test_falko_detect_reports_total_when_out_is_too_small);
     RUN_TEST(test_bspline_span_and_basis_clamp_bad_arguments);
+    RUN_TEST(test_bspline_span_stays_in_range_for_huge_control_point_counts);
     RUN_TEST(test_bspline_eval_refuses_bad_arguments_untouched);
     RUN_TEST(test_lsba_refuses_bad_input_untouched);
     RUN_TEST(test_lsba_collinear_duplicated_and_maximal_inputs_give_finite_fits);
