@@ -216,6 +216,9 @@ float bsf_footpoint_refine(const bsf_point_t *ctrl, size_t n_ctrl, bsf_point_t p
          * A step that does not bring the curve closer is halved (twice at
          * most): far from the curve the distance is not quadratic in t. */
         delta = -g / (h * n_span);
+        if (!(fabsf(delta) * n_span > 1e-4f)) {
+            break; /* converged: a step this small cannot be resolved */
+        }
         for (halving = 0; halving < 3u; ++halving) {
             t_new = t_cur + delta;
             t_new = t_new < 0.0f ? 0.0f : (t_new > 1.0f ? 1.0f : t_new);

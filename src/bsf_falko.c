@@ -125,13 +125,19 @@ typedef struct {
  * (the reference's one extra beam on the right, clamped to the scan instead
  * of read past its end). Any larger window gives the same neighbours: a beam
  * at angle phi from the apex is at least rho sin(phi) > r away when
- * phi > asin(r / rho). So alpha comes from the cheap upper bound
- * asin(s) <= s / sqrt(1 - s^2), with a margin for rounding. */
-static void neigh_window(const bsf_points_t *pts, size_t i, float r, float inv_inc, neigh_t *nb)
+ * phi > asin(r / rho). So alpha comes from a bound that costs one division,
+ * asin(s) <= s / sqrt(1 - s^2) <= s / (1 - s^2) = r rho / (rho^2 - r^2)
+ * (r <= 0.8 rho keeps the denominator positive), with a rounding margin. */
+static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
 {
-    const float s = r / pts->range[i];
-    const float a = s / sqrtf(1.0f - s * s) * inv_inc * (1.0f + 1e-5f);
-    size_t alpha = (a < (float)pts->count) ? (size_t)a : pts->count; /* s <= 0.8: a >= 0 */
+    const float rho = pts->range[i];
+    const float a = r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
+    /* a >= 0; BSF_MAX_POINTS fits int, and int conversion is one instruction */
+    return (a < (float)BSF_MAX_POINTS) ? (size_t)(int)a : (size_t)BSF_MAX_POINTS;
+}
+
+static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, neigh_t *nb)
+{
     nb->beg = (i >= alpha) ? i - alpha : 0u;
     nb->end = (i + alpha + 1u < pts->count) ? i + alpha + 1u : pts->count - 1u;
 }
@@ -208,11 +214,11 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
 /* Steps 3-5 and the sums of step 6 for apex i; 0 when rejected. All
  * rejections are alike, so the cheap ends-and-triangle test runs first and
  * the full count only for its survivors. */
-static int neighbourhood(const bsf_points_t *pts, size_t i, float r, float inv_inc,
+static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alpha,
                          const bsf_falko_params_t *p, neigh_t *nb)
 {
     const ball_t b = make_ball(pts->pt[i], r);
-    neigh_window(pts, i, r, inv_inc, nb);
+    neigh_window(pts, i, alpha, nb);
     if (!find_ends(pts, i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
         return 0;
     }
@@ -237,7 +243,12 @@ static int sector_of(bsf_point_t q, bsf_point_t c, float theta, float sector_wid
     } else if (ang <= -FALKO_PI) {
         ang = -FALKO_ANGLE_LIMIT;
     }
-    return (int)floorf((ang + FALKO_PI - theta) / sector_width);
+    {
+        /* floor without a library call: |x| < 2 pi / sector_width + 1 */
+        const float x = (ang + FALKO_PI - theta) / sector_width;
+        const int k = (int)x;
+        return ((float)k > x) ? k - 1 : k;
+    }
 }
 
 /* Step 8: FALKOLib's sector distance (truncating %), or the true circular one. */
@@ -349,19 +360,21 @@ static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh
     return q;
 }
 
-/* Steps 1-9 for beam i: its raw score, or FALKO_REJECTED. */
-static float beam_score(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p,
-                        float inv_inc, int8_t *sector)
+/* Is beam i an apex candidate at all (step 1)? */
+static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p)
 {
     const float rho = pts->range[i];
-    float r, theta;
-    neigh_t nb;
+    return pts->valid[i] && rho >= p->min_range && rho <= p->max_range;
+}
 
-    if (!pts->valid[i] || !(rho >= p->min_range && rho <= p->max_range)) {
-        return FALKO_REJECTED;
-    }
-    r = neigh_radius(p, rho);
-    if (!neighbourhood(pts, i, r, inv_inc, p, &nb)) {
+/* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
+ * FALKO_REJECTED. */
+static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha,
+                        const bsf_falko_params_t *p, int8_t *sector)
+{
+    float theta;
+    neigh_t nb;
+    if (!neighbourhood(pts, i, r, alpha, p, &nb)) {
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
@@ -397,8 +410,23 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         return BSF_ERR_ARG;
     }
 
+    /* Radius and window of every apex first, in a loop without hard branches
+     * (the exp, division and conversion latencies of successive beams
+     * overlap): r in score[], alpha in peak[]; 0 marks a beam that is no apex. */
     for (i = 0; i < pts->count; ++i) {
-        const float s = beam_score(pts, i, p, 1.0f / inc, work->sector);
+        float r = 0.0f;
+        size_t alpha = 0;
+        if (in_extraction_range(pts, i, p)) {
+            r = neigh_radius(p, pts->range[i]);
+            alpha = window_alpha(pts, i, r, 1.0f / inc);
+        }
+        work->score[i] = r;
+        work->peak[i] = (uint16_t)alpha;
+    }
+    for (i = 0; i < pts->count; ++i) {
+        const float r = work->score[i];
+        const float s = (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], p, work->sector)
+                                   : FALKO_REJECTED;
         work->score[i] = s;
         if (s > (float)score_max) {
             if (s > (float)FALKO_SCORE_LIMIT) {
@@ -427,7 +455,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        (void)neighbourhood(pts, b, r, 1.0f / inc, p, &nb); /* passed before */
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, 1.0f / inc), p,
+                            &nb); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);
         out[k].radius = r;

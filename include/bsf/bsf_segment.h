@@ -46,7 +46,7 @@ typedef struct {
 /** RPOS parameters. */
 typedef struct {
     float alpha_max;             /**< largest turn between successive steps, radians, (0, pi] */
-    float eta;                   /**< largest ratio of successive spacings, finite, >= 1 */
+    float eta;                   /**< largest ratio of successive spacings, 1..1e6 */
     uint16_t min_segment_points; /**< shortest kept segment, points, 1..BSF_MAX_POINTS */
 } bsf_rpos_params_t;
 

@@ -1,0 +1,634 @@
+/* Wire format: CRC, COBS, golden frames of docs/FORMAT.md, round trips,
+ * encoder validation and the stream decoder's handling of damaged input. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bsf/bsf.h"
+#include "stream_fixtures.h"
+#include "unity.h"
+
+#ifdef __arm__
+#define N_ROUND_TRIPS 150u
+#else
+#define N_ROUND_TRIPS 1000u
+#endif
+
+static bsf_result_t res;
+static bsf_frame_t frame;
+static bsf_decoder_t dec;
+static uint8_t buf[BSF_FRAME_MAX_SIZE + 16u];
+static uint8_t body[BSF_FRAME_BODY_MAX_SIZE + 16u];
+static uint8_t scratch[BSF_FRAME_MAX_SIZE + 16u];
+
+/* docs/FORMAT.md, example 1 and example 2 (byte for byte). */
+static const uint8_t golden_minimal[] = {
+    0x02, 0x11, 0x01, 0x01, 0x03, 0x14, 0x14, 0x0e, 0x01, 0x08, 0x14, 0x13, 0x32, 0xe8,
+    0x07, 0xf4, 0x03, 0xe8, 0x07, 0xf4, 0x03, 0x06, 0x32, 0x59, 0xd7, 0x52, 0x55, 0x00};
+static const uint8_t golden_typical[] = {
+    0x31, 0x11, 0x01, 0xd2, 0x09, 0x8e, 0xe0, 0x2a, 0xcc, 0x4a, 0xab, 0x5b, 0xa2, 0xc6, 0x14,
+    0xb0, 0x01, 0x90, 0x07, 0x06, 0x14, 0x06, 0x23, 0x01, 0x3a, 0x5e, 0x89, 0x0e, 0xa0, 0x0c,
+    0x09, 0x1a, 0x06, 0x15, 0x04, 0x13, 0x04, 0x36, 0x5e, 0x02, 0xb6, 0x01, 0x04, 0xea, 0x09,
+    0x0e, 0x0b, 0xa0, 0x10, 0x44, 0xd6, 0x02, 0x08, 0x06, 0x13, 0x1f, 0x93, 0x06, 0xe8, 0x04,
+    0x81, 0x04, 0xfe, 0x04, 0x06, 0x03, 0x17, 0x04, 0x1d, 0x02, 0x70, 0x04, 0x81, 0x03, 0x6e,
+    0xdd, 0x07, 0x06, 0x05, 0x01, 0x05, 0x88, 0x05, 0x18, 0x04, 0x11, 0x49, 0xfb, 0x03, 0xca,
+    0x01, 0xd1, 0x06, 0xa3, 0x02, 0x6b, 0x28, 0x4b, 0x56, 0x08, 0x5a, 0x10, 0x02, 0x06, 0x8e,
+    0x01, 0x89, 0x05, 0xb3, 0x02, 0xf7, 0x01, 0xb3, 0x09, 0x25, 0x63, 0x09, 0x05, 0xd8, 0xd1,
+    0x8b, 0xd8, 0x00};
+
+void setUp(void)
+{
+    bsf_decoder_init(&dec);
+    memset(&frame, 0xA5, sizeof frame);
+}
+
+void tearDown(void)
+{
+}
+
+/* Feeds data to dec in pieces of `chunk` bytes; returns frames delivered
+ * (the last one is in `frame`). */
+static unsigned feed_all(const uint8_t *data, size_t len, size_t chunk)
+{
+    unsigned frames = 0;
+    size_t pos = 0;
+    while (pos < len) {
+        const size_t n = len - pos < chunk ? len - pos : chunk;
+        size_t off = 0;
+        while (off < n) {
+            size_t used = 0;
+            const int r = bsf_decoder_feed(&dec, data + pos + off, n - off, &used, &frame);
+            TEST_ASSERT_TRUE(r == 0 || r == 1);
+            TEST_ASSERT_TRUE(used <= n - off);
+            off += used;
+            frames += (unsigned)r;
+        }
+        pos += n;
+    }
+    return frames;
+}
+
+/* Payload (CRC stripped) of a golden frame. */
+static size_t golden_payload(const uint8_t *golden, size_t len, uint8_t *out)
+{
+    size_t n = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(golden, len - 1u, out, BSF_FRAME_BODY_MAX_SIZE, &n));
+    return n - 4u;
+}
+
+/* Frames a hand-made payload: CRC, COBS, delimiter. Returns the wire length. */
+static size_t reframe(const uint8_t *payload, size_t len, uint8_t *out)
+{
+    uint8_t tmp[BSF_FRAME_BODY_MAX_SIZE];
+    const uint32_t crc = bsf_crc32c(0u, payload, len);
+    size_t n = 0;
+    unsigned i;
+    memcpy(tmp, payload, len);
+    for (i = 0; i < 4u; ++i) {
+        tmp[len + i] = (uint8_t)(crc >> (8u * i));
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(tmp, len + 4u, out, BSF_FRAME_MAX_SIZE, &n));
+    out[n] = 0u;
+    return n + 1u;
+}
+
+static void assert_round_trip(const bsf_frame_info_t *info, const bsf_result_t *in,
+                              const bsf_frame_t *out)
+{
+    const float step = out->quant_step;
+    uint16_t i;
+    TEST_ASSERT_FLOAT_WITHIN(1e-7f, info->quant_step, step);
+    TEST_ASSERT_EQUAL_UINT32(info->seq, out->seq);
+    TEST_ASSERT_TRUE(info->timestamp_ms == out->timestamp_ms);
+    TEST_ASSERT_EQUAL_UINT8(info->has_pose, out->has_pose);
+    if (info->has_pose) {
+        float dtheta = out->pose_theta - info->pose_theta;
+        dtheta -= 6.2831853f * floorf(dtheta / 6.2831853f + 0.5f);
+        TEST_ASSERT_FLOAT_WITHIN(0.0005f + 1e-5f * fabsf(info->pose_x), info->pose_x, out->pose_x);
+        TEST_ASSERT_FLOAT_WITHIN(0.0005f + 1e-5f * fabsf(info->pose_y), info->pose_y, out->pose_y);
+        TEST_ASSERT_FLOAT_WITHIN(0.5f * 9.5874e-5f + 1e-6f, 0.0f, dtheta);
+    }
+    TEST_ASSERT_EQUAL_UINT32(in->stats.n_valid, out->result.stats.n_valid);
+    TEST_ASSERT_UINT32_WITHIN(500u, in->stats.time_ns, out->result.stats.time_ns);
+    TEST_ASSERT_EQUAL_UINT16(in->n_features, out->result.n_features);
+    TEST_ASSERT_EQUAL_UINT16(in->n_ctrl, out->result.n_ctrl);
+    TEST_ASSERT_EQUAL_UINT32(in->n_ctrl, out->result.stats.n_ctrl);
+    TEST_ASSERT_EQUAL_UINT32(in->stats.n_in_features, out->result.stats.n_in_features);
+    for (i = 0; i < in->n_features; ++i) {
+        const bsf_feature_t *a = &in->features[i];
+        const bsf_feature_t *b = &out->result.features[i];
+        uint16_t k;
+        TEST_ASSERT_EQUAL_UINT16(a->first_beam, b->first_beam);
+        TEST_ASSERT_EQUAL_UINT16(a->last_beam, b->last_beam);
+        TEST_ASSERT_EQUAL_UINT16(a->n_points, b->n_points);
+        TEST_ASSERT_EQUAL_UINT16(a->ctrl_first, b->ctrl_first);
+        TEST_ASSERT_EQUAL_UINT8(a->n_ctrl, b->n_ctrl);
+        TEST_ASSERT_EQUAL_UINT8(a->kind, b->kind);
+        TEST_ASSERT_FLOAT_WITHIN(0.00005f + 1e-6f, a->e_curve, b->e_curve);
+        for (k = a->ctrl_first; k < a->ctrl_first + a->n_ctrl; ++k) {
+            const float tol = 0.5f * step * 1.0001f + 4e-7f * (fabsf(in->ctrl[k].x) + fabsf(in->ctrl[k].y));
+            TEST_ASSERT_FLOAT_WITHIN(tol, in->ctrl[k].x, out->result.ctrl[k].x);
+            TEST_ASSERT_FLOAT_WITHIN(tol, in->ctrl[k].y, out->result.ctrl[k].y);
+            TEST_ASSERT_EQUAL_UINT8(in->ctrl_is_vertex[k] != 0u, out->result.ctrl_is_vertex[k]);
+        }
+    }
+}
+
+/* ---- CRC and COBS ---- */
+
+static void test_crc32c_check_value_and_chaining(void)
+{
+    const uint8_t check[] = "123456789";
+    const uint32_t whole = bsf_crc32c(0u, check, 9u);
+    TEST_ASSERT_EQUAL_HEX32(0xE3069283u, whole);
+    TEST_ASSERT_EQUAL_HEX32(whole, bsf_crc32c(bsf_crc32c(0u, check, 4u), check + 4, 5u));
+    TEST_ASSERT_EQUAL_HEX32(0u, bsf_crc32c(0u, check, 0u));
+}
+
+static void test_cobs_encodes_reference_vectors_and_decodes_them_back(void)
+{
+    static const uint8_t in1[] = {0x00};
+    static const uint8_t out1[] = {0x01, 0x01};
+    static const uint8_t in2[] = {0x11, 0x22, 0x00, 0x33};
+    static const uint8_t out2[] = {0x03, 0x11, 0x22, 0x02, 0x33};
+    static const uint8_t in3[] = {0x11, 0x00, 0x00, 0x00};
+    static const uint8_t out3[] = {0x02, 0x11, 0x01, 0x01, 0x01};
+    uint8_t in4[255];
+    size_t n = 0;
+    size_t i;
+
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(in1, 1, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(out1, buf, 2);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(in2, 4, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(5u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(out2, buf, 5);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(in3, 4, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(5u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(out3, buf, 5);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(out2, 5, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(in2, body, 4);
+
+    /* 254 non-zero bytes fill one 0xFF block; the 255th starts another. */
+    for (i = 0; i < sizeof in4; ++i) {
+        in4[i] = (uint8_t)(1u + i % 255u);
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(in4, 254, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(BSF_COBS_MAX_SIZE(254u), (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8(0xFF, buf[0]);
+    TEST_ASSERT_EQUAL_HEX8(0x01, buf[255]);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(buf, n, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_UINT32(254u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(in4, body, 254);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(in4, 255, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(257u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8(0x02, buf[255]);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(buf, n, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_UINT32(255u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(in4, body, 255);
+}
+
+static void test_cobs_refuses_zero_bytes_truncation_and_small_buffers(void)
+{
+    static const uint8_t has_zero[] = {0x03, 0x11, 0x00};
+    static const uint8_t truncated[] = {0x05, 0x11, 0x22};
+    static const uint8_t in[] = {0x11, 0x22, 0x33};
+    size_t n = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_cobs_decode(has_zero, 3, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_cobs_decode(truncated, 3, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_cobs_encode(in, 3, buf, 3, &n));
+    TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_cobs_decode(golden_minimal, sizeof golden_minimal - 1u, body, 3, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_cobs_encode(NULL, 3, buf, sizeof buf, &n));
+}
+
+/* ---- Golden frames ---- */
+
+static void test_golden_minimal_frame_matches_format_md_and_decodes(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    fx_example_minimal(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_minimal, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_minimal, buf, sizeof golden_minimal);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_minimal, sizeof golden_minimal, 5u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT8(BSF_FORMAT_VERSION, frame.version);
+    TEST_ASSERT_EQUAL_UINT8(BSF_FRAME_TYPE_FEATURES, frame.type);
+    TEST_ASSERT_EQUAL_FLOAT(0.5f, frame.result.ctrl[0].y);
+    TEST_ASSERT_EQUAL_FLOAT(0.8f, frame.result.ctrl[1].y);
+}
+
+static void test_golden_typical_frame_matches_format_md_and_decodes(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    printf("typical synthetic frame (6 features, 26 ctrl, 4 vertex copies): %u bytes\n",
+           (unsigned)n);
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_typical, buf, sizeof golden_typical);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_typical, sizeof golden_typical, 1u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT16(26u, frame.result.n_ctrl);
+    TEST_ASSERT_EQUAL_UINT8(1u, frame.result.ctrl_is_vertex[5]);
+    TEST_ASSERT_EQUAL_UINT8(1u, frame.result.ctrl_is_vertex[6]);
+    TEST_ASSERT_EQUAL_UINT8(0u, frame.result.ctrl_is_vertex[7]);
+    TEST_ASSERT_EQUAL_FLOAT(frame.result.ctrl[5].x, frame.result.ctrl[6].x);
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.frames_ok);
+}
+
+static void test_one_shot_decode_reads_golden_body(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(golden_typical, sizeof golden_typical - 1u, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, n, &frame));
+    assert_round_trip(&info, &res, &frame);
+    body[7] ^= 0x40u;
+    memset(&frame, 0x5A, sizeof frame);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CRC, bsf_frame_decode(body, n, &frame));
+    TEST_ASSERT_EQUAL_HEX8(0x5A, frame.version); /* untouched */
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CRC, bsf_frame_decode(body, 4u, &frame));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_decode(NULL, n, &frame));
+}
+
+/* ---- Encoder ---- */
+
+static void test_size_query_equals_written_length(void)
+{
+    fx_rng_t rng;
+    bsf_frame_info_t info;
+    unsigned i;
+    fx_rng_seed(&rng, 11u);
+    for (i = 0; i < 20u; ++i) {
+        size_t need = 0;
+        size_t n = 0;
+        fx_random_result(&rng, 10u, &info, &res);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, NULL, 0u, &need));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)need, (uint32_t)n);
+        TEST_ASSERT_EQUAL_HEX8(0x00, buf[n - 1u]);
+        TEST_ASSERT_NULL(memchr(buf, 0, n - 1u));
+    }
+}
+
+static void test_too_small_buffer_is_refused_without_writing(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    fx_example_typical(&info, &res);
+    memset(buf, 0xEE, sizeof buf);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode(&info, &res, buf, sizeof golden_typical - 1u, &n));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical, (uint32_t)n);
+    TEST_ASSERT_EACH_EQUAL_HEX8(0xEE, buf, sizeof golden_typical);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof golden_typical, &n));
+}
+
+typedef struct {
+    size_t len;
+    size_t calls;
+    size_t largest;
+    size_t fail_after; /* refuse the call with this index (0: never) */
+} sink_log_t;
+
+static int record_sink(void *ctx, const uint8_t *data, size_t len)
+{
+    sink_log_t *log = (sink_log_t *)ctx;
+    ++log->calls;
+    if (log->fail_after != 0u && log->calls >= log->fail_after) {
+        return 1;
+    }
+    memcpy(scratch + log->len, data, len);
+    log->len += len;
+    if (len > log->largest) {
+        log->largest = len;
+    }
+    return 0;
+}
+
+static void test_sink_gets_the_same_bytes_in_blocks_of_at_most_256(void)
+{
+    static bsf_encoder_t work;
+    fx_rng_t rng;
+    bsf_frame_info_t info;
+    sink_log_t log;
+    size_t n = 0;
+    size_t written = 0;
+    fx_rng_seed(&rng, 5u);
+    fx_random_result(&rng, 40u, &info, &res);
+    res.n_features = 0u;
+    while (res.n_features < 20u) { /* make it long enough for several COBS blocks */
+        fx_random_result(&rng, 40u, &info, &res);
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_TRUE(n > 600u);
+    memset(&log, 0, sizeof log);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)written);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)log.len);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(buf, scratch, n);
+    TEST_ASSERT_TRUE(log.largest <= 256u);
+    TEST_ASSERT_TRUE(log.calls >= 3u);
+
+    memset(&log, 0, sizeof log);
+    log.fail_after = 2u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
+    TEST_ASSERT_TRUE(written < n);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&work, &info, &res, NULL, &log, &written));
+}
+
+static void test_random_results_round_trip_within_half_a_step(void)
+{
+    fx_rng_t rng;
+    bsf_frame_info_t info;
+    unsigned i;
+    fx_rng_seed(&rng, 2024u);
+    for (i = 0; i < N_ROUND_TRIPS; ++i) {
+        size_t n = 0;
+        fx_random_result(&rng, 10u, &info, &res);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+        TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 1u + fx_rng_range(&rng, 0u, 40u)));
+        assert_round_trip(&info, &res, &frame);
+    }
+    TEST_ASSERT_EQUAL_UINT32(N_ROUND_TRIPS, dec.stats.frames_ok);
+    TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.bytes_skipped);
+}
+
+static void test_vertex_travels_once_and_is_expanded_on_decode(void)
+{
+    bsf_frame_info_t info;
+    size_t with_vertex = 0;
+    size_t n = 0;
+    fx_example_minimal(&info, &res);
+    /* b0, V, V, b1: the vertex's second copy costs no control point bytes. */
+    res.ctrl[3] = res.ctrl[2];
+    res.ctrl[2] = res.ctrl[1];
+    res.ctrl_is_vertex[1] = 1u;
+    res.ctrl_is_vertex[2] = 1u;
+    res.features[0].n_ctrl = 4u;
+    res.features[0].kind = BSF_FEATURE_AUXILIARY;
+    res.n_ctrl = 4u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &with_vertex));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, with_vertex, 64u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT8(4u, frame.result.features[0].n_ctrl);
+    fx_example_minimal(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, NULL, 0u, &n));
+    /* Only the vertex mask (1 byte) and a larger residual may be added. */
+    TEST_ASSERT_TRUE(with_vertex <= n + 3u);
+}
+
+static void test_encoder_rejects_values_it_cannot_represent(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    unsigned c;
+    for (c = 0; c < 19u; ++c) {
+        bsf_status_t want = BSF_ERR_ARG;
+        fx_example_typical(&info, &res);
+        switch (c) {
+        case 0: res.ctrl[2].x = NAN; break;
+        case 1: res.ctrl[2].y = INFINITY; break;
+        case 2: res.ctrl[0].x = 20000.0f; break; /* > 2^23 steps of 2 mm */
+        case 3: info.quant_step = 0.0f; break;
+        case 4: info.quant_step = 2.0f; break;
+        case 5: info.quant_step = NAN; break;
+        case 6: info.pose_theta = NAN; break;
+        case 7: info.pose_x = 3e6f; break;
+        case 8: res.ctrl_is_vertex[6] = 0u; break; /* vertex without its copy */
+        case 9: res.ctrl[6].x += 0.01f; break;      /* copies differ */
+        case 10: res.features[2].n_ctrl = 2u; break;
+        case 11: res.features[5].n_ctrl = 5u; break; /* beyond result->n_ctrl */
+        case 12: res.features[1].last_beam = 40u; break;
+        case 13: res.features[1].n_points = 56u; break;
+        case 14: res.features[1].kind = 2u; break;
+        case 15: res.stats.n_valid = 100u; break; /* fewer than the points in features */
+        case 16: res.features[0].e_curve = -0.001f; break;
+        case 17: res.n_features = BSF_MAX_SEGMENTS + 1u; want = BSF_ERR_CAPACITY; break;
+        default: res.features[5].last_beam = BSF_MAX_POINTS; break;
+        }
+        TEST_ASSERT_EQUAL_INT_MESSAGE(want, bsf_frame_encode(&info, &res, buf, sizeof buf, &n), "case");
+        TEST_ASSERT_EQUAL_INT(want, bsf_frame_encode(&info, &res, NULL, 0u, &n));
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(NULL, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, NULL));
+}
+
+static void test_worst_case_frame_fits_the_max_size_macro(void)
+{
+    bsf_frame_info_t info;
+    uint16_t i;
+    uint16_t k;
+    size_t n = 0;
+    const float far = (float)BSF_QUANT_MAX_STEPS * 0.0001f;
+    bsf_frame_info_init(&info);
+    info.seq = UINT32_MAX;
+    info.timestamp_ms = UINT64_MAX;
+    info.has_pose = 1u;
+    info.pose_x = -BSF_POSE_XY_MAX;
+    info.pose_y = BSF_POSE_XY_MAX;
+    info.pose_theta = 3.0f;
+    info.quant_step = 0.0001f;
+    memset(&res, 0, sizeof res);
+    res.n_features = BSF_MAX_SEGMENTS;
+    res.n_ctrl = BSF_MAX_CTRL_POINTS;
+    for (i = 0; i < BSF_MAX_SEGMENTS; ++i) {
+        bsf_feature_t *f = &res.features[i];
+        f->ctrl_first = (uint16_t)(i * (BSF_MAX_CTRL_POINTS / BSF_MAX_SEGMENTS));
+        f->n_ctrl = (uint8_t)(BSF_MAX_CTRL_POINTS / BSF_MAX_SEGMENTS);
+        f->first_beam = (uint16_t)(i % 2u == 0u ? BSF_MAX_POINTS - 1u : 0u);
+        f->last_beam = f->first_beam;
+        f->n_points = 0u;
+        f->e_curve = BSF_E_CURVE_MAX;
+        f->kind = 1u;
+        for (k = 0; k < f->n_ctrl; ++k) {
+            res.ctrl[f->ctrl_first + k].x = (k + i) % 2u == 0u ? far : -far;
+            res.ctrl[f->ctrl_first + k].y = (k + i) % 2u == 0u ? -far : far;
+        }
+    }
+    res.stats.n_valid = BSF_MAX_POINTS;
+    res.stats.time_ns = UINT32_MAX;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    printf("worst-case test frame: %u bytes (BSF_FRAME_MAX_SIZE %u)\n", (unsigned)n,
+           (unsigned)BSF_FRAME_MAX_SIZE);
+    TEST_ASSERT_TRUE(n <= BSF_FRAME_MAX_SIZE);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 700u));
+    TEST_ASSERT_EQUAL_UINT16(BSF_MAX_CTRL_POINTS, frame.result.n_ctrl);
+    TEST_ASSERT_FLOAT_WITHIN(0.0001f, far, frame.result.ctrl[0].x);
+}
+
+/* ---- Stream decoder ---- */
+
+static void test_decoder_delivers_each_of_two_frames_in_one_chunk(void)
+{
+    bsf_frame_info_t info;
+    size_t n1 = 0;
+    size_t n2 = 0;
+    size_t used = 0;
+    fx_example_minimal(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n1));
+    info.seq = 7u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf + n1, sizeof buf - n1, &n2));
+    TEST_ASSERT_EQUAL_INT(1, bsf_decoder_feed(&dec, buf, n1 + n2, &used, &frame));
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n1, (uint32_t)used);
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.seq);
+    TEST_ASSERT_EQUAL_INT(1, bsf_decoder_feed(&dec, buf + n1, n2, &used, &frame));
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n2, (uint32_t)used);
+    TEST_ASSERT_EQUAL_UINT32(7u, frame.seq);
+    TEST_ASSERT_EQUAL_INT(0, bsf_decoder_feed(&dec, NULL, 0u, &used, &frame));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_decoder_feed(&dec, buf, 1u, NULL, &frame));
+}
+
+static void test_truncated_frames_are_never_delivered(void)
+{
+    size_t cut;
+    unsigned delivered = 0;
+    const uint8_t zero = 0u;
+    for (cut = 1; cut < sizeof golden_typical - 1u; ++cut) {
+        delivered += feed_all(golden_typical, cut, cut);
+        delivered += feed_all(&zero, 1u, 1u);
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, delivered);
+    TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.frames_ok);
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical - 2u,
+                             dec.stats.bad_crc + dec.stats.malformed);
+    /* Back in step right away. */
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_typical, sizeof golden_typical, 9u));
+}
+
+static void test_oversized_frame_is_skipped_and_counted(void)
+{
+    size_t i;
+    unsigned delivered = 0;
+    for (i = 0; i < sizeof scratch; ++i) {
+        scratch[i] = (uint8_t)(1u + i % 200u);
+    }
+    delivered += feed_all(scratch, sizeof scratch, 1000u);
+    delivered += feed_all(golden_minimal, sizeof golden_minimal, 1000u); /* its 0x00 ends the junk */
+    delivered += feed_all(golden_minimal, sizeof golden_minimal, 1000u);
+    TEST_ASSERT_EQUAL_UINT32(1u, delivered);
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.oversize);
+    TEST_ASSERT_EQUAL_UINT32(sizeof scratch + sizeof golden_minimal - 1u, dec.stats.bytes_skipped);
+}
+
+static void test_stream_of_only_delimiters_yields_nothing_and_counts_nothing(void)
+{
+    static const bsf_decoder_stats_t zero_stats;
+    memset(scratch, 0, 1000u);
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, 1000u, 7u));
+    TEST_ASSERT_EQUAL_MEMORY(&zero_stats, &dec.stats, sizeof zero_stats);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_minimal, sizeof golden_minimal, 3u));
+}
+
+static void test_garbage_before_the_first_frame_is_skipped(void)
+{
+    fx_rng_t rng;
+    size_t i;
+    fx_rng_seed(&rng, 99u);
+    for (i = 0; i < 300u; ++i) {
+        scratch[i] = (uint8_t)fx_rng_range(&rng, 1u, 255u);
+    }
+    scratch[300] = 0u;
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, 301u, 17u));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_typical, sizeof golden_typical, 17u));
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.bad_crc + dec.stats.malformed);
+    TEST_ASSERT_EQUAL_UINT32(300u, dec.stats.bytes_skipped);
+    TEST_ASSERT_EQUAL_UINT32(1234u, frame.seq);
+}
+
+static void test_unknown_version_and_type_are_counted_and_skipped(void)
+{
+    uint8_t payload[64];
+    const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, payload);
+    size_t n;
+    payload[0] = 0x21; /* version 2 */
+    n = reframe(payload, len, scratch);
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.unsupported_version);
+    payload[0] = 0x12; /* version 1, type 2 */
+    n = reframe(payload, len, scratch);
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.unknown_type);
+    payload[0] = 0x11;
+    n = reframe(payload, len, scratch);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(scratch, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.malformed);
+}
+
+static void test_malformed_fields_are_dropped_and_counted(void)
+{
+    uint8_t base[64];
+    uint8_t payload[72];
+    const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, base);
+    unsigned c;
+    /* Payload of example 1: 11 00 00 00 14 14 00 01 | 08 14 13 32 | e8 07 f4 03 e8 07 f4 03 00 32 */
+    for (c = 0; c < 10u; ++c) {
+        size_t plen = len;
+        size_t n;
+        memcpy(payload, base, len);
+        switch (c) {
+        case 0: payload[1] = 0x02; break;             /* reserved flag bit */
+        case 1: payload[plen++] = 0x00; break;        /* trailing byte */
+        case 2: plen -= 1u; break;                    /* field cut short */
+        case 3: payload[4] = 0x00; break;             /* quantisation step 0 */
+        case 4: payload[7] = 0x02; break;             /* 2 features announced, 1 sent */
+        case 5: payload[8] = 0x00; break;             /* 2 control points */
+        case 6: payload[10] = 0xFF; payload[11] = 0x7F; break; /* last beam beyond the caps */
+        case 7: payload[5] = 0x05; break;             /* N smaller than points in features */
+        case 8: /* non-minimal varint: seq as 0x80 0x00 */
+            memmove(payload + 3, payload + 2, len - 2u);
+            payload[2] = 0x80;
+            ++plen;
+            break;
+        default: payload[8] = 0x0A; break;            /* vertex flag without a mask */
+        }
+        n = reframe(payload, plen, scratch);
+        TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u), "malformed frame delivered");
+        TEST_ASSERT_EQUAL_UINT32(c + 1u, dec.stats.malformed);
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.bad_crc);
+    TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.frames_ok);
+}
+
+static void test_bad_crc_is_dropped_and_the_next_frame_decodes(void)
+{
+    memcpy(scratch, golden_typical, sizeof golden_typical);
+    scratch[40] ^= 0x01u;
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, sizeof golden_typical, 50u));
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.bad_crc);
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical - 1u, dec.stats.bytes_skipped);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_typical, sizeof golden_typical, 50u));
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.frames_ok);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_crc32c_check_value_and_chaining);
+    RUN_TEST(test_cobs_encodes_reference_vectors_and_decodes_them_back);
+    RUN_TEST(test_cobs_refuses_zero_bytes_truncation_and_small_buffers);
+    RUN_TEST(test_golden_minimal_frame_matches_format_md_and_decodes);
+    RUN_TEST(test_golden_typical_frame_matches_format_md_and_decodes);
+    RUN_TEST(test_one_shot_decode_reads_golden_body);
+    RUN_TEST(test_size_query_equals_written_length);
+    RUN_TEST(test_too_small_buffer_is_refused_without_writing);
+    RUN_TEST(test_sink_gets_the_same_bytes_in_blocks_of_at_most_256);
+    RUN_TEST(test_random_results_round_trip_within_half_a_step);
+    RUN_TEST(test_vertex_travels_once_and_is_expanded_on_decode);
+    RUN_TEST(test_encoder_rejects_values_it_cannot_represent);
+    RUN_TEST(test_worst_case_frame_fits_the_max_size_macro);
+    RUN_TEST(test_decoder_delivers_each_of_two_frames_in_one_chunk);
+    RUN_TEST(test_truncated_frames_are_never_delivered);
+    RUN_TEST(test_oversized_frame_is_skipped_and_counted);
+    RUN_TEST(test_stream_of_only_delimiters_yields_nothing_and_counts_nothing);
+    RUN_TEST(test_garbage_before_the_first_frame_is_skipped);
+    RUN_TEST(test_unknown_version_and_type_are_counted_and_skipped);
+    RUN_TEST(test_malformed_fields_are_dropped_and_counted);
+    RUN_TEST(test_bad_crc_is_dropped_and_the_next_frame_decodes);
+    return UNITY_END();
+}
