@@ -44,10 +44,9 @@ static float sin_kernel(float r)
 static float cos_kernel(float r)
 {
     const float r2 = r * r;
-    return 1.0f +
-           r2 * (-0.5f +
-                 r2 * (1.0f / 24.0f +
-                       r2 * (-1.0f / 720.0f + r2 * (1.0f / 40320.0f + r2 * (-1.0f / 3628800.0f)))));
+    return 1.0f + r2 * (-0.5f + r2 * (1.0f / 24.0f +
+                                      r2 * (-1.0f / 720.0f +
+                                            r2 * (1.0f / 40320.0f + r2 * (-1.0f / 3628800.0f)))));
 }
 
 /* x = k * pi/2 + r with |r| <= about pi/4; returns r and the quadrant k mod 4. */
@@ -121,11 +120,10 @@ float bsf_expf(float x)
     r = (x - k * LN2_HI) - k * LN2_LO; /* |r| <= about ln2 / 2 */
     /* Taylor series to degree 7: truncation below 5e-9 relative */
     y = 1.0f +
-        r * (1.0f +
-             r * (0.5f +
-                  r * (1.0f / 6.0f +
-                       r * (1.0f / 24.0f +
-                            r * (1.0f / 120.0f + r * (1.0f / 720.0f + r * (1.0f / 5040.0f)))))));
+        r * (1.0f + r * (0.5f + r * (1.0f / 6.0f +
+                                     r * (1.0f / 24.0f +
+                                          r * (1.0f / 120.0f +
+                                               r * (1.0f / 720.0f + r * (1.0f / 5040.0f)))))));
     ki = (int)k;
     if (ki > 127) {
         y *= 2.0f;
@@ -153,8 +151,8 @@ static float atan_unit(float t)
            (t + t * t2 *
                     (-1.0f / 3.0f +
                      t2 * (1.0f / 5.0f +
-                           t2 * (-1.0f / 7.0f +
-                                 t2 * (1.0f / 9.0f + t2 * (-1.0f / 11.0f + t2 * (1.0f / 13.0f)))))));
+                           t2 * (-1.0f / 7.0f + t2 * (1.0f / 9.0f + t2 * (-1.0f / 11.0f +
+                                                                          t2 * (1.0f / 13.0f)))))));
 }
 
 float bsf_atan2f(float y, float x)

@@ -56,7 +56,8 @@ static int untouched(const void *p, size_t n)
     return 1;
 }
 
-#define ASSERT_UNTOUCHED(obj) TEST_ASSERT_TRUE_MESSAGE(untouched(&(obj), sizeof(obj)), #obj " was written")
+#define ASSERT_UNTOUCHED(obj)                                                                      \
+    TEST_ASSERT_TRUE_MESSAGE(untouched(&(obj), sizeof(obj)), #obj " was written")
 
 static int finite_f(float v)
 {
@@ -179,8 +180,8 @@ static void test_scan_to_points_counts_at_and_above_capacity(void)
     TEST_ASSERT_EQUAL_UINT32(BSF_MAX_POINTS, (uint32_t)points.n_valid);
     for (i = 0; i < BSF_MAX_POINTS; ++i) {
         TEST_ASSERT_TRUE(finite_f(points.pt[i].x) && finite_f(points.pt[i].y));
-        TEST_ASSERT_FLOAT_WITHIN(1e-4f, 3.0f, sqrtf(points.pt[i].x * points.pt[i].x +
-                                                    points.pt[i].y * points.pt[i].y));
+        TEST_ASSERT_FLOAT_WITHIN(
+            1e-4f, 3.0f, sqrtf(points.pt[i].x * points.pt[i].x + points.pt[i].y * points.pt[i].y));
     }
 }
 
@@ -337,10 +338,12 @@ static void test_segment_all_invalid_and_empty_scans_give_no_segment(void)
     size_t n = 77u;
     size_t wasted = 77u;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)wasted);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     s.count = 0u;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
@@ -406,10 +409,12 @@ static void test_segment_duplicate_points_stay_together_and_are_counted(void)
         points.range[i] = 1.4142135f;
         points.valid[i] = 1u;
     }
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
     assert_segments_cover(n, wasted);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
     assert_segments_cover(n, wasted);
 }
 
@@ -418,10 +423,12 @@ static void test_segment_collinear_wall_is_one_segment(void)
     size_t n = 0u;
     size_t wasted = 0u;
     wall_points(200u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
     TEST_ASSERT_EQUAL_UINT16(200u, segs[0].n_points);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_rpos(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, &wasted));
     TEST_ASSERT_TRUE(n >= 1u);
     assert_segments_cover(n, wasted);
 }
@@ -433,15 +440,15 @@ static void test_segment_classify_refuses_bad_input_without_changing_segments(vo
     const uint16_t beyond[] = {10u, 60000u};
     size_t n = 0u;
     wall_points(50u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_segment_sved(&points, NULL, segs, BSF_MAX_SEGMENTS, &n, NULL));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
     {
         const bsf_segment_t before = segs[0];
         TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_segment_classify(NULL, 1u, &points, NULL, 0u));
         TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_segment_classify(segs, 1u, NULL, NULL, 0u));
         TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_segment_classify(segs, 1u, &points, NULL, 2u));
-        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
-                              bsf_segment_classify(segs, 1u, &points, descending, 2u));
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_segment_classify(segs, 1u, &points, descending, 2u));
         TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_segment_classify(segs, 1u, &points, repeated, 2u));
         segs[1] = segs[0];
         segs[1].first = 40u;
@@ -452,7 +459,8 @@ static void test_segment_classify_refuses_bad_input_without_changing_segments(vo
         TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_segment_classify(segs, 2u, &points, beyond, 1u));
         TEST_ASSERT_EQUAL_MEMORY(&before, &segs[0], sizeof before);
         points.count = BSF_MAX_POINTS + 1u;
-        TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_segment_classify(segs, 1u, &points, beyond, 2u));
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
+                              bsf_segment_classify(segs, 1u, &points, beyond, 2u));
         TEST_ASSERT_EQUAL_MEMORY(&before, &segs[0], sizeof before);
         points.count = 50u;
     }
@@ -505,31 +513,38 @@ static void test_falko_detect_refuses_null_and_bad_geometry_with_zero_count(void
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(NULL, &p, &falko_work, keypoints, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     n = 77u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, NULL, &falko_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_falko_detect(&points, NULL, &falko_work, keypoints, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     n = 77u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, &p, NULL, keypoints, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, NULL));
     n = 77u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, &p, &falko_work, NULL, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     points.angle_increment = 0.0f;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
     points.angle_increment = NAN;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
     points.angle_increment = INFINITY;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     points.angle_increment = 0.01f;
     points.count = BSF_MAX_POINTS + 1u;
     n = 77u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
+                          bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     points.count = 100u;
     p.grid_sectors = 0;
     n = 77u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM,
+                          bsf_falko_detect(&points, &p, &falko_work, keypoints, 4u, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     ASSERT_UNTOUCHED(keypoints);
 }
@@ -563,8 +578,8 @@ static void test_falko_detect_degenerate_scans_give_finite_keypoints_or_none(voi
     /* all invalid */
     bsf_scan_t s = make_scan(BSF_MAX_POINTS, INFINITY);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints,
-                                                   BSF_MAX_KEYPOINTS, &n));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints, BSF_MAX_KEYPOINTS, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     /* fewer valid beams than a neighbourhood needs */
     s = make_scan(4u, 2.0f);
@@ -573,8 +588,8 @@ static void test_falko_detect_degenerate_scans_give_finite_keypoints_or_none(voi
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     /* a straight wall has no corner */
     wall_points(300u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints,
-                                                   BSF_MAX_KEYPOINTS, &n));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints, BSF_MAX_KEYPOINTS, &n));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
     /* every beam the same point */
     for (i = 0; i < points.count; ++i) {
@@ -582,8 +597,8 @@ static void test_falko_detect_degenerate_scans_give_finite_keypoints_or_none(voi
         points.pt[i].y = 2.0f;
         points.range[i] = 2.236068f;
     }
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints,
-                                                   BSF_MAX_KEYPOINTS, &n));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints, BSF_MAX_KEYPOINTS, &n));
     TEST_ASSERT_TRUE(n <= BSF_MAX_KEYPOINTS);
     for (i = 0; i < n; ++i) {
         TEST_ASSERT_TRUE(finite_f(keypoints[i].point.x) && finite_f(keypoints[i].point.y));
@@ -596,13 +611,14 @@ static void test_falko_detect_reports_total_when_out_is_too_small(void)
     bsf_falko_params_t p = bsf_falko_params_default();
     size_t n = 0u;
     corner_points(400u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints,
-                                                   BSF_MAX_KEYPOINTS, &n));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_falko_detect(&points, &p, &falko_work, keypoints, BSF_MAX_KEYPOINTS, &n));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
     TEST_ASSERT_FLOAT_WITHIN(0.05f, 3.0f, keypoints[0].point.x);
     TEST_ASSERT_FLOAT_WITHIN(0.05f, 2.0f, keypoints[0].point.y);
     n = 0u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_falko_detect(&points, &p, &falko_work, NULL, 0u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
+                          bsf_falko_detect(&points, &p, &falko_work, NULL, 0u, &n));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
 }
 
@@ -665,9 +681,11 @@ static void test_bspline_eval_refuses_bad_arguments_untouched(void)
     ASSERT_UNTOUCHED(pt);
     ASSERT_UNTOUCHED(d1);
     /* out-of-range t is clamped to the ends */
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(c, BSF_MAX_CTRL_PER_FEATURE, -5.0f, &pt, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_bspline_eval(c, BSF_MAX_CTRL_PER_FEATURE, -5.0f, &pt, NULL, NULL));
     TEST_ASSERT_FLOAT_WITHIN(1e-6f, 0.0f, pt.x);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(c, BSF_MAX_CTRL_PER_FEATURE, 1.0e30f, &pt, &d1, NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_bspline_eval(c, BSF_MAX_CTRL_PER_FEATURE, 1.0e30f, &pt, &d1, NULL));
     TEST_ASSERT_FLOAT_WITHIN(1e-4f, (float)(BSF_MAX_CTRL_PER_FEATURE - 1), pt.x);
     TEST_ASSERT_TRUE(finite_f(d1.x) && finite_f(d1.y));
 }
@@ -819,7 +837,8 @@ static void test_pdm_refuses_bad_input_untouched(void)
                           pdm(200u, v_many, BSF_PDM_MAX_VERTICES + 1u, NULL, 64u, &n_ctrl, &e));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_DEGENERATE, pdm(2u, NULL, 0u, NULL, 32u, &n_ctrl, &e));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_DEGENERATE, pdm(0u, NULL, 0u, NULL, 32u, &n_ctrl, &e));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, pdm(BSF_MAX_POINTS + 1u, NULL, 0u, NULL, 32u, &n_ctrl, &e));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
+                          pdm(BSF_MAX_POINTS + 1u, NULL, 0u, NULL, 32u, &n_ctrl, &e));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, pdm(20u, NULL, 0u, NULL, 2u, &n_ctrl, &e));
     bsf_pdm_params_default(&p);
     p.rel_tol = NAN;
@@ -859,12 +878,13 @@ static void test_pdm_collinear_duplicated_and_maximal_inputs_give_finite_fits(vo
     float e = -1.0f;
     size_t k;
     line_pts(BSF_MAX_POINTS);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, pdm(BSF_MAX_POINTS, NULL, 0u, NULL, BSF_MAX_CTRL_PER_FEATURE,
-                                      &n_ctrl, &e));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, pdm(BSF_MAX_POINTS, NULL, 0u, NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e));
     assert_pdm_output_valid(n_ctrl, e);
     TEST_ASSERT_TRUE(e < 1e-3f);
     /* a "vertex" on a straight line */
-    TEST_ASSERT_EQUAL_INT(BSF_OK, pdm(200u, v_mid, 1u, NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          pdm(200u, v_mid, 1u, NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e));
     assert_pdm_output_valid(n_ctrl, e);
     /* each point twice */
     for (k = 100u; k-- > 0u;) {
@@ -1240,9 +1260,8 @@ static void test_frame_encode_refuses_unrepresentable_input_without_writing(void
         bsf_frame_info_init(&info);                                                                \
         small_result();                                                                            \
         stmt;                                                                                      \
-        TEST_ASSERT_EQUAL_INT_MESSAGE(expect,                                                      \
-                                      bsf_frame_encode(&info, &result, frame_buf, 64u, &len),      \
-                                      #stmt);                                                      \
+        TEST_ASSERT_EQUAL_INT_MESSAGE(                                                             \
+            expect, bsf_frame_encode(&info, &result, frame_buf, 64u, &len), #stmt);                \
     } while (0)
     BAD_ENCODE(BSF_ERR_ARG, result.ctrl[1].x = NAN);
     BAD_ENCODE(BSF_ERR_ARG, result.ctrl[1].y = -INFINITY);
@@ -1275,13 +1294,15 @@ static void test_frame_encode_refuses_unrepresentable_input_without_writing(void
     TEST_ASSERT_TRUE(len > 5u && len <= BSF_FRAME_MAX_SIZE);
     {
         size_t need = 0u;
-        TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode(&info, &result, frame_buf, len - 1u, &need));
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                              bsf_frame_encode(&info, &result, frame_buf, len - 1u, &need));
         TEST_ASSERT_EQUAL_UINT32((uint32_t)len, (uint32_t)need);
     }
     ASSERT_UNTOUCHED(frame_buf);
     /* an empty result is a valid frame */
     memset(&result, 0, sizeof result);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &result, frame_buf, sizeof frame_buf, &len));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_frame_encode(&info, &result, frame_buf, sizeof frame_buf, &len));
     TEST_ASSERT_EQUAL_UINT8(0u, frame_buf[len - 1u]);
 }
 
@@ -1308,21 +1329,28 @@ static void test_frame_encode_sink_refuses_null_and_reports_a_failing_sink(void)
     size_t len = 0u;
     bsf_frame_info_init(&info);
     small_result();
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(NULL, &info, &result, counting_sink, &st, &written));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, &info, &result, NULL, &st, &written));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, NULL, &result, counting_sink, &st, &written));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, &info, NULL, counting_sink, &st, &written));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_ERR_ARG, bsf_frame_encode_sink(NULL, &info, &result, counting_sink, &st, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_frame_encode_sink(&encoder, &info, &result, NULL, &st, &written));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, NULL, &result, counting_sink, &st, &written));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, &info, NULL, counting_sink, &st, &written));
     result.ctrl[0].x = NAN;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, &info, &result, counting_sink, &st, &written));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_ERR_ARG, bsf_frame_encode_sink(&encoder, &info, &result, counting_sink, &st, &written));
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)st.calls);
     small_result();
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &result, NULL, 0u, &len));
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode_sink(&encoder, &info, &result, counting_sink, &st, NULL));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_frame_encode_sink(&encoder, &info, &result, counting_sink, &st, NULL));
     TEST_ASSERT_EQUAL_UINT32((uint32_t)len, (uint32_t)st.bytes);
     st.calls = 0u;
     st.bytes = 0u;
     st.fail_at = 1u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode_sink(&encoder, &info, &result, counting_sink, &st, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode_sink(&encoder, &info, &result,
+                                                                counting_sink, &st, &written));
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)st.calls);
 }
 
@@ -1334,7 +1362,8 @@ static size_t encode_small_body(uint8_t *body)
     size_t blen = 0u;
     bsf_frame_info_init(&info);
     small_result();
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &result, frame_buf, sizeof frame_buf, &len));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_frame_encode(&info, &result, frame_buf, sizeof frame_buf, &len));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(frame_buf, len - 1u, body, sizeof bytes, &blen));
     return blen;
 }
@@ -1378,7 +1407,8 @@ static void test_decoded_time_survives_reencoding(void)
 {
     /* version 1 / type 1, no flags, seq 0, time stamp 0, step code 20 (2 mm),
      * N 0, time_us 5000000 (LEB128 c0 96 b1 02), no feature; then CRC-32C */
-    uint8_t body[16] = {0x11u, 0x00u, 0x00u, 0x00u, 0x14u, 0x00u, 0xC0u, 0x96u, 0xB1u, 0x02u, 0x00u};
+    uint8_t body[16] = {0x11u, 0x00u, 0x00u, 0x00u, 0x14u, 0x00u,
+                        0xC0u, 0x96u, 0xB1u, 0x02u, 0x00u};
     const size_t n = 11u;
     const uint32_t crc = bsf_crc32c(0u, body, n);
     bsf_frame_info_t info;
@@ -1396,7 +1426,8 @@ static void test_decoded_time_survives_reencoding(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK, st);
     TEST_ASSERT_EQUAL_UINT32(5000000u, frame.time_us);
     bsf_frame_info_init(&info);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &frame.result, frame_buf, sizeof frame_buf, &len));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_frame_encode(&info, &frame.result, frame_buf, sizeof frame_buf, &len));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(frame_buf, len - 1u, bytes, sizeof bytes, &blen));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(bytes, blen, &frame));
     TEST_ASSERT_EQUAL_UINT32(5000000u, frame.time_us);
@@ -1441,7 +1472,8 @@ static void test_decoder_feed_refuses_null_and_survives_garbage_and_oversize(voi
         size_t len = 0u;
         bsf_frame_info_init(&info);
         small_result();
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &result, frame_buf, sizeof frame_buf, &len));
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_frame_encode(&info, &result, frame_buf, sizeof frame_buf, &len));
         r = bsf_decoder_feed(&decoder, frame_buf, len, &used, &frame);
         TEST_ASSERT_EQUAL_INT(1, r);
         TEST_ASSERT_EQUAL_UINT32((uint32_t)len, (uint32_t)used);

@@ -12,12 +12,12 @@
 #include "fuzz_check.h"
 
 enum {
-    F_RPOS = 0x01,      /* method RPOS-LSBA instead of FALKO-SVED-PDM */
+    F_RPOS = 0x01,       /* method RPOS-LSBA instead of FALKO-SVED-PDM */
     F_RAW_RANGES = 0x02, /* ranges are raw float bits (else uint16 millimetres) */
-    F_RAW_GEOM = 0x04,  /* geometry is raw float bits (else small codes) */
-    F_PARAMS = 0x08,    /* segmentation and FALKO parameters follow */
-    F_OVER_CAP = 0x10,  /* claim one beam more than BSF_MAX_POINTS */
-    F_ENCODE = 0x20     /* also encode and decode the result */
+    F_RAW_GEOM = 0x04,   /* geometry is raw float bits (else small codes) */
+    F_PARAMS = 0x08,     /* segmentation and FALKO parameters follow */
+    F_OVER_CAP = 0x10,   /* claim one beam more than BSF_MAX_POINTS */
+    F_ENCODE = 0x20      /* also encode and decode the result */
 };
 
 static bsf_extractor_t ex;
@@ -116,8 +116,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     in.p = data;
     in.n = size;
     flags = (uint8_t)take_u32(&in, 1u);
-    params = bsf_params_default((flags & F_RPOS) ? BSF_METHOD_RPOS_LSBA
-                                                 : BSF_METHOD_FALKO_SVED_PDM);
+    params =
+        bsf_params_default((flags & F_RPOS) ? BSF_METHOD_RPOS_LSBA : BSF_METHOD_FALKO_SVED_PDM);
     if (flags & F_RAW_GEOM) {
         scan.angle_min = take_raw_float(&in);
         scan.angle_increment = take_raw_float(&in);

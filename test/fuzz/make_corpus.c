@@ -16,8 +16,7 @@ static bsf_result_t res;
 static float ranges[BSF_MAX_POINTS];
 static uint8_t wire[BSF_FRAME_MAX_SIZE];
 
-static int write_file(const char *dir, const char *sub, const char *name, const void *p,
-                      size_t n)
+static int write_file(const char *dir, const char *sub, const char *name, const void *p, size_t n)
 {
     char path[512];
     FILE *f;
