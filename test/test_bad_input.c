@@ -1504,7 +1504,6 @@ int main(void)
     RUN_TEST(test_falko_detect_degenerate_scans_give_finite_keypoints_or_none);
     RUN_TEST(test_falko_detect_reports_total_when_out_is_too_small);
     RUN_TEST(test_bspline_span_and_basis_clamp_bad_arguments);
-    RUN_TEST(test_bspline_span_stays_in_range_for_huge_control_point_counts);
     RUN_TEST(test_bspline_eval_refuses_bad_arguments_untouched);
     RUN_TEST(test_lsba_refuses_bad_input_untouched);
     RUN_TEST(test_lsba_collinear_duplicated_and_maximal_inputs_give_finite_fits);
@@ -1523,7 +1522,10 @@ int main(void)
     RUN_TEST(test_frame_encode_refuses_unrepresentable_input_without_writing);
     RUN_TEST(test_frame_encode_sink_refuses_null_and_reports_a_failing_sink);
     RUN_TEST(test_frame_decode_refuses_short_corrupt_and_unknown_frames_untouched);
-    RUN_TEST(test_decoded_time_survives_reencoding);
     RUN_TEST(test_decoder_feed_refuses_null_and_survives_garbage_and_oversize);
+    /* Known bugs in other modules (see each test), last: under UBSan the
+     * first one aborts the run, and every other case has run by then. */
+    RUN_TEST(test_decoded_time_survives_reencoding);
+    RUN_TEST(test_bspline_span_stays_in_range_for_huge_control_point_counts);
     return UNITY_END();
 }
