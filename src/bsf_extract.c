@@ -38,6 +38,7 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     memset(&p, 0, sizeof p);
     p.method = method;
     p.falko = bsf_falko_params_default();
+    p.bid = bsf_bid_params_default();
     p.sved = bsf_sved_params_default();
     p.rpos = bsf_rpos_params_default();
     bsf_pdm_params_default(&p.pdm);
@@ -67,14 +68,17 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
         }
         break;
     case BSF_METHOD_BID_SVED_PDM:
-        st = BSF_ERR_PARAM; /* BID lands with the B-spline detector */
+        st = bsf_bid_params_check(&p->bid);
+        if (st == BSF_OK) {
+            st = bsf_sved_params_check(&p->sved);
+        }
+        if (st == BSF_OK) {
+            st = bsf_pdm_params_check(&p->pdm);
+        }
         break;
-    case BSF_METHOD_RPOS_LSBA:
-        st = bsf_rpos_params_check(&p->rpos);
-        break;
+    case BSF_METHOD_RPOS_LSBA: st = bsf_rpos_params_check(&p->rpos); break;
     case BSF_METHOD_COUNT:
-    default:
-        return BSF_ERR_PARAM;
+    default: return BSF_ERR_PARAM;
     }
     /* A NULL inside a valid struct cannot happen, so any failure is a value. */
     return st == BSF_OK ? BSF_OK : BSF_ERR_PARAM;
@@ -139,15 +143,16 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex)
     ex->n_keypoints = 0u;
     switch (ex->params.method) {
     case BSF_METHOD_FALKO_SVED_PDM:
-        st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->corner_work.falko,
-                              ex->keypoints, BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+        st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->scratch.falko, ex->keypoints,
+                              BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
     case BSF_METHOD_BID_SVED_PDM:
+        st = bsf_bid_detect(&ex->points, &ex->params.bid, &ex->scratch.bid, ex->keypoints,
+                            BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
     case BSF_METHOD_RPOS_LSBA:
     case BSF_METHOD_COUNT:
-    default:
-        break;
+    default: break;
     }
     if (st != BSF_OK) {
         ex->n_keypoints = 0u;
@@ -181,8 +186,8 @@ static bsf_status_t segment(bsf_extractor_t *ex)
                                 ex->n_keypoints);
 }
 
-/* Gather a segment's valid points into ex->seg_points and the positions of
- * its vertices into ex->vertex_pos: interest beams inside the segment that
+/* Gather a segment's valid points into ex->scratch.fit.seg_points and the positions of
+ * its vertices into ex->scratch.fit.vertex_pos: interest beams inside the segment that
  * are not among its first two or last two points (the rule of
  * bsf_segment_classify). Returns the number of points. */
 static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
@@ -204,15 +209,16 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
             ++k; /* an interest beam on an invalid reading is no vertex */
         }
         if (k < ex->n_keypoints && ex->interest[k] == b) {
-            ex->vertex_pos[nv++] = (uint16_t)n;
+            ex->scratch.fit.vertex_pos[nv++] = (uint16_t)n;
             ++k;
         }
-        ex->seg_points[n++] = ex->points.pt[b];
+        ex->scratch.fit.seg_points[n++] = ex->points.pt[b];
     }
     *n_vertex = 0u;
     for (i = 0; i < nv; ++i) {
-        if (ex->vertex_pos[i] >= 2u && (size_t)ex->vertex_pos[i] + 3u <= n) {
-            ex->vertex_pos[(*n_vertex)++] = ex->vertex_pos[i];
+        if (ex->scratch.fit.vertex_pos[i] >= 2u &&
+            (size_t)ex->scratch.fit.vertex_pos[i] + 3u <= n) {
+            ex->scratch.fit.vertex_pos[(*n_vertex)++] = ex->scratch.fit.vertex_pos[i];
         }
     }
     return n;
@@ -240,7 +246,7 @@ static bsf_status_t fit_features(bsf_extractor_t *ex, bsf_result_t *res)
             if (room < 4u) {
                 return BSF_ERR_CAPACITY;
             }
-            st = bsf_lsba_fit(ex->seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
+            st = bsf_lsba_fit(ex->scratch.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
             if (st == BSF_OK) {
                 n_ctrl = 4u;
                 memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
@@ -248,9 +254,9 @@ static bsf_status_t fit_features(bsf_extractor_t *ex, bsf_result_t *res)
         } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
             st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
         } else {
-            st = bsf_pdm_fit(ex->seg_points, n, ex->vertex_pos, n_vertex, &ex->params.pdm, &ex->pdm,
-                             &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl], room,
-                             &n_ctrl, &e_curve, NULL);
+            st = bsf_pdm_fit(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos, n_vertex,
+                             &ex->params.pdm, &ex->scratch.fit.pdm, &res->ctrl[res->n_ctrl],
+                             &res->ctrl_is_vertex[res->n_ctrl], room, &n_ctrl, &e_curve, NULL);
             if (st == BSF_ERR_BUFFER) {
                 return BSF_ERR_CAPACITY; /* the scan's control-point pool is full */
             }

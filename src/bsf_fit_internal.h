@@ -4,7 +4,7 @@
 #ifndef BSF_FIT_INTERNAL_H
 #define BSF_FIT_INTERNAL_H
 
-#include "bsf/bsf_common.h"
+#include "bsf/bsf_fit.h"
 
 /* Basis of span `span` of a curve with n_span spans at local u, with first
  * and second derivatives with respect to u. All three arrays are required. */
@@ -32,5 +32,17 @@ void bsf_fit_accumulate(float *band, float *rx, float *ry, const uint8_t unk[3],
 /* BSF_OK when all n points are finite with |x|, |y| <= BSF_FIT_MAX_COORD,
  * else BSF_ERR_ARG. */
 bsf_status_t bsf_fit_check_points(const bsf_point_t *pts, size_t n);
+
+/* PDM of one smooth curve (no vertex, no refinement) with n_ctrl control
+ * points, the first solve at chord-length parameters along the points' order
+ * (so the first iterate is the least-squares LSBA fit), then PDM iterations as
+ * in bsf_pdm_fit with p's max_iterations, rel_tol, lambda_per_metre and
+ * footpoint_steps (p is trusted: checked by the caller). Points are trusted
+ * too (finite, checked by the caller). Used by BID. Returns BSF_OK,
+ * BSF_ERR_ARG, BSF_ERR_CAPACITY, BSF_ERR_DEGENERATE (n < 3, n_ctrl < 3 or
+ * all points equal) or BSF_ERR_NUMERIC. */
+bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
+                               const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                               bsf_point_t *ctrl_out, float *e_curve_out, uint32_t *iterations);
 
 #endif /* BSF_FIT_INTERNAL_H */

@@ -42,7 +42,9 @@ size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius);
  * @param order     which direction is better
  * @param threshold candidates must be strictly better than this
  * @param radius    suppression radius, metres, >= 0
- * @param peak      out: at least pts->count entries; the peaks, ascending beam indices
+ * @param peak      out: at least pts->count entries, not overlapping score; it
+ *                  also serves as scratch (the windows); on return its first
+ *                  entries are the peaks, ascending beam indices
  * @return number of peaks written to peak
  */
 size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_t order,

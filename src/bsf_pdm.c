@@ -37,9 +37,10 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     p->lambda_per_metre = 1e-6f;
     p->rel_tol = 0.01f;
     p->target_rms = 0.015f;
-    p->max_iterations = 8u;
+    p->max_iterations = 2u;
+    p->refine_iterations = 1u;
     p->max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE;
-    p->footpoint_steps = 2u;
+    p->footpoint_steps = 1u;
     p->refine = 1u;
 }
 
@@ -52,9 +53,10 @@ bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
     if (!(p->precision_spacing > 0.0f && p->precision_spacing <= BSF_FIT_MAX_COORD) ||
         !(p->lambda_per_metre >= 0.0f && p->lambda_per_metre <= 1.0f) ||
         !(p->rel_tol > 0.0f && p->rel_tol < 1.0f) ||
-        !(p->target_rms > 0.0f && p->target_rms <= BSF_FIT_MAX_COORD) ||
-        p->max_iterations < 1u || p->max_iterations > BSF_PDM_MAX_ITERATIONS ||
-        p->max_ctrl < 3u || p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
+        !(p->target_rms > 0.0f && p->target_rms <= BSF_FIT_MAX_COORD) || p->max_iterations < 1u ||
+        p->max_iterations > BSF_PDM_MAX_ITERATIONS || p->refine_iterations < 1u ||
+        p->refine_iterations > BSF_PDM_MAX_ITERATIONS || p->max_ctrl < 3u ||
+        p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
         p->footpoint_steps > 8u || p->refine > 1u) {
         return BSF_ERR_PARAM;
     }
@@ -243,6 +245,21 @@ static void eval_span(const bsf_point_t *ctrl, size_t n_span, size_t span, float
     e->uuy = 2.0f * (k0 * ay + k2 * by);
 }
 
+/* Only the point and the basis of eval_span (after the last Newton step no
+ * derivative is needed). */
+static void eval_span_point(const bsf_point_t *ctrl, size_t n_span, size_t span, float u,
+                            span_eval_t *e)
+{
+    const bsf_point_t *p = ctrl + span;
+    const float k0 = span == 0u ? 1.0f : 0.5f;
+    const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
+    const float v = 1.0f - u;
+    e->b0 = k0 * v * v;
+    e->b2 = k2 * u * u;
+    e->cx = p[1].x + e->b0 * (p[0].x - p[1].x) + e->b2 * (p[2].x - p[1].x);
+    e->cy = p[1].y + e->b0 * (p[0].y - p[1].y) + e->b2 * (p[2].y - p[1].y);
+}
+
 /* Add one point with basis (b0, 1 - b0 - b2, b2) on `span` to the normal
  * equations. The common case (three distinct unknowns) is written out; a
  * span touching a vertex goes through the general merge. */
@@ -250,29 +267,37 @@ static void accumulate_point(bsf_pdm_work_t *w, size_t span, float b0, float b2,
                              float py)
 {
     const uint8_t *unk = &w->unknown_of[span];
+    const size_t a = unk[0];
     const float b1 = 1.0f - b0 - b2;
-    if (unk[0] != unk[1] && unk[1] != unk[2]) {
-        float *r0 = &w->band[(size_t)unk[0] * 3u];
-        float *r1 = r0 + 3;
-        float *r2 = r0 + 6;
+    float *r0 = &w->band[a * 3u];
+    float *rx = &w->rhs_x[a];
+    float *ry = &w->rhs_y[a];
+    if (unk[1] != a && unk[2] != unk[1]) {
+        /* Three distinct unknowns a, a + 1, a + 2 (rows of stride 3). */
         r0[0] += b0 * b0;
-        r1[0] += b1 * b1;
-        r1[1] += b1 * b0;
-        r2[0] += b2 * b2;
-        r2[1] += b2 * b1;
-        r2[2] += b2 * b0;
-        w->rhs_x[unk[0]] += b0 * px;
-        w->rhs_y[unk[0]] += b0 * py;
-        w->rhs_x[unk[1]] += b1 * px;
-        w->rhs_y[unk[1]] += b1 * py;
-        w->rhs_x[unk[2]] += b2 * px;
-        w->rhs_y[unk[2]] += b2 * py;
+        r0[3] += b1 * b1;
+        r0[4] += b1 * b0;
+        r0[6] += b2 * b2;
+        r0[7] += b2 * b1;
+        r0[8] += b2 * b0;
+        rx[0] += b0 * px;
+        ry[0] += b0 * py;
+        rx[1] += b1 * px;
+        ry[1] += b1 * py;
+        rx[2] += b2 * px;
+        ry[2] += b2 * py;
     } else {
-        float b[3];
-        b[0] = b0;
-        b[1] = b1;
-        b[2] = b2;
-        bsf_fit_accumulate(w->band, w->rhs_x, w->rhs_y, unk, b, 1.0f, px, py);
+        /* A span at a vertex: its two copies share one unknown, so the span
+         * touches two unknowns a, a + 1 with summed weights. */
+        const float w0 = unk[1] == a ? b0 + b1 : b0;
+        const float w1 = unk[1] == a ? b2 : b1 + b2;
+        r0[0] += w0 * w0;
+        r0[3] += w1 * w1;
+        r0[4] += w1 * w0;
+        rx[0] += w0 * px;
+        ry[0] += w0 * py;
+        rx[1] += w1 * px;
+        ry[1] += w1 * py;
     }
 }
 
@@ -408,7 +433,11 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
                     break;
                 }
                 span_new = span_of(t_new, fs, n_span, &un);
-                eval_span(w->ctrl, n_span, span_new, un, &en);
+                if (step + 1u < n_steps) {
+                    eval_span(w->ctrl, n_span, span_new, un, &en);
+                } else {
+                    eval_span_point(w->ctrl, n_span, span_new, un, &en);
+                }
                 {
                     const float fx = en.cx - q.x;
                     const float fy = en.cy - q.y;
@@ -450,13 +479,13 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
  * control points and fragment RMS restored) and ends the solve, so the
  * accepted RMS sequence never increases. */
 static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_params_t *p,
-                            uint32_t *iterations)
+                            size_t max_iterations, uint32_t *iterations)
 {
     float prev = 0.0f;
     size_t it;
 
     w->n_history = 0u;
-    for (it = 0; it < p->max_iterations; ++it) {
+    for (it = 0; it < max_iterations; ++it) {
         bsf_status_t st;
         if (it > 0u) {
             memcpy(w->t_prev, w->t, s->n * sizeof w->t[0]);
@@ -639,7 +668,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     /* The start curve follows the points with known parameters (see
      * init_fit): the first solve needs no projection onto it. */
     assemble(&s, work);
-    st = run_pdm(&s, work, p, &info.iterations);
+    st = run_pdm(&s, work, p, p->max_iterations, &info.iterations);
     if (st != BSF_OK) {
         return st;
     }
@@ -659,7 +688,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
         build_layout(&s, work, t0, t1);
         remap_parameters(&s, work, old_t0, old_t1, t0, t1);
         assemble(&s, work);
-        st = run_pdm(&s, work, p, &info.iterations);
+        st = run_pdm(&s, work, p, p->refine_iterations, &info.iterations);
         if (st != BSF_OK) {
             return st;
         }
@@ -684,6 +713,66 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     info.loaded = s.loaded;
     if (info_out != NULL) {
         *info_out = info;
+    }
+    return BSF_OK;
+}
+
+bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
+                               const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                               bsf_point_t *ctrl_out, float *e_curve_out, uint32_t *iterations)
+{
+    pdm_state_t s;
+    float t0[1];
+    float t1[1];
+    float length = 0.0f;
+    float acc = 0.0f;
+    size_t i;
+    bsf_status_t st;
+
+    if (pts == NULL || p == NULL || work == NULL || ctrl_out == NULL || iterations == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (n > (size_t)BSF_MAX_POINTS || n_ctrl > (size_t)BSF_MAX_CTRL_PER_FEATURE) {
+        return BSF_ERR_CAPACITY;
+    }
+    if (n < 3u || n_ctrl < 3u) {
+        return BSF_ERR_DEGENERATE;
+    }
+    for (i = 1; i < n; ++i) {
+        length += dist(pts[i - 1u], pts[i]);
+    }
+    if (!(length > 0.0f)) {
+        return BSF_ERR_DEGENERATE;
+    }
+    memset(&s, 0, sizeof s);
+    s.pts = pts;
+    s.n = n;
+    s.origin = pts[0];
+    s.n_frag = 1u;
+    s.lambda = p->lambda_per_metre * length;
+    work->frag_first[0] = 0u;
+    work->frag_last[0] = (uint16_t)(n - 1u);
+    work->frag_precision[0] = (uint8_t)(n_ctrl - 2u);
+    work->n_fragments = 1u;
+    work->last_refined = (uint16_t)NO_FRAGMENT;
+    build_layout(&s, work, t0, t1);
+    for (i = 0; i < n; ++i) {
+        if (i > 0u) {
+            acc += dist(pts[i - 1u], pts[i]);
+        }
+        work->t[i] = acc / length;
+    }
+    assemble(&s, work);
+    st = run_pdm(&s, work, p, p->max_iterations, iterations);
+    if (st != BSF_OK) {
+        return st;
+    }
+    for (i = 0; i < n_ctrl; ++i) {
+        ctrl_out[i].x = work->ctrl[i].x + s.origin.x;
+        ctrl_out[i].y = work->ctrl[i].y + s.origin.y;
+    }
+    if (e_curve_out != NULL) {
+        *e_curve_out = s.rms;
     }
     return BSF_OK;
 }

@@ -200,14 +200,12 @@ static void test_indefinite_matrix_fails_with_numeric_status_and_untouched_rhs(v
     float factor[4];
     float rx[2] = {1.0f, 2.0f};
     float ry[2] = {3.0f, 4.0f};
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_NUMERIC,
-                          bsf_spd_band_solve2(band, 2u, 1u, factor, rx, ry, NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_NUMERIC, bsf_spd_band_solve2(band, 2u, 1u, factor, rx, ry, NULL));
     TEST_ASSERT_EQUAL_FLOAT(2.0f, rx[1]);
     TEST_ASSERT_EQUAL_FLOAT(4.0f, ry[1]);
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_spd_band_solve2(band, 2u, 2u, factor, rx, ry, NULL));
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
-                          bsf_spd_band_solve2(band, BSF_LINALG_MAX_M + 1u, 1u, factor, rx, ry,
-                                              NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_spd_band_solve2(band, BSF_LINALG_MAX_M + 1u, 1u,
+                                                                factor, rx, ry, NULL));
 }
 
 static void test_lsba_reproduces_a_straight_wall_exactly(void)

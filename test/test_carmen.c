@@ -41,35 +41,35 @@ static void build_log(char *buf, size_t cap)
     size_t len = 0;
     int i;
 #define ADD(...) len += (size_t)snprintf(buf + len, cap - len, __VA_ARGS__)
-    ADD("# message formats defined: PARAM ODOM FLASER\n");                        /* 1 */
-    ADD("\n");                                                                     /* 2 */
-    ADD("PARAM robot_frontlaser_offset 0.0 nohost 0\n");                          /* 3 */
-    ADD("ODOM 0 0 0 0 0 0 0.000246 pippo 0.000246\n");                            /* 4 */
-    ADD("FLASER 180");                                                             /* 5 */
+    ADD("# message formats defined: PARAM ODOM FLASER\n"); /* 1 */
+    ADD("\n");                                             /* 2 */
+    ADD("PARAM robot_frontlaser_offset 0.0 nohost 0\n");   /* 3 */
+    ADD("ODOM 0 0 0 0 0 0 0.000246 pippo 0.000246\n");     /* 4 */
+    ADD("FLASER 180");                                     /* 5 */
     for (i = 0; i < 180; ++i) {
         ADD(" %d.%02d", 1 + i / 100, i % 100);
     }
     ADD(" 1.5 -2.25 0.5 1.25 -2.5 0.75 1000.125 pippo 1000.2\n");
-    ADD("NEFF 42\n");                                                              /* 6 */
-    ADD("ROBOTLASER1 0 -1.570796 3.141593 0.017453 50.000000 0.100000 0 5 "        /* 7 */
+    ADD("NEFF 42\n");                                                       /* 6 */
+    ADD("ROBOTLASER1 0 -1.570796 3.141593 0.017453 50.000000 0.100000 0 5 " /* 7 */
         "3.36 3.34 81.83 4 2.85e-01 0 10.5 20.25 0.1 11.5 21.25 0.2 0 0 0.55 0.55 0 "
         "975001234.512345 nohost 12.5\n");
-    ADD("FLASER 5 1 2 3\n");                                                       /* 8: short */
-    ADD("ROBOTLASER1 0 -1.57 3.14 0.0174 50 0.1 0 3 1.0 abc 2.0 0 "                /* 9: bad range */
+    ADD("FLASER 5 1 2 3\n");                                        /* 8: short */
+    ADD("ROBOTLASER1 0 -1.57 3.14 0.0174 50 0.1 0 3 1.0 abc 2.0 0 " /* 9: bad range */
         "0 0 0 0 0 0 0 0 0 0 0 5.0 nohost 5.0\n");
-    ADD("FLASER 9000 1 2 3\n");                                                    /* 10: count */
-    ADD("ROBOTLASER1 0 -1.57 3.14 0 50 0.1 0 3 1 1 1 0 "                           /* 11: res 0 */
+    ADD("FLASER 9000 1 2 3\n");                          /* 10: count */
+    ADD("ROBOTLASER1 0 -1.57 3.14 0 50 0.1 0 3 1 1 1 0 " /* 11: res 0 */
         "0 0 0 0 0 0 0 0 0 0 0 5.0 nohost 5.0\n");
-    ADD("VERTEX2 0 0 0 0\n");                                                      /* 12 */
-    ADD("## EDGES\n");                                                             /* 13 */
-    ADD("FLASER 7 1 2 3 4 5 6 7 0 0 0 0 0 0 7.5 pippo 7.5\r\n");                   /* 14: CRLF */
-    ADD("FLASER 361");                                                             /* 15 */
+    ADD("VERTEX2 0 0 0 0\n");                                    /* 12 */
+    ADD("## EDGES\n");                                           /* 13 */
+    ADD("FLASER 7 1 2 3 4 5 6 7 0 0 0 0 0 0 7.5 pippo 7.5\r\n"); /* 14: CRLF */
+    ADD("FLASER 361");                                           /* 15 */
     for (i = 0; i < 361; ++i) {
         ADD(" 2");
     }
     ADD(" 0 0 0 0 0 0 8.5 pippo 8.5\n");
-    ADD("%s\n", big_line);                                                         /* 16: long */
-    ADD("ROBOTLASER1 0 -1.566433 3.141593 0.017453 81.9 0.1 0 2 5.5 6.5 0 "        /* 17: no EOL */
+    ADD("%s\n", big_line);                                                  /* 16: long */
+    ADD("ROBOTLASER1 0 -1.566433 3.141593 0.017453 81.9 0.1 0 2 5.5 6.5 0 " /* 17: no EOL */
         "1 2 3 4 5 6 0 0 0 0 0 9.25 nohost 9.25");
 #undef ADD
     TEST_ASSERT_TRUE(len < cap - 1u);
@@ -86,8 +86,8 @@ static void make_big_line(void)
     len += (size_t)snprintf(big_line + len, sizeof big_line - len,
                             "ROBOTLASER1 0 -2.35619 4.71 0.000942 30 0.1 0 5000");
     for (i = 0; i < 5000; ++i) {
-        len += (size_t)snprintf(big_line + len, sizeof big_line - len, " %d.%02d",
-                                (i % 1000) / 100, (i % 1000) % 100);
+        len += (size_t)snprintf(big_line + len, sizeof big_line - len, " %d.%02d", (i % 1000) / 100,
+                                (i % 1000) % 100);
     }
     len += (size_t)snprintf(big_line + len, sizeof big_line - len,
                             " 0 0 0 0 0 0 0 0 0 0 0 0 77.5 nohost 77.5");
@@ -230,8 +230,7 @@ static void check_log(const char *path)
     fclose(err);
     snprintf(expect, sizeof expect, "%s:8: FLASER: missing or bad field", path);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);
-    snprintf(expect, sizeof expect, "%s:9: ROBOTLASER1: missing or bad field: range reading",
-             path);
+    snprintf(expect, sizeof expect, "%s:9: ROBOTLASER1: missing or bad field: range reading", path);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);
     snprintf(expect, sizeof expect, "%s:10: FLASER: beam count 9000", path);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);

@@ -61,16 +61,20 @@ static void extract_with(bsf_method_t method, const bsf_lidar_t *l, uint64_t see
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
 }
 
-/* Corners over many random poses in a rectangular and an L-shaped room:
- * a visible true corner is found when a keypoint lies within 2 beams of it;
- * a keypoint is a false positive when no true corner lies within 2 beams. */
-static void test_falko_sved_pdm_corner_recall_and_precision(void)
+/* Corners over random poses in a rectangular and an L-shaped room: a
+ * visible true corner is found when a keypoint lies within 2 beams of it; a
+ * keypoint is a false positive when no true corner lies within 2 beams. */
+typedef struct {
+    uint32_t n_true, found_true, n_found, n_false;
+} corner_stats_t;
+
+static corner_stats_t corner_stats(bsf_method_t method, int n_poses)
 {
+    corner_stats_t cs = {0u, 0u, 0u, 0u};
     bsf_scene_rng_t pose_rng;
-    uint32_t tp = 0, n_true = 0, n_found = 0, n_false = 0;
     int it;
     bsf_scene_rng_seed(&pose_rng, 5u);
-    for (it = 0; it < 24; ++it) {
+    for (it = 0; it < n_poses; ++it) {
         bsf_scene_corner_t corners[16];
         size_t n_corners = 0;
         size_t i, k;
@@ -85,18 +89,18 @@ static void test_falko_sved_pdm_corner_recall_and_precision(void)
             TEST_ASSERT_EQUAL_INT(BSF_OK,
                                   bsf_scene_add_l_room(&scene, 0.0, 0.0, 6.0, 5.0, 2.5, 2.0));
         }
-        extract_with(BSF_METHOD_FALKO_SVED_PDM, &l, 100u + (uint64_t)it);
+        extract_with(method, &l, 100u + (uint64_t)it);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, corners, 16u, &n_corners));
         for (i = 0; i < n_corners; ++i) {
             if (!corners[i].visible || corners[i].beam < 3 ||
                 corners[i].beam > (int)l.n_beams - 4) {
                 continue;
             }
-            ++n_true;
+            ++cs.n_true;
             for (k = 0; k < ex.n_keypoints; ++k) {
                 const int d = (int)ex.keypoints[k].index - corners[i].beam;
                 if (d >= -2 && d <= 2) {
-                    ++tp;
+                    ++cs.found_true;
                     break;
                 }
             }
@@ -107,18 +111,35 @@ static void test_falko_sved_pdm_corner_recall_and_precision(void)
                 const int d = (int)ex.keypoints[k].index - corners[i].beam;
                 hit |= corners[i].beam >= 0 && d >= -2 && d <= 2;
             }
-            n_false += hit ? 0u : 1u;
+            cs.n_false += hit ? 0u : 1u;
         }
-        n_found += (uint32_t)ex.n_keypoints;
+        cs.n_found += (uint32_t)ex.n_keypoints;
+        /* keypoints and the features' vertices agree with the pipeline */
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)ex.n_keypoints, res.stats.n_keypoints);
     }
-    printf("FALKO-SVED-PDM corners: %lu true, %lu found, recall %.2f, precision %.2f\n",
-           (unsigned long)n_true, (unsigned long)n_found, (double)tp / (double)n_true,
-           1.0 - (double)n_false / (double)(n_found ? n_found : 1u));
-    TEST_ASSERT_TRUE_MESSAGE(n_true >= 40u, "the scenes should show many corners");
+    printf("%s corners: %lu true, %lu found, recall %.2f, precision %.2f\n",
+           bsf_method_name(method), (unsigned long)cs.n_true, (unsigned long)cs.n_found,
+           (double)cs.found_true / (double)(cs.n_true ? cs.n_true : 1u),
+           1.0 - (double)cs.n_false / (double)(cs.n_found ? cs.n_found : 1u));
+    return cs;
+}
+
+static void test_falko_sved_pdm_corner_recall_and_precision(void)
+{
+    const corner_stats_t cs = corner_stats(BSF_METHOD_FALKO_SVED_PDM, 24);
+    TEST_ASSERT_TRUE_MESSAGE(cs.n_true >= 40u, "the scenes should show many corners");
     /* FALKO (FALKOLib's rules: per-scan score threshold) is conservative:
      * about 60 % recall at 0.5 degree beams, but almost no false corner. */
-    TEST_ASSERT_TRUE_MESSAGE(tp * 2u >= n_true, "corner recall below 50 %");
-    TEST_ASSERT_TRUE_MESSAGE(n_false * 20u <= n_found, "corner precision below 95 %");
+    TEST_ASSERT_TRUE_MESSAGE(cs.found_true * 2u >= cs.n_true, "corner recall below 50 %");
+    TEST_ASSERT_TRUE_MESSAGE(cs.n_false * 20u <= cs.n_found, "corner precision below 95 %");
+}
+
+static void test_bid_sved_pdm_corner_recall_and_precision(void)
+{
+    const corner_stats_t cs = corner_stats(BSF_METHOD_BID_SVED_PDM, 12);
+    TEST_ASSERT_TRUE_MESSAGE(cs.n_true >= 20u, "the scenes should show many corners");
+    TEST_ASSERT_TRUE_MESSAGE(cs.found_true * 10u >= cs.n_true * 8u, "corner recall below 80 %");
+    TEST_ASSERT_TRUE_MESSAGE(cs.n_false * 10u <= cs.n_found, "corner precision below 90 %");
 }
 
 static void test_rpos_lsba_reports_no_corners_and_only_bleak_four_point_features(void)
@@ -168,8 +189,8 @@ static void curve_to_truth(const bsf_lidar_t *l, double *rms, double *max_d)
  * cabinet and a round pillar. */
 static void build_office(void)
 {
-    static const double outline[] = {0.0, 0.0, 14.0, 0.0, 14.0, 6.0, 9.0, 6.0, 9.0, 10.0,
-                                     0.0, 10.0};
+    static const double outline[] = {0.0, 0.0, 14.0, 0.0,  14.0, 6.0,
+                                     9.0, 6.0, 9.0,  10.0, 0.0,  10.0};
     bsf_scene_init(&scene);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 6u, 1));
     TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 5.0, 0.0, 5.0, 3.0) >= 0);
@@ -187,8 +208,8 @@ static void test_curves_stay_close_to_the_true_walls_for_each_noise_level(void)
     for (mi = 0; mi < 2u; ++mi) {
         for (pi = 0; pi < 3u; ++pi) {
             for (si = 0; si < 3u; ++si) {
-                const bsf_lidar_t l = make_lidar(poses[pi][0], poses[pi][1], poses[pi][2],
-                                                 sigmas[si]);
+                const bsf_lidar_t l =
+                    make_lidar(poses[pi][0], poses[pi][1], poses[pi][2], sigmas[si]);
                 const double target = (double)bsf_params_default(methods[mi]).pdm.target_rms;
                 double rms, max_d;
                 build_office();
@@ -230,11 +251,11 @@ static void test_retrievability_and_compactness_equal_hand_counts(void)
         ranges[i] = 2.0f / cosf(a);
     }
     ranges[20] = NAN;
-    ranges[21] = 6.0f;  /* isolated */
+    ranges[21] = 6.0f; /* isolated */
     ranges[22] = -1.0f;
     ranges[23] = 12.0f; /* isolated */
     ranges[24] = 0.0f;
-    ranges[25] = 3.0f;  /* isolated */
+    ranges[25] = 3.0f; /* isolated */
     ranges[26] = INFINITY;
     s.ranges = ranges;
     s.count = 27u;
@@ -368,9 +389,6 @@ static void test_empty_and_single_beam_scans_give_no_features(void)
     s.range_max = 10.0f;
     ranges[0] = 1.0f;
     for (m = 0; m < (int)BSF_METHOD_COUNT; ++m) {
-        if (m == (int)BSF_METHOD_BID_SVED_PDM) {
-            continue; /* checked where BID is built */
-        }
         p = bsf_params_default((bsf_method_t)m);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
         s.count = 0u;
@@ -397,6 +415,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_falko_sved_pdm_corner_recall_and_precision);
+    RUN_TEST(test_bid_sved_pdm_corner_recall_and_precision);
     RUN_TEST(test_rpos_lsba_reports_no_corners_and_only_bleak_four_point_features);
     RUN_TEST(test_curves_stay_close_to_the_true_walls_for_each_noise_level);
     RUN_TEST(test_retrievability_and_compactness_equal_hand_counts);

@@ -106,8 +106,7 @@ static size_t detect_default(const bsf_scan_t *s)
     const bsf_falko_params_t p = bsf_falko_params_default();
     size_t n = 0;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(s, &points));
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_falko_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_falko_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n));
     return n;
 }
 
@@ -374,9 +373,8 @@ static const wall_t room[] = {{2.0f, -2.0f, 2.0f, 2.0f},
 
 static void test_scan_at_capacity_finds_room_corners(void)
 {
-    const bsf_scan_t s =
-        cast_scan(BSF_MAX_POINTS, -135.0f * DEG, 270.0f * DEG / (float)(BSF_MAX_POINTS - 1),
-                  room, 4, NULL, 0);
+    const bsf_scan_t s = cast_scan(BSF_MAX_POINTS, -135.0f * DEG,
+                                   270.0f * DEG / (float)(BSF_MAX_POINTS - 1), room, 4, NULL, 0);
     const size_t n = detect_default(&s);
     TEST_ASSERT_EQUAL_UINT32((uint32_t)BSF_MAX_POINTS, (uint32_t)points.n_valid);
     TEST_ASSERT_EQUAL_UINT32(2u, (uint32_t)n);
@@ -387,9 +385,8 @@ static void test_scan_at_capacity_finds_room_corners(void)
 static void test_too_small_output_reports_capacity_and_total(void)
 {
     const bsf_falko_params_t p = bsf_falko_params_default();
-    const bsf_scan_t s =
-        cast_scan(BSF_MAX_POINTS, -135.0f * DEG, 270.0f * DEG / (float)(BSF_MAX_POINTS - 1),
-                  room, 4, NULL, 0);
+    const bsf_scan_t s = cast_scan(BSF_MAX_POINTS, -135.0f * DEG,
+                                   270.0f * DEG / (float)(BSF_MAX_POINTS - 1), room, 4, NULL, 0);
     size_t n = 0;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_falko_detect(&points, &p, &work, kps, 1, &n));

@@ -99,8 +99,8 @@ static void compare_log(const char *log_rel, const char *ref_rel, int force_flas
         s.range_min = 0.0f;
         s.range_max = 81.0f; /* below the 81.83 no-return code */
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_falko_detect(&points, &prm, &work, kps,
-                                                       BSF_MAX_KEYPOINTS, &n_kp));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_falko_detect(&points, &prm, &work, kps, BSF_MAX_KEYPOINTS, &n_kp));
         for (k = 1; k < n_kp; ++k) {
             TEST_ASSERT_TRUE_MESSAGE(kps[k - 1].index < kps[k].index, "keypoints not ascending");
         }
@@ -151,7 +151,8 @@ static void compare_log(const char *log_rel, const char *ref_rel, int force_flas
         ++ag->scans;
     }
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)carmen_malformed_count(rd));
-    TEST_ASSERT_NULL_MESSAGE(fgets(line, sizeof line, ref), "reference has more scans than the log");
+    TEST_ASSERT_NULL_MESSAGE(fgets(line, sizeof line, ref),
+                             "reference has more scans than the log");
     carmen_close(rd);
     fclose(ref);
     printf("%s: %lu scans, identical %lu (%.2f %%); keypoints: reference %lu, matched %lu, "

@@ -60,8 +60,8 @@ static float max_curve_distance(const bsf_point_t *ref, size_t n_ref, const bsf_
         float step = 1.0f / 400.0f;
         int j;
         int pass;
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(ref, n_ref, (float)i / 100.0f, &a, NULL,
-                                                       NULL));
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_bspline_eval(ref, n_ref, (float)i / 100.0f, &a, NULL, NULL));
         for (j = 0; j <= 400; ++j) {
             bsf_point_t b;
             float d;
@@ -117,8 +117,8 @@ static void test_fit_recovers_known_spline_without_noise(void)
     size_t n_ctrl = 0;
     float e = -1.0f;
     for (i = 0; i < n; ++i) {
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(ref, 4u, (float)i / (float)(n - 1u),
-                                                       &pts[i], NULL, NULL));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_bspline_eval(ref, 4u, (float)i / (float)(n - 1u), &pts[i], NULL, NULL));
     }
     /* Two precision points, like the reference; converge fully. */
     params.refine = 0u;
@@ -202,12 +202,12 @@ static void test_fit_passes_through_vertex_and_both_pieces_are_straight(void)
     for (k = 0; k <= 50; ++k) {
         bsf_point_t a;
         bsf_point_t b;
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(ctrl, n_ctrl, t_v * (float)k / 50.0f, &a,
-                                                       NULL, NULL));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_bspline_eval(ctrl, n_ctrl, t_v * (float)k / 50.0f, &a, NULL, NULL));
         TEST_ASSERT_FLOAT_WITHIN(1e-5f, 0.0f, cross_from(ctrl[0], ctrl[v], a));
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(ctrl, n_ctrl,
-                                                       t_v + (1.0f - t_v) * (float)k / 50.0f, &b,
-                                                       NULL, NULL));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK,
+            bsf_bspline_eval(ctrl, n_ctrl, t_v + (1.0f - t_v) * (float)k / 50.0f, &b, NULL, NULL));
         TEST_ASSERT_FLOAT_WITHIN(1e-5f, 0.0f, cross_from(ctrl[v], ctrl[n_ctrl - 1u], b));
     }
 }
@@ -297,9 +297,9 @@ static void test_refinement_reaches_target_and_one_point_less_misses_it(void)
         TEST_ASSERT_EQUAL_UINT32(3u + info.refinements, (uint32_t)n_ctrl);
         /* One control point less (the last one added) breaks the target. */
         params.max_ctrl = (uint16_t)(n_ctrl - 1u);
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
-                                                  BSF_MAX_CTRL_PER_FEATURE, &n_less, &e_less,
-                                                  NULL));
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                          BSF_MAX_CTRL_PER_FEATURE, &n_less, &e_less, NULL));
         TEST_ASSERT_EQUAL_UINT32((uint32_t)(n_ctrl - 1u), (uint32_t)n_less);
         for (f = 0; f < work.n_fragments; ++f) {
             worst = work.frag_rms[f] > worst ? work.frag_rms[f] : worst;
@@ -444,14 +444,14 @@ static void test_bad_arguments_parameters_and_capacities_are_refused(void)
                           bsf_pdm_fit(pts, BSF_MAX_POINTS + 1u, NULL, 0u, &params, &work, ctrl,
                                       NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
-                          bsf_pdm_fit(pts, n, vpos, BSF_PDM_MAX_VERTICES + 1u, &params, &work,
-                                      ctrl, NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
+                          bsf_pdm_fit(pts, n, vpos, BSF_PDM_MAX_VERTICES + 1u, &params, &work, ctrl,
+                                      NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
     /* Output buffer too small for P0, V, V, P3. */
     vpos[0] = 10u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_pdm_fit(pts, n, vpos, 1u, &params, &work, ctrl, NULL,
                                                       3u, &n_ctrl, &e, NULL));
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(pts, n, vpos, 1u, &params, &work, ctrl, NULL, 4u,
-                                              &n_ctrl, &e, NULL));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_pdm_fit(pts, n, vpos, 1u, &params, &work, ctrl, NULL, 4u, &n_ctrl, &e, NULL));
     TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n_ctrl);
 
     bad = params;

@@ -64,8 +64,8 @@ static void print_stats(const char *what, double *samples, size_t n_scans, int p
     mean /= (double)n_scans;
     printf("%s us/scan (per-scan median over passes): mean %.2f  median %.2f  p99 %.2f  max %.2f;"
            " mean of all calls %.2f\n",
-           what, mean, per_scan[n_scans / 2], per_scan[(n_scans * 99) / 100],
-           per_scan[n_scans - 1], all / ((double)n_scans * (double)passes));
+           what, mean, per_scan[n_scans / 2], per_scan[(n_scans * 99) / 100], per_scan[n_scans - 1],
+           all / ((double)n_scans * (double)passes));
 }
 
 int main(int argc, char **argv)

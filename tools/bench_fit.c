@@ -107,9 +107,8 @@ static void run_case(const bench_case_t *c, size_t reps)
     qsort(lsba_us, N_RUNS, sizeof lsba_us[0], cmp_double);
     printf("%-22s %3zu pts  PDM %6.2f us  it %2u  refine %u  ctrl %2zu  E %6.2f mm"
            "   | LSBA %5.2f us  E %6.2f mm\n",
-           c->name, c->n, pdm_us[N_RUNS / 2], (unsigned)info.iterations,
-           (unsigned)info.refinements, n_ctrl, 1e3 * (double)e, lsba_us[N_RUNS / 2],
-           1e3 * (double)e_lsba);
+           c->name, c->n, pdm_us[N_RUNS / 2], (unsigned)info.iterations, (unsigned)info.refinements,
+           n_ctrl, 1e3 * (double)e, lsba_us[N_RUNS / 2], 1e3 * (double)e_lsba);
     (void)sink;
 }
 

@@ -21,10 +21,14 @@ void bsf_bounds_add(bsf_bounds_t *b, double x, double y)
         b->empty = 0;
         return;
     }
-    if (x < b->min_x) b->min_x = x;
-    if (x > b->max_x) b->max_x = x;
-    if (y < b->min_y) b->min_y = y;
-    if (y > b->max_y) b->max_y = y;
+    if (x < b->min_x)
+        b->min_x = x;
+    if (x > b->max_x)
+        b->max_x = x;
+    if (y < b->min_y)
+        b->min_y = y;
+    if (y > b->max_y)
+        b->max_y = y;
 }
 
 static double sx(const bsf_svg_t *s, double x)
@@ -175,8 +179,10 @@ int bsf_svg_end(bsf_svg_t *svg, const char *legend)
     const double target = span / 4.0;
     double len = pow(10.0, floor(log10(target)));
     double x0, y0, x1;
-    if (2.0 * len <= target) len *= 2.0;
-    if (2.5 * len <= target) len *= 2.5;
+    if (2.0 * len <= target)
+        len *= 2.0;
+    if (2.5 * len <= target)
+        len *= 2.5;
     x0 = svg->margin_px;
     y0 = height_px(svg) - 12.0;
     x1 = x0 + len * svg->px_per_m;

@@ -12,7 +12,7 @@ typedef struct {
     double min_x, min_y, max_x, max_y; /* world bounds, metres */
     double px_per_m;                   /* scale */
     double margin_px;
-    int open_path;                     /* a polyline is being written */
+    int open_path; /* a polyline is being written */
 } bsf_svg_t;
 
 /** Bounds accumulator: start empty, grow with points. */

@@ -26,7 +26,6 @@
 #define EXIT_USAGE 2
 #define EXIT_FAIL 1
 
-
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
@@ -450,10 +449,11 @@ static const char extract_help[] =
     "  --count N        process at most N scans (default: all)\n"
     "  --range-max M    readings >= M metres are invalid (default: the log's declared\n"
     "                   maximum range, capped below the 81.83/81.91 no-return codes)\n"
-    "  --quant STEP     control point quantisation step in metres (default 0.002)\n"
+    "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
+    "Frames carry the laser pose and the time in ms since the log's first scan.\n"
     "A malformed log line is reported as FILE:LINE and skipped. The summary goes to\n"
     "stderr; progress too, when stderr is a terminal.\n";
 
@@ -509,6 +509,8 @@ static int run_extract(const extract_opts_t *o)
     FILE *out;
     progress_t prog;
     unsigned long index = 0, done = 0, failed = 0, malformed;
+    double t0 = 0.0;
+    int have_t0 = 0;
     unsigned long long bytes = 0;
     bsf_frame_info_t info;
     int r;
@@ -549,7 +551,14 @@ static int run_extract(const extract_opts_t *o)
             continue;
         }
         info.seq = (uint32_t)index;
-        info.timestamp_ms = (rec.timestamp > 0.0) ? (uint64_t)llround(rec.timestamp * 1000.0) : 0u;
+        /* ms since the log's first scan: small numbers travel in fewer
+         * bytes, and the metrics never need absolute time. */
+        if (!have_t0) {
+            t0 = rec.timestamp;
+            have_t0 = 1;
+        }
+        info.timestamp_ms =
+            (rec.timestamp > t0) ? (uint64_t)llround((rec.timestamp - t0) * 1000.0) : 0u;
         info.has_pose = 1u;
         info.pose_x = (float)rec.laser_pose.x;
         info.pose_y = (float)rec.laser_pose.y;
@@ -577,9 +586,11 @@ static int run_extract(const extract_opts_t *o)
     if (close_out(out, o->out) != 0 || r < 0) {
         return EXIT_FAIL;
     }
-    fprintf(stderr, "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu failed, %lu malformed lines\n",
-            o->log, done, bsf_method_name(o->method), bytes, done ? (double)bytes / (double)done : 0.0,
-            failed, malformed);
+    fprintf(stderr,
+            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu failed, %lu "
+            "malformed lines\n",
+            o->log, done, bsf_method_name(o->method), bytes,
+            done ? (double)bytes / (double)done : 0.0, failed, malformed);
     return failed ? EXIT_FAIL : 0;
 }
 
@@ -601,7 +612,8 @@ static int cmd_extract(int argc, char **argv)
         } else if ((v = opt_value(argc, argv, &i, "--method", &err)) != NULL) {
             o.method = bsf_method_from_name(v);
             if (o.method == BSF_METHOD_COUNT) {
-                return usage_error("unknown method '%s' (falko-sved-pdm, bid-sved-pdm, rpos-lsba)", v);
+                return usage_error("unknown method '%s' (falko-sved-pdm, bid-sved-pdm, rpos-lsba)",
+                                   v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--first", &err)) != NULL) {
             if (parse_long(v, 0, 1000000000L, &o.first) != 0) {
@@ -616,7 +628,8 @@ static int cmd_extract(int argc, char **argv)
                 return usage_error("--range-max needs metres > 0, got '%s'", v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--quant", &err)) != NULL) {
-            if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) != 0) {
+            if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) !=
+                0) {
                 return usage_error("--quant needs metres in [%g, %g], got '%s'",
                                    (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, v);
             }
@@ -667,8 +680,8 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
     const bsf_scan_counts_t c = counts_of_result(r, 1e-6 * (double)fr->time_us);
     size_t i, k;
     if (!ctx->json) {
-        fprintf(ctx->out,
-                "seq=%lu t=%.3f pose=", (unsigned long)fr->seq, 1e-3 * (double)fr->timestamp_ms);
+        fprintf(ctx->out, "seq=%lu t=%.3f pose=", (unsigned long)fr->seq,
+                1e-3 * (double)fr->timestamp_ms);
         if (fr->has_pose) {
             fprintf(ctx->out, "(%.3f,%.3f,%.4f)", (double)fr->pose_x, (double)fr->pose_y,
                     (double)fr->pose_theta);
@@ -677,13 +690,13 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
         }
         fprintf(ctx->out,
                 " N=%lu features=%u points=%lu ctrl=%lu time_us=%lu quant=%.4f bytes=%zu\n",
-                (unsigned long)c.n_valid, (unsigned)r->n_features,
-                (unsigned long)c.n_in_features, (unsigned long)c.n_ctrl,
-                (unsigned long)fr->time_us, (double)fr->quant_step, bytes);
+                (unsigned long)c.n_valid, (unsigned)r->n_features, (unsigned long)c.n_in_features,
+                (unsigned long)c.n_ctrl, (unsigned long)fr->time_us, (double)fr->quant_step, bytes);
         return ferror(ctx->out) ? -1 : 0;
     }
-    fprintf(ctx->out, "{\"seq\":%lu,\"timestamp_ms\":%llu,\"bytes\":%zu,\"version\":%u,", (unsigned long)fr->seq,
-            (unsigned long long)fr->timestamp_ms, bytes, (unsigned)fr->version);
+    fprintf(ctx->out, "{\"seq\":%lu,\"timestamp_ms\":%llu,\"bytes\":%zu,\"version\":%u,",
+            (unsigned long)fr->seq, (unsigned long long)fr->timestamp_ms, bytes,
+            (unsigned)fr->version);
     if (fr->has_pose) {
         fputs("\"pose\":[", ctx->out);
         print_json_float(ctx->out, fr->pose_x);
@@ -718,7 +731,8 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
         }
         fputs("],\"vertex\":[", ctx->out);
         for (k = 0; k < f->n_ctrl; ++k) {
-            fprintf(ctx->out, "%s%d", k ? "," : "", r->ctrl_is_vertex[(size_t)f->ctrl_first + k] ? 1 : 0);
+            fprintf(ctx->out, "%s%d", k ? "," : "",
+                    r->ctrl_is_vertex[(size_t)f->ctrl_first + k] ? 1 : 0);
         }
         fputs("]}", ctx->out);
     }
@@ -733,18 +747,16 @@ static void print_counters(FILE *f, int json, const bsf_decoder_stats_t *s, unsi
                 "{\"counters\":{\"frames_ok\":%lu,\"bad_crc\":%lu,\"malformed\":%lu,"
                 "\"unsupported_version\":%lu,\"unknown_type\":%lu,\"oversize\":%lu,"
                 "\"bytes_skipped\":%lu,\"seq_gaps\":%lu}}\n",
-                (unsigned long)s->frames_ok, (unsigned long)s->bad_crc,
-                (unsigned long)s->malformed, (unsigned long)s->unsupported_version,
-                (unsigned long)s->unknown_type, (unsigned long)s->oversize,
-                (unsigned long)s->bytes_skipped, gaps);
+                (unsigned long)s->frames_ok, (unsigned long)s->bad_crc, (unsigned long)s->malformed,
+                (unsigned long)s->unsupported_version, (unsigned long)s->unknown_type,
+                (unsigned long)s->oversize, (unsigned long)s->bytes_skipped, gaps);
     } else {
         fprintf(f,
                 "frames ok %lu, bad crc %lu, malformed %lu, unsupported version %lu, unknown "
                 "type %lu, oversize %lu, bytes skipped %lu, missing by sequence %lu\n",
-                (unsigned long)s->frames_ok, (unsigned long)s->bad_crc,
-                (unsigned long)s->malformed, (unsigned long)s->unsupported_version,
-                (unsigned long)s->unknown_type, (unsigned long)s->oversize,
-                (unsigned long)s->bytes_skipped, gaps);
+                (unsigned long)s->frames_ok, (unsigned long)s->bad_crc, (unsigned long)s->malformed,
+                (unsigned long)s->unsupported_version, (unsigned long)s->unknown_type,
+                (unsigned long)s->oversize, (unsigned long)s->bytes_skipped, gaps);
     }
 }
 
@@ -812,9 +824,11 @@ static void print_metrics(FILE *f, const char *name, const frame_list_t *l,
             1e6 * (double)d->m.time_p99_s);
     fprintf(f, "features/scan     %.2f\n", (double)d->m.features_per_scan);
     fprintf(f, "ctrl points/scan  %.2f\n", (double)d->m.ctrl_per_scan);
-    fprintf(f, "bytes/scan        median %zu, p95 %zu, mean %.1f\n", d->bytes_median,
-            d->bytes_p95, d->bytes_mean);
-    fprintf(f, "frames dropped    %lu (bad crc %lu, malformed %lu, unsupported %lu, oversize %lu), missing by sequence %lu\n",
+    fprintf(f, "bytes/scan        median %zu, p95 %zu, mean %.1f\n", d->bytes_median, d->bytes_p95,
+            d->bytes_mean);
+    fprintf(f,
+            "frames dropped    %lu (bad crc %lu, malformed %lu, unsupported %lu, oversize %lu), "
+            "missing by sequence %lu\n",
             frames_dropped(&l->stats), (unsigned long)l->stats.bad_crc,
             (unsigned long)l->stats.malformed, (unsigned long)l->stats.unsupported_version,
             (unsigned long)l->stats.oversize, l->seq_gaps);
@@ -906,10 +920,64 @@ static void for_each_curve_sample(const bsf_frame_t *fr, sample_fn fn, void *ctx
     }
 }
 
+/* Curve samples gathered for robust map bounds: a few stray features (a
+ * reflection, a bad pose) must not shrink the whole map to a corner. */
+typedef struct {
+    double *x, *y;
+    size_t n, cap;
+    int oom;
+} samples_t;
+
 static void bounds_sample(void *ctx, int new_curve, double wx, double wy)
 {
+    samples_t *s = (samples_t *)ctx;
     (void)new_curve;
-    bsf_bounds_add((bsf_bounds_t *)ctx, wx, wy);
+    if (s->oom) {
+        return;
+    }
+    if (s->n == s->cap) {
+        const size_t cap = s->cap ? 2u * s->cap : 4096u;
+        double *nx = (double *)realloc(s->x, cap * sizeof *nx);
+        double *ny = nx ? (double *)realloc(s->y, cap * sizeof *ny) : NULL;
+        if (nx != NULL) {
+            s->x = nx;
+        }
+        if (ny == NULL) {
+            s->oom = 1;
+            return;
+        }
+        s->y = ny;
+        s->cap = cap;
+    }
+    s->x[s->n] = wx;
+    s->y[s->n] = wy;
+    s->n++;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a;
+    const double y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Bounds holding the central 99 % of the samples in x and in y, widened by
+ * 5 %; all of them when there are few. */
+static void robust_bounds(samples_t *s, bsf_bounds_t *b)
+{
+    size_t lo, hi;
+    double mx, my;
+    if (s->n == 0) {
+        return;
+    }
+    qsort(s->x, s->n, sizeof *s->x, cmp_double);
+    qsort(s->y, s->n, sizeof *s->y, cmp_double);
+    lo = s->n >= 1000u ? s->n / 200u : 0u;
+    hi = s->n - 1u - lo;
+    mx = 0.05 * (s->x[hi] - s->x[lo]);
+    my = 0.05 * (s->y[hi] - s->y[lo]);
+    bsf_bounds_add(b, s->x[lo] - mx, s->y[lo] - my);
+    bsf_bounds_add(b, s->x[hi] + mx, s->y[hi] + my);
 }
 
 typedef struct {
@@ -935,8 +1003,8 @@ static int in_range(uint32_t seq, long lo, long hi)
     return (long)seq >= lo && (hi < 0 || (long)seq <= hi);
 }
 
-static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
-                           const frame_list_t *l, bsf_bounds_t *bounds)
+static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi, const frame_list_t *l,
+                           bsf_bounds_t *bounds)
 {
     carmen_reader_t *rd = open_log(log);
     carmen_scan_t rec;
@@ -950,7 +1018,8 @@ static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
         pose2_t p;
         const float rmax = scan_range_max(&rec, 0.0);
         const double th = rec.laser_pose.theta;
-        if (!in_range((uint32_t)index, lo, hi) || (l->n && hi < 0 && index > l->frames[l->n - 1].seq)) {
+        if (!in_range((uint32_t)index, lo, hi) ||
+            (l->n && hi < 0 && index > l->frames[l->n - 1].seq)) {
             ++index;
             if (hi >= 0 && (long)index > hi) {
                 break;
@@ -1051,12 +1120,23 @@ static int write_map_svg(const char *out_path, const frame_list_t *l, long lo, l
     char legend[160];
 
     bsf_bounds_init(&b);
-    for (i = 0; i < l->n; ++i) {
-        if (in_range(l->frames[i].seq, lo, hi)) {
-            for_each_curve_sample(&l->frames[i], bounds_sample, &b);
+    {
+        samples_t smp;
+        memset(&smp, 0, sizeof smp);
+        for (i = 0; i < l->n; ++i) {
+            if (in_range(l->frames[i].seq, lo, hi)) {
+                for_each_curve_sample(&l->frames[i], bounds_sample, &smp);
+            }
+        }
+        robust_bounds(&smp, &b);
+        free(smp.x);
+        free(smp.y);
+        if (smp.oom) {
+            fail_msg("out of memory");
+            return -1;
         }
     }
-    if (points_log != NULL && draw_log_points(NULL, points_log, lo, hi, l, &b) != 0) {
+    if (b.empty && points_log != NULL && draw_log_points(NULL, points_log, lo, hi, l, &b) != 0) {
         return -1;
     }
     if (scene != NULL) {
@@ -1119,7 +1199,8 @@ static int write_map_svg(const char *out_path, const frame_list_t *l, long lo, l
         return -1;
     }
     if (no_pose) {
-        fprintf(stderr, "%s: %lu frames carry no pose; drawn in the sensor frame\n", g_cmd, no_pose);
+        fprintf(stderr, "%s: %lu frames carry no pose; drawn in the sensor frame\n", g_cmd,
+                no_pose);
     }
     return 0;
 }
@@ -1192,14 +1273,30 @@ typedef struct {
 } dataset_t;
 
 static const dataset_t datasets[4] = {
-    {"Intel", "intel.log.gz", -1,
-     {{86.4, 0.192, 0.0158, 0.00190}, {86.4, 0.187, 0.0163, 0.00600}, {68.4, 0.284, 0.0049, 0.00028}}},
-    {"MIT-csail", "mit-csail.log.gz", -1,
-     {{91.4, 0.142, 0.0207, 0.00148}, {91.4, 0.133, 0.0221, 0.00557}, {30.0, 0.395, 0.0045, 0.00022}}},
-    {"Fr-079", "fr079.log.gz", -1,
-     {{91.9, 0.169, 0.0214, 0.00122}, {91.9, 0.158, 0.0230, 0.00590}, {33.9, 0.445, 0.0041, 0.00018}}},
-    {"Fr-Clinic (1000)", "fr-clinic.log.gz", 1000,
-     {{57.1, 0.405, 0.0501, 0.00159}, {57.1, 0.402, 0.0501, 0.00329}, {30.0, 0.425, 0.0157, 0.00020}}},
+    {"Intel",
+     "intel.log.gz",
+     -1,
+     {{86.4, 0.192, 0.0158, 0.00190},
+      {86.4, 0.187, 0.0163, 0.00600},
+      {68.4, 0.284, 0.0049, 0.00028}}},
+    {"MIT-csail",
+     "mit-csail.log.gz",
+     -1,
+     {{91.4, 0.142, 0.0207, 0.00148},
+      {91.4, 0.133, 0.0221, 0.00557},
+      {30.0, 0.395, 0.0045, 0.00022}}},
+    {"Fr-079",
+     "fr079.log.gz",
+     -1,
+     {{91.9, 0.169, 0.0214, 0.00122},
+      {91.9, 0.158, 0.0230, 0.00590},
+      {33.9, 0.445, 0.0041, 0.00018}}},
+    {"Fr-Clinic (1000)",
+     "fr-clinic.log.gz",
+     1000,
+     {{57.1, 0.405, 0.0501, 0.00159},
+      {57.1, 0.402, 0.0501, 0.00329},
+      {30.0, 0.425, 0.0157, 0.00020}}},
 };
 
 typedef struct {
@@ -1344,7 +1441,8 @@ static int cmd_table1(int argc, char **argv)
     if (dir == NULL) {
         return usage_error("table1 needs the data directory (e.g. ../shared/data)");
     }
-    printf("| Data set | Method | Γ %% (paper) | η (paper) | accuracy m (paper) | t s (paper) | t median µs | bytes/scan median | scans |\n");
+    printf("| Data set | Method | Γ %% (paper) | η (paper) | accuracy m (paper) | t s (paper) | t "
+           "median µs | bytes/scan median | scans |\n");
     printf("|---|---|---|---|---|---|---|---|---|\n");
     for (d = 0; d < 4u; ++d) {
         char path[4096];
@@ -1367,7 +1465,8 @@ static int cmd_table1(int argc, char **argv)
                 fail_msg("%s: run failed", path);
                 return EXIT_FAIL;
             }
-            printf("| %s | %s | %.1f (%.1f) | %.3f (%.3f) | %.4f (%.4f) | %.6f (%.5f) | %.1f | %.0f | %lu%s |\n",
+            printf("| %s | %s | %.1f (%.1f) | %.3f (%.3f) | %.4f (%.4f) | %.6f (%.5f) | %.1f | "
+                   "%.0f | %lu%s |\n",
                    datasets[d].name, bsf_method_name((bsf_method_t)m),
                    100.0 * (double)rr.m.retrievability, pp[0], (double)rr.m.compactness, pp[1],
                    (double)rr.m.accuracy, pp[2], (double)rr.m.time_mean_s, pp[3],
@@ -1526,8 +1625,8 @@ int main(int argc, char **argv)
     static const struct {
         const char *name;
         int (*fn)(int, char **);
-    } cmds[] = {{"extract", cmd_extract}, {"decode", cmd_decode},   {"metrics", cmd_metrics},
-                {"render", cmd_render},   {"table1", cmd_table1},   {"demo", cmd_demo}};
+    } cmds[] = {{"extract", cmd_extract}, {"decode", cmd_decode}, {"metrics", cmd_metrics},
+                {"render", cmd_render},   {"table1", cmd_table1}, {"demo", cmd_demo}};
     static char cmd_name[64];
     size_t i;
     if (argc < 2) {

@@ -31,7 +31,7 @@ struct carmen_reader {
 #endif
     FILE *err;
     char *path;
-    char *line;          /* current line, grown as needed */
+    char *line; /* current line, grown as needed */
     size_t line_cap;
     unsigned long line_no;
     unsigned long malformed;
@@ -297,7 +297,8 @@ static void skip_field(fields_t *f, const char *name)
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((format(printf, 2, 3)))
 #endif
-static void report(carmen_reader_t *r, const char *fmt, ...)
+static void
+report(carmen_reader_t *r, const char *fmt, ...)
 {
     va_list ap;
     ++r->malformed;

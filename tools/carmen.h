@@ -48,15 +48,15 @@ typedef struct {
  */
 typedef struct {
     carmen_msg_t type;
-    const float *ranges;       /**< count readings, metres, as written */
-    size_t count;              /**< number of beams (may change from line to line) */
-    float angle_min;           /**< radians */
-    float angle_increment;     /**< radians */
-    float max_range;           /**< declared maximum range, metres */
-    carmen_pose_t laser_pose;  /**< lx ly ltheta (FLASER: x y theta) */
-    carmen_pose_t robot_pose;  /**< rx ry rtheta (FLASER: odom_x odom_y odom_theta) */
-    double timestamp;          /**< ipc_time, seconds */
-    unsigned long line;        /**< 1-based line number in the file */
+    const float *ranges;      /**< count readings, metres, as written */
+    size_t count;             /**< number of beams (may change from line to line) */
+    float angle_min;          /**< radians */
+    float angle_increment;    /**< radians */
+    float max_range;          /**< declared maximum range, metres */
+    carmen_pose_t laser_pose; /**< lx ly ltheta (FLASER: x y theta) */
+    carmen_pose_t robot_pose; /**< rx ry rtheta (FLASER: odom_x odom_y odom_theta) */
+    double timestamp;         /**< ipc_time, seconds */
+    unsigned long line;       /**< 1-based line number in the file */
 } carmen_scan_t;
 
 typedef struct carmen_reader carmen_reader_t;

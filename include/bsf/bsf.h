@@ -16,6 +16,7 @@
 #include "bsf_falko.h"
 #include "bsf_bspline.h"
 #include "bsf_fit.h"
+#include "bsf_bid.h"
 #include "bsf_extract.h"
 #include "bsf_stream.h"
 

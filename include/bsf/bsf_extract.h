@@ -18,6 +18,7 @@
 #include "bsf_scan.h"
 #include "bsf_feature.h"
 #include "bsf_falko.h"
+#include "bsf_bid.h"
 #include "bsf_segment.h"
 #include "bsf_fit.h"
 
@@ -29,7 +30,7 @@ extern "C" {
 typedef enum {
     BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM (default) */
     BSF_METHOD_BID_SVED_PDM = 1,   /**< baseline: B-spline interest points (slow), SVED, PDM */
-    BSF_METHOD_RPOS_LSBA = 2,      /**< baseline: RPOS segments, 4-point least squares, no corners */
+    BSF_METHOD_RPOS_LSBA = 2, /**< baseline: RPOS segments, 4-point least squares, no corners */
     BSF_METHOD_COUNT = 3
 } bsf_method_t;
 
@@ -44,6 +45,7 @@ typedef uint32_t (*bsf_clock_fn)(void *user);
 typedef struct {
     bsf_method_t method;
     bsf_falko_params_t falko; /**< used by FALKO-SVED-PDM */
+    bsf_bid_params_t bid;     /**< used by BID-SVED-PDM */
     bsf_sved_params_t sved;   /**< used by the two SVED methods */
     bsf_rpos_params_t rpos;   /**< used by RPOS-LSBA */
     bsf_pdm_params_t pdm;     /**< used by the two PDM methods */
@@ -69,15 +71,20 @@ BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
 typedef struct {
     bsf_params_t params;
     bsf_points_t points;
-    union {
-        bsf_falko_work_t falko;
-    } corner_work;
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
     bsf_segment_t segments[BSF_MAX_SEGMENTS];
-    bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points, gathered */
-    uint16_t vertex_pos[BSF_MAX_KEYPOINTS];  /**< its vertices, as positions in seg_points */
-    bsf_pdm_work_t pdm;
+    /** Stage scratch. The corner stage and the fitting stage never run at
+     *  the same time, so their working memory overlaps. */
+    union {
+        bsf_falko_work_t falko;
+        bsf_bid_work_t bid;
+        struct {
+            bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
+            uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, positions in seg_points */
+            bsf_pdm_work_t pdm;
+        } fit;
+    } scratch;
     size_t n_keypoints;
     size_t n_segments;
     uint32_t ready; /**< set by a successful init */

@@ -29,16 +29,16 @@ extern "C" {
 
 /** FALKO parameters; start from bsf_falko_params_default(). */
 typedef struct {
-    int min_score_th;    /**< keypoint threshold, percent of scoreMax, 0..100 (50) */
-    float min_range;     /**< beams with range below are never keypoints, metres (0) */
-    float max_range;     /**< beams with range above are never keypoints, metres (30) */
-    int subbeam;         /**< non-zero: refine the keypoint position by two line fits (1) */
-    float nms_radius;    /**< non-maxima suppression radius, metres (0.1) */
-    float neigh_a;       /**< neighbourhood radius r = neigh_a * exp(neigh_b * range), metres (0.1) */
-    float neigh_b;       /**< see neigh_a, 1/metres (0.07) */
+    int min_score_th; /**< keypoint threshold, percent of scoreMax, 0..100 (50) */
+    float min_range;  /**< beams with range below are never keypoints, metres (0) */
+    float max_range;  /**< beams with range above are never keypoints, metres (30) */
+    int subbeam;      /**< non-zero: refine the keypoint position by two line fits (1) */
+    float nms_radius; /**< non-maxima suppression radius, metres (0.1) */
+    float neigh_a;    /**< neighbourhood radius r = neigh_a * exp(neigh_b * range), metres (0.1) */
+    float neigh_b;    /**< see neigh_a, 1/metres (0.07) */
     int neigh_min_points; /**< points needed on each side of the apex, >= 1 (2) */
-    float b_ratio;       /**< triangle test: base and height must be >= r / b_ratio (2.5) */
-    int grid_sectors;    /**< number of angular sectors, 2..64 (16) */
+    float b_ratio;        /**< triangle test: base and height must be >= r / b_ratio (2.5) */
+    int grid_sectors;     /**< number of angular sectors, 2..64 (16) */
     int circular_sector_distance; /**< non-zero: the paper's true circular sector distance
                                        instead of FALKOLib's truncating one (0) */
 } bsf_falko_params_t;
@@ -63,9 +63,9 @@ BSF_NODISCARD bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p);
  * BSF_MAX_POINTS = 1081.
  */
 typedef struct {
-    float score[BSF_MAX_POINTS];       /**< per-beam raw score, then NMS strength */
-    uint16_t peak[BSF_MAX_POINTS];     /**< NMS candidates, then keypoint beams */
-    int8_t sector[BSF_MAX_POINTS];     /**< angular sectors of one neighbourhood */
+    float score[BSF_MAX_POINTS];   /**< per-beam raw score, then NMS strength */
+    uint16_t peak[BSF_MAX_POINTS]; /**< NMS candidates, then keypoint beams */
+    int8_t sector[BSF_MAX_POINTS]; /**< angular sectors of one neighbourhood */
 } bsf_falko_work_t;
 
 /**
@@ -74,6 +74,10 @@ typedef struct {
  * Only valid beams (pts->valid) are used, as apexes and as neighbours. For
  * non-maxima suppression an invalid beam counts as a beam far away (window
  * 0), which is how FALKOLib treats the datasets' no-return codes (81.83 m).
+ * FALKOLib uses every reading as a neighbour, also those beyond max_range;
+ * to match it exactly, build the points with a range_max above
+ * max_range + r(max_range) (e.g. 81 m, just below the no-return code), not
+ * with range_max = max_range.
  * The angle increment may be negative (clockwise scans); its magnitude is used.
  *
  * @param pts     scan points (bsf_scan_to_points); count <= BSF_MAX_POINTS

@@ -47,7 +47,8 @@ typedef struct {
  *  NULL or inconsistent counts: points in features > N, a non-finite or
  *  negative error sum, a NaN time (+inf or negative time is "not measured"),
  *  or points or control points in features while n_features is 0. */
-BSF_NODISCARD bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *counts, bsf_scan_metrics_t *out);
+BSF_NODISCARD bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *counts,
+                                            bsf_scan_metrics_t *out);
 
 /**
  * Dataset accumulator. Sums are kept in float pairs (Kahan) so millions of
@@ -56,15 +57,15 @@ BSF_NODISCARD bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *counts, bsf
  * scans it will add; NULL/0 when it does not want quantiles).
  */
 typedef struct {
-    float sum[4];   /**< Kahan sums of Gamma, eta, accuracy, time */
-    float comp[4];  /**< Kahan compensations */
-    uint32_t n[4];  /**< scans where each metric is defined */
+    float sum[4];  /**< Kahan sums of Gamma, eta, accuracy, time */
+    float comp[4]; /**< Kahan compensations */
+    uint32_t n[4]; /**< scans where each metric is defined */
     uint32_t n_scans;
     uint32_t sum_features; /**< over all scans */
     uint32_t sum_ctrl;
-    uint32_t sum_points;   /**< points in features */
-    uint32_t sum_valid;    /**< N */
-    float *time_samples;   /**< lent by the caller, may be NULL */
+    uint32_t sum_points; /**< points in features */
+    uint32_t sum_valid;  /**< N */
+    float *time_samples; /**< lent by the caller, may be NULL */
     size_t time_cap;
     size_t time_count;
 } bsf_metrics_acc_t;

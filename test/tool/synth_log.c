@@ -40,7 +40,8 @@ int main(int argc, char **argv)
         return 1;
     }
     bsf_scene_rng_seed(&rng, 42u);
-    fprintf(f, "# synthetic log written by synth_log\nPARAM robot_front_laser_max 50.0 nohost 0 0\n");
+    fprintf(f,
+            "# synthetic log written by synth_log\nPARAM robot_front_laser_max 50.0 nohost 0 0\n");
     for (k = 0; k < n; ++k) {
         const double x = 1.0 + 3.0 * (double)k / (double)n;
         bsf_lidar_t l = bsf_lidar_default(x, 1.2, 0.3, 181u, 3.14159265);
@@ -87,9 +88,10 @@ int main(int argc, char **argv)
     if (fclose(f) != 0 || bsf_metrics_acc_summary(&acc, &s) != BSF_OK) {
         return 1;
     }
-    printf("scans=%lu\nretrievability=%.6f\ncompactness=%.6f\naccuracy=%.7f\nfeatures_per_scan=%.4f\n"
-           "ctrl_per_scan=%.4f\n",
-           (unsigned long)s.n_scans, 100.0 * (double)s.retrievability, (double)s.compactness,
-           (double)s.accuracy, (double)s.features_per_scan, (double)s.ctrl_per_scan);
+    printf(
+        "scans=%lu\nretrievability=%.6f\ncompactness=%.6f\naccuracy=%.7f\nfeatures_per_scan=%.4f\n"
+        "ctrl_per_scan=%.4f\n",
+        (unsigned long)s.n_scans, 100.0 * (double)s.retrievability, (double)s.compactness,
+        (double)s.accuracy, (double)s.features_per_scan, (double)s.ctrl_per_scan);
     return 0;
 }
