@@ -19,6 +19,7 @@ static float ranges[BSF_MAX_POINTS + 1];
 static bsf_point_t pts[BSF_MAX_POINTS + 1];
 static bsf_segment_t segs[BSF_MAX_SEGMENTS + 1];
 static bsf_falko_work_t falko_work;
+static bsf_bid_work_t bid_work;
 static bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
 static bsf_pdm_work_t pdm_work;
 static bsf_point_t ctrl[BSF_MAX_CTRL_PER_FEATURE];
@@ -622,6 +623,82 @@ static void test_falko_detect_reports_total_when_out_is_too_small(void)
     TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
 }
 
+/* ---- bsf_bid.h ---------------------------------------------------------------------- */
+
+static void test_bid_params_check_refuses_null_and_each_out_of_range_field(void)
+{
+    bsf_bid_params_t p = bsf_bid_params_default();
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bid_params_check(&p));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_params_check(NULL));
+#define BAD_BID(field, value)                                                                      \
+    do {                                                                                           \
+        p = bsf_bid_params_default();                                                              \
+        p.field = value;                                                                           \
+        TEST_ASSERT_EQUAL_INT_MESSAGE(BSF_ERR_PARAM, bsf_bid_params_check(&p), #field);            \
+    } while (0)
+    BAD_BID(neigh_a, 0.0f);
+    BAD_BID(neigh_a, NAN);
+    BAD_BID(neigh_a, 1.0e9f);
+    BAD_BID(neigh_b, -1.0f);
+    BAD_BID(neigh_b, INFINITY);
+    BAD_BID(t_th, 0.0f);
+    BAD_BID(t_th, 1.0f);
+    BAD_BID(t_th, NAN);
+    BAD_BID(nms_radius, -0.1f);
+    BAD_BID(min_side_points, 0u);
+    BAD_BID(max_iterations, 0u);
+    BAD_BID(max_iterations, BSF_PDM_MAX_ITERATIONS + 1u);
+    BAD_BID(rel_tol, 0.0f);
+    BAD_BID(rel_tol, 1.0f);
+#undef BAD_BID
+}
+
+static void test_bid_detect_refuses_bad_input_and_handles_degenerate_scans(void)
+{
+    bsf_bid_params_t p = bsf_bid_params_default();
+    size_t n = 77u;
+    size_t i;
+    wall_points(60u);
+    fill(keypoints, sizeof keypoints);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_detect(NULL, &p, &bid_work, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_detect(&points, &p, NULL, keypoints, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_detect(&points, &p, &bid_work, keypoints, 4u, NULL));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_detect(&points, &p, &bid_work, NULL, 4u, &n));
+    points.angle_increment = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_detect(&points, &p, &bid_work, keypoints, 4u, &n));
+    points.angle_increment = 0.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_bid_detect(&points, &p, &bid_work, keypoints, 4u, &n));
+    points.angle_increment = 0.01f;
+    p.t_th = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_bid_detect(&points, &p, &bid_work, keypoints, 4u, &n));
+    p = bsf_bid_params_default();
+    points.count = BSF_MAX_POINTS + 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY,
+                          bsf_bid_detect(&points, &p, &bid_work, keypoints, 4u, &n));
+    ASSERT_UNTOUCHED(keypoints);
+    /* all invalid, then every beam the same point: no crash, finite keypoints */
+    {
+        bsf_scan_t s = make_scan(200u, NAN);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_bid_detect(&points, NULL, &bid_work, keypoints, BSF_MAX_KEYPOINTS, &n));
+        TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
+    }
+    wall_points(60u);
+    for (i = 0; i < points.count; ++i) {
+        points.pt[i].x = 1.0f;
+        points.pt[i].y = 2.0f;
+    }
+    {
+        const bsf_status_t st =
+            bsf_bid_detect(&points, NULL, &bid_work, keypoints, BSF_MAX_KEYPOINTS, &n);
+        TEST_ASSERT_TRUE(st == BSF_OK || st == BSF_ERR_CAPACITY);
+        for (i = 0; i < n && i < BSF_MAX_KEYPOINTS; ++i) {
+            TEST_ASSERT_TRUE(finite_f(keypoints[i].point.x) && finite_f(keypoints[i].score));
+        }
+    }
+}
+
 /* ---- bsf_bspline.h -------------------------------------------------------------- */
 
 static void test_bspline_span_and_basis_clamp_bad_arguments(void)
@@ -1059,6 +1136,7 @@ static void test_extractor_init_refuses_bad_params_and_extract_then_refuses_it(v
     fill(&extractor, sizeof extractor);
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_extract(&extractor, &s, &result));
     p = bsf_params_default(BSF_METHOD_BID_SVED_PDM);
+    p.bid.t_th = 1.0f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_extractor_init(&extractor, &p));
     p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&extractor, &p));
@@ -1503,6 +1581,8 @@ int main(void)
     RUN_TEST(test_falko_detect_refuses_null_and_bad_geometry_with_zero_count);
     RUN_TEST(test_falko_detect_degenerate_scans_give_finite_keypoints_or_none);
     RUN_TEST(test_falko_detect_reports_total_when_out_is_too_small);
+    RUN_TEST(test_bid_params_check_refuses_null_and_each_out_of_range_field);
+    RUN_TEST(test_bid_detect_refuses_bad_input_and_handles_degenerate_scans);
     RUN_TEST(test_bspline_span_and_basis_clamp_bad_arguments);
     RUN_TEST(test_bspline_eval_refuses_bad_arguments_untouched);
     RUN_TEST(test_lsba_refuses_bad_input_untouched);
