@@ -1482,19 +1482,6 @@ static const char demo_help[] =
     "encodes it into a stream (default demo.bsf), decodes the stream, prints the\n"
     "metrics and draws the map (default demo.svg) over the true walls.\n";
 
-static void build_office(bsf_scene_t *sc)
-{
-    static const double outline[] = {0.0, 0.0, 14.0, 0.0,  14.0, 6.0,
-                                     9.0, 6.0, 9.0,  10.0, 0.0,  10.0};
-    bsf_scene_init(sc);
-    (void)bsf_scene_add_polyline(sc, outline, 6u, 1);
-    /* a partition wall with a doorway, a cabinet, a pillar */
-    (void)bsf_scene_add_segment(sc, 5.0, 0.0, 5.0, 3.0);
-    (void)bsf_scene_add_segment(sc, 5.0, 4.2, 5.0, 7.0);
-    (void)bsf_scene_add_rect_room(sc, 2.0, 7.5, 3.5, 8.3);
-    (void)bsf_scene_add_circle(sc, 10.5, 3.0, 0.45);
-}
-
 static int cmd_demo(int argc, char **argv)
 {
     static float ranges[BSF_MAX_POINTS];
@@ -1536,7 +1523,7 @@ static int cmd_demo(int argc, char **argv)
             return err;
         }
     }
-    build_office(&scene);
+    bsf_scene_demo_office(&scene);
     bsf_scene_rng_seed(&rng, 2026u);
     if (init_extractor(method) != 0) {
         return EXIT_FAIL;
@@ -1547,16 +1534,13 @@ static int cmd_demo(int argc, char **argv)
     }
     bsf_frame_info_init(&info);
     for (k = 0; k < n_scans; ++k) {
-        /* a loop through both rooms and the doorway */
-        const double s = (double)k / (double)n_scans;
-        const double x = 3.0 + 8.0 * (0.5 - 0.5 * cos(2.0 * M_PI * s));
-        const double y = 3.6 + 1.2 * sin(2.0 * M_PI * s);
-        const double th =
-            atan2(1.2 * 2.0 * M_PI * cos(2.0 * M_PI * s), 8.0 * M_PI * sin(2.0 * M_PI * s) + 1e-9);
-        bsf_lidar_t lid = bsf_lidar_default(x, y, th, 361u, 1.5 * M_PI);
+        double x, y, th;
+        bsf_lidar_t lid;
         bsf_scan_t sc;
         size_t len = 0;
         bsf_status_t st;
+        bsf_scene_demo_pose(k, n_scans, &x, &y, &th);
+        lid = bsf_lidar_default(x, y, th, 361u, 1.5 * M_PI);
         lid.noise_sigma = 0.01;
         lid.range_max = 20.0;
         lid.no_return = 81.83f;

@@ -52,8 +52,10 @@ typedef struct {
     uint8_t has_time;
 } bsf_scan_metrics_t;
 
-/** Compute one scan's metrics. Returns BSF_ERR_ARG on NULL or inconsistent counts
- *  (points in features > N, non-finite or negative error sum). */
+/** Compute one scan's metrics. Returns BSF_OK, or BSF_ERR_ARG (out untouched) on
+ *  NULL or inconsistent counts: points in features > N, a non-finite or
+ *  negative error sum, a NaN time (+inf or negative time is "not measured"),
+ *  or points or control points in features while n_features is 0. */
 BSF_NODISCARD bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *counts,
                                             bsf_scan_metrics_t *out);
 
