@@ -208,10 +208,9 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         !get_u32(&r, UINT32_MAX, &seq) || !get_varint(&r, UINT64_MAX, &timestamp)) {
         return BSF_ERR_FORMAT;
     }
-    if ((flags & BSF_WIRE_FLAG_POSE) != 0u &&
-        (!get_signed(&r, BSF_WIRE_POSE_MM_MAX, &pose[0]) ||
-         !get_signed(&r, BSF_WIRE_POSE_MM_MAX, &pose[1]) || !get_u8(&r, &theta[0]) ||
-         !get_u8(&r, &theta[1]))) {
+    if ((flags & BSF_WIRE_FLAG_POSE) != 0u && (!get_signed(&r, BSF_WIRE_POSE_MM_MAX, &pose[0]) ||
+                                               !get_signed(&r, BSF_WIRE_POSE_MM_MAX, &pose[1]) ||
+                                               !get_u8(&r, &theta[0]) || !get_u8(&r, &theta[1]))) {
         return BSF_ERR_FORMAT;
     }
     if (!get_u32(&r, BSF_WIRE_STEP_CODE_MAX, &step_code) || step_code == 0u ||
@@ -263,7 +262,8 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         if (n_f < 3u) {
             return BSF_ERR_FORMAT;
         }
-        if (n_f > (uint32_t)BSF_MAX_CTRL_PER_FEATURE || n_ctrl + n_f > (size_t)BSF_MAX_CTRL_POINTS) {
+        if (n_f > (uint32_t)BSF_MAX_CTRL_PER_FEATURE ||
+            n_ctrl + n_f > (size_t)BSF_MAX_CTRL_POINTS) {
             return BSF_ERR_CAPACITY;
         }
         st = get_ctrl(&r, m, mask, step, n_ctrl, res, prev);

@@ -162,8 +162,7 @@ static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f
         if (res->ctrl_is_vertex[slot] != 0u) {
             int32_t q2[2];
             if (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
-                !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] ||
-                q2[1] != q[1]) {
+                !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] || q2[1] != q[1]) {
                 return BSF_ERR_ARG;
             }
             *mask |= (uint64_t)1u << j;
@@ -261,8 +260,7 @@ static int32_t round_to_int(float v)
 
 /* The whole frame through w. It may fail half-way, so every caller runs it
  * in counting mode first and writes only when that pass succeeded. */
-static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info,
-                                const bsf_result_t *res)
+static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const bsf_result_t *res)
 {
     uint32_t step_code;
     float step;
@@ -272,7 +270,8 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info,
     int64_t prev[2] = {0, 0};
     bsf_status_t st;
 
-    if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS || res->n_ctrl > (uint32_t)BSF_MAX_CTRL_POINTS) {
+    if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS ||
+        res->n_ctrl > (uint32_t)BSF_MAX_CTRL_POINTS) {
         return BSF_ERR_CAPACITY;
     }
     st = check_info(info, &step_code);

@@ -21,7 +21,7 @@
 #define BSF_WIRE_STEP_CODE_MAX 10000u
 #define BSF_WIRE_E_CURVE_CODE_MAX 10000000u
 #define BSF_WIRE_POSE_MM_MAX 2000000000L
-#define BSF_WIRE_THETA_PER_RAD 10430.378350470453f /* 65536 / (2 pi) */
+#define BSF_WIRE_THETA_PER_RAD 10430.378350470453f     /* 65536 / (2 pi) */
 #define BSF_WIRE_RAD_PER_THETA 9.5873799242852573e-05f /* 2 pi / 65536 */
 
 /* CRC-32C of any body (payload followed by its own CRC, little-endian). */

@@ -37,8 +37,8 @@ typedef struct {
     uint8_t vertex[8];
 } fx_feature_def_t;
 
-static void build(bsf_result_t *res, const fx_feature_def_t *defs, uint16_t n_defs, uint32_t n_valid,
-                  uint32_t time_ns)
+static void build(bsf_result_t *res, const fx_feature_def_t *defs, uint16_t n_defs,
+                  uint32_t n_valid, uint32_t time_ns)
 {
     uint16_t i;
     memset(res, 0, sizeof *res);
@@ -79,26 +79,55 @@ void fx_example_minimal(bsf_frame_info_t *info, bsf_result_t *res)
 void fx_example_typical(bsf_frame_info_t *info, bsf_result_t *res)
 {
     static const fx_feature_def_t defs[6] = {
-        {3, 38, 35, 0, 0.0058f, 4,
-         {{0.094f, -1.801f}, {0.512f, -1.797f}, {1.248f, -1.806f}, {1.662f, -1.812f}}, {0}},
-        {41, 95, 55, 1, 0.0094f, 5,
-         {{1.843f, -1.807f}, {3.102f, -1.794f}, {3.102f, -1.794f}, {3.095f, -0.412f},
+        {3,
+         38,
+         35,
+         0,
+         0.0058f,
+         4,
+         {{0.094f, -1.801f}, {0.512f, -1.797f}, {1.248f, -1.806f}, {1.662f, -1.812f}},
+         {0}},
+        {41,
+         95,
+         55,
+         1,
+         0.0094f,
+         5,
+         {{1.843f, -1.807f},
+          {3.102f, -1.794f},
+          {3.102f, -1.794f},
+          {3.095f, -0.412f},
           {3.089f, 0.286f}},
          {0, 1, 1, 0, 0}},
         {99, 118, 20, 0, 0.0031f, 3, {{2.301f, 0.902f}, {2.052f, 1.217f}, {1.788f, 1.540f}}, {0}},
-        {121, 150, 28, 1, 0.0112f, 5,
-         {{1.402f, 1.650f}, {0.901f, 1.652f}, {0.412f, 1.655f}, {0.412f, 1.655f},
-          {0.405f, 2.304f}},
+        {121,
+         150,
+         28,
+         1,
+         0.0112f,
+         5,
+         {{1.402f, 1.650f}, {0.901f, 1.652f}, {0.412f, 1.655f}, {0.412f, 1.655f}, {0.405f, 2.304f}},
          {0, 0, 1, 1, 0}},
-        {153, 170, 18, 0, 0.0073f, 5,
+        {153,
+         170,
+         18,
+         0,
+         0.0073f,
+         5,
          {{-0.102f, 2.506f},
           {-0.351f, 2.498f},
           {-0.602f, 2.445f},
           {-0.803f, 2.352f},
           {-0.951f, 2.214f}},
          {0}},
-        {172, 178, 7, 0, 0.0142f, 4,
-         {{-1.602f, 1.905f}, {-1.701f, 1.506f}, {-1.798f, 1.003f}, {-1.850f, 0.702f}}, {0}},
+        {172,
+         178,
+         7,
+         0,
+         0.0142f,
+         4,
+         {{-1.602f, 1.905f}, {-1.701f, 1.506f}, {-1.798f, 1.003f}, {-1.850f, 0.702f}},
+         {0}},
     };
     bsf_frame_info_init(info);
     info->seq = 1234u;
@@ -189,7 +218,8 @@ void fx_random_result(fx_rng_t *rng, uint32_t max_features, bsf_frame_info_t *in
 
     for (i = 0; i < n_features && res->n_ctrl + 20u <= BSF_MAX_CTRL_POINTS; ++i) {
         bsf_feature_t *f = &res->features[res->n_features];
-        uint8_t n_vertex = (uint8_t)(fx_rng_range(rng, 0u, 3u) == 0u ? fx_rng_range(rng, 1u, 2u) : 0u);
+        uint8_t n_vertex =
+            (uint8_t)(fx_rng_range(rng, 0u, 3u) == 0u ? fx_rng_range(rng, 1u, 2u) : 0u);
         uint8_t n_ctrl = (uint8_t)fx_rng_range(rng, 3u, 20u);
         const float r = fx_rng_float(rng, 0.3f, 8.0f);
         const float a = fx_rng_float(rng, -3.14159f, 3.14159f);
@@ -206,7 +236,9 @@ void fx_random_result(fx_rng_t *rng, uint32_t max_features, bsf_frame_info_t *in
         span = fx_rng_range(rng, 2u, beams_per_feature > 4u ? beams_per_feature - 2u : 2u);
         f->first_beam = (uint16_t)beam;
         f->last_beam = (uint16_t)(beam + span);
-        f->n_points = (uint16_t)(span + 1u - (fx_rng_range(rng, 0u, 4u) == 0u ? fx_rng_range(rng, 1u, 2u) : 0u));
+        f->n_points =
+            (uint16_t)(span + 1u -
+                       (fx_rng_range(rng, 0u, 4u) == 0u ? fx_rng_range(rng, 1u, 2u) : 0u));
         f->e_curve = fx_rng_float(rng, 0.0f, 0.03f);
         beam += span + fx_rng_range(rng, 1u, 2u);
         points += f->n_points;

@@ -22,19 +22,18 @@ static uint8_t body[BSF_FRAME_BODY_MAX_SIZE + 16u];
 static uint8_t scratch[BSF_FRAME_MAX_SIZE + 16u];
 
 /* docs/FORMAT.md, example 1 and example 2 (byte for byte). */
-static const uint8_t golden_minimal[] = {
-    0x02, 0x11, 0x01, 0x01, 0x03, 0x14, 0x14, 0x0e, 0x01, 0x08, 0x14, 0x13, 0x32, 0xe8,
-    0x07, 0xf4, 0x03, 0xe8, 0x07, 0xf4, 0x03, 0x06, 0x32, 0x59, 0xd7, 0x52, 0x55, 0x00};
+static const uint8_t golden_minimal[] = {0x02, 0x11, 0x01, 0x01, 0x03, 0x32, 0x14, 0x0e, 0x01, 0x08,
+                                         0x14, 0x13, 0x32, 0x90, 0x03, 0xc8, 0x01, 0x90, 0x03, 0xc8,
+                                         0x01, 0x06, 0x14, 0x2d, 0xdc, 0x7d, 0xa3, 0x00};
 static const uint8_t golden_typical[] = {
-    0x31, 0x11, 0x01, 0xd2, 0x09, 0x8e, 0xe0, 0x2a, 0xcc, 0x4a, 0xab, 0x5b, 0xa2, 0xc6, 0x14,
-    0xb0, 0x01, 0x90, 0x07, 0x06, 0x14, 0x06, 0x23, 0x01, 0x3a, 0x5e, 0x89, 0x0e, 0xa0, 0x0c,
-    0x09, 0x1a, 0x06, 0x15, 0x04, 0x13, 0x04, 0x36, 0x5e, 0x02, 0xb6, 0x01, 0x04, 0xea, 0x09,
-    0x0e, 0x0b, 0xa0, 0x10, 0x44, 0xd6, 0x02, 0x08, 0x06, 0x13, 0x1f, 0x93, 0x06, 0xe8, 0x04,
-    0x81, 0x04, 0xfe, 0x04, 0x06, 0x03, 0x17, 0x04, 0x1d, 0x02, 0x70, 0x04, 0x81, 0x03, 0x6e,
-    0xdd, 0x07, 0x06, 0x05, 0x01, 0x05, 0x88, 0x05, 0x18, 0x04, 0x11, 0x49, 0xfb, 0x03, 0xca,
-    0x01, 0xd1, 0x06, 0xa3, 0x02, 0x6b, 0x28, 0x4b, 0x56, 0x08, 0x5a, 0x10, 0x02, 0x06, 0x8e,
-    0x01, 0x89, 0x05, 0xb3, 0x02, 0xf7, 0x01, 0xb3, 0x09, 0x25, 0x63, 0x09, 0x05, 0xd8, 0xd1,
-    0x8b, 0xd8, 0x00};
+    0x22, 0x11, 0x01, 0xd2, 0x09, 0x8e, 0xe0, 0x2a, 0xcc, 0x4a, 0xab, 0x5b, 0xa2, 0xc6, 0x32,
+    0xb0, 0x01, 0x90, 0x07, 0x06, 0x14, 0x06, 0x23, 0x01, 0x3a, 0x26, 0xcf, 0x05, 0xf2, 0x04,
+    0x03, 0x0a, 0x02, 0x07, 0x0e, 0x13, 0x04, 0x36, 0x5e, 0x02, 0x4a, 0x02, 0xf6, 0x03, 0x04,
+    0x03, 0xc0, 0x06, 0x45, 0x8a, 0x01, 0x08, 0x06, 0x13, 0x1f, 0xbb, 0x02, 0xf6, 0x01, 0xcb,
+    0x01, 0x80, 0x02, 0x02, 0x01, 0x17, 0x04, 0x1d, 0x02, 0x70, 0x04, 0x9b, 0x01, 0x2c, 0x8b,
+    0x03, 0x02, 0x01, 0x01, 0x01, 0x84, 0x02, 0x18, 0x04, 0x11, 0x49, 0xc9, 0x01, 0x50, 0xd3,
+    0x02, 0x73, 0x2b, 0x12, 0x1d, 0x22, 0x02, 0x22, 0x10, 0x02, 0x06, 0x8e, 0x01, 0x83, 0x02,
+    0x7b, 0x63, 0xe1, 0x03, 0x0f, 0x27, 0x05, 0x02, 0x0c, 0x7a, 0x19, 0xb6, 0x00};
 
 void setUp(void)
 {
@@ -72,7 +71,8 @@ static unsigned feed_all(const uint8_t *data, size_t len, size_t chunk)
 static size_t golden_payload(const uint8_t *golden, size_t len, uint8_t *out)
 {
     size_t n = 0;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(golden, len - 1u, out, BSF_FRAME_BODY_MAX_SIZE, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_cobs_decode(golden, len - 1u, out, BSF_FRAME_BODY_MAX_SIZE, &n));
     return n - 4u;
 }
 
@@ -126,7 +126,8 @@ static void assert_round_trip(const bsf_frame_info_t *info, const bsf_result_t *
         TEST_ASSERT_EQUAL_UINT8(a->kind, b->kind);
         TEST_ASSERT_FLOAT_WITHIN(0.00005f + 1e-6f, a->e_curve, b->e_curve);
         for (k = a->ctrl_first; k < a->ctrl_first + a->n_ctrl; ++k) {
-            const float tol = 0.5f * step * 1.0001f + 4e-7f * (fabsf(in->ctrl[k].x) + fabsf(in->ctrl[k].y));
+            const float tol =
+                0.5f * step * 1.0001f + 4e-7f * (fabsf(in->ctrl[k].x) + fabsf(in->ctrl[k].y));
             TEST_ASSERT_FLOAT_WITHIN(tol, in->ctrl[k].x, out->result.ctrl[k].x);
             TEST_ASSERT_FLOAT_WITHIN(tol, in->ctrl[k].y, out->result.ctrl[k].y);
             TEST_ASSERT_EQUAL_UINT8(in->ctrl_is_vertex[k] != 0u, out->result.ctrl_is_vertex[k]);
@@ -199,7 +200,8 @@ static void test_cobs_refuses_zero_bytes_truncation_and_small_buffers(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_cobs_decode(truncated, 3, body, sizeof body, &n));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_cobs_encode(in, 3, buf, 3, &n));
     TEST_ASSERT_EQUAL_UINT32(4u, (uint32_t)n);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_cobs_decode(golden_minimal, sizeof golden_minimal - 1u, body, 3, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_cobs_decode(golden_minimal, sizeof golden_minimal - 1u, body, 3, &n));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_cobs_encode(NULL, 3, buf, sizeof buf, &n));
 }
 
@@ -246,7 +248,8 @@ static void test_one_shot_decode_reads_golden_body(void)
     bsf_frame_info_t info;
     size_t n = 0;
     fx_example_typical(&info, &res);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(golden_typical, sizeof golden_typical - 1u, body, sizeof body, &n));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_cobs_decode(golden_typical, sizeof golden_typical - 1u, body, sizeof body, &n));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, n, &frame));
     assert_round_trip(&info, &res, &frame);
     body[7] ^= 0x40u;
@@ -283,7 +286,8 @@ static void test_too_small_buffer_is_refused_without_writing(void)
     size_t n = 0;
     fx_example_typical(&info, &res);
     memset(buf, 0xEE, sizeof buf);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode(&info, &res, buf, sizeof golden_typical - 1u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_frame_encode(&info, &res, buf, sizeof golden_typical - 1u, &n));
     TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical, (uint32_t)n);
     TEST_ASSERT_EACH_EQUAL_HEX8(0xEE, buf, sizeof golden_typical);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof golden_typical, &n));
@@ -328,7 +332,8 @@ static void test_sink_gets_the_same_bytes_in_blocks_of_at_most_256(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
     TEST_ASSERT_TRUE(n > 600u);
     memset(&log, 0, sizeof log);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
     TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)written);
     TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)log.len);
     TEST_ASSERT_EQUAL_HEX8_ARRAY(buf, scratch, n);
@@ -337,9 +342,11 @@ static void test_sink_gets_the_same_bytes_in_blocks_of_at_most_256(void)
 
     memset(&log, 0, sizeof log);
     log.fail_after = 2u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_frame_encode_sink(&work, &info, &res, record_sink, &log, &written));
     TEST_ASSERT_TRUE(written < n);
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode_sink(&work, &info, &res, NULL, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bsf_frame_encode_sink(&work, &info, &res, NULL, &log, &written));
 }
 
 static void test_random_results_round_trip_within_half_a_step(void)
@@ -394,14 +401,14 @@ static void test_encoder_rejects_values_it_cannot_represent(void)
         switch (c) {
         case 0: res.ctrl[2].x = NAN; break;
         case 1: res.ctrl[2].y = INFINITY; break;
-        case 2: res.ctrl[0].x = 20000.0f; break; /* > 2^23 steps of 2 mm */
+        case 2: res.ctrl[0].x = 50000.0f; break; /* > 2^23 steps of 5 mm */
         case 3: info.quant_step = 0.0f; break;
         case 4: info.quant_step = 2.0f; break;
         case 5: info.quant_step = NAN; break;
         case 6: info.pose_theta = NAN; break;
         case 7: info.pose_x = 3e6f; break;
         case 8: res.ctrl_is_vertex[6] = 0u; break; /* vertex without its copy */
-        case 9: res.ctrl[6].x += 0.01f; break;      /* copies differ */
+        case 9: res.ctrl[6].x += 0.01f; break;     /* copies differ */
         case 10: res.features[2].n_ctrl = 2u; break;
         case 11: res.features[5].n_ctrl = 5u; break; /* beyond result->n_ctrl */
         case 12: res.features[1].last_beam = 40u; break;
@@ -409,10 +416,14 @@ static void test_encoder_rejects_values_it_cannot_represent(void)
         case 14: res.features[1].kind = 2u; break;
         case 15: res.stats.n_valid = 100u; break; /* fewer than the points in features */
         case 16: res.features[0].e_curve = -0.001f; break;
-        case 17: res.n_features = BSF_MAX_SEGMENTS + 1u; want = BSF_ERR_CAPACITY; break;
+        case 17:
+            res.n_features = BSF_MAX_SEGMENTS + 1u;
+            want = BSF_ERR_CAPACITY;
+            break;
         default: res.features[5].last_beam = BSF_MAX_POINTS; break;
         }
-        TEST_ASSERT_EQUAL_INT_MESSAGE(want, bsf_frame_encode(&info, &res, buf, sizeof buf, &n), "case");
+        TEST_ASSERT_EQUAL_INT_MESSAGE(want, bsf_frame_encode(&info, &res, buf, sizeof buf, &n),
+                                      "case");
         TEST_ASSERT_EQUAL_INT(want, bsf_frame_encode(&info, &res, NULL, 0u, &n));
     }
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(NULL, &res, buf, sizeof buf, &n));
@@ -495,8 +506,7 @@ static void test_truncated_frames_are_never_delivered(void)
     }
     TEST_ASSERT_EQUAL_UINT32(0u, delivered);
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.frames_ok);
-    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical - 2u,
-                             dec.stats.bad_crc + dec.stats.malformed);
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_typical - 2u, dec.stats.bad_crc + dec.stats.malformed);
     /* Back in step right away. */
     TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_typical, sizeof golden_typical, 9u));
 }
@@ -509,7 +519,8 @@ static void test_oversized_frame_is_skipped_and_counted(void)
         scratch[i] = (uint8_t)(1u + i % 200u);
     }
     delivered += feed_all(scratch, sizeof scratch, 1000u);
-    delivered += feed_all(golden_minimal, sizeof golden_minimal, 1000u); /* its 0x00 ends the junk */
+    delivered +=
+        feed_all(golden_minimal, sizeof golden_minimal, 1000u); /* its 0x00 ends the junk */
     delivered += feed_all(golden_minimal, sizeof golden_minimal, 1000u);
     TEST_ASSERT_EQUAL_UINT32(1u, delivered);
     TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.oversize);
@@ -566,29 +577,34 @@ static void test_malformed_fields_are_dropped_and_counted(void)
     uint8_t payload[72];
     const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, base);
     unsigned c;
-    /* Payload of example 1: 11 00 00 00 14 14 00 01 | 08 14 13 32 | e8 07 f4 03 e8 07 f4 03 00 32 */
+    /* Payload of example 1: 11 00 00 00 32 14 00 01 | 08 14 13 32 | 90 03 c8 01 90 03 c8 01 00 14
+     */
     for (c = 0; c < 10u; ++c) {
         size_t plen = len;
         size_t n;
         memcpy(payload, base, len);
         switch (c) {
-        case 0: payload[1] = 0x02; break;             /* reserved flag bit */
-        case 1: payload[plen++] = 0x00; break;        /* trailing byte */
-        case 2: plen -= 1u; break;                    /* field cut short */
-        case 3: payload[4] = 0x00; break;             /* quantisation step 0 */
-        case 4: payload[7] = 0x02; break;             /* 2 features announced, 1 sent */
-        case 5: payload[8] = 0x00; break;             /* 2 control points */
-        case 6: payload[10] = 0xFF; payload[11] = 0x7F; break; /* last beam beyond the caps */
-        case 7: payload[5] = 0x05; break;             /* N smaller than points in features */
-        case 8: /* non-minimal varint: seq as 0x80 0x00 */
+        case 0: payload[1] = 0x02; break;      /* reserved flag bit */
+        case 1: payload[plen++] = 0x00; break; /* trailing byte */
+        case 2: plen -= 1u; break;             /* field cut short */
+        case 3: payload[4] = 0x00; break;      /* quantisation step 0 */
+        case 4: payload[7] = 0x02; break;      /* 2 features announced, 1 sent */
+        case 5: payload[8] = 0x00; break;      /* 2 control points */
+        case 6:
+            payload[10] = 0xFF;
+            payload[11] = 0x7F;
+            break;                        /* last beam beyond the caps */
+        case 7: payload[5] = 0x05; break; /* N smaller than points in features */
+        case 8:                           /* non-minimal varint: seq as 0x80 0x00 */
             memmove(payload + 3, payload + 2, len - 2u);
             payload[2] = 0x80;
             ++plen;
             break;
-        default: payload[8] = 0x0A; break;            /* vertex flag without a mask */
+        default: payload[8] = 0x0A; break; /* vertex flag without a mask */
         }
         n = reframe(payload, plen, scratch);
-        TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u), "malformed frame delivered");
+        TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u),
+                                         "malformed frame delivered");
         TEST_ASSERT_EQUAL_UINT32(c + 1u, dec.stats.malformed);
     }
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.bad_crc);

@@ -194,6 +194,67 @@ static void test_rate_1e2_every_intact_frame_decoded_none_false(void)
     run_and_check(10000u, "1e-2", 4u);
 }
 
+/* Damage that the CRC cannot see (it is recomputed): the parser must reject
+ * it or deliver a frame the encoder can represent again, never crash. */
+static void test_crc_valid_mutations_are_rejected_or_consistent(void)
+{
+    static uint8_t body[BSF_FRAME_BODY_MAX_SIZE];
+    static bsf_frame_t again;
+    fx_rng_t rng;
+    uint32_t i;
+    unsigned accepted = 0;
+    unsigned rejected = 0;
+    fx_rng_seed(&rng, 77u);
+    for (i = 0; i < N_FRAMES; ++i) {
+        const size_t n = encode_frame(i, sent);
+        size_t len = 0;
+        size_t n_back = 0;
+        uint32_t crc;
+        uint32_t k;
+        const uint32_t hits = fx_rng_range(&rng, 1u, 3u);
+        bsf_frame_info_t info;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(sent, n - 1u, body, sizeof body, &len));
+        len -= 4u;
+        for (k = 0; k < hits; ++k) {
+            const uint32_t what = fx_rng_range(&rng, 0u, 9u);
+            if (what == 0u && len > 1u) {
+                --len; /* cut the last byte */
+            } else if (what == 1u && len + 5u < sizeof body) {
+                body[len++] = (uint8_t)fx_rng_next(&rng); /* add one */
+            } else {
+                body[fx_rng_range(&rng, 0u, (uint32_t)len - 1u)] = (uint8_t)fx_rng_next(&rng);
+            }
+        }
+        crc = bsf_crc32c(0u, body, len);
+        for (k = 0; k < 4u; ++k) {
+            body[len + k] = (uint8_t)(crc >> (8u * k));
+        }
+        if (bsf_frame_decode(body, len + 4u, &frame) != BSF_OK) {
+            ++rejected;
+            continue;
+        }
+        ++accepted;
+        bsf_frame_info_init(&info);
+        info.seq = frame.seq;
+        info.timestamp_ms = frame.timestamp_ms;
+        info.has_pose = frame.has_pose;
+        info.pose_x = frame.pose_x;
+        info.pose_y = frame.pose_y;
+        info.pose_theta = frame.pose_theta;
+        info.quant_step = frame.quant_step;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_frame_encode(&info, &frame.result, check, sizeof check, &n_back));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(check, n_back - 1u, body, sizeof body, &len));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, len, &again));
+        TEST_ASSERT_EQUAL_UINT16(frame.result.n_features, again.result.n_features);
+        TEST_ASSERT_EQUAL_UINT16(frame.result.n_ctrl, again.result.n_ctrl);
+        TEST_ASSERT_EQUAL_UINT32(frame.result.stats.n_valid, again.result.stats.n_valid);
+    }
+    printf("crc-valid mutations: %u rejected, %u accepted as consistent frames\n", rejected,
+           accepted);
+    TEST_ASSERT_TRUE(rejected > 0u);
+}
+
 static void test_clean_channel_delivers_every_frame(void)
 {
     const tally_t t = run_channel(0u, 5u);
@@ -206,6 +267,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_clean_channel_delivers_every_frame);
+    RUN_TEST(test_crc_valid_mutations_are_rejected_or_consistent);
     RUN_TEST(test_rate_1e4_every_intact_frame_decoded_none_false);
     RUN_TEST(test_rate_1e3_every_intact_frame_decoded_none_false);
     RUN_TEST(test_rate_3e3_every_intact_frame_decoded_none_false);

@@ -34,8 +34,8 @@ extern "C" {
 /** Smallest and largest quantisation step, metres (wire codes 1..10000). */
 #define BSF_QUANT_STEP_MIN 0.0001f
 #define BSF_QUANT_STEP_MAX 1.0f
-/** Default quantisation step, metres (adds at most 1 mm per coordinate). */
-#define BSF_QUANT_STEP_DEFAULT 0.002f
+/** Default quantisation step, metres (adds at most 2.5 mm per coordinate). */
+#define BSF_QUANT_STEP_DEFAULT 0.005f
 /** Largest |coordinate| / step a control point may have (2^23 - 1). */
 #define BSF_QUANT_MAX_STEPS 8388607L
 /** Largest |pose x|, |pose y| that can be sent, metres (int32 millimetres). */
