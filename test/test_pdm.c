@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "bsf/bsf.h"
+#include "bsf_scene.h"
 #include "unity.h"
 
 #define N_MAX 200
@@ -356,6 +357,54 @@ static void test_refinement_stops_at_the_per_fragment_cap(void)
     assert_all_finite(ctrl, n_ctrl);
 }
 
+/* A whole room seen as one segment with no vertex (the corner detector
+ * missed every corner): 541 beams over 270 degrees of a rectangular room with
+ * a round pillar, 1 cm noise. Warm-starting every refinement from the
+ * previous footpoints gets stuck here (E_curve up to 0.18 m); refinement far
+ * from the target restarts from arc length and stays within 7 cm, with every
+ * control point finite. */
+static bsf_point_t room_pts[BSF_MAX_POINTS];
+static float room_ranges[BSF_MAX_POINTS];
+
+static void test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck(void)
+{
+    static const double pose[4][3] = {{2.0, 2.0, 0.3}, {3.0, 1.2, 1.2}, {1.5, 2.5, 2.5},
+                                      {4.0, 2.0, -0.7}};
+    static bsf_scene_t scene;
+    size_t k;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
+    for (k = 0; k < 4u; ++k) {
+        bsf_lidar_t l = bsf_lidar_default(pose[k][0], pose[k][1], pose[k][2], 541u, 4.71238898);
+        bsf_scene_rng_t rng;
+        size_t n = 0;
+        size_t i;
+        size_t n_ctrl = 0;
+        float e = -1.0f;
+        l.noise_sigma = 0.01;
+        bsf_scene_rng_seed(&rng, 5u + k);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL,
+                                                     BSF_MAX_POINTS));
+        for (i = 0; i < l.n_beams; ++i) {
+            const float r = room_ranges[i];
+            const float a = (float)(l.angle_min + l.angle_increment * (double)i);
+            if (r > 0.05f && r < (float)l.range_max) {
+                room_pts[n].x = r * cosf(a);
+                room_pts[n].y = r * sinf(a);
+                ++n;
+            }
+        }
+        TEST_ASSERT_TRUE(n > 500u);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl,
+                                                  NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e,
+                                                  NULL));
+        TEST_ASSERT_TRUE(n_ctrl <= BSF_MAX_CTRL_PER_FEATURE);
+        assert_all_finite(ctrl, n_ctrl);
+        TEST_ASSERT_TRUE_MESSAGE(e >= 0.0f && e <= 0.07f, "PDM stuck on a room without vertices");
+    }
+}
+
 static void test_degenerate_inputs_give_defined_status_and_never_nan(void)
 {
     size_t n_ctrl = 77u;
@@ -480,6 +529,7 @@ int main(void)
     RUN_TEST(test_refinement_reaches_target_and_one_point_less_misses_it);
     RUN_TEST(test_refinement_refines_only_the_curved_fragment_of_a_corner);
     RUN_TEST(test_refinement_stops_at_the_per_fragment_cap);
+    RUN_TEST(test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck);
     RUN_TEST(test_degenerate_inputs_give_defined_status_and_never_nan);
     RUN_TEST(test_bad_arguments_parameters_and_capacities_are_refused);
     return UNITY_END();
