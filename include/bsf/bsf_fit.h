@@ -66,10 +66,9 @@ typedef struct {
     /** Error-driven refinement target, metres, > 0. Default 0.015. */
     float target_rms;
     /** Most PDM iterations of the first solve, 1..BSF_PDM_MAX_ITERATIONS.
-     *  Default 2. Measured on Intel (FALKO-SVED-PDM, bsf extract + metrics):
-     *  the defaults give compactness 0.185 and accuracy 11.9 mm; max_iterations
-     *  8, refine_iterations 8 and footpoint_steps 2 give 0.178 and 10.8 mm
-     *  for about three times the fitting time. */
+     *  Default 2. With refinement a solve stops early once every fragment
+     *  meets target_rms. Measured on Intel (FALKO-SVED-PDM, bsf extract +
+     *  metrics): the defaults give compactness 0.185 and accuracy 11.7 mm. */
     uint16_t max_iterations;
     /** Most PDM iterations after each refinement step (warm-started from the
      *  previous footpoints), 1..BSF_PDM_MAX_ITERATIONS. Default 1. */
@@ -143,12 +142,19 @@ typedef struct {
  * until the RMS improves by less than rel_tol or max_iterations is reached;
  * an iteration that raises the RMS (possible through the bending term) is
  * undone and ends the solve, so the RMS never increases.
- * With refinement, the worst fragment whose RMS exceeds target_rms (and whose
+ * With refinement, a solve also ends as soon as every fragment meets
+ * target_rms. Then the worst fragment whose RMS exceeds target_rms (and whose
  * cap of one precision point per 4 of its points, and the control-point cap,
- * allow it) receives one more precision point and the fit is warm-started
- * (parameters remapped fragment by fragment, refine_iterations iterations);
- * this repeats until every fragment meets the target or none can grow. A
- * result above target_rms is therefore not an error: compare e_curve_out.
+ * allow it) grows: while its RMS is above twice the target, by the points an
+ * h^3 error law predicts to halve the excess (at least one), and the new
+ * layout is fitted afresh from arc length (a warm start can stay stuck on a
+ * corner the vertices miss); nearer the target, by exactly one point with a
+ * warm start (parameters remapped fragment by fragment, refine_iterations
+ * iterations), plus a fresh fit from arc length kept when it is better if the
+ * fragment's RMS fell by less than 10 %. This repeats until every fragment
+ * meets the target or none can grow; the last point added is always a single
+ * step. A result above target_rms is therefore not an error: compare
+ * e_curve_out.
  *
  * @param pts           n points of the segment in scan order, metres
  * @param n             3..BSF_MAX_POINTS
