@@ -788,7 +788,7 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     }
     build_layout(&s, work, t0, t1);
     start_from_arc_length(&s, work, t0, t1);
-    st = run_pdm(&s, work, p, p->max_iterations, p->refine ? p->target_rms : 0.0f, n_vertex == 0u,
+    st = run_pdm(&s, work, p, p->max_iterations, p->refine ? p->target_rms : 0.0f, 0,
                  &info.iterations);
     if (st != BSF_OK) {
         return st;
