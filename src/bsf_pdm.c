@@ -376,9 +376,10 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
  * in the neighbouring span). The end points keep parameters 0 and 1: they
  * anchor the curve's ends, which would otherwise drift past the data. Fills
  * the RMS per fragment (a vertex point belongs to both its fragments) and
- * overall, and assembles the next normal equations at the new parameters in
- * the same sweep, so no basis is computed twice. */
-static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
+ * overall, and (when another iteration may follow) assembles the next normal
+ * equations at the new parameters in the same sweep, so no basis is computed
+ * twice. */
+static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next)
 {
     const size_t n_span = s->n_ctrl - 2u;
     const float fs = (float)n_span;
@@ -395,7 +396,9 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
     size_t f = 0;
     size_t i;
 
-    clear_normal_equations(s, w);
+    if (assemble_next) {
+        clear_normal_equations(s, w);
+    }
     sums_reset(&acc, 0u);
     load_span(w->ctrl, n_span, 0u, &c);
     cn = c;
@@ -494,11 +497,13 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
             }
         }
         w->t[i] = t;
-        if (c.span != acc.span) {
-            sums_flush(w, &acc);
-            sums_reset(&acc, c.span);
+        if (assemble_next) {
+            if (c.span != acc.span) {
+                sums_flush(w, &acc);
+                sums_reset(&acc, c.span);
+            }
+            sums_add(&acc, b0, b2, qx, qy);
         }
-        sums_add(&acc, b0, b2, qx, qy);
         total += best;
         frag_sum += best;
         if (i == frag_end) {
@@ -511,7 +516,9 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps)
             }
         }
     }
-    sums_flush(w, &acc);
+    if (assemble_next) {
+        sums_flush(w, &acc);
+    }
     s->rms = sqrtf(total / (float)s->n);
 }
 
@@ -557,7 +564,7 @@ static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_par
         if (st != BSF_OK) {
             return st;
         }
-        footpoint_pass(s, w, p->footpoint_steps);
+        footpoint_pass(s, w, p->footpoint_steps, it + 1u < max_iterations);
         ++*iterations;
         if (it > 0u && s->rms > prev) {
             memcpy(w->t, w->t_prev, s->n * sizeof w->t[0]);
