@@ -16,6 +16,9 @@
  * the four datasets: fewer refits and no warm start stuck on a corner the
  * vertices miss). */
 #define PDM_FAR_RATIO 2.0f
+/* Far growth aims at this multiple of target_rms (above 1, so the last
+ * points before the target still come one at a time). */
+#define PDM_FAR_AIM 1.5f
 /* A warm-started refinement that lowered the refined fragment's RMS by less
  * than this fraction also tries a restart from arc length. */
 #define PDM_COLD_GAIN 0.1f
@@ -632,7 +635,7 @@ static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const floa
 
 /* Precision points to add to fragment f, whose RMS is above PDM_FAR_RATIO *
  * target: as many as an h^3 error law (quadratic splines on a smooth shape)
- * predicts to bring it down to that level, at least one, within the
+ * predicts to bring it down to PDM_FAR_AIM * target, at least one, within the
  * fragment's cap and the control-point cap. The law errs low on a corner the
  * vertices miss (its error falls more slowly), so a fragment is rarely grown
  * past need, and the last points before the target are always added one at
@@ -642,7 +645,7 @@ static size_t far_growth(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f
                          size_t max_ctrl)
 {
     const size_t room = max_ctrl - s->n_ctrl;
-    const float ratio = w->frag_rms[f] / (PDM_FAR_RATIO * target);
+    const float ratio = w->frag_rms[f] / (PDM_FAR_AIM * target);
     const size_t k = w->frag_precision[f];
     const size_t cap = precision_cap(w, f);
     const float now = (float)(k + 1u);

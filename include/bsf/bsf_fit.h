@@ -146,8 +146,8 @@ typedef struct {
  * target_rms. Then the worst fragment whose RMS exceeds target_rms (and whose
  * cap of one precision point per 4 of its points, and the control-point cap,
  * allow it) grows: while its RMS is above twice the target, by the points an
- * h^3 error law predicts to bring it down to twice the target (at least
- * one), and the new layout is fitted afresh from arc length (a warm start can
+ * h^3 error law predicts to bring it down to 1.5 times the target (at
+ * least one), and the new layout is fitted afresh from arc length (a warm start can
  * stay stuck on a corner the vertices miss); nearer the target, by exactly one point with a
  * warm start (parameters remapped fragment by fragment, refine_iterations
  * iterations), plus a fresh fit from arc length kept when it is better if the
