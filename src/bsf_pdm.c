@@ -618,8 +618,13 @@ static size_t pick_fragment(const pdm_state_t *s, const bsf_pdm_work_t *w, float
 static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const float *old_t0,
                              const float *old_t1, const float *t0, const float *t1)
 {
-    size_t f = 0;
+    float scale[BSF_PDM_MAX_FRAGMENTS];
+    size_t f;
     size_t i;
+    for (f = 0; f < s->n_frag; ++f) {
+        scale[f] = (t1[f] - t0[f]) / (old_t1[f] - old_t0[f]);
+    }
+    f = 0;
     for (i = 0; i < s->n; ++i) {
         float t = w->t[i];
         while (f + 1u < s->n_frag && t > old_t1[f]) {
@@ -628,7 +633,7 @@ static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const floa
         while (f > 0u && t < old_t0[f]) {
             --f;
         }
-        t = t0[f] + (t - old_t0[f]) * (t1[f] - t0[f]) / (old_t1[f] - old_t0[f]);
+        t = t0[f] + (t - old_t0[f]) * scale[f];
         w->t[i] = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
     }
 }
