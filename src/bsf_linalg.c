@@ -9,12 +9,46 @@ static int finite_f(float v)
 
 /* In-place banded Cholesky of factor (holding A + loading * I). Returns 0 on
  * a bad pivot. */
+/* band_cholesky for half-bandwidth 2 (every PDM solve), written out: row i
+ * holds (L[i][i], L[i][i-1], L[i][i-2]) at f[3i], f[3i+1], f[3i+2]. Same
+ * arithmetic order and pivot test as the general loop. */
+static int band_cholesky_bw2(float *f, size_t m, float loading)
+{
+    size_t i;
+    for (i = 0; i < m; ++i) {
+        float *r = f + i * 3u;
+        const float diag = r[0] + loading;
+        float sum = diag;
+        if (i >= 2u) {
+            r[2] = r[2] / f[(i - 2u) * 3u];
+            sum -= r[2] * r[2];
+        }
+        if (i >= 1u) {
+            float off = r[1];
+            if (i >= 2u) {
+                off -= r[2] * f[(i - 1u) * 3u + 1u];
+            }
+            r[1] = off / f[(i - 1u) * 3u];
+            sum -= r[1] * r[1];
+        }
+        if (!(sum > BSF_LINALG_PIVOT_REL * diag) || !finite_f(sum)) {
+            return 0;
+        }
+        r[0] = sqrtf(sum);
+    }
+    return 1;
+}
+
 static int band_cholesky(float *f, size_t m, size_t bw, float loading)
 {
     const size_t w = bw + 1u;
     size_t i;
     size_t j;
     size_t k;
+
+    if (bw == 2u) {
+        return band_cholesky_bw2(f, m, loading);
+    }
 
     for (i = 0; i < m; ++i) {
         const size_t j0 = i > bw ? i - bw : 0u;
