@@ -21,7 +21,7 @@
 #define PDM_FAR_AIM 1.5f
 /* A warm-started refinement that lowered the refined fragment's RMS by less
  * than this fraction also tries a restart from arc length. */
-#define PDM_COLD_GAIN 0.1f
+#define PDM_COLD_GAIN 0.05f
 /* Footpoint steps shorter than this fraction of a span are not taken. */
 #define PDM_STEP_EPS 1e-6f
 /* Failed footpoint steps longer than this fraction of a span are halved and

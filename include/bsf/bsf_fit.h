@@ -151,7 +151,7 @@ typedef struct {
  * stay stuck on a corner the vertices miss); nearer the target, by exactly one point with a
  * warm start (parameters remapped fragment by fragment, refine_iterations
  * iterations), plus a fresh fit from arc length kept when it is better if the
- * fragment's RMS fell by less than 10 %. This repeats until every fragment
+ * fragment's RMS fell by less than 5 %. This repeats until every fragment
  * meets the target or none can grow; the last point added is always a single
  * step. A result above target_rms is therefore not an error: compare
  * e_curve_out.
