@@ -278,6 +278,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const size_t a = w->frag_first[f];
         const size_t b = w->frag_last[f];
         const float len = s->frag_len[f];
+        const float inv_len = len > 0.0f ? 1.0f / len : 0.0f;
         const float range = t1[f] - t0[f];
         const unsigned straight = w->frag_precision[f] == 0u;
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
@@ -293,7 +294,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
                 arc += dist(s->pts[i - 1u], s->pts[i]);
             }
             /* Coincident points: fall back to even spacing by index. */
-            frac = len > 0.0f ? arc / len : (float)(i - a) / (float)(b - a);
+            frac = len > 0.0f ? arc * inv_len : (float)(i - a) / (float)(b - a);
             frac = frac > 1.0f ? 1.0f : frac;
             if (straight) {
                 /* A straight fragment at a vertex is not traversed at
