@@ -368,13 +368,13 @@ static float room_ranges[BSF_MAX_POINTS];
 
 static void test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck(void)
 {
-    static const double pose[4][3] = {{2.0, 2.0, 0.3}, {3.0, 1.2, 1.2}, {1.5, 2.5, 2.5},
-                                      {4.0, 2.0, -0.7}};
+    static const double pose[4][3] = {
+        {2.0, 2.0, 0.3}, {3.0, 1.2, 1.2}, {1.5, 2.5, 2.5}, {4.0, 2.0, -0.7}};
     static bsf_scene_t scene;
     size_t k;
     bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
     for (k = 0; k < 4u; ++k) {
         bsf_lidar_t l = bsf_lidar_default(pose[k][0], pose[k][1], pose[k][2], 541u, 4.71238898);
         bsf_scene_rng_t rng;
@@ -384,8 +384,8 @@ static void test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck(
         float e = -1.0f;
         l.noise_sigma = 0.01;
         bsf_scene_rng_seed(&rng, 5u + k);
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL,
-                                                     BSF_MAX_POINTS));
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL, BSF_MAX_POINTS));
         for (i = 0; i < l.n_beams; ++i) {
             const float r = room_ranges[i];
             const float a = (float)(l.angle_min + l.angle_increment * (double)i);
@@ -396,9 +396,8 @@ static void test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck(
             }
         }
         TEST_ASSERT_TRUE(n > 500u);
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl,
-                                                  NULL, BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e,
-                                                  NULL));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                                  BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
         TEST_ASSERT_TRUE(n_ctrl <= BSF_MAX_CTRL_PER_FEATURE);
         assert_all_finite(ctrl, n_ctrl);
         TEST_ASSERT_TRUE_MESSAGE(e >= 0.0f && e <= 0.07f, "PDM stuck on a room without vertices");
