@@ -1,6 +1,7 @@
 /* BID: the B-spline interest point detector (design brief section 5). */
 #include "bsf/bsf_bid.h"
 #include "bsf_fit_internal.h"
+#include "bsf_math.h"
 #include "bsf_nms.h"
 
 #include <math.h>
@@ -168,7 +169,7 @@ bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid_params_t *p,
         if (!pts->valid[q] || bsf_fit_check_points(&pts->pt[q], 1u) != BSF_OK) {
             continue;
         }
-        r = p->neigh_a * expf(p->neigh_b * pts->range[q]);
+        r = p->neigh_a * bsf_expf(p->neigh_b * pts->range[q]);
         n = gather(pts, q, r, work->neigh, &n_left, &n_right);
         if (n_left < p->min_side_points || n_right < p->min_side_points ||
             bsf_fit_check_points(work->neigh, n) != BSF_OK) {
@@ -184,7 +185,7 @@ bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid_params_t *p,
         out[k].index = (uint16_t)b;
         out[k].point = pts->pt[b];
         out[k].orientation = 0.0f;
-        out[k].radius = p->neigh_a * expf(p->neigh_b * pts->range[b]);
+        out[k].radius = p->neigh_a * bsf_expf(p->neigh_b * pts->range[b]);
         out[k].score = work->score[b];
     }
     *n_out = n_peak;

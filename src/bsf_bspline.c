@@ -28,9 +28,15 @@ size_t bsf_bspline_span(size_t n_ctrl, float t, float *u_out)
         t = 1.0f;
     }
     x = t * (float)n_span;
-    span = (size_t)x;
-    if (span >= n_span) {
+    /* Compare before converting: for a huge n_span the float product can
+     * exceed what size_t holds, and that conversion is undefined. */
+    if (x >= (float)n_span) {
         span = n_span - 1u; /* t == 1 belongs to the last span */
+    } else {
+        span = (size_t)x;
+        if (span >= n_span) {
+            span = n_span - 1u;
+        }
     }
     if (u_out != NULL) {
         float u = x - (float)span;

@@ -37,6 +37,7 @@
 
 #include <math.h>
 
+#include "bsf_math.h"
 #include "bsf_nms.h"
 
 #define FALKO_PI 3.14159265358979f
@@ -87,7 +88,7 @@ bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p)
 /* Neighbourhood radius of a beam at range rho (step 2). */
 static float neigh_radius(const bsf_falko_params_t *p, float rho)
 {
-    const float r = p->neigh_a * expf(p->neigh_b * rho);
+    const float r = p->neigh_a * bsf_expf(p->neigh_b * rho);
     return (r >= rho) ? 0.8f * rho : r;
 }
 
@@ -253,13 +254,13 @@ static float corner_orientation(const neigh_t *nb)
 {
     const float x = nb->sum_lx / (float)nb->n_left + nb->sum_rx / (float)nb->n_right;
     const float y = nb->sum_ly / (float)nb->n_left + nb->sum_ry / (float)nb->n_right;
-    return atan2f(y, x);
+    return bsf_atan2f(y, x);
 }
 
 /* Step 7: sector of neighbour q seen from the apex c, not wrapped. */
 static int sector_of(bsf_point_t q, bsf_point_t c, float theta, float sector_width)
 {
-    float ang = atan2f(c.y - q.y, c.x - q.x);
+    float ang = bsf_atan2f(c.y - q.y, c.x - q.x);
     if (ang >= FALKO_PI) {
         ang = FALKO_ANGLE_LIMIT;
     } else if (ang <= -FALKO_PI) {
@@ -354,9 +355,9 @@ static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball
         }
     }
     /* Direction of largest spread, then the normal a quarter turn away. */
-    t = 0.5f * atan2f(2.0f * sxy, sxx - syy) + 0.5f * FALKO_PI;
-    *nx = cosf(t);
-    *ny = sinf(t);
+    t = 0.5f * bsf_atan2f(2.0f * sxy, sxx - syy) + 0.5f * FALKO_PI;
+    *nx = bsf_cosf(t);
+    *ny = bsf_sinf(t);
     *d = *nx * mx + *ny * my;
 }
 

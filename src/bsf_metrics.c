@@ -10,6 +10,26 @@ static int finite_nonneg(float v)
     return v == v && v >= 0.0f && v <= 3.402823466e38f;
 }
 
+bsf_status_t bsf_metrics_counts(const bsf_result_t *r, bsf_scan_counts_t *out)
+{
+    bsf_scan_counts_t c;
+    size_t i;
+    if (r == NULL || out == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&c, 0, sizeof c);
+    c.n_valid = r->stats.n_valid;
+    c.n_features = r->n_features;
+    for (i = 0; i < r->n_features; ++i) {
+        c.n_in_features += r->features[i].n_points;
+        c.n_ctrl += r->features[i].n_ctrl;
+        c.sum_e_curve += r->features[i].e_curve;
+    }
+    c.time_s = r->stats.time_ns > 0u ? (float)r->stats.time_ns * 1e-9f : -1.0f;
+    *out = c;
+    return BSF_OK;
+}
+
 bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *c, bsf_scan_metrics_t *out)
 {
     bsf_scan_metrics_t m;

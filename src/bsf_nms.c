@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "bsf_math.h"
+
 /* asin(0.8): the reference's window angle when the radius reaches the range. */
 #define BSF_ASIN_0_8 0.927295218f
 
@@ -32,7 +34,7 @@ static window_ctx_t window_ctx(const bsf_points_t *pts, float radius)
     c.inv_inc = 1.0f / c.inc;
     /* asin(s) < inc, hence window 0, whenever s < sin(inc); the margin keeps
      * rounding on the safe side. */
-    c.far_ratio = sinf(c.inc) * 0.999f;
+    c.far_ratio = bsf_sinf(c.inc) * 0.999f;
     c.close = clamp_window(BSF_ASIN_0_8 / c.inc);
     return c;
 }
@@ -59,7 +61,7 @@ static size_t half_window(const bsf_points_t *pts, size_t i, const window_ctx_t 
     if (lo == hi) {
         return lo;
     }
-    return clamp_window(asinf(s) / c->inc);
+    return clamp_window(bsf_asinf(s) / c->inc);
 }
 
 size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius)

@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "bsf_math.h"
+
 /* Bounds on the geometry that keep every beam angle finite and meaningful:
  * beyond these, angle_min + i * increment can overflow or lose all precision
  * in float, and sinf/cosf would return garbage or NaN. */
@@ -43,8 +45,8 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
         const float r = scan->ranges[i];
         if (bsf_range_is_valid(r, scan->range_min, scan->range_max)) {
             const float a = scan->angle_min + (float)i * scan->angle_increment;
-            out->pt[i].x = r * cosf(a);
-            out->pt[i].y = r * sinf(a);
+            out->pt[i].x = r * bsf_cosf(a);
+            out->pt[i].y = r * bsf_sinf(a);
             out->range[i] = r;
             out->valid[i] = 1u;
             ++n_valid;

@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "bsf_math.h"
+
 #define BSF_SEG_PI_F 3.14159265f
 
 static int is_finite_f(float v)
@@ -178,7 +180,7 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
          * steps within a^2 * poly(x) join. expf is left for the few steps
          * near or beyond the threshold. NaN breaks. */
         if (!(d2 <= a2) && !(d2 <= a2 * exp_lower_bound(two_b * pts->range[i])) &&
-            !(d2 <= a2 * expf(two_b * pts->range[i]))) {
+            !(d2 <= a2 * bsf_expf(two_b * pts->range[i]))) {
             if (!sink_close(&sink, first, last, n_cur)) {
                 return BSF_ERR_CAPACITY;
             }
@@ -234,7 +236,7 @@ bsf_status_t bsf_segment_rpos(const bsf_points_t *pts, const bsf_rpos_params_t *
         return BSF_ERR_PARAM;
     }
     sink.min_points = p->min_segment_points;
-    cos_max = cosf(p->alpha_max);
+    cos_max = bsf_cosf(p->alpha_max);
     cos_max2 = cos_max * cos_max;
     eta2 = p->eta * p->eta;
 

@@ -35,7 +35,6 @@ static void run(bsf_method_t method, bsf_metrics_summary_t *s)
     while ((r = carmen_next(rd, &rec)) > 0) {
         bsf_scan_t sc;
         bsf_scan_counts_t c;
-        size_t i;
         sc.ranges = rec.ranges;
         sc.count = rec.count;
         sc.angle_min = rec.angle_min;
@@ -43,15 +42,7 @@ static void run(bsf_method_t method, bsf_metrics_summary_t *s)
         sc.range_min = 0.0f;
         sc.range_max = carmen_valid_range_max(&rec);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &sc, &res));
-        c.n_valid = res.stats.n_valid;
-        c.n_in_features = res.stats.n_in_features;
-        c.n_ctrl = res.stats.n_ctrl;
-        c.n_features = res.stats.n_features;
-        c.sum_e_curve = 0.0f;
-        for (i = 0; i < res.n_features; ++i) {
-            c.sum_e_curve += res.features[i].e_curve;
-        }
-        c.time_s = -1.0f;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_counts(&res, &c));
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
     }
     TEST_ASSERT_EQUAL_INT(0, r);

@@ -123,6 +123,34 @@ static void test_time_array_overflow_is_an_error_not_a_truncation(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_acc_init(&acc, NULL, 3u));
 }
 
+static void test_counts_of_a_result_sum_its_features(void)
+{
+    static bsf_result_t r;
+    bsf_scan_counts_t c;
+    memset(&r, 0, sizeof r);
+    r.n_features = 2u;
+    r.features[0].n_points = 30u;
+    r.features[0].n_ctrl = 5u;
+    r.features[0].e_curve = 0.01f;
+    r.features[1].n_points = 12u;
+    r.features[1].n_ctrl = 3u;
+    r.features[1].e_curve = 0.02f;
+    r.stats.n_valid = 50u;
+    r.stats.time_ns = 12000u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_counts(&r, &c));
+    TEST_ASSERT_EQUAL_UINT32(50u, c.n_valid);
+    TEST_ASSERT_EQUAL_UINT32(42u, c.n_in_features);
+    TEST_ASSERT_EQUAL_UINT32(8u, c.n_ctrl);
+    TEST_ASSERT_EQUAL_UINT32(2u, c.n_features);
+    TEST_ASSERT_FLOAT_WITHIN(1e-7f, 0.03f, c.sum_e_curve);
+    TEST_ASSERT_FLOAT_WITHIN(1e-10f, 12e-6f, c.time_s);
+    r.stats.time_ns = 0u; /* no clock: time not measured */
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_counts(&r, &c));
+    TEST_ASSERT_TRUE(c.time_s < 0.0f);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_counts(NULL, &c));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_counts(&r, NULL));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -132,5 +160,6 @@ int main(void)
     RUN_TEST(test_dataset_means_skip_undefined_scans);
     RUN_TEST(test_time_quantiles_are_nearest_rank);
     RUN_TEST(test_time_array_overflow_is_an_error_not_a_truncation);
+    RUN_TEST(test_counts_of_a_result_sum_its_features);
     return UNITY_END();
 }

@@ -559,3 +559,25 @@ double bsf_scene_distance_to_surface(const bsf_scene_t *scene, double wx, double
     }
     return best;
 }
+
+void bsf_scene_demo_office(bsf_scene_t *sc)
+{
+    static const double outline[] = {0.0, 0.0, 14.0, 0.0, 14.0, 6.0, 9.0, 6.0, 9.0, 10.0,
+                                     0.0, 10.0};
+    bsf_scene_init(sc);
+    (void)bsf_scene_add_polyline(sc, outline, 6u, 1);
+    /* a partition wall with a doorway, a cabinet, a pillar */
+    (void)bsf_scene_add_segment(sc, 5.0, 0.0, 5.0, 3.0);
+    (void)bsf_scene_add_segment(sc, 5.0, 4.2, 5.0, 7.0);
+    (void)bsf_scene_add_rect_room(sc, 2.0, 7.5, 3.5, 8.3);
+    (void)bsf_scene_add_circle(sc, 10.5, 3.0, 0.45);
+}
+
+void bsf_scene_demo_pose(long k, long n, double *x, double *y, double *theta)
+{
+    const double s = (double)k / (double)n;
+    *x = 3.0 + 8.0 * (0.5 - 0.5 * cos(2.0 * SCENE_PI * s));
+    *y = 3.6 + 1.2 * sin(2.0 * SCENE_PI * s);
+    *theta = atan2(1.2 * 2.0 * SCENE_PI * cos(2.0 * SCENE_PI * s),
+                   8.0 * SCENE_PI * sin(2.0 * SCENE_PI * s) + 1e-9);
+}

@@ -237,6 +237,19 @@ void bsf_scene_sensor_to_world(const bsf_scene_pose_t *pose, double sx, double s
 void bsf_scene_world_to_sensor(const bsf_scene_pose_t *pose, double wx, double wy, double *sx,
                                double *sy);
 
+/**
+ * The demo scene of `bsf demo` (also used by the fuzz corpus and the
+ * host/target determinism check): a 14 m x 10 m L-shaped office with a
+ * partition wall and doorway, a cabinet and a round pillar.
+ */
+void bsf_scene_demo_office(bsf_scene_t *scene);
+
+/**
+ * The demo's sensor pose for scan k of n (a loop through both rooms and the
+ * doorway): world position in metres and heading in radians, in (-pi, pi].
+ */
+void bsf_scene_demo_pose(long k, long n, double *x, double *y, double *theta);
+
 #ifdef __cplusplus
 }
 #endif

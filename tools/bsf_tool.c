@@ -354,19 +354,14 @@ static unsigned long frames_dropped(const bsf_decoder_stats_t *s)
 
 /* ---- metrics ------------------------------------------------------------------ */
 
-static bsf_scan_counts_t counts_of_result(const bsf_result_t *r, double time_s)
+/* A result's metric counts; the library's own definition (time from the
+ * result's stats: for a decoded frame, the extraction time it carries). */
+static bsf_scan_counts_t counts_of_result(const bsf_result_t *r)
 {
     bsf_scan_counts_t c;
-    size_t i;
-    memset(&c, 0, sizeof c);
-    c.n_valid = r->stats.n_valid;
-    c.n_features = r->n_features;
-    for (i = 0; i < r->n_features; ++i) {
-        c.n_in_features += r->features[i].n_points;
-        c.n_ctrl += r->features[i].n_ctrl;
-        c.sum_e_curve += r->features[i].e_curve;
+    if (bsf_metrics_counts(r, &c) != BSF_OK) {
+        memset(&c, 0, sizeof c);
     }
-    c.time_s = (float)time_s;
     return c;
 }
 
@@ -418,7 +413,7 @@ static int metrics_of_frames(const frame_list_t *l, dataset_metrics_t *out)
     }
     for (i = 0; i < l->n && rc == 0; ++i) {
         const bsf_frame_t *f = &l->frames[i];
-        const bsf_scan_counts_t c = counts_of_result(&f->result, 1e-6 * (double)f->time_us);
+        const bsf_scan_counts_t c = counts_of_result(&f->result);
         if (bsf_metrics_acc_add(&acc, &c) != BSF_OK) {
             fail_msg("frame seq %lu has inconsistent counts", (unsigned long)f->seq);
             rc = -1;
@@ -677,7 +672,7 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
 {
     decode_ctx_t *ctx = (decode_ctx_t *)vctx;
     const bsf_result_t *r = &fr->result;
-    const bsf_scan_counts_t c = counts_of_result(r, 1e-6 * (double)fr->time_us);
+    const bsf_scan_counts_t c = counts_of_result(r);
     size_t i, k;
     if (!ctx->json) {
         fprintf(ctx->out, "seq=%lu t=%.3f pose=", (unsigned long)fr->seq,
@@ -1359,7 +1354,7 @@ static int run_dataset(const char *path, bsf_method_t method, long max_scans, ru
             out->failed++;
             continue;
         }
-        counts[n] = counts_of_result(&g_res, 1e-9 * (double)g_res.stats.time_ns);
+        counts[n] = counts_of_result(&g_res);
         bytes[n] = len;
         ++n;
         progress_tick(&prog, n, path);
@@ -1487,19 +1482,6 @@ static const char demo_help[] =
     "encodes it into a stream (default demo.bsf), decodes the stream, prints the\n"
     "metrics and draws the map (default demo.svg) over the true walls.\n";
 
-static void build_office(bsf_scene_t *sc)
-{
-    static const double outline[] = {0.0, 0.0, 14.0, 0.0,  14.0, 6.0,
-                                     9.0, 6.0, 9.0,  10.0, 0.0,  10.0};
-    bsf_scene_init(sc);
-    (void)bsf_scene_add_polyline(sc, outline, 6u, 1);
-    /* a partition wall with a doorway, a cabinet, a pillar */
-    (void)bsf_scene_add_segment(sc, 5.0, 0.0, 5.0, 3.0);
-    (void)bsf_scene_add_segment(sc, 5.0, 4.2, 5.0, 7.0);
-    (void)bsf_scene_add_rect_room(sc, 2.0, 7.5, 3.5, 8.3);
-    (void)bsf_scene_add_circle(sc, 10.5, 3.0, 0.45);
-}
-
 static int cmd_demo(int argc, char **argv)
 {
     static float ranges[BSF_MAX_POINTS];
@@ -1541,7 +1523,7 @@ static int cmd_demo(int argc, char **argv)
             return err;
         }
     }
-    build_office(&scene);
+    bsf_scene_demo_office(&scene);
     bsf_scene_rng_seed(&rng, 2026u);
     if (init_extractor(method) != 0) {
         return EXIT_FAIL;
@@ -1552,16 +1534,13 @@ static int cmd_demo(int argc, char **argv)
     }
     bsf_frame_info_init(&info);
     for (k = 0; k < n_scans; ++k) {
-        /* a loop through both rooms and the doorway */
-        const double s = (double)k / (double)n_scans;
-        const double x = 3.0 + 8.0 * (0.5 - 0.5 * cos(2.0 * M_PI * s));
-        const double y = 3.6 + 1.2 * sin(2.0 * M_PI * s);
-        const double th =
-            atan2(1.2 * 2.0 * M_PI * cos(2.0 * M_PI * s), 8.0 * M_PI * sin(2.0 * M_PI * s) + 1e-9);
-        bsf_lidar_t lid = bsf_lidar_default(x, y, th, 361u, 1.5 * M_PI);
+        double x, y, th;
+        bsf_lidar_t lid;
         bsf_scan_t sc;
         size_t len = 0;
         bsf_status_t st;
+        bsf_scene_demo_pose(k, n_scans, &x, &y, &th);
+        lid = bsf_lidar_default(x, y, th, 361u, 1.5 * M_PI);
         lid.noise_sigma = 0.01;
         lid.range_max = 20.0;
         lid.no_return = 81.83f;

@@ -5,6 +5,7 @@
 #include "carmen.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -368,9 +369,16 @@ static int parse_robotlaser1(carmen_reader_t *r, fields_t *f, carmen_scan_t *s)
     skip_field(f, "accuracy");
     skip_field(f, "remission mode");
     n = get_count(f, "beam count");
-    if (f->what == NULL && !(res != 0.0 && isfinite(res) && isfinite(start))) {
+    /* Checked as the float the scan carries: 1e-50 is non-zero but becomes 0,
+     * and a finite double beyond FLT_MAX would not convert at all. */
+    if (f->what == NULL &&
+        !(isfinite(start) && fabs(start) <= (double)FLT_MAX && isfinite(res) && fabs(res) <= (double)FLT_MAX &&
+          (float)res != 0.0f)) {
         report(r, "ROBOTLASER1: angular resolution or start angle is zero or not finite");
         return 0;
+    }
+    if (isfinite(maxr) && fabs(maxr) > (double)FLT_MAX) {
+        maxr = maxr > 0.0 ? HUGE_VAL : -HUGE_VAL;
     }
     if (!get_ranges(r, f, n, "ROBOTLASER1")) {
         return f->what != NULL ? -1 : 0;

@@ -37,7 +37,9 @@ typedef struct {
  *
  * Geometry: beam i points at angle_min + i * angle_increment (radians, CCW).
  *  - ROBOTLASER1: angle_min = start, angle_increment = res from the line
- *    (the fov field is ignored); max_range = the line's maxrange.
+ *    (the fov field is ignored); max_range = the line's maxrange. A line
+ *    whose start or res is not a finite float, or whose res is 0 as a float,
+ *    is malformed.
  *  - FLASER (CARMEN's readlog convention): angle_min = -pi/2; increment
  *    1 deg for 180 or 181 beams, 0.5 deg for 360 or 361 beams; any other
  *    count N >= 2 spreads the beams over exactly 180 deg (pi / (N - 1)), and

@@ -16,6 +16,7 @@
 #define BSF_METRICS_H
 
 #include "bsf_common.h"
+#include "bsf_feature.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -31,6 +32,14 @@ typedef struct {
     float time_s;           /**< extraction time, seconds; negative when not measured */
 } bsf_scan_counts_t;
 
+/**
+ * The counts of one extraction result: N from its stats, the sums over its
+ * features, and the time from stats.time_ns (-1, "not measured", when it is 0,
+ * which means no clock was set). Works as well on a decoded frame's result.
+ * @return BSF_OK; BSF_ERR_ARG for NULL.
+ */
+BSF_NODISCARD bsf_status_t bsf_metrics_counts(const bsf_result_t *result, bsf_scan_counts_t *out);
+
 /** Per-scan metrics. A `has_*` flag is 0 where the value is undefined (then the value is 0). */
 typedef struct {
     float retrievability; /**< Gamma as a ratio in [0,1] */
@@ -43,8 +52,10 @@ typedef struct {
     uint8_t has_time;
 } bsf_scan_metrics_t;
 
-/** Compute one scan's metrics. Returns BSF_ERR_ARG on NULL or inconsistent counts
- *  (points in features > N, non-finite or negative error sum). */
+/** Compute one scan's metrics. Returns BSF_OK, or BSF_ERR_ARG (out untouched) on
+ *  NULL or inconsistent counts: points in features > N, a non-finite or
+ *  negative error sum, a NaN time (+inf or negative time is "not measured"),
+ *  or points or control points in features while n_features is 0. */
 BSF_NODISCARD bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *counts,
                                             bsf_scan_metrics_t *out);
 

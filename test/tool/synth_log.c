@@ -72,15 +72,9 @@ int main(int argc, char **argv)
         if (bsf_extract(&ex, &sc, &res) != BSF_OK) {
             return 1;
         }
-        c.n_valid = res.stats.n_valid;
-        c.n_in_features = res.stats.n_in_features;
-        c.n_ctrl = res.stats.n_ctrl;
-        c.n_features = res.stats.n_features;
-        c.sum_e_curve = 0.0f;
-        for (i = 0; i < res.n_features; ++i) {
-            c.sum_e_curve += res.features[i].e_curve;
+        if (bsf_metrics_counts(&res, &c) != BSF_OK) {
+            return 1;
         }
-        c.time_s = -1.0f;
         if (bsf_metrics_acc_add(&acc, &c) != BSF_OK) {
             return 1;
         }

@@ -1,0 +1,368 @@
+/*
+ * bench_m4_icount - instructions per scan of bsf_extract on the Cortex-M4F,
+ * counted under QEMU (mps2-an386) with -icount, for every method, on a fixed
+ * set of scans: synthetic scenes (tools/bsf_scene.h) and, when the build found
+ * ../shared/data/intel.log.gz, real Intel scans compiled in at build time
+ * (tools/gen_scan_array.py; BSF_BENCH_HAVE_LOG).
+ *
+ * Counting: with -icount shift=S every guest instruction advances virtual
+ * time by 2^S ns, and SysTick (25 MHz on this board) counts that time, so
+ * delta ticks / (2^S * 0.025) = instructions executed (25.6 at S=10, 3.2 at
+ * S=7). The ratio is not assumed: a calibration loop of known length measures
+ * it first. SysTick is 24 bits wide (655 k instructions at shift=10); its
+ * interrupt counts the wraps, so long scans are counted exactly too (the
+ * handler adds about 10 instructions per 655 k). These are instruction counts, not cycles:
+ * QEMU models no pipeline, flash wait states or FPU latencies.
+ *
+ * Also the stack high-water mark of the calls (painted stack, bytes below
+ * the caller's frame; libm included, unlike tools/stack_report.py).
+ *
+ * Prints numbers, judges none; fails only if an extraction fails. Run:
+ *   ctest --test-dir build-m4 -R bench_m4_icount -V
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bsf/bsf.h"
+#include "bsf_scene.h"
+
+#ifdef BSF_BENCH_HAVE_LOG
+#include "bench_log_scans.h"
+#endif
+
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYST_MASK 0x00FFFFFFu
+
+#define MAX_SCANS 4096
+#define N_SYNTH_SCENES 3
+#define N_SYNTH_POSES 2
+
+static bsf_extractor_t g_ex;
+static bsf_result_t g_res;
+static float g_synth_ranges[N_SYNTH_SCENES * N_SYNTH_POSES * 2][361];
+
+/* Per-scan results of one method on one set. */
+static uint32_t g_whole[MAX_SCANS];
+static uint32_t g_stage[BSF_STAGE_COUNT][MAX_SCANS];
+static uint32_t g_sorted[MAX_SCANS];
+
+static double g_ticks_per_instr;
+static uint32_t g_stack_bytes;
+
+/* SysTick counts down through 24 bits; its interrupt counts the wraps, so a
+ * count of any length is exact. The interrupt runs through a vector table of
+ * our own in RAM (VTOR), leaving the shared startup code alone. */
+#define SCB_ICSR (*(volatile uint32_t *)0xE000ED04u)
+#define SCB_VTOR (*(volatile uint32_t *)0xE000ED08u)
+#define ICSR_PENDSTSET (1u << 26)
+#define N_VECTORS 16u
+
+typedef void (*vector_t)(void);
+static vector_t g_vectors[N_VECTORS] __attribute__((aligned(128)));
+static volatile uint32_t g_wraps;
+
+static void systick_isr(void)
+{
+    ++g_wraps;
+}
+
+static void systick_start(void)
+{
+    const vector_t *boot = (const vector_t *)(uintptr_t)SCB_VTOR;
+    uint32_t i;
+    for (i = 0; i < N_VECTORS; ++i) {
+        g_vectors[i] = boot[i];
+    }
+    g_vectors[15] = systick_isr;
+    SCB_VTOR = (uint32_t)(uintptr_t)g_vectors;
+    __asm volatile("dsb\n\tisb" ::: "memory");
+    g_wraps = 0u;
+    SYST_RVR = SYST_MASK;
+    SYST_CVR = 0u;
+    SYST_CSR = 7u; /* enable, interrupt on wrap, core clock */
+}
+
+/* Up-counting SysTick ticks since systick_start, 32 bits (wraps harmlessly:
+ * only differences are used). A reload whose interrupt is still pending is
+ * counted from the pending bit. */
+static uint32_t ticks_now(void)
+{
+    uint32_t w, v, pend;
+    do {
+        w = g_wraps;
+        v = SYST_CVR & SYST_MASK;
+        pend = SCB_ICSR & ICSR_PENDSTSET;
+    } while (w != g_wraps);
+    if (pend != 0u && v > SYST_MASK / 2u) {
+        ++w;
+    }
+    return (w << 24) + (SYST_MASK - v);
+}
+
+/* Clock hook for the per-stage split (clock_hz 1e9: stage_ns holds raw ticks). */
+static uint32_t hook_ticks(void *user)
+{
+    (void)user;
+    return ticks_now();
+}
+
+/* Exactly 2 instructions per iteration (subs, bne). */
+static void spin(uint32_t n)
+{
+    __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
+}
+
+static uint32_t ticks_of_spin(uint32_t n)
+{
+    const uint32_t t0 = ticks_now();
+    spin(n);
+    return ticks_now() - t0;
+}
+
+/* Ticks per instruction from two loops differing by 2 * 200000 instructions
+ * (the call and reading overhead cancels). */
+static void calibrate(void)
+{
+    const uint32_t a = ticks_of_spin(100000u);
+    const uint32_t b = ticks_of_spin(300000u);
+    g_ticks_per_instr = (double)(b - a) / 400000.0;
+}
+
+static uint32_t to_instr(uint32_t ticks)
+{
+    return (uint32_t)((double)ticks / g_ticks_per_instr + 0.5);
+}
+
+/* Stack high-water mark: paint the free stack below the caller's frame,
+ * run, then find the deepest word overwritten. Counts everything bsf_extract
+ * uses, libm included. */
+#define PAINT_BYTES 8192u
+#define PAINT_WORD 0xDEADBEEFu
+
+static uint32_t *paint_base(void)
+{
+    uint32_t sp;
+    __asm volatile("mov %0, sp" : "=r"(sp));
+    return (uint32_t *)(uintptr_t)((sp - PAINT_BYTES - 256u) & ~7u);
+}
+
+static void __attribute__((noinline)) stack_paint(void)
+{
+    volatile uint32_t *p = paint_base();
+    uint32_t i;
+    for (i = 0; i < PAINT_BYTES / 4u; ++i) {
+        p[i] = PAINT_WORD;
+    }
+}
+
+/* Bytes used below the paint top (the painting function's own frame is above it). */
+static uint32_t __attribute__((noinline)) stack_used(uint32_t *base)
+{
+    uint32_t i = 0;
+    while (i < PAINT_BYTES / 4u && base[i] == PAINT_WORD) {
+        ++i;
+    }
+    return PAINT_BYTES - 4u * i;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a;
+    const uint32_t y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static uint32_t median_of(const uint32_t *v, size_t n, uint32_t *max_out)
+{
+    memcpy(g_sorted, v, n * sizeof *v);
+    qsort(g_sorted, n, sizeof *g_sorted, cmp_u32);
+    if (max_out != NULL) {
+        *max_out = g_sorted[n - 1u];
+    }
+    return g_sorted[n / 2u];
+}
+
+typedef struct {
+    const bsf_scan_t *(*get)(size_t i, bsf_scan_t *tmp);
+    size_t n;
+    const char *name;
+} scan_source_t;
+
+/* Measure every scan of a source with one method; print one line. */
+static int run_method(const scan_source_t *src, bsf_method_t method)
+{
+    bsf_params_t p = bsf_params_default(method);
+    size_t i;
+    unsigned long feats = 0;
+    double mean = 0.0;
+    uint32_t max_whole, med_whole, s;
+
+    if (bsf_extractor_init(&g_ex, &p) != BSF_OK) {
+        printf("  %-15s SKIPPED: not available in this build\n", bsf_method_name(method));
+        return 0;
+    }
+    uint32_t *painted = paint_base();
+    uint32_t stack_top_used;
+    stack_paint();
+    /* What the measuring itself leaves below the paint top (subtracted). */
+    stack_top_used = stack_used(painted);
+    for (i = 0; i < src->n; ++i) {
+        bsf_scan_t tmp;
+        const bsf_scan_t *scan = src->get(i, &tmp);
+        uint32_t t0, t1;
+        bsf_status_t st;
+
+        /* Whole call, no clock hook: what firmware without timing pays. */
+        t0 = ticks_now();
+        st = bsf_extract(&g_ex, scan, &g_res);
+        t1 = ticks_now();
+        if (st != BSF_OK) {
+            printf("  %s: scan %u: %s\n", bsf_method_name(method), (unsigned)i, bsf_status_str(st));
+            return 1;
+        }
+        g_whole[i] = to_instr(t1 - t0);
+        mean += (double)g_whole[i];
+        feats += g_res.stats.n_features;
+    }
+    g_stack_bytes = stack_used(painted) - stack_top_used;
+    /* Per-stage split with the hook (a few instructions more per stage). */
+    p.clock = hook_ticks;
+    p.clock_user = NULL;
+    p.clock_hz = 1000000000u;
+    if (bsf_extractor_init(&g_ex, &p) != BSF_OK) {
+        return 1;
+    }
+    for (i = 0; i < src->n; ++i) {
+        bsf_scan_t tmp;
+        const bsf_scan_t *scan = src->get(i, &tmp);
+        if (bsf_extract(&g_ex, scan, &g_res) != BSF_OK) {
+            return 1;
+        }
+        for (s = 0; s < BSF_STAGE_COUNT; ++s) {
+            g_stage[s][i] = to_instr(g_res.stats.stage_ns[s]);
+        }
+    }
+    med_whole = median_of(g_whole, src->n, &max_whole);
+    printf("  %-15s %9lu %9lu %9lu |", bsf_method_name(method), (unsigned long)med_whole,
+           (unsigned long)(mean / (double)src->n + 0.5), (unsigned long)max_whole);
+    for (s = 0; s < BSF_STAGE_COUNT; ++s) {
+        printf(" %8lu", (unsigned long)median_of(g_stage[s], src->n, NULL));
+    }
+    printf(" | %5.2f | %5lu\n", (double)feats / (double)src->n, (unsigned long)g_stack_bytes);
+    return 0;
+}
+
+static int run_source(const scan_source_t *src)
+{
+    int m, rc = 0;
+    printf("\n%s: %u scans\n", src->name, (unsigned)src->n);
+    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %5s | %5s\n", "instructions", "median", "mean",
+           "max", "points", "corners", "segment", "fit", "feat", "stack");
+    printf("  %-15s %29s | %35s |\n", "", "whole bsf_extract per scan",
+           "median per stage (with clock hook)");
+    for (m = 0; m < BSF_METHOD_COUNT; ++m) {
+        rc |= run_method(src, (bsf_method_t)m);
+    }
+    return rc;
+}
+
+/* ---- synthetic scenes ------------------------------------------------------ */
+
+static bsf_scan_t g_synth_scans[N_SYNTH_SCENES * N_SYNTH_POSES * 2];
+
+static const bsf_scan_t *get_synth(size_t i, bsf_scan_t *tmp)
+{
+    (void)tmp;
+    return &g_synth_scans[i];
+}
+
+static int make_synthetic(size_t *n_out)
+{
+    bsf_scene_t scene;
+    bsf_scene_rng_t rng;
+    size_t sc, pose, res, n = 0;
+    bsf_scene_rng_seed(&rng, 4242u);
+    for (sc = 0; sc < N_SYNTH_SCENES; ++sc) {
+        bsf_status_t st;
+        bsf_scene_init(&scene);
+        if (sc == 0u) {
+            st = bsf_scene_add_rect_room(&scene, -3.0, -2.0, 5.0, 4.0);
+        } else if (sc == 1u) {
+            st = bsf_scene_add_l_room(&scene, -4.0, -3.0, 12.0, 8.0, 5.0, 3.0);
+        } else {
+            st = bsf_scene_add_room_with_pillar(&scene, -5.0, -4.0, 6.0, 5.0, 1.5, 1.0, 0.4);
+        }
+        if (st != BSF_OK) {
+            return 1;
+        }
+        for (pose = 0; pose < N_SYNTH_POSES; ++pose) {
+            for (res = 0; res < 2u; ++res) {
+                const size_t beams = res == 0u ? 180u : 361u;
+                bsf_lidar_t l =
+                    bsf_lidar_default(-1.0 + 0.5 * (double)pose, -0.5 + 0.3 * (double)pose,
+                                      0.7 * (double)pose, beams, 3.14159265358979);
+                l.noise_sigma = 0.01;
+                if (bsf_scene_scan(&scene, &l, &rng, g_synth_ranges[n], NULL, 361u) != BSF_OK) {
+                    return 1;
+                }
+                g_synth_scans[n] = bsf_scene_lidar_scan(&l, g_synth_ranges[n]);
+                ++n;
+            }
+        }
+    }
+    *n_out = n;
+    return 0;
+}
+
+#ifdef BSF_BENCH_HAVE_LOG
+static const bsf_scan_t *get_log(size_t i, bsf_scan_t *tmp)
+{
+    const bench_log_scan_t *s = &bench_log_scans[i];
+    tmp->ranges = &bench_log_ranges[s->first];
+    tmp->count = s->count;
+    tmp->angle_min = s->angle_min;
+    tmp->angle_increment = s->angle_increment;
+    tmp->range_min = 0.0f;
+    tmp->range_max = s->range_max;
+    return tmp;
+}
+#endif
+
+int main(void)
+{
+    scan_source_t src;
+    int rc = 0;
+
+    systick_start();
+    calibrate();
+    printf("bench_m4_icount: Cortex-M4F under QEMU -icount; %.4f SysTick ticks per "
+           "instruction (calibrated; 25.6 expected at shift=10)\n",
+           g_ticks_per_instr);
+    printf("counts are instructions executed, not cycles; BSF_MAX_POINTS %d\n", BSF_MAX_POINTS);
+    if (g_ticks_per_instr < 0.5) {
+        printf("no usable instruction clock (run QEMU with -icount shift=10)\n");
+        return 1;
+    }
+
+    if (make_synthetic(&src.n) != 0) {
+        printf("synthetic scene setup failed\n");
+        return 1;
+    }
+    src.get = get_synth;
+    src.name = "synthetic: rect room, L-room, room with pillar; 2 poses; 180 and 361 beams over "
+               "180 deg; sigma 1 cm";
+    rc |= run_source(&src);
+
+#ifdef BSF_BENCH_HAVE_LOG
+    src.get = get_log;
+    src.n = bench_log_n_scans < MAX_SCANS ? bench_log_n_scans : MAX_SCANS;
+    src.name = bench_log_description;
+    rc |= run_source(&src);
+#else
+    printf("\nSKIPPED: intel.log.gz not found at build time: no real scans compiled in\n");
+#endif
+    return rc;
+}
