@@ -6,10 +6,12 @@
 #include "bsf_wire.h"
 
 /*
- * One writer serves three uses: counting (buf == NULL, sink == NULL),
- * writing to a buffer (COBS code bytes are patched in place once their
- * block ends) and feeding a sink (a block is collected in work->block and
- * handed over whole, because its code byte must go first).
+ * One writer serves four uses: costing the control point values of one
+ * class at every Exp-Golomb order (nothing is emitted), counting (buf ==
+ * NULL, sink == NULL), writing to a buffer (COBS code bytes are patched in
+ * place once their block ends) and feeding a sink (a block is collected in
+ * work->block and handed over whole, because its code byte must go first).
+ * The payload's bit stream goes through put_bits, whole bytes through put_u8.
  */
 typedef struct {
     uint8_t *buf;
@@ -312,7 +314,8 @@ static int32_t round_to_int(float v)
 }
 
 /* The whole frame through w. It may fail half-way, so every caller runs it
- * in counting mode first and writes only when that pass succeeded. */
+ * in costing and counting mode first and writes only when those passes
+ * succeeded. */
 static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const bsf_result_t *res)
 {
     uint32_t step_code;
