@@ -4,46 +4,79 @@
 
 #include "bsf_wire.h"
 
+/* Bit reader over the payload after byte 0, most significant bit first. */
 typedef struct {
     const uint8_t *p;
-    size_t len;
-    size_t pos;
+    size_t len;     /* bytes */
+    size_t bit_pos; /* bits consumed */
 } reader_t;
 
-static int get_u8(reader_t *r, uint8_t *v)
+static int get_bit(reader_t *r, uint32_t *bit)
 {
-    if (r->pos >= r->len) {
+    if (r->bit_pos >= 8u * r->len) {
         return 0;
     }
-    *v = r->p[r->pos++];
+    *bit = (uint32_t)(r->p[r->bit_pos >> 3] >> (7u - (r->bit_pos & 7u))) & 1u;
+    ++r->bit_pos;
     return 1;
 }
 
-/* An unsigned LEB128 varint of at most 64 bits, in its shortest form. */
-static int get_varint(reader_t *r, uint64_t max, uint64_t *v)
+/* n (<= 32) bits as an unsigned number. */
+static int get_bits(reader_t *r, unsigned n, uint32_t *v)
 {
-    uint64_t value = 0;
-    unsigned shift = 0;
-    uint8_t b;
-
-    for (;;) {
-        if (!get_u8(r, &b)) {
+    uint32_t value = 0;
+    unsigned i;
+    for (i = 0; i < n; ++i) {
+        uint32_t bit;
+        if (!get_bit(r, &bit)) {
             return 0;
         }
-        if (shift == 63u && (b & 0x7Eu) != 0u) {
-            return 0; /* more than 64 bits */
+        value = (value << 1) | bit;
+    }
+    *v = value;
+    return 1;
+}
+
+/*
+ * An Exp-Golomb code of order k (k <= 25) whose value is at most max
+ * (max >> k < 2^63). The run of leading zeros is cut off as soon as it is
+ * too long for max, so the work per code is bounded.
+ */
+static int get_eg(reader_t *r, unsigned k, uint64_t max, uint64_t *v)
+{
+    const unsigned max_zeros = bsf_wire_bitlen((max >> k) + 1u) - 1u;
+    unsigned zeros = 0;
+    uint64_t u = 1u;
+    uint64_t value;
+    uint32_t bit;
+    unsigned i;
+
+    for (;;) {
+        if (!get_bit(r, &bit)) {
+            return 0;
         }
-        value |= (uint64_t)(b & 0x7Fu) << shift;
-        if ((b & 0x80u) == 0u) {
+        if (bit != 0u) {
             break;
         }
-        shift += 7u;
-        if (shift > 63u) {
+        if (++zeros > max_zeros) {
             return 0;
         }
     }
-    if (b == 0u && shift > 0u) {
-        return 0; /* a redundant zero group: not the shortest form */
+    for (i = 0; i < zeros; ++i) {
+        if (!get_bit(r, &bit)) {
+            return 0;
+        }
+        u = (u << 1) | bit;
+    }
+    if (u - 1u > (max >> k)) {
+        return 0;
+    }
+    value = u - 1u;
+    for (i = 0; i < k; ++i) {
+        if (!get_bit(r, &bit)) {
+            return 0;
+        }
+        value = (value << 1) | bit;
     }
     if (value > max) {
         return 0;
@@ -52,21 +85,21 @@ static int get_varint(reader_t *r, uint64_t max, uint64_t *v)
     return 1;
 }
 
-static int get_u32(reader_t *r, uint32_t max, uint32_t *v)
+static int get_u32(reader_t *r, unsigned k, uint32_t max, uint32_t *v)
 {
     uint64_t u;
-    if (!get_varint(r, max, &u)) {
+    if (!get_eg(r, k, max, &u)) {
         return 0;
     }
     *v = (uint32_t)u;
     return 1;
 }
 
-/* A zigzag varint whose magnitude is at most max_abs. */
-static int get_signed(reader_t *r, int64_t max_abs, int64_t *v)
+/* A zigzag Exp-Golomb code whose magnitude is at most max_abs. */
+static int get_signed(reader_t *r, unsigned k, int64_t max_abs, int64_t *v)
 {
     uint64_t u;
-    if (!get_varint(r, 2u * (uint64_t)max_abs, &u)) {
+    if (!get_eg(r, k, 2u * (uint64_t)max_abs, &u)) {
         return 0;
     }
     *v = bsf_wire_unzigzag(u);
@@ -79,12 +112,12 @@ static int in_quant_range(int64_t q)
 }
 
 /* A point relative to ref, checked to stay in the quantisation range. */
-static int get_point(reader_t *r, const int64_t ref[2], int64_t q[2])
+static int get_point(reader_t *r, unsigned k, const int64_t ref[2], int64_t q[2])
 {
     int64_t d;
     unsigned c;
     for (c = 0; c < 2u; ++c) {
-        if (!get_signed(r, 2 * BSF_QUANT_MAX_STEPS, &d)) {
+        if (!get_signed(r, k, 2 * BSF_QUANT_MAX_STEPS, &d)) {
             return 0;
         }
         q[c] = ref[c] + d;
@@ -120,15 +153,16 @@ static unsigned popcount64(uint64_t v)
 }
 
 /* Control points of one feature (see put_ctrl in the encoder). */
-static bsf_status_t get_ctrl(reader_t *r, uint32_t m, uint64_t mask, float step, size_t base,
-                             bsf_result_t *res, int64_t prev[2])
+static bsf_status_t get_ctrl(reader_t *r, const uint32_t k_ctrl[BSF_WIRE_N_CLASSES], uint32_t m,
+                             uint64_t mask, float step, size_t base, bsf_result_t *res,
+                             int64_t prev[2])
 {
     uint32_t i_a = 0;
     size_t s_a = base;
     unsigned c_a = (mask & 1u) != 0u ? 2u : 1u;
     int64_t q_a[2];
 
-    if (!get_point(r, prev, q_a)) {
+    if (!get_point(r, k_ctrl[BSF_WIRE_CLASS_FIRST], prev, q_a)) {
         return BSF_ERR_FORMAT;
     }
     store_point(res, s_a, q_a, step, c_a);
@@ -145,7 +179,7 @@ static bsf_status_t get_ctrl(reader_t *r, uint32_t m, uint64_t mask, float step,
         k = i_b - i_a - 1u;
         c_b = ((mask >> i_b) & 1u) != 0u ? 2u : 1u;
         s_b = s_a + c_a + k;
-        if (!get_point(r, q_a, q_b)) {
+        if (!get_point(r, k_ctrl[BSF_WIRE_CLASS_ANCHOR], q_a, q_b)) {
             return BSF_ERR_FORMAT;
         }
         store_point(res, s_b, q_b, step, c_b);
@@ -154,7 +188,7 @@ static bsf_status_t get_ctrl(reader_t *r, uint32_t m, uint64_t mask, float step,
             int64_t q[2];
             pred[0] = bsf_wire_predict(q_a[0], q_b[0], s, k);
             pred[1] = bsf_wire_predict(q_a[1], q_b[1], s, k);
-            if (!get_point(r, pred, q)) {
+            if (!get_point(r, k_ctrl[BSF_WIRE_CLASS_PREC], pred, q)) {
                 return BSF_ERR_FORMAT;
             }
             store_point(res, s_a + c_a + s - 1u, q, step, 1u);
@@ -179,55 +213,65 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
     reader_t r;
     bsf_result_t *res = out != NULL ? &out->result : NULL;
     uint8_t b0;
-    uint8_t flags;
+    uint32_t has_pose;
     uint32_t seq;
     uint64_t timestamp;
     int64_t pose[2] = {0, 0};
-    uint8_t theta[2] = {0, 0};
+    uint32_t theta = 0;
     uint32_t step_code;
     uint32_t n_valid;
     uint32_t time_us;
     uint32_t n_features;
+    uint32_t k_ctrl[BSF_WIRE_N_CLASSES];
     uint32_t i;
+    uint32_t pad;
     float step;
     size_t n_ctrl = 0;
     uint32_t sum_points = 0;
     int64_t prev_last_beam = -1;
     int64_t prev[2] = {0, 0};
 
-    r.p = p;
-    r.len = len;
-    r.pos = 0;
-    if (!get_u8(&r, &b0)) {
+    if (len < 1u) {
         return BSF_ERR_FORMAT;
     }
+    b0 = p[0];
     if ((b0 >> 4) != BSF_FORMAT_VERSION || (b0 & 0x0Fu) != BSF_FRAME_TYPE_FEATURES) {
         return BSF_ERR_VERSION;
     }
-    if (!get_u8(&r, &flags) || (flags & ~BSF_WIRE_FLAGS_KNOWN) != 0u ||
-        !get_u32(&r, UINT32_MAX, &seq) || !get_varint(&r, UINT64_MAX, &timestamp)) {
+    r.p = p + 1;
+    r.len = len - 1u;
+    r.bit_pos = 0;
+    if (!get_bits(&r, 1u, &has_pose) || !get_u32(&r, BSF_WIRE_K_SEQ, UINT32_MAX, &seq) ||
+        !get_eg(&r, BSF_WIRE_K_TIMESTAMP, UINT64_MAX, &timestamp)) {
         return BSF_ERR_FORMAT;
     }
-    if ((flags & BSF_WIRE_FLAG_POSE) != 0u && (!get_signed(&r, BSF_WIRE_POSE_MM_MAX, &pose[0]) ||
-                                               !get_signed(&r, BSF_WIRE_POSE_MM_MAX, &pose[1]) ||
-                                               !get_u8(&r, &theta[0]) || !get_u8(&r, &theta[1]))) {
+    if (has_pose != 0u && (!get_signed(&r, BSF_WIRE_K_POSE, BSF_WIRE_POSE_MM_MAX, &pose[0]) ||
+                           !get_signed(&r, BSF_WIRE_K_POSE, BSF_WIRE_POSE_MM_MAX, &pose[1]) ||
+                           !get_bits(&r, 16u, &theta))) {
         return BSF_ERR_FORMAT;
     }
-    if (!get_u32(&r, BSF_WIRE_STEP_CODE_MAX, &step_code) || step_code == 0u ||
-        !get_u32(&r, (uint32_t)BSF_MAX_POINTS, &n_valid) || !get_u32(&r, UINT32_MAX, &time_us) ||
-        !get_u32(&r, UINT32_MAX, &n_features)) {
+    if (!get_u32(&r, BSF_WIRE_K_STEP, BSF_WIRE_STEP_CODE_MAX, &step_code) || step_code == 0u ||
+        !get_u32(&r, BSF_WIRE_K_N, (uint32_t)BSF_MAX_POINTS, &n_valid) ||
+        !get_u32(&r, BSF_WIRE_K_TIME_US, BSF_WIRE_TIME_US_MAX, &time_us) ||
+        !get_u32(&r, BSF_WIRE_K_FEATURES, UINT32_MAX >> BSF_WIRE_K_FEATURES, &n_features)) {
         return BSF_ERR_FORMAT;
     }
     if (n_features > (uint32_t)BSF_MAX_SEGMENTS) {
         return BSF_ERR_CAPACITY;
     }
+    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
+        if (!get_bits(&r, BSF_WIRE_K_CTRL_BITS, &k_ctrl[i]) || k_ctrl[i] > BSF_WIRE_K_CTRL_MAX) {
+            return BSF_ERR_FORMAT;
+        }
+    }
     step = (float)step_code * BSF_QUANT_STEP_UNIT;
 
     for (i = 0; i < n_features; ++i) {
-        uint32_t desc;
+        uint32_t kind;
         uint32_t m;
+        uint32_t has_mask;
         uint32_t span;
-        uint32_t missing = 0;
+        uint32_t missing;
         uint32_t e_code;
         uint64_t mask = 0;
         uint32_t n_f;
@@ -235,27 +279,37 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         int64_t first;
         bsf_status_t st;
 
-        if (!get_u32(&r, UINT32_MAX, &desc) || !get_signed(&r, 65536, &gap) ||
-            !get_u32(&r, 65535u, &span)) {
+        if (!get_bits(&r, 1u, &kind) || !get_u32(&r, BSF_WIRE_K_M, 62u, &m) ||
+            !get_bits(&r, 1u, &has_mask)) {
             return BSF_ERR_FORMAT;
         }
-        if ((desc >> BSF_WIRE_DESC_SHIFT) > (uint32_t)BSF_MAX_CTRL_PER_FEATURE - 2u) {
+        m += 2u; /* distinct control points */
+        if (m > (uint32_t)BSF_MAX_CTRL_PER_FEATURE) {
             return BSF_ERR_CAPACITY;
         }
-        m = (desc >> BSF_WIRE_DESC_SHIFT) + 2u;
+        if (has_mask != 0u) {
+            uint32_t j;
+            for (j = 0; j < m; ++j) {
+                uint32_t bit;
+                if (!get_bits(&r, 1u, &bit)) {
+                    return BSF_ERR_FORMAT;
+                }
+                mask |= (uint64_t)bit << j;
+            }
+            if (mask == 0u) {
+                return BSF_ERR_FORMAT; /* a mask is sent only when it has a vertex */
+            }
+        }
+        if (!get_signed(&r, BSF_WIRE_K_GAP, (int64_t)BSF_MAX_POINTS, &gap) ||
+            !get_u32(&r, BSF_WIRE_K_SPAN, (uint32_t)BSF_MAX_POINTS - 1u, &span)) {
+            return BSF_ERR_FORMAT;
+        }
         first = prev_last_beam + 1 + gap;
         if (first < 0 || first + (int64_t)span >= (int64_t)BSF_MAX_POINTS) {
             return BSF_ERR_FORMAT;
         }
-        if ((desc & BSF_WIRE_DESC_MISSING) != 0u &&
-            (!get_u32(&r, span + 1u, &missing) || missing == 0u)) {
-            return BSF_ERR_FORMAT;
-        }
-        if (!get_u32(&r, BSF_WIRE_E_CURVE_CODE_MAX, &e_code)) {
-            return BSF_ERR_FORMAT;
-        }
-        if ((desc & BSF_WIRE_DESC_VERTICES) != 0u &&
-            (!get_varint(&r, UINT64_MAX, &mask) || mask == 0u || (m < 64u && (mask >> m) != 0u))) {
+        if (!get_u32(&r, BSF_WIRE_K_MISSING, span + 1u, &missing) ||
+            !get_u32(&r, BSF_WIRE_K_E_CURVE, BSF_WIRE_E_CURVE_CODE_MAX, &e_code)) {
             return BSF_ERR_FORMAT;
         }
         n_f = m + popcount64(mask);
@@ -266,7 +320,7 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
             n_ctrl + n_f > (size_t)BSF_MAX_CTRL_POINTS) {
             return BSF_ERR_CAPACITY;
         }
-        st = get_ctrl(&r, m, mask, step, n_ctrl, res, prev);
+        st = get_ctrl(&r, k_ctrl, m, mask, step, n_ctrl, res, prev);
         if (st != BSF_OK) {
             return st;
         }
@@ -277,25 +331,25 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
             f->n_points = (uint16_t)(span + 1u - missing);
             f->ctrl_first = (uint16_t)n_ctrl;
             f->n_ctrl = (uint8_t)n_f;
-            f->kind = (uint8_t)(desc & BSF_WIRE_DESC_KIND);
-            f->e_curve = (float)e_code / 10000.0f;
+            f->kind = (uint8_t)kind;
+            f->e_curve = (float)e_code / BSF_WIRE_E_CURVE_PER_M;
         }
         n_ctrl += n_f;
         sum_points += span + 1u - missing;
         prev_last_beam = first + (int64_t)span;
     }
-    if (r.pos != r.len || sum_points > n_valid) {
+    /* Only zero padding up to the end of the last byte may follow. */
+    if (8u * r.len - r.bit_pos >= 8u || !get_bits(&r, (unsigned)(8u * r.len - r.bit_pos), &pad) ||
+        pad != 0u || sum_points > n_valid) {
         return BSF_ERR_FORMAT;
     }
     if (out != NULL) {
-        const uint32_t theta_code = (uint32_t)theta[0] | ((uint32_t)theta[1] << 8);
-        const int32_t theta_signed =
-            theta_code >= 32768u ? (int32_t)theta_code - 65536 : (int32_t)theta_code;
+        const int32_t theta_signed = theta >= 32768u ? (int32_t)theta - 65536 : (int32_t)theta;
         out->version = (uint8_t)(b0 >> 4);
         out->type = (uint8_t)(b0 & 0x0Fu);
         out->seq = seq;
         out->timestamp_ms = timestamp;
-        out->has_pose = (flags & BSF_WIRE_FLAG_POSE) != 0u ? 1u : 0u;
+        out->has_pose = (uint8_t)has_pose;
         out->pose_x = (float)pose[0] / 1000.0f;
         out->pose_y = (float)pose[1] / 1000.0f;
         out->pose_theta = (float)theta_signed * BSF_WIRE_RAD_PER_THETA;
@@ -308,7 +362,7 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         res->stats.n_in_features = sum_points;
         res->stats.n_ctrl = (uint32_t)n_ctrl;
         res->stats.n_features = n_features;
-        res->stats.time_ns = time_us <= UINT32_MAX / 1000u ? time_us * 1000u : UINT32_MAX;
+        res->stats.time_ns = time_us * 1000u; /* time_us <= BSF_WIRE_TIME_US_MAX: no overflow */
     }
     return BSF_OK;
 }

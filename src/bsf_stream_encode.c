@@ -1,14 +1,17 @@
 #include "bsf/bsf_stream.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "bsf_wire.h"
 
 /*
- * One writer serves three uses: counting (buf == NULL, sink == NULL),
- * writing to a buffer (COBS code bytes are patched in place once their
- * block ends) and feeding a sink (a block is collected in work->block and
- * handed over whole, because its code byte must go first).
+ * One writer serves four uses: costing the control point values of one
+ * class at every Exp-Golomb order (nothing is emitted), counting (buf ==
+ * NULL, sink == NULL), writing to a buffer (COBS code bytes are patched in
+ * place once their block ends) and feeding a sink (a block is collected in
+ * work->block and handed over whole, because its code byte must go first).
+ * The payload's bit stream goes through put_bits, whole bytes through put_u8.
  */
 typedef struct {
     uint8_t *buf;
@@ -21,6 +24,13 @@ typedef struct {
     bsf_sink_fn sink;
     void *ctx;
     int failed;
+    uint32_t acc;   /* pending bits of the payload's bit stream, MSB first */
+    unsigned n_acc; /* number of pending bits (< 8 between calls) */
+    /* Costing runs: when cost_class < BSF_WIRE_N_CLASSES nothing is emitted
+     * and cost[k] sums the bits the values of that class take at order k. */
+    unsigned cost_class;
+    uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
 } writer_t;
 
 static void emit(writer_t *w, const uint8_t *data, size_t len)
@@ -74,25 +84,70 @@ static void put_u8(writer_t *w, uint8_t b)
     }
 }
 
-static void put_varint(writer_t *w, uint64_t v)
+/* The n (<= 24) low bits of v, most significant first. */
+static void put_bits(writer_t *w, uint32_t v, unsigned n)
 {
-    while (v >= 0x80u) {
-        put_u8(w, (uint8_t)((v & 0x7Fu) | 0x80u));
-        v >>= 7;
+    if (w->cost_class < BSF_WIRE_N_CLASSES) {
+        return;
     }
-    put_u8(w, (uint8_t)v);
+    while (n > 0u) {
+        const unsigned take = n > 8u ? 8u : n;
+        n -= take;
+        w->acc = (w->acc << take) | ((v >> n) & ((1u << take) - 1u));
+        w->n_acc += take;
+        if (w->n_acc >= 8u) {
+            w->n_acc -= 8u;
+            put_u8(w, (uint8_t)(w->acc >> w->n_acc));
+        }
+    }
 }
 
-static void put_signed(writer_t *w, int64_t v)
+/* Exp-Golomb code of order k: for u = (v >> k) + 1 of b bits, b - 1 zeros,
+ * u itself, then the k low bits of v. */
+static void put_eg(writer_t *w, uint64_t v, unsigned k)
 {
-    put_varint(w, bsf_wire_zigzag(v));
+    const uint64_t u = (v >> k) + 1u;
+    const unsigned b = bsf_wire_bitlen(u);
+    unsigned i;
+    for (i = 1u; i < b; ++i) {
+        put_bits(w, 0u, 1u);
+    }
+    for (i = b; i > 0u; --i) {
+        put_bits(w, (uint32_t)(u >> (i - 1u)) & 1u, 1u);
+    }
+    for (i = k; i > 0u; --i) {
+        put_bits(w, (uint32_t)(v >> (i - 1u)) & 1u, 1u);
+    }
+}
+
+static void put_seg(writer_t *w, int64_t v, unsigned k)
+{
+    put_eg(w, bsf_wire_zigzag(v), k);
+}
+
+/* A control point value of class cls: costed or written at the frame's order. */
+static void put_ctrl_value(writer_t *w, unsigned cls, int64_t v)
+{
+    const uint64_t z = bsf_wire_zigzag(v);
+    if (w->cost_class == cls) {
+        unsigned k;
+        for (k = 0; k <= BSF_WIRE_K_CTRL_MAX; ++k) {
+            w->cost[k] += bsf_wire_eg_bits(z, k);
+        }
+    } else if (w->cost_class >= BSF_WIRE_N_CLASSES) {
+        put_eg(w, z, w->k_ctrl[cls]);
+    }
 }
 
 /* Ends the frame: the CRC (not itself checksummed), the last block, 0x00. */
 static void finish(writer_t *w)
 {
-    const uint32_t crc = w->crc;
+    uint32_t crc;
     unsigned i;
+    if (w->n_acc > 0u) {
+        put_bits(w, 0u, 8u - w->n_acc); /* pad the last byte with zeros */
+    }
+    crc = w->crc;
     for (i = 0; i < 4u; ++i) {
         put_u8(w, (uint8_t)(crc >> (8u * i)));
     }
@@ -176,10 +231,10 @@ static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f
     return BSF_OK;
 }
 
-static void put_delta(writer_t *w, const int32_t q[2], const int64_t ref[2])
+static void put_delta(writer_t *w, unsigned cls, const int32_t q[2], const int64_t ref[2])
 {
-    put_signed(w, (int64_t)q[0] - ref[0]);
-    put_signed(w, (int64_t)q[1] - ref[1]);
+    put_ctrl_value(w, cls, (int64_t)q[0] - ref[0]);
+    put_ctrl_value(w, cls, (int64_t)q[1] - ref[1]);
 }
 
 /*
@@ -200,7 +255,7 @@ static void put_ctrl(writer_t *w, const bsf_result_t *res, const bsf_feature_t *
     int64_t ref[2];
 
     (void)quantise_point(p[0], step, q_a);
-    put_delta(w, q_a, prev);
+    put_delta(w, BSF_WIRE_CLASS_FIRST, q_a, prev);
     while (s_a + c_a < n) {
         const size_t t = s_a + c_a;
         size_t s_b = t;
@@ -212,7 +267,7 @@ static void put_ctrl(writer_t *w, const bsf_result_t *res, const bsf_feature_t *
         (void)quantise_point(p[s_b], step, q_b);
         ref[0] = q_a[0];
         ref[1] = q_a[1];
-        put_delta(w, q_b, ref);
+        put_delta(w, BSF_WIRE_CLASS_ANCHOR, q_b, ref);
         for (i = t; i < s_b; ++i) {
             const uint32_t k = (uint32_t)(s_b - t);
             const uint32_t s = (uint32_t)(i - t) + 1u;
@@ -220,7 +275,7 @@ static void put_ctrl(writer_t *w, const bsf_result_t *res, const bsf_feature_t *
             (void)quantise_point(p[i], step, q);
             ref[0] = bsf_wire_predict(q_a[0], q_b[0], s, k);
             ref[1] = bsf_wire_predict(q_a[1], q_b[1], s, k);
-            put_delta(w, q, ref);
+            put_delta(w, BSF_WIRE_CLASS_PREC, q, ref);
         }
         s_a = s_b;
         c_a = vtx[s_b] != 0u ? 2u : 1u;
@@ -259,7 +314,8 @@ static int32_t round_to_int(float v)
 }
 
 /* The whole frame through w. It may fail half-way, so every caller runs it
- * in counting mode first and writes only when that pass succeeded. */
+ * in costing and counting mode first and writes only when those passes
+ * succeeded. */
 static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const bsf_result_t *res)
 {
     uint32_t step_code;
@@ -285,50 +341,47 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
 
     block_start(w);
     put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES));
-    put_u8(w, info->has_pose != 0u ? (uint8_t)BSF_WIRE_FLAG_POSE : 0u);
-    put_varint(w, info->seq);
-    put_varint(w, info->timestamp_ms);
+    put_bits(w, info->has_pose != 0u ? 1u : 0u, 1u);
+    put_eg(w, info->seq, BSF_WIRE_K_SEQ);
+    put_eg(w, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
         const uint32_t theta =
             (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
-        put_signed(w, round_to_int(info->pose_x * 1000.0f));
-        put_signed(w, round_to_int(info->pose_y * 1000.0f));
-        put_u8(w, (uint8_t)(theta & 0xFFu));
-        put_u8(w, (uint8_t)(theta >> 8));
+        put_seg(w, round_to_int(info->pose_x * 1000.0f), BSF_WIRE_K_POSE);
+        put_seg(w, round_to_int(info->pose_y * 1000.0f), BSF_WIRE_K_POSE);
+        put_bits(w, theta, 16u);
     }
-    put_varint(w, step_code);
-    put_varint(w, res->stats.n_valid);
-    put_varint(w, ((uint64_t)res->stats.time_ns + 500u) / 1000u);
-    put_varint(w, res->n_features);
+    put_eg(w, step_code, BSF_WIRE_K_STEP);
+    put_eg(w, res->stats.n_valid, BSF_WIRE_K_N);
+    put_eg(w, ((uint64_t)res->stats.time_ns + 500u) / 1000u, BSF_WIRE_K_TIME_US);
+    put_eg(w, res->n_features, BSF_WIRE_K_FEATURES);
+    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
+        put_bits(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
+    }
 
     for (i = 0; i < res->n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
         uint32_t n_unique = 0;
         uint64_t mask = 0;
         uint32_t span;
-        uint32_t missing;
-        uint32_t desc;
+        uint32_t j;
 
         st = scan_feature(res, f, step, &n_unique, &mask);
         if (st != BSF_OK) {
             return st;
         }
         span = (uint32_t)(f->last_beam - f->first_beam);
-        missing = span + 1u - f->n_points;
         sum_points += f->n_points;
-        desc = (uint32_t)f->kind | (mask != 0u ? BSF_WIRE_DESC_VERTICES : 0u) |
-               (missing != 0u ? BSF_WIRE_DESC_MISSING : 0u) |
-               ((n_unique - 2u) << BSF_WIRE_DESC_SHIFT);
-        put_varint(w, desc);
-        put_signed(w, (int64_t)f->first_beam - prev_last_beam - 1);
-        put_varint(w, span);
-        if (missing != 0u) {
-            put_varint(w, missing);
+        put_bits(w, f->kind, 1u);
+        put_eg(w, n_unique - 2u, BSF_WIRE_K_M);
+        put_bits(w, mask != 0u ? 1u : 0u, 1u);
+        for (j = 0; mask != 0u && j < n_unique; ++j) {
+            put_bits(w, (uint32_t)(mask >> j) & 1u, 1u);
         }
-        put_varint(w, (uint64_t)floorf(f->e_curve * 10000.0f + 0.5f));
-        if (mask != 0u) {
-            put_varint(w, mask);
-        }
+        put_seg(w, (int64_t)f->first_beam - prev_last_beam - 1, BSF_WIRE_K_GAP);
+        put_eg(w, span, BSF_WIRE_K_SPAN);
+        put_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
+        put_eg(w, (uint64_t)floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f), BSF_WIRE_K_E_CURVE);
         put_ctrl(w, res, f, step, prev);
         prev_last_beam = f->last_beam;
     }
@@ -364,19 +417,60 @@ static void writer_init(writer_t *w)
     w->sink = NULL;
     w->ctx = NULL;
     w->failed = 0;
+    w->acc = 0u;
+    w->n_acc = 0u;
+    w->cost_class = BSF_WIRE_N_CLASSES;
+    memset(w->cost, 0, sizeof w->cost);
+    memset(w->k_ctrl, 0, sizeof w->k_ctrl);
+}
+
+/*
+ * The Exp-Golomb order of each control point class that makes the frame
+ * shortest (one costing run per class; ties go to the smaller order). The
+ * chosen total never exceeds the total at order 25, which bounds every
+ * value by 26 bits (BSF_FRAME_CTRL_MAX_BITS).
+ */
+static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result_t *res,
+                                  uint8_t k_ctrl[BSF_WIRE_N_CLASSES])
+{
+    writer_t w;
+    unsigned cls;
+    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
+        unsigned k;
+        unsigned best = 0;
+        bsf_status_t st;
+        writer_init(&w);
+        w.cost_class = cls;
+        st = write_frame(&w, info, res);
+        if (st != BSF_OK) {
+            return st;
+        }
+        for (k = 1; k <= BSF_WIRE_K_CTRL_MAX; ++k) {
+            if (w.cost[k] < w.cost[best]) {
+                best = k;
+            }
+        }
+        k_ctrl[cls] = (uint8_t)best;
+    }
+    return BSF_OK;
 }
 
 bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
                               uint8_t *buf, size_t cap, size_t *out_len)
 {
     writer_t w;
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
     bsf_status_t st;
 
     if (info == NULL || result == NULL || out_len == NULL) {
         return BSF_ERR_ARG;
     }
-    writer_init(&w);
-    st = write_frame(&w, info, result);
+    st = choose_orders(info, result, k_ctrl);
+    if (st == BSF_OK) {
+        writer_init(&w);
+        memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
+        st = write_frame(&w, info, result);
+    }
     if (st != BSF_OK) {
         *out_len = 0u;
         return st;
@@ -389,6 +483,7 @@ bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *
         return BSF_ERR_BUFFER;
     }
     writer_init(&w);
+    memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
     w.buf = buf;
     w.cap = cap;
     return write_frame(&w, info, result);
@@ -399,6 +494,7 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
                                    size_t *written)
 {
     writer_t w;
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
     bsf_status_t st;
 
     if (written != NULL) {
@@ -407,12 +503,12 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
     if (work == NULL || info == NULL || result == NULL || sink == NULL) {
         return BSF_ERR_ARG;
     }
-    writer_init(&w);
-    st = write_frame(&w, info, result);
+    st = choose_orders(info, result, k_ctrl);
     if (st != BSF_OK) {
         return st;
     }
     writer_init(&w);
+    memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
     w.work = work;
     w.sink = sink;
     w.ctx = ctx;

@@ -7,19 +7,33 @@
 
 #include <stdint.h>
 
-/* Flag bits of payload byte 1. */
-#define BSF_WIRE_FLAG_POSE 0x01u
-#define BSF_WIRE_FLAGS_KNOWN 0x01u
+/* Exp-Golomb orders of the fixed-parameter fields (FORMAT.md section 3). */
+#define BSF_WIRE_K_SEQ 8u
+#define BSF_WIRE_K_TIMESTAMP 20u
+#define BSF_WIRE_K_POSE 10u
+#define BSF_WIRE_K_STEP 4u
+#define BSF_WIRE_K_N 6u
+#define BSF_WIRE_K_TIME_US 5u
+#define BSF_WIRE_K_FEATURES 2u
+#define BSF_WIRE_K_M 1u
+#define BSF_WIRE_K_GAP 2u
+#define BSF_WIRE_K_SPAN 3u
+#define BSF_WIRE_K_MISSING 0u
+#define BSF_WIRE_K_E_CURVE 4u
 
-/* Feature descriptor bits. */
-#define BSF_WIRE_DESC_KIND 0x01u
-#define BSF_WIRE_DESC_VERTICES 0x02u
-#define BSF_WIRE_DESC_MISSING 0x04u
-#define BSF_WIRE_DESC_SHIFT 3u
+/* Control point value classes, each with its own per-frame order 0..25. */
+#define BSF_WIRE_CLASS_FIRST 0u  /* first point of a feature */
+#define BSF_WIRE_CLASS_ANCHOR 1u /* next anchor minus previous anchor */
+#define BSF_WIRE_CLASS_PREC 2u   /* precision point minus its prediction */
+#define BSF_WIRE_N_CLASSES 3u
+#define BSF_WIRE_K_CTRL_BITS 5u
+#define BSF_WIRE_K_CTRL_MAX 25u /* order at which any value below 2^25 costs 26 bits */
 
 /* Wire codes and units. */
 #define BSF_WIRE_STEP_CODE_MAX 10000u
-#define BSF_WIRE_E_CURVE_CODE_MAX 10000000u
+#define BSF_WIRE_E_CURVE_PER_M 2000.0f /* E_curve unit 0.5 mm */
+#define BSF_WIRE_E_CURVE_CODE_MAX 2000000u
+#define BSF_WIRE_TIME_US_MAX 4294967u /* UINT32_MAX ns, the range of bsf_stats_t.time_ns */
 #define BSF_WIRE_POSE_MM_MAX 2000000000L
 #define BSF_WIRE_THETA_PER_RAD 10430.378350470453f     /* 65536 / (2 pi) */
 #define BSF_WIRE_RAD_PER_THETA 9.5873799242852573e-05f /* 2 pi / 65536 */
@@ -54,6 +68,27 @@ static inline int64_t bsf_wire_predict(int64_t a, int64_t b, uint32_t s, uint32_
         --q;
     }
     return a + q;
+}
+
+/* Bits of v: 0 for 0, else 1 + floor(log2 v) (binary search: the encoder
+ * evaluates it 26 times per control point value when it picks the orders). */
+static inline unsigned bsf_wire_bitlen(uint64_t v)
+{
+    unsigned n = 0;
+    unsigned half;
+    for (half = 32u; half > 0u; half >>= 1) {
+        if ((v >> half) != 0u) {
+            v >>= half;
+            n += half;
+        }
+    }
+    return n + (unsigned)v;
+}
+
+/* Length in bits of the Exp-Golomb code of order k of v (v >> k < 2^63). */
+static inline unsigned bsf_wire_eg_bits(uint64_t v, unsigned k)
+{
+    return 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
 }
 
 #endif /* BSF_WIRE_H */

@@ -22,18 +22,18 @@ static uint8_t body[BSF_FRAME_BODY_MAX_SIZE + 16u];
 static uint8_t scratch[BSF_FRAME_MAX_SIZE + 16u];
 
 /* docs/FORMAT.md, example 1 and example 2 (byte for byte). */
-static const uint8_t golden_minimal[] = {0x02, 0x11, 0x01, 0x01, 0x03, 0x32, 0x14, 0x0e, 0x01, 0x08,
-                                         0x14, 0x13, 0x32, 0x90, 0x03, 0xc8, 0x01, 0x90, 0x03, 0xc8,
-                                         0x01, 0x06, 0x14, 0x2d, 0xdc, 0x7d, 0xa3, 0x00};
+static const uint8_t golden_minimal[] = {
+    0x04, 0x11, 0x40, 0x20, 0x01, 0x05, 0x42, 0xa9, 0x05, 0x42, 0x0e, 0xc6, 0x1b,
+    0xe9, 0x48, 0x72, 0x14, 0x87, 0x22, 0x15, 0x42, 0xc9, 0xc6, 0x33, 0x00,
+};
 static const uint8_t golden_typical[] = {
-    0x22, 0x11, 0x01, 0xd2, 0x09, 0x8e, 0xe0, 0x2a, 0xcc, 0x4a, 0xab, 0x5b, 0xa2, 0xc6, 0x32,
-    0xb0, 0x01, 0x90, 0x07, 0x06, 0x14, 0x06, 0x23, 0x01, 0x3a, 0x26, 0xcf, 0x05, 0xf2, 0x04,
-    0x03, 0x0a, 0x02, 0x07, 0x0e, 0x13, 0x04, 0x36, 0x5e, 0x02, 0x4a, 0x02, 0xf6, 0x03, 0x04,
-    0x03, 0xc0, 0x06, 0x45, 0x8a, 0x01, 0x08, 0x06, 0x13, 0x1f, 0xbb, 0x02, 0xf6, 0x01, 0xcb,
-    0x01, 0x80, 0x02, 0x02, 0x01, 0x17, 0x04, 0x1d, 0x02, 0x70, 0x04, 0x9b, 0x01, 0x2c, 0x8b,
-    0x03, 0x02, 0x01, 0x01, 0x01, 0x84, 0x02, 0x18, 0x04, 0x11, 0x49, 0xc9, 0x01, 0x50, 0xd3,
-    0x02, 0x73, 0x2b, 0x12, 0x1d, 0x22, 0x02, 0x22, 0x10, 0x02, 0x06, 0x8e, 0x01, 0x83, 0x02,
-    0x7b, 0x63, 0xe1, 0x03, 0x0f, 0x27, 0x05, 0x02, 0x0c, 0x7a, 0x19, 0xb6, 0x00};
+    0x56, 0x11, 0x97, 0x4b, 0x56, 0x01, 0xc2, 0x94, 0xc1, 0x8d, 0x5e, 0x35, 0x11, 0x09, 0xe0, 0x1d,
+    0x82, 0x8e, 0x71, 0x10, 0xa2, 0xb5, 0xca, 0x63, 0x4f, 0x2f, 0x28, 0x37, 0x65, 0xca, 0x51, 0x07,
+    0xd4, 0x79, 0x50, 0x44, 0xed, 0x09, 0x06, 0x78, 0x10, 0x11, 0xcc, 0xa6, 0xf6, 0x6e, 0xd7, 0x65,
+    0x2d, 0x80, 0xd6, 0x92, 0x41, 0x2b, 0x4c, 0x8d, 0xd6, 0x10, 0x5c, 0x15, 0xb0, 0x2c, 0x21, 0x48,
+    0x67, 0xf5, 0x27, 0x41, 0xd3, 0xf3, 0x17, 0x96, 0x10, 0x89, 0xb0, 0x98, 0x8d, 0xd5, 0x8c, 0x1f,
+    0xdf, 0x19, 0x30, 0x93, 0x15, 0xa7, 0x05, 0xd7, 0x3f, 0x0a, 0x14, 0x00,
+};
 
 void setUp(void)
 {
@@ -124,7 +124,7 @@ static void assert_round_trip(const bsf_frame_info_t *info, const bsf_result_t *
         TEST_ASSERT_EQUAL_UINT16(a->ctrl_first, b->ctrl_first);
         TEST_ASSERT_EQUAL_UINT8(a->n_ctrl, b->n_ctrl);
         TEST_ASSERT_EQUAL_UINT8(a->kind, b->kind);
-        TEST_ASSERT_FLOAT_WITHIN(0.00005f + 1e-6f, a->e_curve, b->e_curve);
+        TEST_ASSERT_FLOAT_WITHIN(0.00025f + 1e-6f, a->e_curve, b->e_curve);
         for (k = a->ctrl_first; k < a->ctrl_first + a->n_ctrl; ++k) {
             const float tol =
                 0.5f * step * 1.0001f + 4e-7f * (fabsf(in->ctrl[k].x) + fabsf(in->ctrl[k].y));
@@ -571,44 +571,144 @@ static void test_unknown_version_and_type_are_counted_and_skipped(void)
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.malformed);
 }
 
+/* A payload written field by field (FORMAT.md section 3), MSB first. */
+typedef struct {
+    uint8_t byte[64];
+    size_t bits;
+} bitbuf_t;
+
+static void bb_bits(bitbuf_t *w, uint64_t v, unsigned n)
+{
+    while (n > 0u) {
+        const unsigned bit = (unsigned)(v >> --n) & 1u;
+        if (w->bits % 8u == 0u) {
+            w->byte[w->bits / 8u] = 0u;
+        }
+        w->byte[w->bits / 8u] |= (uint8_t)(bit << (7u - w->bits % 8u));
+        ++w->bits;
+    }
+}
+
+static void bb_eg(bitbuf_t *w, uint64_t v, unsigned k)
+{
+    const uint64_t u = (v >> k) + 1u;
+    unsigned n = 0;
+    while ((u >> n) > 1u) {
+        ++n;
+    }
+    bb_bits(w, 0u, n);
+    bb_bits(w, u, n + 1u);
+    bb_bits(w, v & ((1u << k) - 1u), k);
+}
+
+static void bb_seg(bitbuf_t *w, int64_t v, unsigned k)
+{
+    bb_eg(w, v < 0 ? ((uint64_t)(-(v + 1)) << 1) | 1u : (uint64_t)v << 1, k);
+}
+
+/* Example 1 of FORMAT.md with one defect (0: none); returns the payload length. */
+static size_t example1_payload(unsigned defect, uint8_t *out)
+{
+    bitbuf_t w;
+    size_t len;
+    w.bits = 0;
+    bb_bits(&w, 0x11u, 8u);
+    bb_bits(&w, 0u, 1u); /* no pose */
+    if (defect == 8u) {
+        bb_bits(&w, 0u, 30u); /* seq: a zero run too long for 32 bits */
+    }
+    bb_eg(&w, 0u, 8u);                            /* seq */
+    bb_eg(&w, 0u, 20u);                           /* timestamp */
+    bb_eg(&w, defect == 3u ? 0u : 50u, 4u);       /* step code */
+    bb_eg(&w, defect == 7u ? 5u : 20u, 6u);       /* N */
+    bb_eg(&w, defect == 10u ? 4294968u : 0u, 5u); /* extraction time, us */
+    bb_eg(&w, defect == 4u ? 2u : 1u, 2u);        /* features */
+    bb_bits(&w, 8u, 5u);                          /* k_first */
+    bb_bits(&w, 8u, 5u);                          /* k_anchor */
+    bb_bits(&w, defect == 11u ? 26u : 0u, 5u);    /* k_precision */
+    bb_bits(&w, 0u, 1u);                          /* bleak */
+    bb_eg(&w, defect == 5u ? 0u : 1u, 1u);        /* m - 2 */
+    bb_bits(&w, defect == 9u ? 1u : 0u, 1u);      /* vertex mask follows */
+    if (defect == 9u) {
+        bb_bits(&w, 0u, 3u); /* a mask without any vertex */
+    }
+    bb_seg(&w, defect == 6u ? 1070 : 10, 2u); /* gap: first beam 10 (1070: beyond the caps) */
+    bb_eg(&w, 19u, 3u);                       /* span */
+    bb_eg(&w, 0u, 0u);                        /* missing */
+    bb_eg(&w, 10u, 4u);                       /* E_curve, 0.5 mm */
+    bb_seg(&w, 200, 8u);                      /* first point */
+    bb_seg(&w, 100, 8u);
+    bb_seg(&w, 200, 8u); /* last anchor - first */
+    bb_seg(&w, 100, 8u);
+    if (defect != 5u) {
+        bb_seg(&w, 0, 0u); /* middle point - prediction */
+        bb_seg(&w, 10, 0u);
+    }
+    if (defect == 12u) {
+        bb_bits(&w, 1u, 1u); /* a set padding bit */
+    }
+    len = (w.bits + 7u) / 8u;
+    if (defect == 1u) {
+        w.byte[len++] = 0u; /* trailing byte */
+    }
+    if (defect == 2u) {
+        --len; /* cut short */
+    }
+    memcpy(out, w.byte, len);
+    return len;
+}
+
+static void test_field_by_field_payload_equals_the_golden_one(void)
+{
+    uint8_t golden[64];
+    uint8_t built[64];
+    const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, golden);
+    TEST_ASSERT_EQUAL_UINT32(len, example1_payload(0u, built));
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden, built, len);
+}
+
 static void test_malformed_fields_are_dropped_and_counted(void)
 {
-    uint8_t base[64];
     uint8_t payload[72];
-    const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, base);
     unsigned c;
-    /* Payload of example 1: 11 00 00 00 32 14 00 01 | 08 14 13 32 | 90 03 c8 01 90 03 c8 01 00 14
-     */
-    for (c = 0; c < 10u; ++c) {
-        size_t plen = len;
-        size_t n;
-        memcpy(payload, base, len);
-        switch (c) {
-        case 0: payload[1] = 0x02; break;      /* reserved flag bit */
-        case 1: payload[plen++] = 0x00; break; /* trailing byte */
-        case 2: plen -= 1u; break;             /* field cut short */
-        case 3: payload[4] = 0x00; break;      /* quantisation step 0 */
-        case 4: payload[7] = 0x02; break;      /* 2 features announced, 1 sent */
-        case 5: payload[8] = 0x00; break;      /* 2 control points */
-        case 6:
-            payload[10] = 0xFF;
-            payload[11] = 0x7F;
-            break;                        /* last beam beyond the caps */
-        case 7: payload[5] = 0x05; break; /* N smaller than points in features */
-        case 8:                           /* non-minimal varint: seq as 0x80 0x00 */
-            memmove(payload + 3, payload + 2, len - 2u);
-            payload[2] = 0x80;
-            ++plen;
-            break;
-        default: payload[8] = 0x0A; break; /* vertex flag without a mask */
-        }
-        n = reframe(payload, plen, scratch);
+    for (c = 1; c <= 12u; ++c) {
+        const size_t plen = example1_payload(c, payload);
+        const size_t n = reframe(payload, plen, scratch);
         TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u),
                                          "malformed frame delivered");
-        TEST_ASSERT_EQUAL_UINT32(c + 1u, dec.stats.malformed);
+        TEST_ASSERT_EQUAL_UINT32(c, dec.stats.malformed);
     }
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.bad_crc);
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.frames_ok);
+}
+
+/* bsf_stats_t.time_ns is uint32 ns: 4 294 967 us is the last extraction time
+ * a frame can carry and re-encode alike; one more is malformed. */
+static void test_extraction_time_beyond_time_ns_range_is_refused(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    size_t len = 0;
+    fx_example_minimal(&info, &res);
+    res.stats.time_ns = UINT32_MAX;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(4294967u, frame.time_us);
+    TEST_ASSERT_EQUAL_UINT32(4294967000u, frame.result.stats.time_ns);
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_frame_encode(&info, &frame.result, scratch, sizeof scratch, &len));
+    TEST_ASSERT_EQUAL_UINT32(n, len);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(buf, scratch, n);
+    /* One microsecond more: refused by the one-shot decoder too. */
+    len = example1_payload(10u, body);
+    {
+        const uint32_t crc = bsf_crc32c(0u, body, len);
+        unsigned i;
+        for (i = 0; i < 4u; ++i) {
+            body[len + i] = (uint8_t)(crc >> (8u * i));
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_frame_decode(body, len + 4u, &frame));
 }
 
 static void test_bad_crc_is_dropped_and_the_next_frame_decodes(void)
@@ -644,7 +744,9 @@ int main(void)
     RUN_TEST(test_stream_of_only_delimiters_yields_nothing_and_counts_nothing);
     RUN_TEST(test_garbage_before_the_first_frame_is_skipped);
     RUN_TEST(test_unknown_version_and_type_are_counted_and_skipped);
+    RUN_TEST(test_field_by_field_payload_equals_the_golden_one);
     RUN_TEST(test_malformed_fields_are_dropped_and_counted);
+    RUN_TEST(test_extraction_time_beyond_time_ns_range_is_refused);
     RUN_TEST(test_bad_crc_is_dropped_and_the_next_frame_decodes);
     return UNITY_END();
 }

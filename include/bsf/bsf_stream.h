@@ -42,7 +42,7 @@ extern "C" {
 #define BSF_POSE_XY_MAX 2000000.0f
 /** Largest |pose theta| accepted, radians (wrapped into [-pi, pi) on the wire). */
 #define BSF_POSE_THETA_MAX 25.0f
-/** Largest E_curve that can be sent, metres (wire unit 0.1 mm). */
+/** Largest E_curve that can be sent, metres (wire unit 0.5 mm). */
 #define BSF_E_CURVE_MAX 1000.0f
 
 /* ---- Worst-case sizes (depend only on the caps in bsf_config.h) ---------- */
@@ -50,20 +50,27 @@ extern "C" {
 /** COBS-encoded length of n bytes, worst case (delimiter not included). */
 #define BSF_COBS_MAX_SIZE(n) ((n) + (n) / 254u + 1u)
 
-/** Largest fixed frame header (version/type, flags, seq, time stamp, pose,
- * step, N, extraction time, feature count), bytes. */
-#define BSF_FRAME_HEADER_MAX_SIZE 42u
-/** Largest per-feature header (descriptor, beams, E_curve, vertex mask), bytes. */
-#define BSF_FRAME_FEATURE_MAX_SIZE 25u
-/** Largest size of one control point on the wire (two 4-byte varints), bytes. */
-#define BSF_FRAME_CTRL_MAX_SIZE 8u
+/* The bounds below assume these caps (FORMAT.md section 7). */
+#if BSF_MAX_POINTS > 65536 || BSF_MAX_SEGMENTS > 65536 || BSF_MAX_CTRL_PER_FEATURE > 64
+#error "bsf_stream.h: the wire-format size bounds need smaller caps"
+#endif
+
+/** Largest frame header (version/type byte, pose flag, seq, time stamp, pose,
+ * step, N, extraction time, feature count, control point orders), bits. */
+#define BSF_FRAME_HEADER_MAX_BITS 433u
+/** Largest feature header (kind, point count, vertex mask, beams, E_curve), bits. */
+#define BSF_FRAME_FEATURE_MAX_BITS 211u
+/** Largest size of one distinct control point on the wire (two 26-bit codes), bits. */
+#define BSF_FRAME_CTRL_MAX_BITS 52u
 /** Size of the CRC-32C trailer, bytes. */
 #define BSF_FRAME_CRC_SIZE 4u
 
 /** Largest payload + CRC ("frame body", before COBS), bytes, for the caps. */
 #define BSF_FRAME_BODY_MAX_SIZE                                                                    \
-    (BSF_FRAME_HEADER_MAX_SIZE + BSF_FRAME_FEATURE_MAX_SIZE * (unsigned)BSF_MAX_SEGMENTS +         \
-     BSF_FRAME_CTRL_MAX_SIZE * (unsigned)BSF_MAX_CTRL_POINTS + BSF_FRAME_CRC_SIZE)
+    ((BSF_FRAME_HEADER_MAX_BITS + BSF_FRAME_FEATURE_MAX_BITS * (unsigned)BSF_MAX_SEGMENTS +        \
+      BSF_FRAME_CTRL_MAX_BITS * (unsigned)BSF_MAX_CTRL_POINTS + 7u) /                              \
+         8u +                                                                                      \
+     BSF_FRAME_CRC_SIZE)
 
 /** Largest encoded frame on the wire (COBS body + 0x00 delimiter), bytes. */
 #define BSF_FRAME_MAX_SIZE (BSF_COBS_MAX_SIZE(BSF_FRAME_BODY_MAX_SIZE) + 1u)
@@ -179,7 +186,7 @@ BSF_NODISCARD bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_
  * One decoded frame. `result` holds the features as the encoder saw them:
  * control points dequantised (within half a step of the originals),
  * vertices expanded to two flagged copies, ctrl_first the running sum of
- * n_ctrl, E_curve in 0.1 mm steps; result.stats carries n_valid,
+ * n_ctrl, E_curve in 0.5 mm steps; result.stats carries n_valid,
  * n_in_features, n_ctrl, n_features and time_ns (= time_us * 1000), the
  * other stats are 0 (they do not travel).
  */
@@ -193,7 +200,7 @@ typedef struct {
     float pose_y;          /**< metres (1 mm resolution) */
     float pose_theta;      /**< radians in [-pi, pi) (2*pi/65536 resolution) */
     float quant_step;      /**< metres */
-    uint32_t time_us;      /**< extraction time, microseconds */
+    uint32_t time_us;      /**< extraction time, microseconds (<= 4 294 967) */
     bsf_result_t result;   /**< features, control points, vertex flags, stats */
 } bsf_frame_t;
 
@@ -204,8 +211,10 @@ typedef struct {
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers; BSF_ERR_CRC when the CRC
  *         does not match (or len < 5); BSF_ERR_VERSION for a version other
  *         than BSF_FORMAT_VERSION or an unknown frame type; BSF_ERR_FORMAT for
- *         any malformed or out-of-range field, non-minimal varint or trailing
- *         byte; BSF_ERR_CAPACITY when the frame exceeds this build's caps.
+ *         any malformed or out-of-range field (including an extraction time
+ *         above 4 294 967 us, which bsf_stats_t.time_ns cannot hold), a
+ *         truncated code, non-zero padding or a trailing byte;
+ *         BSF_ERR_CAPACITY when the frame exceeds this build's caps.
  */
 BSF_NODISCARD bsf_status_t bsf_frame_decode(const uint8_t *body, size_t len, bsf_frame_t *out);
 
