@@ -462,13 +462,21 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
             n_try = fabsf(delta) > PDM_HALVE_MIN ? 3u : 1u;
             delta *= inv_fs;
             for (halving = 0; halving < n_try; ++halving) {
+                const float du_try = delta * fs;
+                const float u_try = u + du_try;
                 t_new = t + delta;
                 t_new = t_new < 0.0f ? 0.0f : (t_new > 1.0f ? 1.0f : t_new);
                 if (!(fabsf(t_new - t) > 1e-7f)) {
                     break;
                 }
-                span_new = span_of(t_new, fs, n_span, &u_new);
-                if (span_new == c.span) {
+                if (u_try >= 0.0f && u_try < 1.0f) {
+                    /* Still on span c, a quadratic in u: its Taylor expansion
+                     * to second order is exact. */
+                    span_new = c.span;
+                    u_new = u_try;
+                    nex = ex + du_try * (ux + 0.5f * du_try * c.uux);
+                    ney = ey + du_try * (uy + 0.5f * du_try * c.uuy);
+                } else if ((span_new = span_of(t_new, fs, n_span, &u_new)) == c.span) {
                     nb0 = c.k0 * (1.0f - u_new) * (1.0f - u_new);
                     nb2 = c.k2 * u_new * u_new;
                     nex = c.p1x + nb0 * c.ax + nb2 * c.bx - qx;
@@ -492,8 +500,6 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
             best = d;
             t = t_new;
             u = u_new;
-            b0 = nb0;
-            b2 = nb2;
             ex = nex;
             ey = ney;
             if (span_new != c.span) {
@@ -502,6 +508,8 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
         }
         w->t[i] = t;
         if (assemble_next) {
+            b0 = c.k0 * (1.0f - u) * (1.0f - u);
+            b2 = c.k2 * u * u;
             if (c.span != acc.span) {
                 sums_flush(w, &acc);
                 sums_reset(&acc, c.span);
