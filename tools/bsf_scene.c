@@ -562,8 +562,8 @@ double bsf_scene_distance_to_surface(const bsf_scene_t *scene, double wx, double
 
 void bsf_scene_demo_office(bsf_scene_t *sc)
 {
-    static const double outline[] = {0.0, 0.0, 14.0, 0.0, 14.0, 6.0, 9.0, 6.0, 9.0, 10.0,
-                                     0.0, 10.0};
+    static const double outline[] = {0.0, 0.0, 14.0, 0.0,  14.0, 6.0,
+                                     9.0, 6.0, 9.0,  10.0, 0.0,  10.0};
     bsf_scene_init(sc);
     (void)bsf_scene_add_polyline(sc, outline, 6u, 1);
     /* a partition wall with a doorway, a cabinet, a pillar */

@@ -371,9 +371,8 @@ static int parse_robotlaser1(carmen_reader_t *r, fields_t *f, carmen_scan_t *s)
     n = get_count(f, "beam count");
     /* Checked as the float the scan carries: 1e-50 is non-zero but becomes 0,
      * and a finite double beyond FLT_MAX would not convert at all. */
-    if (f->what == NULL &&
-        !(isfinite(start) && fabs(start) <= (double)FLT_MAX && isfinite(res) && fabs(res) <= (double)FLT_MAX &&
-          (float)res != 0.0f)) {
+    if (f->what == NULL && !(isfinite(start) && fabs(start) <= (double)FLT_MAX && isfinite(res) &&
+                             fabs(res) <= (double)FLT_MAX && (float)res != 0.0f)) {
         report(r, "ROBOTLASER1: angular resolution or start angle is zero or not finite");
         return 0;
     }
