@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Per-platform pieces for bsf's own executables (tests, benchmarks).
 
 # Turn an executable into a bare-metal image for QEMU's mps2-an386: our

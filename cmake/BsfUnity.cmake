@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Provides the target `unity` (ThrowTheSwitch Unity 2.6.1, MIT licence).
 #
 # Unity is never part of this repository. In order of preference:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # The warning wall for bsf's own targets. It is PRIVATE to each target, so
 # projects that consume bsf never inherit it.
 set(BSF_WARNING_FLAGS

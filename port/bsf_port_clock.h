@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_port_clock.h - ready-made clock hooks for bsf's timing (bsf_params_t
  * clock / clock_user / clock_hz). A hook returns a free-running 32-bit tick

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # CMake toolchain file: Arm Cortex-M4F (hard float), arm-none-eabi-gcc,
 # newlib-nano with semihosting, tests run on QEMU's mps2-an386 board.
 #

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* BID: the B-spline interest point detector (design brief section 5). */
 #include "bsf/bsf_bid.h"
 #include "bsf_fit_internal.h"

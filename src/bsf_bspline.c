@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_bspline.h"
 #include "bsf/bsf_fit.h"
 #include "bsf_fit_internal.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_stream.h"
 
 /* CRC-32C, reflected, four bits at a time: a 64-byte table instead of the

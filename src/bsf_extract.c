@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
 
 #include <string.h>
@@ -307,6 +308,7 @@ bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan, bsf_result
     if (st != BSF_OK) {
         return st;
     }
+    res->stats.n_beams = (uint32_t)ex->points.count;
     res->stats.n_valid = (uint32_t)ex->points.n_valid;
     clock_stage(&clk, &res->stats, BSF_STAGE_POINTS);
 

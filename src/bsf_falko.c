@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * FALKO keypoints, following FALKOLib's FALKOExtractor::extract step by step
  * (design brief section 4), in float and in caller-owned memory.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_fit_internal.h - helpers shared by the spline fitters (not public).
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf_linalg.h"
 
 #include <math.h>

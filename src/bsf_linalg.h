@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_linalg.h - small symmetric positive definite solves for the spline
  * fitters (internal to the library).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* LSBA: the paper's least-squares baseline with four control points. */
 #include "bsf/bsf_fit.h"
 #include "bsf/bsf_bspline.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_math.h - internal: the transcendental functions the library needs,
  * computed with + - * / and sqrtf only.

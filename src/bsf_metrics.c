@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_metrics.h"
 
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_nms.h - non-maxima suppression over beam indices (internal, shared by
  * the FALKO and BID corner detectors).

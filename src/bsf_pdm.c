@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* PDM: point distance minimisation with boundary, vertex and precision
  * control points, and error-driven refinement (design brief section 7). */
 #include "bsf/bsf_fit.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_scan.h"
 
 #include <math.h>

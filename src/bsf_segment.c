@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_segment.h"
 
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_common.h"
 
 const char *bsf_status_str(bsf_status_t status)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_wire.h - internal: rules shared by the frame encoder and decoder
  * (docs/FORMAT.md sections "Integers" and "Control points").

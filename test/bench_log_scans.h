@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench_log_scans.h - real scans compiled into a benchmark image. The
  * definitions are generated at build time by tools/gen_scan_array.py from a

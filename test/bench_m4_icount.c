@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench_m4_icount - instructions per scan of bsf_extract on the Cortex-M4F,
  * counted under QEMU (mps2-an386) with -icount, for every method, on a fixed

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "stream_fixtures.h"
 
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * stream_fixtures.h - results for the wire-format tests: the worked
  * examples of docs/FORMAT.md and a generator of plausible random results.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Bad-input matrix: every public function of include/bsf/ (every header) fed NULL
  * pointers, empty and maximal counts, counts above the caps, non-finite and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* BID: corners found on synthetic scans, nothing on walls and circles. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Quadratic B-spline evaluation, the banded Cholesky solve and LSBA. */
 #include <math.h>
 #include <string.h>

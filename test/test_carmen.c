@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * CARMEN log reader (tools/carmen.c): small logs written by the test, plain
  * and gzip-compressed, with every kind of line the datasets hold plus

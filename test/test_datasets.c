@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Table 1 on Intel: FALKO-SVED-PDM with the shipped defaults must be no
  * worse than the paper on retrievability, compactness and accuracy at once.
  * N counts every reading below the log's declared maximum range (50 m for

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The whole pipeline on synthetic scenes with ground truth: corners found,
  * curves close to the TRUE surfaces, metrics equal to hand counts, and the
  * extraction API's argument and parameter checks. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * FALKO on synthetic scans ray-cast in the test (walls and a pillar), the
  * shared beam NMS (white-box), and the refused or degenerate calls.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * FALKO against the reference FALKOLib: keypoint beam indices on every scan
  * of the Intel logs compared with the files in ../shared/ref/ (see the ref README).

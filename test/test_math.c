@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The library's own sin, cos, exp, atan2 and asin (src/bsf_math.c): close to
  * the C library's, and the special values callers can meet. White-box. */
 #include <math.h>

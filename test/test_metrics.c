@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Metrics: per-scan definitions, undefined cases, dataset means and quantiles. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* PDM: recovery, vertices, monotone iterations, refinement, degenerate input. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Scan model: which readings become points, and which calls are refused. */
 #include <math.h>
 #include <string.h>

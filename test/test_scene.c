@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Synthetic scenes: exact ray hits, noise statistics, ground-truth corners. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Segmentation: SVED and RPOS break rules, the waste rule, classification
  * and refused input. Scenes come from the synthetic LIDAR (tools/bsf_scene). */
 #include <math.h>

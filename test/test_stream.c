@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Wire format: CRC, COBS, golden frames of docs/FORMAT.md, round trips,
  * encoder validation and the stream decoder's handling of damaged input. */
 #include <math.h>

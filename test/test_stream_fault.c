@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Fault injection: a long stream of frames through a channel that flips,
  * drops and inserts bytes. Every frame that arrived intact must be decoded,
  * and no frame that differs from what was sent may ever be delivered. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench_extract - time the whole pipeline (bsf_extract) per stage, per
  * dataset and per method, then how the time grows with the beam count.

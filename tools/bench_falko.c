@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench_falko - time bsf_falko_detect on every scan of a CARMEN log.
  *

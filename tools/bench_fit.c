@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench_fit: microseconds per spline fit and PDM iterations to converge on
  * typical synthetic segments (host tool, not a test).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench_segment - time SVED, RPOS and classification, and report how many
  * points they keep, on a CARMEN log and on a synthetic 180-beam scene.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bid_calibrate: N_q of BID at synthetic corners, straight walls and circles,
  * used to choose the default threshold t_th (host tool, not a test).
  *

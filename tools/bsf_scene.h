@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_scene.h - synthetic 2D LIDAR scenes for tests, demos and benchmarks.
  *

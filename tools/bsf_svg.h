@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_svg.h - a minimal SVG writer for maps in world coordinates (metres,
  * y up). Host-only helper of the bsf tool.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf - the host tool: extract B-spline features from CARMEN logs into the
  * bsf wire format, decode it, compute the paper's metrics, draw maps,

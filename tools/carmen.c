@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* popen/pclose for the gzip fallback */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * carmen.h - streaming reader of CARMEN log files (host only, not part of the
  * library). Reads plain or gzip-compressed logs (zlib's gzopen reads both)

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Bytes per scan: bsf frames against the raw scan and its per-scan compression.
 
 For each CARMEN log (ROBOTLASER1 or FLASER lines) this prints, per scan:

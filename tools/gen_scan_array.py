@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Turn the ROBOTLASER1 scans of a CARMEN log (plain or .gz) into a C file
 for test/bench_log_scans.h, so a bare-metal benchmark can run real scans.
 

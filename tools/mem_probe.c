@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * mem_probe.c - compiled (never linked or run) by tools/mem_report.py: each
  * array below is exactly as large as one of bsf's caller-owned objects, so

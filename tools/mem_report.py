@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """RAM cost of bsf's caller-owned objects for several beam caps.
 
     mem_report.py [--cc CC --nm NM [--cflags FLAGS]] ... [--points 180,361,1081]

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Worst-case stack of a library entry point from GCC's call graphs.
 
     stack_report.py [--root FUNC ...] [--limit BYTES] DIR

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf.h - umbrella header of the bsf library: include this one.
  *

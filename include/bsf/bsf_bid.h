@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_bid.h - BID, the B-spline interest point detector (design brief
  * section 5): the paper's deliberately expensive baseline corner detector.

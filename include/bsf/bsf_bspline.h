@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_bspline.h - clamped uniform quadratic B-splines in the plane.
  *

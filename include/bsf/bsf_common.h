@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_common.h - status codes and basic types shared by every bsf module.
  */

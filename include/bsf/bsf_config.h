@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_config.h - compile-time capacities of the bsf library.
  *

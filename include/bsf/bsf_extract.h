@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_extract.h - the whole pipeline in one call: scan -> points -> corners
  * -> segments -> B-spline features, for the three methods of the paper.

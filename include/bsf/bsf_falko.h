@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_falko.h - FALKO corner (keypoint) detector, compatible with the
  * reference FALKOLib (dlr1516/falkolib, commit 836b412c) at its defaults.

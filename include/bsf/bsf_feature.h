@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_feature.h - what extraction produces: B-spline features of one scan
  * and the scan's statistics. The stream encoder and the metrics consume it.
@@ -25,8 +26,11 @@ typedef enum {
  * in n_ctrl (as in the paper's compactness metric).
  */
 typedef struct {
-    uint16_t first_beam; /**< first beam index covered (inclusive) */
-    uint16_t last_beam;  /**< last beam index covered (inclusive) */
+    /** First and last beam index covered (inclusive). first_beam > last_beam
+     *  means the run wraps through the seam of a full-circle scan: beams
+     *  first_beam .. stats.n_beams - 1, then 0 .. last_beam. */
+    uint16_t first_beam;
+    uint16_t last_beam;
     uint16_t n_points;   /**< valid points assigned to the feature */
     uint16_t ctrl_first; /**< index of the first control point in the result pool */
     uint8_t n_ctrl;      /**< stored control points, 3..BSF_MAX_CTRL_PER_FEATURE */
@@ -43,15 +47,25 @@ typedef enum {
     BSF_STAGE_COUNT = 4
 } bsf_stage_t;
 
+/** Bits of bsf_stats_t.cut: which compile-time cap cut a scan's output. */
+#define BSF_CUT_KEYPOINTS 0x1u /**< more interest points than BSF_MAX_KEYPOINTS */
+#define BSF_CUT_SEGMENTS 0x2u  /**< more kept segments than BSF_MAX_SEGMENTS */
+#define BSF_CUT_CTRL 0x4u      /**< more control points than BSF_MAX_CTRL_POINTS */
+
 /** Per-scan statistics (paper section 6.1 metrics are computed from these). */
 typedef struct {
-    uint32_t n_valid;       /**< N: valid readings in the scan */
-    uint32_t n_in_features; /**< points in kept features (numerator of retrievability) */
-    uint32_t n_ctrl;        /**< stored control points of all features */
-    uint32_t n_features;    /**< kept features */
-    uint32_t n_keypoints;   /**< interest points found by the corner stage */
-    uint32_t n_unfitted;    /**< segments whose fit failed (counted as wasted) */
-    uint32_t time_ns;       /**< whole extraction time, ns; 0 when no clock is set */
+    uint32_t n_beams;         /**< beams of the scan (index space, valid or not) */
+    uint32_t n_valid;         /**< N: valid readings in the scan */
+    uint32_t n_in_features;   /**< points in kept features (numerator of retrievability) */
+    uint32_t n_ctrl;          /**< stored control points of all features */
+    uint32_t n_features;      /**< kept features */
+    uint32_t n_keypoints;     /**< interest points found by the corner stage */
+    uint32_t n_unfitted;      /**< segments whose fit failed (counted as wasted) */
+    uint32_t cut;             /**< BSF_CUT_* bits; 0 when every cap held */
+    uint32_t n_cut_keypoints; /**< interest points dropped by the keypoint cap */
+    uint32_t n_cut_segments;  /**< kept segments left out because of a cap */
+    uint32_t n_cut_points;    /**< valid points of those segments (wasted in retrievability) */
+    uint32_t time_ns;         /**< whole extraction time, ns; 0 when no clock is set */
     uint32_t stage_ns[BSF_STAGE_COUNT]; /**< per-stage time, ns; 0 when no clock */
 } bsf_stats_t;
 

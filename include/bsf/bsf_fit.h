@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_fit.h - fit a clamped uniform quadratic B-spline (bsf_bspline.h) to
  * the points of one segment: LSBA (least squares, 4 control points, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_metrics.h - the paper's four quality metrics (section 6.1), per scan
  * and aggregated over a dataset, exactly as design section 8 defines them.

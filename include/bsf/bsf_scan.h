@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_scan.h - the scan model: ranges plus geometry in, points plus a
  * validity mask out.

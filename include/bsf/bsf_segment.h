@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_segment.h - split a scan's points into segments (runs of beams that
  * belong to one surface), drop the short ones as wasted, and classify the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bsf_stream.h - the serial wire format (docs/FORMAT.md is the normative
  * spec): one frame per scan, COBS-framed with a 0x00 delimiter and checked

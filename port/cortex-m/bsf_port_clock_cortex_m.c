@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Cortex-M clock hooks: DWT cycle counter, and SysTick as a free-running
  * counter (the one QEMU emulates). Register addresses are architectural
  * (ARMv7-M), the same on every M3/M4/M7. */

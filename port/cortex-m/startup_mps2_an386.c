@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Minimal startup for QEMU's mps2-an386 (Cortex-M4F): vector table, FPU
  * enable, .data copy, .bss zeroing, newlib semihosting init, then main().

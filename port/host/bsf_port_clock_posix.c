@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* POSIX clock hook (host builds): CLOCK_MONOTONIC, nanoseconds, 32-bit wrap. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 199309L

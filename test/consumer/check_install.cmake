@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Run by CTest: install the build tree into a scratch prefix, then build and
 # run the consumer project against that prefix only.
 file(REMOVE_RECURSE "${WORK_DIR}")

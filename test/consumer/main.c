@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Converts a three-beam scan with the installed library; exit 0 when the
  * library answers as documented. */
 #include <bsf/bsf.h>

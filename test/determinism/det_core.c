@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "det_core.h"
 
 #include <string.h>

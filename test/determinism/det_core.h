@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * det_core.h - the host/target determinism workload: the demo office's scans
  * (tools/bsf_scene, double precision) extracted with two methods and encoded

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * det_expect - run the determinism workload on the host and write its
  * results as a C header (the reference the cross build's test_determinism

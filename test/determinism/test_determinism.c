@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Host/target determinism: the frames the library makes for the demo
  * office's scans must be byte-identical on the host and on the Cortex-M4F.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * libFuzzer harness: the CARMEN log reader (tools/carmen.c) fed arbitrary
  * text through a temporary file (the reader's real path: zlib reads plain

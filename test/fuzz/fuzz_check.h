@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * fuzz_check.h - invariants every harness checks on library output. A
  * violation prints what broke and aborts, which libFuzzer reports as a crash

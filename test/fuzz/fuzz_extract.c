@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * libFuzzer harness: the extractor fed arbitrary ranges, geometry and some
  * parameters. Checks: the status is one the API documents, an error leaves

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * libFuzzer harness: the stream decoder fed arbitrary bytes in arbitrary
  * chunks. Every delivered frame must be within the caps and finite, and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * make_corpus - write the fuzzers' seed corpus (test/fuzz/corpus/) from the
  * project's own encoder and scenes: real frames of demo-office scans, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Writes a small synthetic CARMEN log (ROBOTLASER1 lines, plus lines a reader
  * must skip) and prints the metrics the library itself computes on the same

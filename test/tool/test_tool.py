@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """CTest driver for the host tool `bsf`: runs it the way a user does.
 
 Usage: test_tool.py BSF_EXE SYNTH_LOG_EXE WORK_DIR
