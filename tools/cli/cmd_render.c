@@ -5,11 +5,20 @@
 #include "tool.h"
 
 static const char render_help[] =
-    "Usage: bsf render IN -o MAP.svg [--scans K..L] [--points LOG] [--width PX]\n"
-    "Draw the stream's B-spline features in the world frame (poses from the\n"
-    "stream), vertices as squares, with a scale bar. --scans keeps the frames with\n"
-    "sequence numbers K..L; --points draws those scans' raw points from LOG\n"
-    "underneath (same sequence numbering: the n-th laser scan of the log).\n";
+    "Usage: bsf render IN -o MAP.svg [--scans K..L] [--points LOG]\n"
+    "Draw the stream's B-spline features (exact quadratic curves) in the world\n"
+    "frame (poses from the stream) over a grid labelled in metres, with the robot's\n"
+    "path and last pose, vertices as red squares, a legend and a scale bar.\n"
+    "--scans keeps the frames with sequence numbers K..L (K..K: one scan);\n"
+    "--points draws those scans' raw points from LOG underneath (same numbering:\n"
+    "the n-th laser scan of the log), thinned to one per pixel-sized cell, so a\n"
+    "whole log stays a few megabytes.\n";
+
+#define RENDER_CURVE_COLOUR "#1f5fbf"
+#define RENDER_VERTEX_COLOUR "#d62728"
+#define RENDER_PATH_COLOUR "#2ca02c"
+#define RENDER_POINT_COLOUR "#9a9a9a"
+#define RENDER_WALL_COLOUR "#c8c8c8"
 
 typedef struct {
     double x, y, c, s;
@@ -118,22 +127,24 @@ static void robust_bounds(samples_t *s, bsf_bounds_t *b)
     bsf_bounds_add(b, s->x[hi] + mx, s->y[hi] + my);
 }
 
-typedef struct {
-    bsf_svg_t *svg;
-    int open;
-} draw_ctx_t;
-
-static void draw_sample(void *vctx, int new_curve, double wx, double wy)
+/* A frame's features as exact curves in the world frame. */
+static void draw_features(bsf_svg_t *svg, const bsf_frame_t *fr)
 {
-    draw_ctx_t *ctx = (draw_ctx_t *)vctx;
-    if (new_curve) {
-        if (ctx->open) {
-            bsf_svg_path_end(ctx->svg, "#1f5fbf", 1.6);
+    const bsf_result_t *r = &fr->result;
+    const pose2_t pose = pose_of(fr);
+    double xy[2 * BSF_MAX_CTRL_PER_FEATURE];
+    size_t i, k;
+    for (i = 0; i < r->n_features; ++i) {
+        const bsf_feature_t *f = &r->features[i];
+        if (f->n_ctrl > BSF_MAX_CTRL_PER_FEATURE || (size_t)f->ctrl_first + f->n_ctrl > r->n_ctrl) {
+            continue; /* the decoder never delivers these */
         }
-        bsf_svg_path_begin(ctx->svg);
-        ctx->open = 1;
+        for (k = 0; k < f->n_ctrl; ++k) {
+            const bsf_point_t *c = &r->ctrl[f->ctrl_first + k];
+            to_world(&pose, (double)c->x, (double)c->y, &xy[2 * k], &xy[2 * k + 1]);
+        }
+        bsf_svg_curve_bspline2(svg, xy, f->n_ctrl);
     }
-    bsf_svg_path_point(ctx->svg, wx, wy);
 }
 
 static int in_range(uint32_t seq, long lo, long hi)
@@ -141,8 +152,14 @@ static int in_range(uint32_t seq, long lo, long hi)
     return (long)seq >= lo && (hi < 0 || (long)seq <= hi);
 }
 
-static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi, const frame_list_t *l,
-                           bsf_bounds_t *bounds)
+/* Raw points are thinned to one per cell of this size (and at least one
+ * pixel): a map stays a few megabytes whatever the number of scans. */
+#define RENDER_POINT_CELL_M 0.01
+
+/* The log's scans in the range, as world points: into the bounds (pts NULL)
+ * or drawn (thinned) into pts. */
+static int draw_log_points(bsf_svg_points_t *pts, const char *log, long lo, long hi,
+                           const frame_list_t *l, bsf_bounds_t *bounds)
 {
     carmen_reader_t *rd = open_log(log);
     carmen_scan_t rec;
@@ -176,8 +193,8 @@ static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi, co
                 continue;
             }
             to_world(&p, (double)rg * cos(a), (double)rg * sin(a), &wx, &wy);
-            if (svg != NULL) {
-                bsf_svg_dot(svg, wx, wy, 0.6, "#b0b0b0");
+            if (pts != NULL) {
+                bsf_svg_points_add(pts, wx, wy);
             } else {
                 bsf_bounds_add(bounds, wx, wy);
             }
@@ -186,6 +203,40 @@ static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi, co
     }
     carmen_close(rd);
     return r < 0 ? -1 : 0;
+}
+
+/* The robot's path: the poses of the drawn frames, in order. A jump of more
+ * than 5 m (a new log segment, a relocalisation) starts a new line. */
+static unsigned long draw_path(bsf_svg_t *svg, const frame_list_t *l, long lo, long hi)
+{
+    size_t i;
+    unsigned long n = 0;
+    double px = 0.0, py = 0.0;
+    for (i = 0; i < l->n; ++i) {
+        const bsf_frame_t *fr = &l->frames[i];
+        const double x = (double)fr->pose_x, y = (double)fr->pose_y;
+        if (!in_range(fr->seq, lo, hi) || !fr->has_pose) {
+            continue;
+        }
+        if (n == 0 || hypot(x - px, y - py) > 5.0) {
+            bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
+            bsf_svg_path_begin(svg);
+        }
+        bsf_svg_path_point(svg, x, y);
+        px = x;
+        py = y;
+        ++n;
+    }
+    bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
+    for (i = l->n; i-- > 0;) { /* where the robot is at the last frame drawn */
+        const bsf_frame_t *fr = &l->frames[i];
+        if (in_range(fr->seq, lo, hi) && fr->has_pose) {
+            bsf_svg_robot(svg, (double)fr->pose_x, (double)fr->pose_y, (double)fr->pose_theta,
+                          RENDER_PATH_COLOUR);
+            break;
+        }
+    }
+    return n;
 }
 
 static int parse_scan_range(const char *v, long *lo, long *hi)
@@ -241,7 +292,7 @@ static void draw_scene(bsf_svg_t *svg, const bsf_scene_t *scene, bsf_bounds_t *b
             }
         }
         if (svg != NULL) {
-            bsf_svg_path_end(svg, "#c8c8c8", 5.0);
+            bsf_svg_path_end(svg, RENDER_WALL_COLOUR, 5.0);
         }
     }
 }
@@ -251,11 +302,13 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
 {
     bsf_bounds_t b;
     bsf_svg_t svg;
-    draw_ctx_t dc;
     FILE *out;
     size_t i, k;
-    unsigned long drawn = 0, no_pose = 0;
-    char legend[160];
+    unsigned long drawn = 0, no_pose = 0, vertices = 0, path_poses;
+    bsf_svg_points_t pts;
+    bsf_svg_legend_item_t key[5];
+    size_t n_key = 0;
+    char caption[200];
 
     bsf_bounds_init(&b);
     {
@@ -264,6 +317,12 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
         for (i = 0; i < l->n; ++i) {
             if (in_range(l->frames[i].seq, lo, hi)) {
                 for_each_curve_sample(&l->frames[i], bounds_sample, &smp);
+            }
+        }
+        for (i = 0; i < l->n; ++i) { /* the robot's positions belong in the picture */
+            const bsf_frame_t *fr = &l->frames[i];
+            if (in_range(fr->seq, lo, hi) && fr->has_pose) {
+                bounds_sample(&smp, 0, (double)fr->pose_x, (double)fr->pose_y);
             }
         }
         robust_bounds(&smp, &b);
@@ -291,17 +350,31 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
         }
         return -1;
     }
-    if (points_log != NULL && draw_log_points(&svg, points_log, lo, hi, l, NULL) != 0) {
-        if (out != stdout) {
-            fclose(out);
+    bsf_svg_grid(&svg);
+    memset(&pts, 0, sizeof pts);
+    if (points_log != NULL) {
+        /* dots a cell wide, between 1.8 and 5 px: visible on a whole map,
+         * clear on a one-scan close-up */
+        const double dot_px = fmin(5.0, fmax(1.8, RENDER_POINT_CELL_M * svg.px_per_m));
+        int prc =
+            bsf_svg_points_begin(&pts, &svg, RENDER_POINT_CELL_M, dot_px, RENDER_POINT_COLOUR);
+        if (prc != 0) {
+            fail_msg("out of memory");
+        } else {
+            prc = draw_log_points(&pts, points_log, lo, hi, l, NULL);
         }
-        return -1;
+        bsf_svg_points_end(&pts);
+        if (prc != 0) {
+            if (out != stdout) {
+                fclose(out);
+            }
+            return -1;
+        }
     }
     if (scene != NULL) {
         draw_scene(&svg, scene, NULL);
     }
-    dc.svg = &svg;
-    dc.open = 0;
+    bsf_svg_curves_begin(&svg, RENDER_CURVE_COLOUR, 1.6);
     for (i = 0; i < l->n; ++i) {
         const bsf_frame_t *fr = &l->frames[i];
         if (!in_range(fr->seq, lo, hi)) {
@@ -309,11 +382,10 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
         }
         ++drawn;
         no_pose += fr->has_pose ? 0u : 1u;
-        for_each_curve_sample(fr, draw_sample, &dc);
+        draw_features(&svg, fr);
     }
-    if (dc.open) {
-        bsf_svg_path_end(&svg, "#1f5fbf", 1.6);
-    }
+    bsf_svg_curves_end(&svg);
+    path_poses = draw_path(&svg, l, lo, hi);
     /* vertices on top */
     for (i = 0; i < l->n; ++i) {
         const bsf_frame_t *fr = &l->frames[i];
@@ -326,14 +398,41 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
                 double wx, wy;
                 to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx,
                          &wy);
-                bsf_svg_square(&svg, wx, wy, 2.5, "#d02020");
+                bsf_svg_vertex(&svg, wx, wy, 3.5, RENDER_VERTEX_COLOUR);
+                ++vertices;
                 ++k;
             }
         }
     }
-    snprintf(legend, sizeof legend, "%lu scans; blue: B-spline features; red squares: vertices%s",
-             drawn, points_log ? "; grey: raw points" : (scene ? "; grey: true walls" : ""));
-    if (bsf_svg_end(&svg, legend) != 0 || close_out(out, out_path) != 0) {
+    key[n_key].key = BSF_SVG_KEY_LINE;
+    key[n_key].colour = RENDER_CURVE_COLOUR;
+    key[n_key++].text = "B-spline features";
+    key[n_key].key = BSF_SVG_KEY_VERTEX;
+    key[n_key].colour = RENDER_VERTEX_COLOUR;
+    key[n_key++].text = "vertices (corners)";
+    if (path_poses > 0) {
+        key[n_key].key = BSF_SVG_KEY_LINE;
+        key[n_key].colour = RENDER_PATH_COLOUR;
+        key[n_key++].text = "robot path and last pose";
+    }
+    if (points_log != NULL) {
+        key[n_key].key = BSF_SVG_KEY_DOT;
+        key[n_key].colour = RENDER_POINT_COLOUR;
+        key[n_key++].text = "raw LIDAR points (thinned)";
+    }
+    if (scene != NULL) {
+        key[n_key].key = BSF_SVG_KEY_LINE;
+        key[n_key].colour = RENDER_WALL_COLOUR;
+        key[n_key++].text = "true walls";
+    }
+    bsf_svg_legend(&svg, key, n_key);
+    snprintf(caption, sizeof caption, "%lu scans, %lu vertices", drawn, vertices);
+    if (points_log != NULL) {
+        size_t len = strlen(caption);
+        snprintf(caption + len, sizeof caption - len, "; %lu raw points, %lu drawn (%.0f cm grid)",
+                 pts.kept + pts.merged + pts.outside, pts.kept, 100.0 * pts.cell_m);
+    }
+    if (bsf_svg_end(&svg, caption) != 0 || close_out(out, out_path) != 0) {
         return -1;
     }
     if (no_pose) {
