@@ -83,27 +83,41 @@ check(r.returncode == 0 and "frame seq=1 " not in out and "frame seq=2 " in out,
 check("dropped=1 missing=1" in out and "counters: frames ok %d, bad crc 1" % (n_frames - 1) in out,
       "listen's counters show the dropped frame and the gap in sequence numbers")
 
+# A frame cut short at the end of the input is counted, never delivered.
+r = run(["listen", "-"], input=stream[:first_end] + stream[first_end:second_end - 9])
+out = r.stdout.decode()
+counters = dict((f.rpartition(" ")[0], int(f.rpartition(" ")[2]))
+                for f in out.splitlines()[-1][len("counters: "):].split(", "))
+check(r.returncode == 0 and out.count("frame seq=") == 1 and counters.get("frames ok") == 1
+      and counters.get("bad crc", 0) + counters.get("malformed", 0) == 1,
+      "listen counts a frame cut short by the end of input as dropped")
+
 # 3. On a terminal (a pseudo-terminal here) listen sets raw mode and the baud rate.
-master, slave = pty.openpty()
-slave_name = os.ttyname(slave)
-p = subprocess.Popen([BSF, "listen", slave_name, "--baud", "57600", "--count", "3"], cwd=WORK,
-                     stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-note = read_line(p.stderr.fileno(), 10.0)
-check(b"raw 8N1 at 57600 baud" in note, "listen on a tty reports raw mode at the baud rate (%r)" % note)
-attrs = termios.tcgetattr(slave)
-check(attrs[4] == termios.B57600 and attrs[5] == termios.B57600, "the tty's speed is 57600 baud")
-check(not (attrs[3] & (termios.ICANON | termios.ECHO)) and not (attrs[0] & termios.ICRNL),
-      "the tty is in raw mode (no line editing, echo or CR translation)")
-os.write(master, stream[:second_end + 400])
 try:
-    out, err = p.communicate(timeout=10)
-except subprocess.TimeoutExpired:
-    p.kill()
-    out, err = p.communicate()
-check(p.returncode == 0 and out.decode().count("frame seq=") == 3,
-      "listen delivers the frames written into the tty and stops after --count 3")
-os.close(master)
-os.close(slave)
+    master, slave = pty.openpty()
+    slave_name = os.ttyname(slave)
+except OSError as e:  # a container without /dev/pts
+    master = None
+    print("skipped  listen on a tty (%s)" % e)
+if master is not None:
+    p = subprocess.Popen([BSF, "listen", slave_name, "--baud", "57600", "--count", "3"], cwd=WORK,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    note = read_line(p.stderr.fileno(), 10.0)
+    check(b"raw 8N1 at 57600 baud" in note, "listen on a tty reports raw mode at the baud rate (%r)" % note)
+    attrs = termios.tcgetattr(slave)
+    check(attrs[4] == termios.B57600 and attrs[5] == termios.B57600, "the tty's speed is 57600 baud")
+    check(not (attrs[3] & (termios.ICANON | termios.ECHO)) and not (attrs[0] & termios.ICRNL),
+          "the tty is in raw mode (no line editing, echo or CR translation)")
+    os.write(master, stream[:second_end + 400])
+    try:
+        out, err = p.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        out, err = p.communicate()
+    check(p.returncode == 0 and out.decode().count("frame seq=") == 3,
+          "listen delivers the frames written into the tty and stops after --count 3")
+    os.close(master)
+    os.close(slave)
 
 # 4. Bad options: clear message, non-zero exit.
 for args, what in [(["listen", "-", "--baud", "12345"], "a non-standard baud rate"),

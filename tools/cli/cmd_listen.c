@@ -322,7 +322,17 @@ int cmd_listen(int argc, char **argv)
             break;
         }
         if (got == 0) {
-            break; /* end of input: the sender closed the pipe */
+            /* End of input: the sender closed the pipe. A frame cut short
+             * is counted as dropped (never used); one complete but for its
+             * delimiter is intact and delivered, as `bsf decode` does. */
+            static const uint8_t delimiter = 0u;
+            size_t used = 0;
+            if (bsf_decoder_feed(&dec, &delimiter, 1u, &used, &frame) == 1) {
+                note_seq(&ls, frame.seq);
+                ++ls.frames;
+                print_frame_line(&ls, &frame, since_delim + 1u, &dec.stats);
+            }
+            break;
         }
         if (save_fd >= 0 && write_all(save_fd, buf, (size_t)got) != 0) {
             fail_msg("write error on %s: %s", save_path, strerror(errno));
