@@ -205,38 +205,85 @@ static int draw_log_points(bsf_svg_points_t *pts, const char *log, long lo, long
     return r < 0 ? -1 : 0;
 }
 
-/* The robot's path: the poses of the drawn frames, in order. A jump of more
- * than 5 m (a new log segment, a relocalisation) starts a new line. */
-static unsigned long draw_path(bsf_svg_t *svg, const frame_list_t *l, long lo, long hi)
+/* The robot's path: the poses of the frames drawn, fed in order to
+ * path_add(), one polyline; a jump of more than 5 m (a new log segment, a
+ * relocalisation) starts a new line. path_end() marks the last pose. */
+typedef struct {
+    unsigned long n;
+    double x, y, theta;
+} path_t;
+
+static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
 {
-    size_t i;
-    unsigned long n = 0;
-    double px = 0.0, py = 0.0;
-    for (i = 0; i < l->n; ++i) {
-        const bsf_frame_t *fr = &l->frames[i];
-        const double x = (double)fr->pose_x, y = (double)fr->pose_y;
-        if (!in_range(fr->seq, lo, hi) || !fr->has_pose) {
-            continue;
-        }
-        if (n == 0 || hypot(x - px, y - py) > 5.0) {
-            bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
-            bsf_svg_path_begin(svg);
-        }
-        bsf_svg_path_point(svg, x, y);
-        px = x;
-        py = y;
-        ++n;
+    const double x = (double)fr->pose_x, y = (double)fr->pose_y;
+    if (!fr->has_pose) {
+        return;
     }
+    if (p->n == 0 || hypot(x - p->x, y - p->y) > 5.0) {
+        bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
+        bsf_svg_path_begin(svg);
+    }
+    bsf_svg_path_point(svg, x, y);
+    p->x = x;
+    p->y = y;
+    p->theta = (double)fr->pose_theta;
+    ++p->n;
+}
+
+static void path_end(bsf_svg_t *svg, const path_t *p)
+{
     bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
-    for (i = l->n; i-- > 0;) { /* where the robot is at the last frame drawn */
-        const bsf_frame_t *fr = &l->frames[i];
-        if (in_range(fr->seq, lo, hi) && fr->has_pose) {
-            bsf_svg_robot(svg, (double)fr->pose_x, (double)fr->pose_y, (double)fr->pose_theta,
-                          RENDER_PATH_COLOUR);
-            break;
+    if (p->n > 0) {
+        bsf_svg_robot(svg, p->x, p->y, p->theta, RENDER_PATH_COLOUR);
+    }
+}
+
+/* A frame's vertices (pairs of flagged control points) as markers; returns
+ * how many. */
+static unsigned long draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
+{
+    const pose2_t pose = pose_of(fr);
+    unsigned long n = 0;
+    size_t k;
+    for (k = 0; k + 1u < fr->result.n_ctrl; ++k) {
+        if (fr->result.ctrl_is_vertex[k] && fr->result.ctrl_is_vertex[k + 1u]) {
+            double wx, wy;
+            to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx, &wy);
+            bsf_svg_vertex(svg, wx, wy, 3.5, RENDER_VERTEX_COLOUR);
+            ++n;
+            ++k;
         }
     }
     return n;
+}
+
+/* The legend row: the layers that are in the picture. */
+static void draw_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
+{
+    bsf_svg_legend_item_t key[5];
+    size_t n = 0;
+    key[n].key = BSF_SVG_KEY_LINE;
+    key[n].colour = RENDER_CURVE_COLOUR;
+    key[n++].text = "B-spline features";
+    key[n].key = BSF_SVG_KEY_VERTEX;
+    key[n].colour = RENDER_VERTEX_COLOUR;
+    key[n++].text = "vertices (corners)";
+    if (have_path) {
+        key[n].key = BSF_SVG_KEY_LINE;
+        key[n].colour = RENDER_PATH_COLOUR;
+        key[n++].text = "robot path and last pose";
+    }
+    if (have_points) {
+        key[n].key = BSF_SVG_KEY_DOT;
+        key[n].colour = RENDER_POINT_COLOUR;
+        key[n++].text = "raw LIDAR points (thinned)";
+    }
+    if (have_scene) {
+        key[n].key = BSF_SVG_KEY_LINE;
+        key[n].colour = RENDER_WALL_COLOUR;
+        key[n++].text = "true walls";
+    }
+    bsf_svg_legend(svg, key, n);
 }
 
 static int parse_scan_range(const char *v, long *lo, long *hi)
@@ -303,11 +350,10 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
     bsf_bounds_t b;
     bsf_svg_t svg;
     FILE *out;
-    size_t i, k;
-    unsigned long drawn = 0, no_pose = 0, vertices = 0, path_poses;
+    size_t i;
+    unsigned long drawn = 0, no_pose = 0, vertices = 0;
     bsf_svg_points_t pts;
-    bsf_svg_legend_item_t key[5];
-    size_t n_key = 0;
+    path_t path;
     char caption[200];
 
     bsf_bounds_init(&b);
@@ -385,47 +431,20 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
         draw_features(&svg, fr);
     }
     bsf_svg_curves_end(&svg);
-    path_poses = draw_path(&svg, l, lo, hi);
+    memset(&path, 0, sizeof path);
+    for (i = 0; i < l->n; ++i) {
+        if (in_range(l->frames[i].seq, lo, hi)) {
+            path_add(&svg, &path, &l->frames[i]);
+        }
+    }
+    path_end(&svg, &path);
     /* vertices on top */
     for (i = 0; i < l->n; ++i) {
-        const bsf_frame_t *fr = &l->frames[i];
-        const pose2_t pose = pose_of(fr);
-        if (!in_range(fr->seq, lo, hi)) {
-            continue;
-        }
-        for (k = 0; k + 1u < fr->result.n_ctrl; ++k) {
-            if (fr->result.ctrl_is_vertex[k] && fr->result.ctrl_is_vertex[k + 1u]) {
-                double wx, wy;
-                to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx,
-                         &wy);
-                bsf_svg_vertex(&svg, wx, wy, 3.5, RENDER_VERTEX_COLOUR);
-                ++vertices;
-                ++k;
-            }
+        if (in_range(l->frames[i].seq, lo, hi)) {
+            vertices += draw_vertices(&svg, &l->frames[i]);
         }
     }
-    key[n_key].key = BSF_SVG_KEY_LINE;
-    key[n_key].colour = RENDER_CURVE_COLOUR;
-    key[n_key++].text = "B-spline features";
-    key[n_key].key = BSF_SVG_KEY_VERTEX;
-    key[n_key].colour = RENDER_VERTEX_COLOUR;
-    key[n_key++].text = "vertices (corners)";
-    if (path_poses > 0) {
-        key[n_key].key = BSF_SVG_KEY_LINE;
-        key[n_key].colour = RENDER_PATH_COLOUR;
-        key[n_key++].text = "robot path and last pose";
-    }
-    if (points_log != NULL) {
-        key[n_key].key = BSF_SVG_KEY_DOT;
-        key[n_key].colour = RENDER_POINT_COLOUR;
-        key[n_key++].text = "raw LIDAR points (thinned)";
-    }
-    if (scene != NULL) {
-        key[n_key].key = BSF_SVG_KEY_LINE;
-        key[n_key].colour = RENDER_WALL_COLOUR;
-        key[n_key++].text = "true walls";
-    }
-    bsf_svg_legend(&svg, key, n_key);
+    draw_legend(&svg, path.n > 0, points_log != NULL, scene != NULL);
     snprintf(caption, sizeof caption, "%lu scans, %lu vertices", drawn, vertices);
     if (points_log != NULL) {
         size_t len = strlen(caption);
