@@ -49,47 +49,67 @@ r = run(["demo", "--stream", "demo.bsf", "--svg", "demo.svg"])
 check(r.returncode == 0, "bsf demo writes a stream and a map")
 with open(os.path.join(WORK, "demo.bsf"), "rb") as f:
     stream = f.read()
-first_end = stream.index(b"\x00") + 1
-n_frames = stream.count(b"\x00")
+# The stream's frames (a metadata frame may come first and now and then).
+ends = [i + 1 for i, b in enumerate(stream) if b == 0]
+n_frames = len(ends)
+ref = run(["listen", "demo.bsf"], text=True).stdout.splitlines()[:-1]
+check(len(ref) == n_frames and all(l.startswith(("frame seq=", "metadata ")) for l in ref),
+      "listen prints one line per frame of a file (%d)" % n_frames)
+n_scans = sum(1 for l in ref if l.startswith("frame seq="))
+
+
+def counters_of(text):
+    last = text.splitlines()[-1] if text.strip() else ""
+    if not last.startswith("counters: "):
+        return {}
+    return dict((f.rpartition(" ")[0], int(f.rpartition(" ")[2]))
+                for f in last[len("counters: "):].split(", "))
+
 
 # ---- listen -------------------------------------------------------------------
 # 1. On a pipe, a frame is printed as soon as its delimiter arrives, while the
 #    pipe stays open (no block buffering on either side).
 p = subprocess.Popen([BSF, "listen", "-", "-o", "saved.bsf"], cwd=WORK, stdin=subprocess.PIPE,
                      stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-p.stdin.write(stream[:first_end])
+p.stdin.write(stream[:ends[0]])
 p.stdin.flush()
 line = read_line(p.stdout.fileno(), 10.0)
-check(line.startswith(b"frame seq=0 "), "listen prints the first frame before the pipe closes (%r)" % line[:60])
+check(line.decode().split(" | ")[0] == ref[0].split(" | ")[0],
+      "listen prints the first frame before the pipe closes (%r)" % line[:60])
 check(p.poll() is None, "listen still runs while the pipe is open")
-p.stdin.write(stream[first_end:])
+p.stdin.write(stream[ends[0]:])
 p.stdin.close()
 rest = p.stdout.read().decode()
 p.wait(timeout=10)
 check(p.returncode == 0, "listen exits 0 at the end of the stream")
-check(rest.count("frame seq=") == n_frames - 1, "listen prints every frame (%d)" % n_frames)
-check("counters: frames ok %d, bad crc 0" % n_frames in rest, "listen prints the final counters")
+check(rest.count("frame seq=") + line.count(b"frame seq=") == n_scans, "listen prints every scan (%d)" % n_scans)
+c = counters_of(rest)
+check(c.get("frames ok") == n_frames and c.get("bad crc") == 0 and c.get("missing by sequence") == 0,
+      "listen prints the final counters")
 with open(os.path.join(WORK, "saved.bsf"), "rb") as f:
     check(f.read() == stream, "listen -o saves the bytes received unchanged")
 
-# 2. A damaged frame is dropped and counted; the next frame is delivered.
-second_end = stream.index(b"\x00", first_end) + 1
+# 2. A damaged scan is dropped and counted; the next frame is delivered.
+k = next(i for i in range(5, n_frames - 1) if ref[i].startswith("frame seq=") and ref[i + 1].startswith("frame seq="))
 bad = bytearray(stream)
-bad[(first_end + second_end) // 2] ^= 0x55 if bad[(first_end + second_end) // 2] != 0x55 else 0x0F
+pos = (ends[k - 1] + ends[k]) // 2
+bad[pos] ^= 0x55 if bad[pos] != 0x55 else 0x0F
 r = run(["listen", "-"], input=bytes(bad))
 out = r.stdout.decode()
-check(r.returncode == 0 and "frame seq=1 " not in out and "frame seq=2 " in out,
-      "listen drops a corrupted frame and resynchronises at the next one")
-check("dropped=1 missing=1" in out and "counters: frames ok %d, bad crc 1" % (n_frames - 1) in out,
+lost_seq = ref[k].split()[1]
+next_seq = ref[k + 1].split()[1]
+check(r.returncode == 0 and (lost_seq + " ") not in out and (next_seq + " ") in out,
+      "listen drops a corrupted frame (%s) and resynchronises at the next one" % lost_seq)
+c = counters_of(out)
+check("dropped=1 missing=1" in out and c.get("frames ok") == n_frames - 1 and c.get("bad crc") == 1,
       "listen's counters show the dropped frame and the gap in sequence numbers")
 
 # A frame cut short at the end of the input is counted, never delivered.
-r = run(["listen", "-"], input=stream[:first_end] + stream[first_end:second_end - 9])
+r = run(["listen", "-"], input=stream[:ends[0]] + stream[ends[0]:ends[1] - 9])
 out = r.stdout.decode()
-counters = dict((f.rpartition(" ")[0], int(f.rpartition(" ")[2]))
-                for f in out.splitlines()[-1][len("counters: "):].split(", "))
-check(r.returncode == 0 and out.count("frame seq=") == 1 and counters.get("frames ok") == 1
-      and counters.get("bad crc", 0) + counters.get("malformed", 0) == 1,
+c = counters_of(out)
+check(r.returncode == 0 and len(out.splitlines()) == 2 and c.get("frames ok") == 1
+      and c.get("bad crc", 0) + c.get("malformed", 0) == 1,
       "listen counts a frame cut short by the end of input as dropped")
 
 # 3. On a terminal (a pseudo-terminal here) listen sets raw mode and the baud rate.
@@ -108,7 +128,7 @@ if master is not None:
     check(attrs[4] == termios.B57600 and attrs[5] == termios.B57600, "the tty's speed is 57600 baud")
     check(not (attrs[3] & (termios.ICANON | termios.ECHO)) and not (attrs[0] & termios.ICRNL),
           "the tty is in raw mode (no line editing, echo or CR translation)")
-    os.write(master, stream[:second_end + 400])
+    os.write(master, stream[:ends[5]])
     try:
         out, err = p.communicate(timeout=10)
     except subprocess.TimeoutExpired:

@@ -26,7 +26,7 @@ static const char listen_help[] =
     "                default 115200. Ignored (with a note) on pipes and files.\n"
     "  -o, --save FILE  also write every byte received, unchanged, to FILE\n"
     "  --features    one more line per feature (kind, beams, E_curve, control points)\n"
-    "  --count N     stop after N frames delivered\n"
+    "  --count N     stop after N scans (features frames) delivered\n"
     "\n"
     "Frame line: seq, time stamp, pose, features, control points, vertices, bytes\n"
     "on the wire, then ok/dropped counters so far and frames missing by sequence.\n";
@@ -122,7 +122,7 @@ static void on_signal(int sig)
 
 typedef struct {
     int features;
-    unsigned long frames;
+    unsigned long frames; /* scans delivered */
     unsigned long seq_gaps;
     int have_seq;
     uint32_t last_seq;
@@ -171,6 +171,24 @@ static void print_frame_line(listen_state_t *ls, const bsf_frame_t *fr, size_t b
     }
 }
 
+#ifdef BSF_FRAME_TYPE_METADATA
+/* What produced the stream: a sender repeats it, so a receiver that joins a
+ * live link late learns it within a few frames. */
+static void print_metadata_line(const bsf_frame_t *fr, size_t bytes, const bsf_decoder_stats_t *s)
+{
+    const bsf_metadata_t *m = &fr->metadata;
+    const char *method = bsf_method_name((bsf_method_t)m->method);
+    printf("metadata library=%u.%u.%u method=%s beams=%lu angle_min=%.6f angle_increment=%.6f "
+           "range=%.3f..%.3f quant=%.4f source=%s%s%s bytes=%zu | ok=%lu dropped=%lu\n",
+           (unsigned)m->lib_version_major, (unsigned)m->lib_version_minor,
+           (unsigned)m->lib_version_patch, method != NULL ? method : "unknown",
+           (unsigned long)m->n_beams, (double)m->angle_min, (double)m->angle_increment,
+           (double)m->range_min, (double)m->range_max, (double)m->quant_step,
+           m->source_len ? "\"" : "", m->source_len ? m->source : "none", m->source_len ? "\"" : "",
+           bytes, (unsigned long)s->frames_ok, dropped(s));
+}
+#endif
+
 static void note_seq(listen_state_t *ls, uint32_t seq)
 {
     if (ls->have_seq && seq != ls->last_seq + 1u) {
@@ -181,6 +199,22 @@ static void note_seq(listen_state_t *ls, uint32_t seq)
     }
     ls->have_seq = 1;
     ls->last_seq = seq;
+}
+
+/* One delivered frame: its line, and sequence accounting for scans (a
+ * metadata frame has no place in the sequence of scans). */
+static void deliver(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
+                    const bsf_decoder_stats_t *s)
+{
+#ifdef BSF_FRAME_TYPE_METADATA
+    if (fr->type == BSF_FRAME_TYPE_METADATA) {
+        print_metadata_line(fr, bytes, s);
+        return;
+    }
+#endif
+    ++ls->frames;
+    note_seq(ls, fr->seq);
+    print_frame_line(ls, fr, bytes, s);
 }
 
 static void print_summary(const bsf_decoder_stats_t *s, unsigned long gaps)
@@ -327,10 +361,8 @@ int cmd_listen(int argc, char **argv)
              * delimiter is intact and delivered, as `bsf decode` does. */
             static const uint8_t delimiter = 0u;
             size_t used = 0;
-            if (bsf_decoder_feed(&dec, &delimiter, 1u, &used, &frame) == 1) {
-                note_seq(&ls, frame.seq);
-                ++ls.frames;
-                print_frame_line(&ls, &frame, since_delim + 1u, &dec.stats);
+            if (bsf_decoder_feed(&dec, &delimiter, 1u, &used, &frame) > 0) {
+                deliver(&ls, &frame, since_delim + 1u, &dec.stats);
             }
             break;
         }
@@ -355,10 +387,8 @@ int cmd_listen(int argc, char **argv)
                 }
             }
             off += used;
-            if (r == 1) {
-                note_seq(&ls, frame.seq);
-                ++ls.frames;
-                print_frame_line(&ls, &frame, frame_bytes, &dec.stats);
+            if (r > 0) {
+                deliver(&ls, &frame, frame_bytes, &dec.stats);
                 if (fflush(stdout) != 0) {
                     fail_msg("write error on stdout");
                     rc = EXIT_FAIL;

@@ -60,13 +60,24 @@ check(n_frames >= 50, "the host encoder wrote %d frames" % n_frames)
 
 
 def frame_lines(text):
-    """seq -> the frame line without its running counters."""
+    """seq -> the scan's line without its running counters (metadata lines left out)."""
     out = {}
     for line in text.splitlines():
         if line.startswith("frame seq="):
             seq = int(line.split()[1].split("=")[1])
             out[seq] = line.split(" | ")[0]
     return out
+
+
+def frame_kinds(text):
+    """In stream order, one entry per delivered frame: its seq, or None for metadata."""
+    kinds = []
+    for line in text.splitlines():
+        if line.startswith("frame seq="):
+            kinds.append(int(line.split()[1].split("=")[1]))
+        elif line.startswith("metadata "):
+            kinds.append(None)
+    return kinds
 
 
 def summary(text):
@@ -83,7 +94,9 @@ def summary(text):
 reference = subprocess.run([args.bsf, "listen", expected_path], capture_output=True, text=True)
 check(reference.returncode == 0, "bsf listen on the expected file exits 0")
 ref_lines = frame_lines(reference.stdout)
-check(len(ref_lines) == n_frames, "bsf listen decodes every expected frame")
+kinds = frame_kinds(reference.stdout)
+n_scans = len(ref_lines)
+check(len(kinds) == n_frames and n_scans >= 50, "bsf listen decodes every expected frame (%d scans)" % n_scans)
 
 os.mkfifo(fifo)
 qemu_cmd = [args.qemu, "-M", "mps2-an386", "-display", "none", "-monitor", "none",
@@ -91,18 +104,20 @@ qemu_cmd = [args.qemu, "-M", "mps2-an386", "-display", "none", "-monitor", "none
             "-serial", "file:" + fifo, "-kernel", args.firmware]
 
 # Which input bytes the relay drops, flips or precedes with noise (lossy mode).
+# (Frame indices count every frame of the stream, metadata included.)
 drop, flip, noise_before = set(), set(), {}
-lost = set()
+damaged = set()
 if args.mode == "lossy":
     def mid(k):
         return (frames[k][0] + frames[k][1]) // 2
 
-    flip.add(mid(3)); lost.add(3)                       # one corrupted byte
-    drop.add(mid(10)); lost.add(10)                     # one byte lost
-    drop.add(frames[17][1] - 1); lost.update({17, 18})  # a delimiter lost: two frames merge
-    drop.update(range(frames[30][0], frames[30][0] + 20)); lost.add(30)  # head of a frame lost
-    drop.update(range(mid(40), mid(41))); lost.update({40, 41})          # a burst over a boundary
+    flip.add(mid(3)); damaged.add(3)                       # one corrupted byte
+    drop.add(mid(10)); damaged.add(10)                     # one byte lost
+    drop.add(frames[17][1] - 1); damaged.update({17, 18})  # a delimiter lost: two frames merge
+    drop.update(range(frames[30][0], frames[30][0] + 20)); damaged.add(30)  # head of a frame lost
+    drop.update(range(mid(40), mid(41))); damaged.update({40, 41})          # a burst over a boundary
     noise_before[frames[50][0]] = bytes([0x13, 0x37, 0x42, 0x00])  # a junk frame between two: none lost
+lost = {kinds[k] for k in damaged if kinds[k] is not None}  # scans lost
 
 if args.mode == "clean":
     listen = subprocess.Popen([args.bsf, "listen", fifo, "-o", received_path],
@@ -176,6 +191,7 @@ if args.mode == "clean":
           % (len(received), len(expected)))
     check(got == ref_lines, "every frame delivered, decoded as from the expected file")
     check(counters.get("frames ok") == n_frames, "counters: %d frames ok" % n_frames)
+    check(kinds == frame_kinds(listen_out), "the frames arrive in the order sent")
     dropped = sum(counters.get(k, -1) for k in ("bad crc", "malformed", "unsupported version",
                                                  "oversize"))
     check(dropped == 0 and counters.get("missing by sequence") == 0,
@@ -185,11 +201,11 @@ else:
     check(relay_stats["in"] == len(expected), "the relay saw the whole stream from QEMU")
     want = {s: l for s, l in ref_lines.items() if s not in lost}
     check(set(got) == set(want),
-          "exactly the undamaged frames delivered (%d of %d; lost %s)"
-          % (len(got), n_frames, sorted(set(ref_lines) - set(got))))
+          "exactly the undamaged scans delivered (%d of %d; lost %s)"
+          % (len(got), n_scans, sorted(set(ref_lines) - set(got))))
     check(all(got.get(s) == l for s, l in want.items()),
-          "each delivered frame decodes exactly as on the clean link")
-    check(counters.get("frames ok") == n_frames - len(lost), "counters: frames ok")
+          "each delivered scan decodes exactly as on the clean link")
+    check(counters.get("frames ok") == n_frames - len(damaged), "counters: frames ok")
     dropped = sum(counters.get(k, 0) for k in ("bad crc", "malformed", "unsupported version",
                                                 "oversize"))
     # 5 damaged places plus the junk frame: each is at least one dropped frame
