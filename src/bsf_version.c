@@ -1,0 +1,7 @@
+/* SPDX-License-Identifier: MIT */
+#include "bsf/bsf_version.h"
+
+const char *bsf_version(void)
+{
+    return BSF_VERSION_STRING;
+}
