@@ -39,6 +39,31 @@ endfunction()
 
 set(strict -std=c99 -Wall -Wextra -pedantic -Wconversion -Wshadow -Wstrict-prototypes -Werror)
 
+# LIB_CAPS: the caps the library under test was built with (BSF_CAPS),
+# comma-separated.
+string(REPLACE "," ";" LIB_CAPS "${LIB_CAPS}")
+set(lib_defs)
+foreach(cap IN LISTS LIB_CAPS)
+    list(APPEND lib_defs -D${cap})
+endforeach()
+
+# The symbol suffix (bsf_abi.h) for the default caps overridden by the
+# NAME=VALUE pairs given.
+function(caps_suffix out)
+    set(BSF_MAX_POINTS 1081)
+    set(BSF_MAX_KEYPOINTS 64)
+    set(BSF_MAX_SEGMENTS 128)
+    set(BSF_MAX_CTRL_PER_FEATURE 32)
+    set(BSF_MAX_CTRL_POINTS 512)
+    foreach(cap IN LISTS ARGN)
+        string(REPLACE "=" ";" cap "${cap}")
+        list(GET cap 0 name)
+        list(GET cap 1 value)
+        set(${name} ${value})
+    endforeach()
+    set(${out} "capsP${BSF_MAX_POINTS}K${BSF_MAX_KEYPOINTS}S${BSF_MAX_SEGMENTS}F${BSF_MAX_CTRL_PER_FEATURE}C${BSF_MAX_CTRL_POINTS}" PARENT_SCOPE)
+endfunction()
+
 if(MODE STREQUAL "install_static")
     file(REMOVE_RECURSE "${WORK_DIR}")
     run_checked("cmake --install" "${CMAKE_COMMAND}" --install "${BSF_BINARY_DIR}" --prefix "${WORK_DIR}")
@@ -57,7 +82,7 @@ elseif(MODE STREQUAL "install_shared")
     run_checked("configure shared bsf" "${CMAKE_COMMAND}" -S "${BSF_SOURCE_DIR}" -B "${WORK_DIR}/build"
         -G "${GENERATOR}" -DCMAKE_C_COMPILER=${C_COMPILER} -DCMAKE_BUILD_TYPE=Release
         -DBUILD_SHARED_LIBS=ON -DBSF_BUILD_TESTS=OFF -DBSF_BUILD_TOOLS=OFF
-        -DCMAKE_INSTALL_LIBDIR=lib)
+        -DCMAKE_INSTALL_LIBDIR=lib "-DBSF_CAPS=${LIB_CAPS}")
     run_checked("build shared bsf" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build" -j 2)
     run_checked("install shared bsf" "${CMAKE_COMMAND}" --install "${WORK_DIR}/build" --prefix "${WORK_DIR}/prefix")
     foreach(f lib/libbsf.so lib/libbsf.so.${SOVERSION} lib/pkgconfig/bsf.pc)
@@ -141,30 +166,45 @@ elseif(MODE STREQUAL "caps_mismatch")
     set(link -I${PREFIX}/include ${CONSUMER_SOURCE_DIR}/main.c -L${PREFIX}/${LIBDIR} -lbsf -lm
         -Wl,-rpath,${PREFIX}/${LIBDIR})
     # Control: the library's own caps link and run.
-    run_checked("matching caps" ${C_COMPILER} ${strict} ${link} -o ${WORK_DIR}/same)
+    run_checked("matching caps" ${C_COMPILER} ${strict} ${lib_defs} ${link} -o ${WORK_DIR}/same)
     run_consumer("${WORK_DIR}/same")
     # Other caps on the command line, then in a BSF_CONFIG_HEADER: the link
     # must refuse, naming the program's caps.
+    if(LIB_CAPS)
+        set(other_defs "")
+        caps_suffix(other_expect)
+    else()
+        set(other_defs -DBSF_MAX_POINTS=361)
+        caps_suffix(other_expect BSF_MAX_POINTS=361)
+    endif()
     file(WRITE "${WORK_DIR}/my_bsf_config.h" "#define BSF_MAX_SEGMENTS 32\n")
-    foreach(case "-DBSF_MAX_POINTS=361|capsP361K64S128F32C512"
-                 "-DBSF_CONFIG_HEADER=\"my_bsf_config.h\"|capsP1081K64S32F32C512")
-        string(REPLACE "|" ";" case "${case}")
-        list(GET case 0 define)
-        list(GET case 1 expect)
-        execute_process(COMMAND ${C_COMPILER} ${strict} ${define} -I${WORK_DIR} ${link}
+    caps_suffix(header_expect ${LIB_CAPS} BSF_MAX_SEGMENTS=32)
+    foreach(case other header)
+        if(case STREQUAL "other")
+            set(defs ${other_defs})
+            set(expect ${other_expect})
+            set(what "the default caps")
+            if(other_defs)
+                set(what "${other_defs}")
+            endif()
+        else()
+            set(defs ${lib_defs} "-DBSF_CONFIG_HEADER=\"my_bsf_config.h\"")
+            set(expect ${header_expect})
+            set(what "a BSF_CONFIG_HEADER setting BSF_MAX_SEGMENTS 32")
+        endif()
+        execute_process(COMMAND ${C_COMPILER} ${strict} ${defs} -I${WORK_DIR} ${link}
                 -o ${WORK_DIR}/mismatched
             RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
         if(rc EQUAL 0)
-            message(FATAL_ERROR "a program built with ${define} linked against the library "
-                "built with the default caps")
+            message(FATAL_ERROR "a program built with ${what} linked against a library built "
+                "with [${LIB_CAPS}] (empty: the defaults)")
         endif()
         if(NOT "${out}${err}" MATCHES "undefined reference to `bsf_[a-z_]+_${expect}'"
-                AND NOT "${out}${err}" MATCHES "undefined symbol: bsf_[a-z_]+_${expect}"
-                AND NOT "${out}${err}" MATCHES "_bsf_[a-z_]+_${expect}")
-            message(FATAL_ERROR "the link of a program built with ${define} failed, but not with "
+                AND NOT "${out}${err}" MATCHES "undefined symbol: _?bsf_[a-z_]+_${expect}")
+            message(FATAL_ERROR "the link of a program built with ${what} failed, but not with "
                 "the documented message (undefined reference to bsf_..._${expect}):\n${out}${err}")
         endif()
-        message(STATUS "${define}: link refused as documented (bsf_..._${expect} undefined)")
+        message(STATUS "${what}: link refused as documented (bsf_..._${expect} undefined)")
     endforeach()
 
 elseif(MODE STREQUAL "exports")
@@ -173,7 +213,7 @@ elseif(MODE STREQUAL "exports")
     # symbol names the caps guard gives them).
     file(REMOVE_RECURSE "${WORK_DIR}")
     file(WRITE "${WORK_DIR}/api.c" "#include <bsf/bsf.h>\n")
-    run_checked("preprocess" ${C_COMPILER} -E -P -I${PREFIX}/include "${WORK_DIR}/api.c")
+    run_checked("preprocess" ${C_COMPILER} -E -P ${lib_defs} -I${PREFIX}/include "${WORK_DIR}/api.c")
     string(REGEX MATCHALL "bsf_[A-Za-z0-9_]+[ \t]*\\(" decl "${run_out}")
     list(TRANSFORM decl REPLACE "[ \t]*\\($" "")
     list(REMOVE_DUPLICATES decl)

@@ -5,9 +5,9 @@
 # Included from test/CMakeLists.txt on host builds.
 #
 #   consumer_find_package         find_package(bsf CONFIG), static install
-#   consumer_find_package_shared  find_package(bsf CONFIG), shared install
+#   consumer_find_package_shared  find_package(bsf CONFIG), shared install with other caps
 #   consumer_pkgconfig_static     Makefile + pkg-config, static install
-#   consumer_pkgconfig_shared     Makefile + pkg-config, shared install
+#   consumer_pkgconfig_shared     Makefile + pkg-config, shared install with other caps
 #   consumer_subdirectory         add_subdirectory(bsf) from a strict parent
 #   consumer_copy_sources         src/ + include/ in a plain compiler command
 #   consumer_caps_mismatch        other caps than the installed library: link refused
@@ -28,6 +28,10 @@ set(_bsf_consumer_args
     -DNM=${CMAKE_NM}
     -DREADELF=${CMAKE_READELF}
     -DSOVERSION=${_bsf_soversion})
+# The shared library is built with other caps than the default, so the
+# shared consumers also prove that the caps travel with the package.
+set(_bsf_shared_caps BSF_MAX_POINTS=361)
+string(REPLACE ";" "," _bsf_shared_caps_arg "${_bsf_shared_caps}")
 set(_bsf_static_prefix ${_bsf_consumer_work}/static)
 set(_bsf_shared_prefix ${_bsf_consumer_work}/shared/prefix)
 
@@ -36,7 +40,7 @@ function(bsf_consumer_test name mode)
     cmake_parse_arguments(C "SHARED" "PREFIX;LIBDIR" "FIXTURES" ${ARGN})
     set(extra)
     if(C_SHARED)
-        list(APPEND extra -DSHARED=1)
+        list(APPEND extra -DSHARED=1 -DLIB_CAPS=${_bsf_shared_caps_arg})
     endif()
     add_test(NAME ${name}
         COMMAND ${CMAKE_COMMAND} ${_bsf_consumer_args} -DMODE=${mode}
@@ -58,7 +62,8 @@ set_tests_properties(consumer_install_static PROPERTIES TIMEOUT 120 FIXTURES_SET
     LABELS consumer)
 add_test(NAME consumer_install_shared
     COMMAND ${CMAKE_COMMAND} ${_bsf_consumer_args} -DMODE=install_shared
-        -DWORK_DIR=${_bsf_consumer_work}/shared -P ${_bsf_consumer_dir}/consumer_test.cmake)
+        -DWORK_DIR=${_bsf_consumer_work}/shared -DLIB_CAPS=${_bsf_shared_caps_arg}
+        -P ${_bsf_consumer_dir}/consumer_test.cmake)
 set_tests_properties(consumer_install_shared PROPERTIES TIMEOUT 180 FIXTURES_SETUP bsf_shared
     LABELS consumer)
 
@@ -73,3 +78,4 @@ bsf_consumer_test(consumer_copy_sources copy_sources)
 bsf_consumer_test(consumer_caps_mismatch caps_mismatch ${_st})
 bsf_consumer_test(consumer_caps_mismatch_shared caps_mismatch ${_sh})
 bsf_consumer_test(consumer_shared_exports exports ${_sh})
+set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${_bsf_consumer_dir}/tool_notice.cmake)
