@@ -220,7 +220,7 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
         t0 = ticks_now();
         st = bsf_extract(&g_ex, scan, &g_res);
         t1 = ticks_now();
-        if (st != BSF_OK) {
+        if (st < 0) { /* BSF_OK_CUT is a result like any other */
             printf("  %s: scan %u: %s\n", bsf_method_name(method), (unsigned)i, bsf_status_str(st));
             return 1;
         }
@@ -239,7 +239,7 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
     for (i = 0; i < src->n; ++i) {
         bsf_scan_t tmp;
         const bsf_scan_t *scan = src->get(i, &tmp);
-        if (bsf_extract(&g_ex, scan, &g_res) != BSF_OK) {
+        if (bsf_extract(&g_ex, scan, &g_res) < 0) {
             return 1;
         }
         for (s = 0; s < BSF_STAGE_COUNT; ++s) {

@@ -134,5 +134,21 @@ with open(os.path.join(WORK, "broken.log"), "w") as f:
 r = run(["extract", "broken.log", "-o", "broken.bsf"], text=True)
 check(r.returncode == 0 and "broken.log:4" in r.stderr, "malformed line reported as broken.log:4 and skipped")
 
+# 7. a scan that exceeds a cap is kept with what fits and reported as cut, not failed
+exp = subprocess.run([SYNTH, os.path.join(WORK, "clutter.log"), "12", "clutter"], capture_output=True, text=True)
+check(exp.returncode == 0, "synth_log writes the clutter log")
+expected = dict(l.split("=") for l in exp.stdout.split())
+n_cut = int(expected["cut_scans"])
+check(0 < n_cut < 12, "some clutter scans exceed the keypoint cap (%d of 12)" % n_cut)
+r = run(["extract", "clutter.log", "-o", "clutter.bsf"], text=True)
+check(r.returncode == 0, "bsf extract keeps cut scans and exits 0")
+check("12 scans extracted" in r.stderr and ("%d cut by the caps" % n_cut) in r.stderr and " 0 failed" in r.stderr,
+      "bsf extract counts %d cut scans apart from failed ones" % n_cut)
+check(("left out %s keypoints" % expected["cut_keypoints"]) in r.stderr, "bsf extract totals the cut keypoints")
+check(r.stderr.count("cut by the caps:") == min(n_cut, 10), "each cut scan is reported with file:line")
+r = run(["metrics", "clutter.bsf"], text=True)
+check(r.returncode == 0 and metrics_of(r.stdout).get("scans", ["?"])[0] == "12",
+      "bsf metrics reads every scan of the cut stream")
+
 print("%d checks failed" % len(failures) if failures else "all tool checks passed")
 sys.exit(1 if failures else 0)

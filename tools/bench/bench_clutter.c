@@ -62,10 +62,9 @@ int main(int argc, char **argv)
                                 {"1081/270", 1081u, 1.5 * pi},
                                 {"3200/360", 3200u, 2.0 * pi * 3199.0 / 3200.0}};
     /* office: a few chairs; cluttered: a furnished room; dense: a store room */
-    clutter_t levels[] = {
-        {"office", 6u, 12u, 4u, 6.0, 4.0, 0.8},
-        {"cluttered", 12u, 40u, 12u, 6.0, 4.0, 0.8},
-        {"dense", 20u, 80u, 30u, 6.0, 4.0, 0.8}};
+    clutter_t levels[] = {{"office", 6u, 12u, 4u, 6.0, 4.0, 0.8},
+                          {"cluttered", 12u, 40u, 12u, 6.0, 4.0, 0.8},
+                          {"dense", 20u, 80u, 30u, 6.0, 4.0, 0.8}};
     const bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
     const size_t n_scans = argc > 1 ? (size_t)strtoul(argv[1], NULL, 10) : 200u;
     size_t si;
