@@ -7,6 +7,7 @@
  * and clutter level, the keypoints, kept segments and control points one
  * scan needs (median, p99, max). The README's memory section is made from
  * its output:  build/tools/bench_clutter [SCANS_PER_ROW]
+ * (or one custom row: SCANS TEETH POSTS BOXES HALF_W HALF_H CLEAR NOISE)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,6 +38,7 @@ typedef struct {
     double half_w;
     double half_h;
     double clear;
+    double noise;
 } clutter_t;
 
 static int cmp_u32(const void *a, const void *b)
@@ -62,21 +64,35 @@ int main(int argc, char **argv)
                                 {"1081/270", 1081u, 1.5 * pi},
                                 {"3200/360", 3200u, 2.0 * pi * 3199.0 / 3200.0}};
     /* office: a few chairs; cluttered: a furnished room; dense: a store room */
-    clutter_t levels[] = {{"office", 6u, 12u, 4u, 6.0, 4.0, 0.8},
-                          {"cluttered", 12u, 40u, 12u, 6.0, 4.0, 0.8},
-                          {"dense", 20u, 80u, 30u, 6.0, 4.0, 0.8}};
+    /* 12 m x 8 m rooms: an office with a few chairs, a furnished room, a
+     * store room, the furnished room seen by a 3 cm-noise sensor; then a
+     * 30 m x 20 m hall full of posts (nothing within 2.5 m). */
+    clutter_t levels[] = {{"office", 6u, 12u, 4u, 6.0, 4.0, 0.8, 0.01},
+                          {"cluttered", 12u, 40u, 12u, 6.0, 4.0, 0.8, 0.01},
+                          {"store", 20u, 80u, 30u, 6.0, 4.0, 0.8, 0.01},
+                          {"clut-3cm", 12u, 40u, 12u, 6.0, 4.0, 0.8, 0.03},
+                          {"hall", 10u, 300u, 10u, 15.0, 10.0, 2.5, 0.01}};
+    const size_t n_levels = sizeof levels / sizeof levels[0];
     const bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
     const size_t n_scans = argc > 1 ? (size_t)strtoul(argv[1], NULL, 10) : 200u;
     size_t si;
     size_t li;
-    if (argc == 8) { /* SCANS TEETH POSTS BOXES HALF_W HALF_H CLEAR: a custom "dense" */
-        levels[2].name = "custom";
-        levels[2].n_teeth = (size_t)strtoul(argv[2], NULL, 10);
-        levels[2].n_posts = (size_t)strtoul(argv[3], NULL, 10);
-        levels[2].n_boxes = (size_t)strtoul(argv[4], NULL, 10);
-        levels[2].half_w = strtod(argv[5], NULL);
-        levels[2].half_h = strtod(argv[6], NULL);
-        levels[2].clear = strtod(argv[7], NULL);
+    size_t first_level = 0u;
+    if (argc == 9) { /* SCANS TEETH POSTS BOXES HALF_W HALF_H CLEAR NOISE: one custom level */
+        clutter_t *c = &levels[n_levels - 1u];
+        c->name = "custom";
+        c->n_teeth = (size_t)strtoul(argv[2], NULL, 10);
+        c->n_posts = (size_t)strtoul(argv[3], NULL, 10);
+        c->n_boxes = (size_t)strtoul(argv[4], NULL, 10);
+        c->half_w = strtod(argv[5], NULL);
+        c->half_h = strtod(argv[6], NULL);
+        c->clear = strtod(argv[7], NULL);
+        c->noise = strtod(argv[8], NULL);
+        first_level = n_levels - 1u;
+    } else if (argc > 2) {
+        fprintf(stderr, "usage: bench_clutter [SCANS [TEETH POSTS BOXES HALF_W HALF_H CLEAR "
+                        "NOISE]]\n");
+        return 2;
     }
     if (n_scans < 1u || n_scans > MAX_SCANS) {
         fprintf(stderr, "bench_clutter: SCANS_PER_ROW must be 1..%d\n", MAX_SCANS);
@@ -90,7 +106,7 @@ int main(int argc, char **argv)
     printf("%-9s %-9s | keypoints p50 p99 max | segments p50 p99 max | ctrl p50 p99 max\n",
            "sensor", "clutter");
     for (si = 0; si < sizeof sensors / sizeof sensors[0]; ++si) {
-        for (li = 0; li < sizeof levels / sizeof levels[0]; ++li) {
+        for (li = first_level; li < n_levels; ++li) {
             size_t k;
             for (k = 0; k < n_scans; ++k) {
                 bsf_scene_rng_t rng;
@@ -114,7 +130,7 @@ int main(int argc, char **argv)
                 }
                 l = bsf_lidar_default(0.0, 0.0, 2.0 * pi * bsf_scene_rng_uniform(&rng),
                                       sensors[si].beams, sensors[si].fov);
-                l.noise_sigma = 0.01;
+                l.noise_sigma = levels[li].noise;
                 if (bsf_scene_scan(&g_scene, &l, &rng, g_ranges, NULL, BSF_MAX_POINTS) != BSF_OK) {
                     return 1;
                 }
