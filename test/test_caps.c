@@ -6,10 +6,12 @@
  * BSF_FRAME_MAX_SIZE and decode to the same features. Built twice: against
  * the default library (1081 beams) and against a copy with
  * BSF_MAX_POINTS = 3200, where the full-circle 3200-beam scans run too. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "bsf/bsf.h"
+#include "bsf_nms.h"
 #include "bsf_scene.h"
 #include "unity.h"
 
@@ -287,6 +289,38 @@ static void test_3200_beams_ctrl_cap_fits_the_largest_first(void)
 }
 #endif
 
+/* The keypoint rule itself: the cap best scores in either order, ties to the
+ * lower beam, kept in beam order; negative and infinite scores order right. */
+static void test_keep_best_keeps_the_strongest_in_beam_order(void)
+{
+    static float score[16];
+    uint16_t peak[8] = {1u, 3u, 4u, 6u, 9u, 11u, 12u, 15u};
+    uint16_t low[8];
+    size_t n;
+    score[1] = 5.0f;
+    score[3] = -2.0f;
+    score[4] = 7.0f;
+    score[6] = 5.0f;
+    score[9] = INFINITY;
+    score[11] = 0.0f;
+    score[12] = 5.0f;
+    score[15] = -INFINITY;
+    memcpy(low, peak, sizeof low);
+    n = bsf_nms_keep_best(score, BSF_NMS_HIGHER_IS_BETTER, peak, 8u, 4u);
+    TEST_ASSERT_EQUAL_UINT32(4u, n);
+    TEST_ASSERT_EQUAL_UINT16(1u, peak[0]); /* 5: the first two of three tied 5s */
+    TEST_ASSERT_EQUAL_UINT16(4u, peak[1]); /* 7 */
+    TEST_ASSERT_EQUAL_UINT16(6u, peak[2]); /* 5 */
+    TEST_ASSERT_EQUAL_UINT16(9u, peak[3]); /* +inf */
+    n = bsf_nms_keep_best(score, BSF_NMS_LOWER_IS_BETTER, low, 8u, 3u);
+    TEST_ASSERT_EQUAL_UINT32(3u, n);
+    TEST_ASSERT_EQUAL_UINT16(3u, low[0]);  /* -2 */
+    TEST_ASSERT_EQUAL_UINT16(11u, low[1]); /* 0 */
+    TEST_ASSERT_EQUAL_UINT16(15u, low[2]); /* -inf */
+    TEST_ASSERT_EQUAL_UINT32(2u, bsf_nms_keep_best(score, BSF_NMS_LOWER_IS_BETTER, low, 2u, 5u));
+    TEST_ASSERT_EQUAL_UINT32(0u, bsf_nms_keep_best(score, BSF_NMS_LOWER_IS_BETTER, low, 3u, 0u));
+}
+
 /* The input is never truncated: a scan longer than BSF_MAX_POINTS stays an error. */
 static void test_too_long_scan_is_still_an_error(void)
 {
@@ -312,6 +346,7 @@ int main(void)
     RUN_TEST(test_3200_beams_segment_cap_keeps_the_largest);
     RUN_TEST(test_3200_beams_ctrl_cap_fits_the_largest_first);
 #endif
+    RUN_TEST(test_keep_best_keeps_the_strongest_in_beam_order);
     RUN_TEST(test_too_long_scan_is_still_an_error);
     return UNITY_END();
 }
