@@ -307,19 +307,19 @@ static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf
     bsf_feature_t *f;
     size_t n_vertex = 0u;
     size_t n_ctrl = 0u;
-    size_t room;
+    size_t n;
     float e_curve = 0.0f;
     bsf_status_t st;
-    const size_t n = gather_segment(ex, s, &n_vertex);
+    const size_t room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
+    const int lsba = ex->params.method == BSF_METHOD_RPOS_LSBA;
 
-    if (res->n_features >= BSF_MAX_SEGMENTS) {
+    /* No fit when no feature could fit: a feature has at least 3 control
+     * points (4 from LSBA). */
+    if (res->n_features >= BSF_MAX_SEGMENTS || room < (lsba ? 4u : 3u)) {
         return BSF_ERR_BUFFER;
     }
-    room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
-    if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
-        if (room < 4u) {
-            return BSF_ERR_BUFFER;
-        }
+    n = gather_segment(ex, s, &n_vertex);
+    if (lsba) {
         st = bsf_lsba_fit(ex->scratch.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
         if (st == BSF_OK) {
             n_ctrl = 4u;
