@@ -382,8 +382,15 @@ static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
     }
 }
 
-/* Sort the features by first beam and lay their control points out in that
- * order, as a result fitted in beam order has them. In place, no memory. */
+/* Beam order of features: by first beam, one wrapping through the seam of a
+ * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
+static uint32_t beam_order_key(const bsf_feature_t *f)
+{
+    return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
+}
+
+/* Sort the features into beam order and lay their control points out in
+ * that order, as a result fitted in beam order has them. In place. */
 static void put_features_in_beam_order(bsf_result_t *res)
 {
     size_t i;
@@ -391,7 +398,7 @@ static void put_features_in_beam_order(bsf_result_t *res)
     for (i = 1; i < res->n_features; ++i) {
         const bsf_feature_t f = res->features[i];
         size_t j = i;
-        while (j > 0u && res->features[j - 1u].first_beam > f.first_beam) {
+        while (j > 0u && beam_order_key(&res->features[j - 1u]) > beam_order_key(&f)) {
             res->features[j] = res->features[j - 1u];
             --j;
         }

@@ -118,7 +118,8 @@ BSF_NODISCARD bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_par
  *    again from the one covering the most points down (ties: beam order);
  *    a segment whose feature does not fit the room left is cut, a smaller
  *    one after it may still fit. Features then come out sorted by first
- *    beam, with their control points laid out in that order (BSF_CUT_CTRL).
+ *    beam (one wrapping through a full-circle seam last), with their
+ *    control points laid out in that order (BSF_CUT_CTRL).
  * A cut segment counts in stats.n_cut_segments and its points in
  * stats.n_cut_points: they are part of N but of no feature, so they are
  * wasted in retrievability. A cut result never exceeds any cap, so it always
