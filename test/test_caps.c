@@ -204,8 +204,11 @@ static void assert_largest_segments_kept(void)
         min_kept = ex.segments[i].n_points < min_kept ? ex.segments[i].n_points : min_kept;
     }
     TEST_ASSERT_TRUE(res.stats.n_cut_segments > 0u);
-    /* a rule that kept small segments would cut more points than this */
-    TEST_ASSERT_TRUE(res.stats.n_cut_points <= res.stats.n_cut_segments * min_kept);
+    if ((res.stats.cut & BSF_CUT_CTRL) == 0u) {
+        /* a rule that kept small segments would cut more points than this
+         * (a control-point cut may also leave out a kept segment) */
+        TEST_ASSERT_TRUE(res.stats.n_cut_points <= res.stats.n_cut_segments * min_kept);
+    }
     TEST_ASSERT_TRUE(res.stats.n_cut_points >=
                      res.stats.n_cut_segments * ex.params.sved.min_segment_points);
 }
@@ -256,8 +259,8 @@ static const clutter_case_t k3200 = {3200u, FULL_3200, 80u, 20u, 5u, 6.0, 4.0, 0
 static const clutter_case_t s3200 = {3200u, FULL_3200, 10u,  300u, 10u, 15.0,
                                      10.0,  2.5,       0.25, 0.01, 1u};
 /* 3 cm range noise (a low-cost sensor): more control points per feature */
-static const clutter_case_t c3200 = {3200u, FULL_3200, 10u,  60u,  60u, 10.0,
-                                     8.0,   0.8,       0.25, 0.03, 4u};
+static const clutter_case_t c3200 = {3200u, FULL_3200, 10u,  80u,  80u, 10.0,
+                                     8.0,   0.8,       0.25, 0.03, 3u};
 
 static void test_3200_beams_keypoint_cap_keeps_the_strongest(void)
 {
