@@ -36,7 +36,7 @@ static void note_cut_scan(cut_totals_t *t, const char *log, unsigned long line, 
 {
     if (t->scans < CUT_MESSAGES_MAX) {
         fprintf(stderr,
-                "%s:%lu: scan %lu cut by the caps: %lu keypoints, %lu segments (%lu points) "
+                "%s:%lu: scan %lu cut by a cap: %lu keypoints, %lu segments (%lu points) "
                 "left out%s\n",
                 log, line, index, (unsigned long)s->n_cut_keypoints,
                 (unsigned long)s->n_cut_segments, (unsigned long)s->n_cut_points,
@@ -147,7 +147,7 @@ static int run_extract(const extract_opts_t *o)
         return EXIT_FAIL;
     }
     fprintf(stderr,
-            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu cut by the caps, "
+            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu cut by a cap, "
             "%lu failed, %lu malformed lines\n",
             o->log, done, bsf_method_name(o->method), bytes,
             done ? (double)bytes / (double)done : 0.0, cut.scans, failed, malformed);
