@@ -106,9 +106,11 @@ int main(int argc, char **argv)
     }
     printf(
         "scans=%lu\nretrievability=%.6f\ncompactness=%.6f\naccuracy=%.7f\nfeatures_per_scan=%.4f\n"
-        "ctrl_per_scan=%.4f\ncut_scans=%lu\ncut_keypoints=%lu\n",
+        "ctrl_per_scan=%.4f\ncut_scans=%lu\ncut_keypoints=%lu\n"
+        "caps=BSF_MAX_POINTS=%d,BSF_MAX_KEYPOINTS=%d,BSF_MAX_SEGMENTS=%d,BSF_MAX_CTRL_POINTS=%d\n",
         (unsigned long)s.n_scans, 100.0 * (double)s.retrievability, (double)s.compactness,
         (double)s.accuracy, (double)s.features_per_scan, (double)s.ctrl_per_scan,
-        (unsigned long)s.n_cut_scans, (unsigned long)s.cut_keypoints);
+        (unsigned long)s.n_cut_scans, (unsigned long)s.cut_keypoints, BSF_MAX_POINTS,
+        BSF_MAX_KEYPOINTS, BSF_MAX_SEGMENTS, BSF_MAX_CTRL_POINTS);
     return 0;
 }
