@@ -414,6 +414,10 @@ def encode(
     """
     step = quant_step if quant_step is not None else (frame.quant_step or QUANT_STEP_DEFAULT)
     step = _finite("quant_step", step)
+    pose = frame.pose
+    if pose is not None:
+        if len(pose) != 3 or not all(isinstance(v, (int, float, np.floating)) and math.isfinite(v) for v in pose):
+            raise BsfError(f"pose must be three finite numbers (x, y, theta), got {pose!r}")
     feats = []
     ctrl = []
     vert = []
@@ -439,7 +443,7 @@ def encode(
     return _core.encode(
         int(frame.seq if seq is None else seq),
         int(frame.timestamp_ms if timestamp_ms is None else timestamp_ms),
-        frame.pose,
+        pose,
         step,
         (feats, ctrl_b, vert_b, stats),
     )
@@ -454,20 +458,14 @@ class Decoder:
 
     def __init__(self) -> None:
         self._dec = _core.Decoder()
-        self._pending = 0
 
     def feed(self, data: Union[bytes, bytearray, memoryview]) -> List[Frame]:
         """Decode ``data``; returns the frames completed by it."""
-        out = []
-        for t in self._dec.feed(data):
-            fr = _frame_from_tuple(t)
-            if fr is not None:
-                out.append(fr)
-        return out
+        return [fr for fr in (_frame_from_tuple(t, n) for t, n in self._dec.feed(data)) if fr is not None]
 
     def finish(self) -> List[Frame]:
         """End of stream: a last frame that lacks only its 0x00 is still delivered."""
-        return [fr for fr in (_frame_from_tuple(t) for t in self._dec.finish()) if fr is not None]
+        return [fr for fr in (_frame_from_tuple(t, n) for t, n in self._dec.finish()) if fr is not None]
 
     @property
     def counters(self) -> Dict[str, int]:

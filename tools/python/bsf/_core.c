@@ -573,7 +573,9 @@ static void Extractor_dealloc(ExtractorObject *self)
 
 static int Extractor_init(ExtractorObject *self, PyObject *args, PyObject *kwds)
 {
-    static char *kwlist[] = {"method", "params", "timing", NULL};
+    /* char arrays, not literals: the kwlist of the C API is char *[] */
+    static char kw_method[] = "method", kw_params[] = "params", kw_timing[] = "timing";
+    static char *kwlist[] = {kw_method, kw_params, kw_timing, NULL};
     PyObject *method = NULL, *params = NULL;
     int timing = 1;
     bsf_params_t p;
@@ -694,6 +696,7 @@ static PyTypeObject ExtractorType = {
 typedef struct {
     PyObject_HEAD bsf_decoder_t *dec;
     bsf_frame_t *frame;
+    size_t since_frame; /* bytes consumed since the last delivered frame */
 } DecoderObject;
 
 static void Decoder_dealloc(DecoderObject *self)
@@ -718,6 +721,7 @@ static int Decoder_init(DecoderObject *self, PyObject *args, PyObject *kwds)
         }
     }
     bsf_decoder_init(self->dec);
+    self->since_frame = 0;
     return 0;
 }
 
@@ -758,8 +762,13 @@ static PyObject *decoder_run(DecoderObject *self, const uint8_t *data, size_t le
             return raise_status((bsf_status_t)r, "decoder");
         }
         off += used;
+        self->since_frame += used;
         if (r == 1) {
-            PyObject *t = frame_to_tuple(self->frame);
+            /* (frame, its size on the wire counted like `bsf decode`: every
+             * byte since the previous frame, skipped ones included) */
+            PyObject *t =
+                Py_BuildValue("(Nn)", frame_to_tuple(self->frame), (Py_ssize_t)self->since_frame);
+            self->since_frame = 0;
             if (t == NULL || PyList_Append(out, t) != 0) {
                 Py_XDECREF(t);
                 Py_DECREF(out);
@@ -818,7 +827,7 @@ static PyObject *Decoder_get_counters(DecoderObject *self, void *closure)
 }
 
 static PyMethodDef Decoder_methods[] = {
-    {"feed", (PyCFunction)Decoder_feed, METH_O, "feed(bytes) -> list of frame tuples"},
+    {"feed", (PyCFunction)Decoder_feed, METH_O, "feed(bytes) -> list of (frame tuple, bytes)"},
     {"finish", (PyCFunction)Decoder_finish, METH_NOARGS,
      "end of stream: deliver a last frame that lacks only its delimiter"},
     {NULL, NULL, 0, NULL}};
@@ -861,7 +870,8 @@ static void Carmen_dealloc(CarmenObject *self)
 
 static int Carmen_init(CarmenObject *self, PyObject *args, PyObject *kwds)
 {
-    static char *kwlist[] = {"path", NULL};
+    static char kw_path[] = "path";
+    static char *kwlist[] = {kw_path, NULL};
     PyObject *path = NULL;
     const char *p;
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "O&", kwlist, PyUnicode_FSConverter, &path)) {
