@@ -2,7 +2,7 @@
 """Build of the bsf extension: the library's own C sources, compiled in place.
 
 The sources are read from the repository around this package (../../src,
-../../include, ../../port and ../carmen.c), never copied, so the package
+../../include, ../../port and ../carmen/carmen.c), never copied, so the package
 must be built from a checkout: ``pip install ./tools/python`` (pip >= 21.3
 builds in the source tree). An sdist of this directory alone cannot build
 and says so below.
@@ -52,7 +52,7 @@ def _sources():
     # Relative to this directory, as setup() requires.
     files = sorted(SRC.glob("*.c")) + [
         PORT / "host" / "bsf_port_clock_posix.c",
-        TOOLS / "carmen.c",
+        TOOLS / "carmen" / "carmen.c",
         HERE / "bsf" / "_core.c",
     ]
     return [os.path.relpath(p, HERE).replace(os.sep, "/") for p in files]
@@ -94,7 +94,7 @@ setup(
         Extension(
             "bsf._core",
             sources=_sources(),
-            include_dirs=[str(INCLUDE), str(SRC), str(PORT), str(TOOLS)],
+            include_dirs=[str(INCLUDE), str(PORT), str(TOOLS / "carmen")],
             define_macros=define_macros,
             libraries=libraries,
             extra_compile_args=extra_compile_args,
