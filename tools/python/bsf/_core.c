@@ -726,10 +726,15 @@ static int Decoder_init(DecoderObject *self, PyObject *args, PyObject *kwds)
 }
 
 /* ("features", version, type, seq, timestamp_ms, pose|None, quant_step,
- *  time_us, result). Other frame types get their own tag here. */
+ *  time_us, result). Other frame types get their own tag here (the
+ *  version-2 metadata frame: a "metadata" tuple of bsf_metadata_t). */
 static PyObject *frame_to_tuple(const bsf_frame_t *f)
 {
     PyObject *pose, *res;
+    if (f->type != BSF_FRAME_TYPE_FEATURES) {
+        /* a frame type this layer does not convert yet: tagged, skipped by Python */
+        return Py_BuildValue("(sii)", "other", (int)f->version, (int)f->type);
+    }
     if (f->has_pose) {
         pose = Py_BuildValue("(ddd)", (double)f->pose_x, (double)f->pose_y, (double)f->pose_theta);
     } else {

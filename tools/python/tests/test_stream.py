@@ -4,6 +4,7 @@ import io
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -69,7 +70,8 @@ def test_feed_byte_by_byte_equals_whole():
 
 
 def test_read_file_object_path_pipe_and_stdin(tmp_path):
-    data = b"".join(bsf.encode(f) for f in _frames(4))
+    encoded = [bsf.encode(f) for f in _frames(4)]
+    data = b"".join(encoded)
     p = tmp_path / "s.bsf"
     p.write_bytes(data)
     assert [f.seq for f in bsf.read(p)] == [0, 1, 2, 3]
@@ -77,12 +79,20 @@ def test_read_file_object_path_pipe_and_stdin(tmp_path):
     # a pipe: each frame must come out as soon as its bytes are in, before the writer is done
     r, w = os.pipe()
     src = os.fdopen(r, "rb", buffering=0)
+
+    def _stuck(*_):
+        raise TimeoutError("read() did not deliver a complete frame from the pipe")
+
+    old = signal.signal(signal.SIGALRM, _stuck)
+    signal.alarm(20)  # a regression fails here instead of hanging the suite
     it = bsf.read(src)
-    os.write(w, data[: len(bsf.encode(_frames(1)[0]))])
+    os.write(w, encoded[0])
     assert next(it).seq == 0  # would block forever if read() waited for a full buffer
-    os.write(w, data[len(bsf.encode(_frames(1)[0])) :])
+    os.write(w, b"".join(encoded[1:]))
     os.close(w)
     assert [f.seq for f in it] == [1, 2, 3]
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, old)
     src.close()
     code = "import bsf,sys; print([f.seq for f in bsf.read('-')])"
     out = subprocess.run([sys.executable, "-c", code], input=data, capture_output=True, check=True)
