@@ -654,7 +654,8 @@ static PyObject *Extractor_extract(ExtractorObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS st = bsf_extract(self->ex, &scan, self->res);
     Py_END_ALLOW_THREADS self->busy = 0;
     PyBuffer_Release(&ranges);
-    if (st != BSF_OK) {
+    /* BSF_OK_CUT is a result: what fits the caps, stats.cut says what was left out */
+    if (st < 0) {
         return raise_status(st, "extraction failed");
     }
     return result_to_tuple(self->res);

@@ -136,3 +136,13 @@ def test_bsf_error_is_a_value_error_with_status():
     with pytest.raises(bsf.BsfError) as e:
         bsf.encode(bsf.Frame(0, 0, (3e6, 0.0, 0.0), [], bsf.ScanStats()))  # beyond BSF_POSE_XY_MAX
     assert e.value.status == -1 and "BSF_ERR_ARG" in str(e.value)
+
+
+def test_a_scan_over_a_cap_keeps_what_fits():
+    # 1365 runs of 3 beams alternating between 2 m and 6 m: more segments than
+    # the host cap; the library returns BSF_OK_CUT, which is a result, not an error
+    r = np.where((np.arange(4096) // 3) % 2 == 0, 2.0, 6.0)
+    fr = bsf.extract(r, -np.pi, 2 * np.pi / 4096, 0.05, 30.0, sved_min_segment_points=3)
+    assert fr.stats.cut == 2 and fr.stats.n_cut_segments > 0  # BSF_CUT_SEGMENTS
+    assert len(fr.features) == bsf.caps["BSF_MAX_SEGMENTS"]
+    assert len(bsf.decode(bsf.encode(fr))[0].features) == len(fr.features)
