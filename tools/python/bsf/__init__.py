@@ -41,6 +41,9 @@ __all__ = [
     "Feature",
     "ScanStats",
     "Frame",
+    "Metadata",
+    "StreamWriter",
+    "HAS_METADATA",
     "Extractor",
     "Decoder",
     "CarmenScan",
@@ -62,6 +65,9 @@ caps: Dict[str, int] = dict(_core.caps)
 
 #: Extraction methods, as the C tool spells them.
 METHODS: Tuple[str, ...] = ("falko-sved-pdm", "bid-sved-pdm", "rpos-lsba")
+
+#: True when this build's wire format has the metadata frame (format version 2).
+HAS_METADATA: bool = hasattr(_core, "encode_metadata")
 
 #: Default quantisation step of control points on the wire, metres.
 QUANT_STEP_DEFAULT: float = float(_core.QUANT_STEP_DEFAULT)
@@ -183,6 +189,39 @@ class Feature:
         return _transform(pts, pose)
 
 
+@dataclass(frozen=True)
+class Metadata:
+    """A metadata frame (stream format version 2): what produced the stream.
+
+    Frames after it are interpreted with it: ``timestamp_ms`` counts from
+    ``time_origin_us`` (Unix time, microseconds), beams follow its geometry
+    unless a frame carries its own.
+    """
+
+    lib_version: Tuple[int, int, int]
+    method_id: int
+    target_rms: float
+    quant_step: float
+    caps: Dict[str, int]  #: points, keypoints, segments, ctrl_per_feature, ctrl_points
+    n_beams: int
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    time_origin_us: Optional[int] = None
+    source: Optional[str] = None
+    version: int = 2
+    bytes: int = 0
+
+    @property
+    def method(self) -> Optional[str]:
+        """The method's name, None for an id this version does not know."""
+        return METHODS[self.method_id] if 0 <= self.method_id < len(METHODS) else None
+
+    def _to_dict(self) -> Dict[str, Any]:
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("version", "bytes")}
+
+
 @dataclass(frozen=True, eq=False)
 class Frame:
     """One scan's features, as extracted or as decoded from a stream.
@@ -201,6 +240,17 @@ class Frame:
     version: int = 0  #: wire format version (0 for a fresh extraction)
     type: int = 1  #: frame type (1: features)
     bytes: int = 0  #: size on the wire (decoded frames; 0 otherwise)
+    #: (angle_min, angle_increment) when the frame carries its own scan geometry
+    geometry: Optional[Tuple[float, float]] = None
+    #: the stream's metadata in force for this frame (decoded streams of version 2)
+    metadata: Optional[Metadata] = None
+
+    @property
+    def unix_time_ms(self) -> Optional[float]:
+        """Absolute scan time (ms since 1970) when the stream's metadata gives a time origin."""
+        if self.metadata is None or self.metadata.time_origin_us is None:
+            return None
+        return self.metadata.time_origin_us / 1000.0 + self.timestamp_ms
 
     def sample(self, n: int = 32, world: bool = True) -> List[np.ndarray]:
         """Every feature sampled with :meth:`Feature.sample`; in the world frame
@@ -238,16 +288,20 @@ def _features_from(res: tuple, n_beams_hint: int = 0) -> Tuple[List[Feature], Sc
     return out, stats
 
 
-def _frame_from_tuple(t: tuple, nbytes: int = 0) -> Optional[Frame]:
-    """A decoder tuple to a Frame; None for a frame type this version skips.
+def _frame_from_tuple(t: tuple, nbytes: int = 0, meta: Optional[Metadata] = None) -> Union[Frame, Metadata, None]:
+    """A decoder tuple to a Frame or a Metadata; None for a frame type this version skips.
 
-    The tag in t[0] says the frame type: "features" today. A metadata frame
-    type (stream format version 2) gets its own tag and class here.
+    The tag in t[0] says the frame type ("features", "metadata", "other").
     """
+    if t[0] == "metadata":
+        d = dict(t[3])
+        d["lib_version"] = tuple(d["lib_version"])
+        return Metadata(**d, version=t[1], bytes=nbytes)
     if t[0] != "features":
         return None
-    _, version, ftype, seq, ts, pose, quant, time_us, res = t
-    feats, stats = _features_from(res)
+    _, version, ftype, seq, ts, pose, quant, time_us, res, geometry = t
+    hint = meta.n_beams if meta is not None else 0
+    feats, stats = _features_from(res, hint)
     return Frame(
         seq=seq,
         timestamp_ms=ts,
@@ -259,6 +313,8 @@ def _frame_from_tuple(t: tuple, nbytes: int = 0) -> Optional[Frame]:
         version=version,
         type=ftype,
         bytes=nbytes,
+        geometry=None if geometry is None else (float(geometry[0]), float(geometry[1])),
+        metadata=meta,
     )
 
 
@@ -399,7 +455,7 @@ def extract(
 
 
 def encode(
-    frame: Frame,
+    frame: Union[Frame, Metadata],
     quant_step: Optional[float] = None,
     *,
     no_time: bool = False,
@@ -411,7 +467,12 @@ def encode(
     ``quant_step`` defaults to the frame's own (a decoded frame) or
     :data:`QUANT_STEP_DEFAULT`. ``no_time`` sends 0 as extraction time
     (reproducible bytes); ``seq`` and ``timestamp_ms`` override the frame's.
+    A :class:`Metadata` is encoded as a metadata frame (format version 2).
     """
+    if isinstance(frame, Metadata):
+        if not HAS_METADATA:
+            raise BsfError("this build's stream format has no metadata frame")
+        return _core.encode_metadata(frame._to_dict())
     step = quant_step if quant_step is not None else (frame.quant_step or QUANT_STEP_DEFAULT)
     step = _finite("quant_step", step)
     pose = frame.pose
@@ -446,6 +507,7 @@ def encode(
         pose,
         step,
         (feats, ctrl_b, vert_b, stats),
+        frame.geometry,
     )
 
 
@@ -458,14 +520,25 @@ class Decoder:
 
     def __init__(self) -> None:
         self._dec = _core.Decoder()
+        self.metadata: Optional[Metadata] = None  #: the last metadata frame delivered
 
-    def feed(self, data: Union[bytes, bytearray, memoryview]) -> List[Frame]:
-        """Decode ``data``; returns the frames completed by it."""
-        return [fr for fr in (_frame_from_tuple(t, n) for t, n in self._dec.feed(data)) if fr is not None]
+    def _convert(self, items: list) -> List[Union[Frame, Metadata]]:
+        out: List[Union[Frame, Metadata]] = []
+        for t, n in items:
+            fr = _frame_from_tuple(t, n, self.metadata)
+            if isinstance(fr, Metadata):
+                self.metadata = fr
+            if fr is not None:
+                out.append(fr)
+        return out
 
-    def finish(self) -> List[Frame]:
+    def feed(self, data: Union[bytes, bytearray, memoryview]) -> List[Union[Frame, Metadata]]:
+        """Decode ``data``; returns the frames (and metadata frames) completed by it."""
+        return self._convert(self._dec.feed(data))
+
+    def finish(self) -> List[Union[Frame, Metadata]]:
         """End of stream: a last frame that lacks only its 0x00 is still delivered."""
-        return [fr for fr in (_frame_from_tuple(t, n) for t, n in self._dec.finish()) if fr is not None]
+        return self._convert(self._dec.finish())
 
     @property
     def counters(self) -> Dict[str, int]:
@@ -473,8 +546,9 @@ class Decoder:
         return dict(self._dec.counters)
 
 
-def decode(data: Union[bytes, bytearray, memoryview]) -> List[Frame]:
-    """All frames of a complete stream held in memory.
+def decode(data: Union[bytes, bytearray, memoryview]) -> List[Union[Frame, Metadata]]:
+    """All frames of a complete stream held in memory, metadata frames included
+    (``[f for f in decode(b) if isinstance(f, bsf.Frame)]`` keeps the scans).
 
     Raises BsfError when non-empty data holds no valid frame (garbage or the
     wrong file); damaged frames among good ones are dropped (see :class:`Decoder`).
@@ -542,7 +616,7 @@ def _chunks(f: Any, size: int) -> Iterator[bytes]:
         yield b
 
 
-def read(source: Source, *, baudrate: int = 115200, chunk_size: int = 65536) -> Iterator[Frame]:
+def read(source: Source, *, baudrate: int = 115200, chunk_size: int = 65536) -> Iterator[Union[Frame, Metadata]]:
     """Iterate over the frames of a stream as they arrive.
 
     ``source`` is a path (a file, a named pipe, a tty device), "-" for
@@ -552,7 +626,8 @@ def read(source: Source, *, baudrate: int = 115200, chunk_size: int = 65536) -> 
     extra (pyserial); ``baudrate`` is used when this function opens one.
 
     Frames are yielded as soon as their delimiter has been read (no block
-    buffering). Damaged frames are skipped. Raises BsfError at the end when
+    buffering), metadata frames (:class:`Metadata`, format version 2) in
+    stream order among them; each Frame's ``metadata`` is the one in force. Damaged frames are skipped. Raises BsfError at the end when
     the source held bytes but no valid frame.
     """
     f, close, name = _open_source(source, baudrate)
@@ -624,23 +699,16 @@ def _round_ms(seconds: float) -> int:
     return int(i) + (1 if x - i >= 0.5 else 0)
 
 
-def extract_log(
+def _log_frames(
     path: Union[str, "os.PathLike[str]"],
-    method: str = "falko-sved-pdm",
-    *,
-    first: int = 0,
-    count: Optional[int] = None,
-    range_max: Optional[float] = None,
-    timing: bool = True,
-    errors: Optional[List[str]] = None,
-    **params: Union[int, float],
-) -> Iterator[Frame]:
-    """The frames ``bsf extract LOG`` writes, extracted here: sequence number =
-    scan index, time in ms since the first extracted scan, the laser pose.
-
-    A scan the library refuses is skipped (its message is appended to
-    ``errors`` when given, else raised).
-    """
+    method: str,
+    first: int,
+    count: Optional[int],
+    range_max: Optional[float],
+    timing: bool,
+    errors: Optional[List[str]],
+    params: Dict[str, Union[int, float]],
+) -> Iterator[Tuple[CarmenScan, float, Frame]]:
     ex = Extractor(method, timing=timing, **params)
     t0: Optional[float] = None
     done = 0
@@ -660,10 +728,129 @@ def extract_log(
         if t0 is None:
             t0 = s.timestamp
         ts = _round_ms(s.timestamp - t0) if s.timestamp > t0 else 0
-        theta = float(np.float32(math.remainder(s.laser_pose[2], 2.0 * math.pi)))
-        pose = (float(np.float32(s.laser_pose[0])), float(np.float32(s.laser_pose[1])), theta)
+        pose = (s.laser_pose[0], s.laser_pose[1], math.remainder(s.laser_pose[2], 2.0 * math.pi))
         done += 1
-        yield replace(fr, seq=index, timestamp_ms=ts, pose=pose)
+        yield s, rmax, replace(fr, seq=index, timestamp_ms=ts, pose=pose)
+
+
+def extract_log(
+    path: Union[str, "os.PathLike[str]"],
+    method: str = "falko-sved-pdm",
+    *,
+    first: int = 0,
+    count: Optional[int] = None,
+    range_max: Optional[float] = None,
+    timing: bool = True,
+    errors: Optional[List[str]] = None,
+    **params: Union[int, float],
+) -> Iterator[Frame]:
+    """The scan frames ``bsf extract LOG`` writes, extracted here: sequence
+    number = scan index, time in ms since the first extracted scan, the laser
+    pose. (``python -m bsf extract LOG`` also writes the metadata frames.)
+
+    A scan the library refuses is skipped (its message is appended to
+    ``errors`` when given, else raised).
+    """
+    for _, _, fr in _log_frames(path, method, first, count, range_max, timing, errors, params):
+        yield fr
+
+
+class StreamWriter:
+    """Writes frames to a binary stream as ``bsf extract`` does.
+
+    With format version 2 (:data:`HAS_METADATA`): a metadata frame first (this
+    build's caps, the method, target RMS, step, the scan geometry, the time
+    origin, the source name), again when the range limits change, when time
+    goes back before the origin, and every ``meta_every`` frames; a scan whose
+    beams differ from the metadata carries its own geometry; frame times are
+    ms since the origin. With version 1: frames only, times in ms since
+    ``v1_time_origin_us`` (0: Unix time; None: the frame's own timestamp_ms).
+    """
+
+    def __init__(
+        self,
+        out: IO[bytes],
+        method: str = "falko-sved-pdm",
+        params: Optional[Dict[str, Union[int, float]]] = None,
+        quant_step: float = QUANT_STEP_DEFAULT,
+        source: Optional[str] = None,
+        meta_every: int = 64,
+        v1_time_origin_us: Optional[int] = None,
+    ):
+        self.out = out
+        self._first_us: Optional[int] = v1_time_origin_us
+        self.quant_step = quant_step
+        self.meta_every = int(meta_every)
+        self.frames = self.metadata_frames = self.bytes = 0
+        self._since = 0
+        self._meta: Optional[Metadata] = None
+        full = dict(_core.default_params(method))
+        full.update(params or {})
+        self._method_id = METHODS.index(method)
+        self._target = float(np.float32(full["pdm_target_rms"])) if method != "rpos-lsba" else 0.0
+        if source is not None:
+            raw = source.encode("utf-8")[:64]
+            source = raw.decode("utf-8", "ignore") or None
+        self._source = source
+
+    def _emit(self, data: bytes) -> None:
+        self.out.write(data)
+        self.bytes += len(data)
+
+    def write(
+        self,
+        frame: Frame,
+        time_us: int,
+        n_beams: int,
+        angle_min: float,
+        angle_increment: float,
+        range_min: float,
+        range_max: float,
+        no_time: bool = False,
+    ) -> None:
+        """Write one scan's frame; ``time_us`` is its absolute time (Unix µs)."""
+        f32 = lambda v: float(np.float32(v))  # noqa: E731
+        if not HAS_METADATA:
+            # the frame's own time, or ms since the given origin
+            ts = frame.timestamp_ms if self._first_us is None else max(0, (time_us - self._first_us + 500) // 1000)
+            self._emit(encode(frame, self.quant_step, no_time=no_time, timestamp_ms=ts))
+            self.frames += 1
+            return
+        m = self._meta
+        ranges = (f32(range_min), f32(range_max))
+        if m is None or (m.range_min, m.range_max) != ranges or time_us < (m.time_origin_us or 0) or self._since >= self.meta_every:
+            origin = time_us if m is None or time_us < (m.time_origin_us or 0) else m.time_origin_us
+            d = dict(_core.default_metadata())
+            d.update(
+                method_id=self._method_id,
+                target_rms=self._target,
+                quant_step=f32(self.quant_step),
+                n_beams=int(n_beams),
+                angle_min=f32(angle_min),
+                angle_increment=f32(angle_increment),
+                range_min=ranges[0],
+                range_max=ranges[1],
+                time_origin_us=origin,
+                source=self._source,
+            )
+            d["lib_version"] = tuple(d["lib_version"])
+            m = self._meta = Metadata(**d)
+            self._emit(encode(m))
+            self.metadata_frames += 1
+            self._since = 0
+        same = m.n_beams == n_beams and m.angle_min == f32(angle_min) and m.angle_increment == f32(angle_increment)
+        geometry = None if same else (f32(angle_min), f32(angle_increment))
+        ts = (time_us - (m.time_origin_us or 0) + 500) // 1000
+        self._emit(encode(replace(frame, geometry=geometry), self.quant_step, no_time=no_time, timestamp_ms=ts))
+        self.frames += 1
+        self._since += 1
+
+
+def _round_us(seconds: float) -> int:
+    """llround(seconds * 1e6) for seconds >= 0."""
+    x = seconds * 1e6
+    i = math.floor(x)
+    return int(i) + (1 if x - i >= 0.5 else 0)
 
 
 def plot(frames: Union[Frame, Iterable[Frame]], ax: Any = None, **kwargs: Any) -> Any:

@@ -7,7 +7,7 @@ import os
 import sys
 from typing import List, Optional
 
-from . import METHODS, QUANT_STEP_DEFAULT, BsfError, encode, extract_log, read
+from . import METHODS, QUANT_STEP_DEFAULT, BsfError, read
 
 BAG_SUFFIXES = (".bag", ".db3", ".mcap")
 
@@ -68,21 +68,22 @@ def cmd_extract(a: argparse.Namespace) -> int:
     except OSError as e:
         print(f"bsf: {e}", file=sys.stderr)
         return 1
+    from . import StreamWriter, _log_frames, _round_us
+
+    writer = StreamWriter(dst, a.method, params, a.quant, source=os.path.basename(a.input))
     try:
-        for fr in extract_log(
-            a.input,
-            a.method,
-            first=a.first,
-            count=a.count,
-            range_max=a.range_max,
-            timing=not a.no_time,
-            errors=errors,
-            **params,
-        ):
-            data = encode(fr, a.quant)
-            dst.write(data)
-            n += 1
-            nbytes += len(data)
+        for scan, rmax, fr in _log_frames(a.input, a.method, a.first, a.count, a.range_max, not a.no_time, errors, params):
+            writer.write(
+                fr,
+                _round_us(scan.timestamp),
+                len(scan.ranges),
+                scan.angle_min,
+                scan.angle_increment,
+                0.0,
+                rmax,
+                no_time=a.no_time,
+            )
+        n, nbytes = writer.frames, writer.bytes
     except (BsfError, TypeError, OSError) as e:
         print(f"bsf: {e}", file=sys.stderr)
         return 1

@@ -30,6 +30,7 @@ static const char *status_name(bsf_status_t st)
 {
     switch (st) {
     case BSF_OK: return "BSF_OK";
+    case BSF_OK_CUT: return "BSF_OK_CUT";
     case BSF_ERR_ARG: return "BSF_ERR_ARG";
     case BSF_ERR_CAPACITY: return "BSF_ERR_CAPACITY";
     case BSF_ERR_PARAM: return "BSF_ERR_PARAM";
@@ -726,15 +727,67 @@ static int Decoder_init(DecoderObject *self, PyObject *args, PyObject *kwds)
     return 0;
 }
 
+#ifdef BSF_FRAME_TYPE_METADATA
+/* bsf_metadata_t as a dict (format version 2). */
+static PyObject *metadata_to_dict(const bsf_metadata_t *m)
+{
+    PyObject *origin, *source;
+    if (m->has_time_origin) {
+        origin = PyLong_FromLongLong((long long)m->time_origin_us);
+    } else {
+        origin = Py_None;
+        Py_INCREF(origin);
+    }
+    if (m->source_len > 0u) {
+        source = PyUnicode_DecodeUTF8(m->source, (Py_ssize_t)m->source_len, "replace");
+    } else {
+        source = Py_None;
+        Py_INCREF(source);
+    }
+    if (origin == NULL || source == NULL) {
+        Py_XDECREF(origin);
+        Py_XDECREF(source);
+        return NULL;
+    }
+    return Py_BuildValue(
+        "{s(iii)sisdsds{sksksksksk}skdsdsdsdsNsN}", "lib_version", (int)m->lib_version_major,
+        (int)m->lib_version_minor, (int)m->lib_version_patch, "method_id", (int)m->method,
+        "target_rms", (double)m->target_rms, "quant_step", (double)m->quant_step, "caps", "points",
+        (unsigned long)m->max_points, "keypoints", (unsigned long)m->max_keypoints, "segments",
+        (unsigned long)m->max_segments, "ctrl_per_feature", (unsigned long)m->max_ctrl_per_feature,
+        "ctrl_points", (unsigned long)m->max_ctrl_points, "n_beams", (unsigned long)m->n_beams,
+        "angle_min", (double)m->angle_min, "angle_increment", (double)m->angle_increment,
+        "range_min", (double)m->range_min, "range_max", (double)m->range_max, "time_origin_us",
+        origin, "source", source);
+}
+#endif
+
 /* ("features", version, type, seq, timestamp_ms, pose|None, quant_step,
- *  time_us, result). Other frame types get their own tag here (the
- *  version-2 metadata frame: a "metadata" tuple of bsf_metadata_t). */
+ *  time_us, result, geometry|None), ("metadata", version, type, dict) or
+ *  ("other", version, type) for a type this layer does not convert. */
 static PyObject *frame_to_tuple(const bsf_frame_t *f)
 {
-    PyObject *pose, *res;
+    PyObject *pose, *res, *geometry;
+#ifdef BSF_FRAME_TYPE_METADATA
+    if (f->type == BSF_FRAME_TYPE_METADATA) {
+        return Py_BuildValue("(siiN)", "metadata", (int)f->version, (int)f->type,
+                             metadata_to_dict(&f->metadata));
+    }
+#endif
     if (f->type != BSF_FRAME_TYPE_FEATURES) {
-        /* a frame type this layer does not convert yet: tagged, skipped by Python */
         return Py_BuildValue("(sii)", "other", (int)f->version, (int)f->type);
+    }
+#ifdef BSF_FRAME_TYPE_METADATA
+    if (f->has_geometry) {
+        geometry = Py_BuildValue("(dd)", (double)f->angle_min, (double)f->angle_increment);
+        if (geometry == NULL) {
+            return NULL;
+        }
+    } else
+#endif
+    {
+        geometry = Py_None;
+        Py_INCREF(geometry);
     }
     if (f->has_pose) {
         pose = Py_BuildValue("(ddd)", (double)f->pose_x, (double)f->pose_y, (double)f->pose_theta);
@@ -746,11 +799,12 @@ static PyObject *frame_to_tuple(const bsf_frame_t *f)
     if (pose == NULL || res == NULL) {
         Py_XDECREF(pose);
         Py_XDECREF(res);
+        Py_DECREF(geometry);
         return NULL;
     }
-    return Py_BuildValue("(siikKNdkN)", "features", (int)f->version, (int)f->type,
+    return Py_BuildValue("(siikKNdkNN)", "features", (int)f->version, (int)f->type,
                          (unsigned long)f->seq, (unsigned long long)f->timestamp_ms, pose,
-                         (double)f->quant_step, (unsigned long)f->time_us, res);
+                         (double)f->quant_step, (unsigned long)f->time_us, res, geometry);
 }
 
 static PyObject *decoder_run(DecoderObject *self, const uint8_t *data, size_t len)
@@ -825,11 +879,26 @@ static PyObject *Decoder_get_counters(DecoderObject *self, void *closure)
         return NULL;
     }
     s = &self->dec->stats;
-    return Py_BuildValue(
-        "{sksksksksksksk}", "frames_ok", (unsigned long)s->frames_ok, "bad_crc",
-        (unsigned long)s->bad_crc, "malformed", (unsigned long)s->malformed, "unsupported_version",
-        (unsigned long)s->unsupported_version, "unknown_type", (unsigned long)s->unknown_type,
-        "oversize", (unsigned long)s->oversize, "bytes_skipped", (unsigned long)s->bytes_skipped);
+    {
+        PyObject *d = Py_BuildValue(
+            "{sksksksksksksk}", "frames_ok", (unsigned long)s->frames_ok, "bad_crc",
+            (unsigned long)s->bad_crc, "malformed", (unsigned long)s->malformed,
+            "unsupported_version", (unsigned long)s->unsupported_version, "unknown_type",
+            (unsigned long)s->unknown_type, "oversize", (unsigned long)s->oversize, "bytes_skipped",
+            (unsigned long)s->bytes_skipped);
+#ifdef BSF_FRAME_TYPE_METADATA
+        if (d != NULL) {
+            PyObject *v = PyLong_FromUnsignedLong((unsigned long)s->metadata);
+            if (v == NULL || PyDict_SetItemString(d, "metadata", v) != 0) {
+                Py_XDECREF(v);
+                Py_DECREF(d);
+                return NULL;
+            }
+            Py_DECREF(v);
+        }
+#endif
+        return d;
+    }
 }
 
 static PyMethodDef Decoder_methods[] = {
@@ -977,7 +1046,8 @@ static PyObject *core_encode(PyObject *mod, PyObject *args)
     bsf_status_t st;
     size_t len = 0;
     (void)mod;
-    if (!PyArg_ParseTuple(args, "kKOdO", &seq, &ts, &pose, &quant, &res_tup)) {
+    PyObject *geometry = Py_None;
+    if (!PyArg_ParseTuple(args, "kKOdO|O", &seq, &ts, &pose, &quant, &res_tup, &geometry)) {
         return NULL;
     }
     if (seq > 0xFFFFFFFFul) {
@@ -997,6 +1067,20 @@ static PyObject *core_encode(PyObject *mod, PyObject *args)
         info.pose_x = (float)x;
         info.pose_y = (float)y;
         info.pose_theta = (float)th;
+    }
+    if (geometry != Py_None) {
+#ifdef BSF_FRAME_TYPE_METADATA
+        double amin, ainc;
+        if (!PyArg_ParseTuple(geometry, "dd", &amin, &ainc)) {
+            return NULL;
+        }
+        info.has_geometry = 1u;
+        info.angle_min = (float)amin;
+        info.angle_increment = (float)ainc;
+#else
+        PyErr_SetString(g_bsf_error, "this stream format version cannot carry a frame's geometry");
+        return NULL;
+#endif
     }
     res = (bsf_result_t *)PyMem_RawMalloc(sizeof *res);
     if (res == NULL) {
@@ -1024,6 +1108,140 @@ static PyObject *core_encode(PyObject *mod, PyObject *args)
     }
     return out;
 }
+
+#ifdef BSF_FRAME_TYPE_METADATA
+static int dict_double(PyObject *d, const char *key, double *out)
+{
+    PyObject *v = PyDict_GetItemString(d, key); /* borrowed */
+    if (v == NULL) {
+        PyErr_Format(PyExc_KeyError, "metadata needs %s", key);
+        return -1;
+    }
+    *out = PyFloat_AsDouble(v);
+    return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+static int dict_ulong(PyObject *d, const char *key, unsigned long hi, unsigned long *out)
+{
+    PyObject *v = PyDict_GetItemString(d, key); /* borrowed */
+    if (v == NULL) {
+        PyErr_Format(PyExc_KeyError, "metadata needs %s", key);
+        return -1;
+    }
+    *out = PyLong_AsUnsignedLong(v);
+    if (*out == (unsigned long)-1 && PyErr_Occurred()) {
+        return -1;
+    }
+    if (*out > hi) {
+        PyErr_Format(g_bsf_error, "metadata %s = %lu is above %lu", key, *out, hi);
+        return -1;
+    }
+    return 0;
+}
+
+/* encode_metadata(dict) -> bytes, the dict of metadata_to_dict (lib_version
+ * is always this library's). */
+static PyObject *core_encode_metadata(PyObject *mod, PyObject *arg)
+{
+    bsf_metadata_t m;
+    PyObject *caps, *origin, *source, *out;
+    double target, step, amin, ainc, rmin, rmax;
+    unsigned long method, n_beams, cp, ck, cs, cf, cc;
+    size_t len = 0;
+    bsf_status_t st;
+    (void)mod;
+    if (!PyDict_Check(arg)) {
+        PyErr_SetString(PyExc_TypeError, "metadata must be a dict");
+        return NULL;
+    }
+    bsf_metadata_init(&m);
+    caps = PyDict_GetItemString(arg, "caps");
+    if (caps == NULL || !PyDict_Check(caps)) {
+        PyErr_SetString(PyExc_KeyError, "metadata needs caps (a dict)");
+        return NULL;
+    }
+    if (dict_ulong(arg, "method_id", 255ul, &method) || dict_double(arg, "target_rms", &target) ||
+        dict_double(arg, "quant_step", &step) || dict_ulong(arg, "n_beams", 65535ul, &n_beams) ||
+        dict_double(arg, "angle_min", &amin) || dict_double(arg, "angle_increment", &ainc) ||
+        dict_double(arg, "range_min", &rmin) || dict_double(arg, "range_max", &rmax) ||
+        dict_ulong(caps, "points", 65535ul, &cp) || dict_ulong(caps, "keypoints", 65535ul, &ck) ||
+        dict_ulong(caps, "segments", 65535ul, &cs) ||
+        dict_ulong(caps, "ctrl_per_feature", 65535ul, &cf) ||
+        dict_ulong(caps, "ctrl_points", 65535ul, &cc)) {
+        return NULL;
+    }
+    m.method = (uint8_t)method;
+    m.target_rms = (float)target;
+    m.quant_step = (float)step;
+    m.n_beams = (uint32_t)n_beams;
+    m.angle_min = (float)amin;
+    m.angle_increment = (float)ainc;
+    m.range_min = (float)rmin;
+    m.range_max = (float)rmax;
+    m.max_points = (uint32_t)cp;
+    m.max_keypoints = (uint32_t)ck;
+    m.max_segments = (uint32_t)cs;
+    m.max_ctrl_per_feature = (uint32_t)cf;
+    m.max_ctrl_points = (uint32_t)cc;
+    origin = PyDict_GetItemString(arg, "time_origin_us");
+    if (origin != NULL && origin != Py_None) {
+        int overflow = 0;
+        const long long v = PyLong_AsLongLongAndOverflow(origin, &overflow);
+        if (v == -1 && PyErr_Occurred()) {
+            return NULL;
+        }
+        if (overflow != 0) {
+            PyErr_SetString(g_bsf_error, "metadata time_origin_us does not fit in 64 bits");
+            return NULL;
+        }
+        m.has_time_origin = 1u;
+        m.time_origin_us = (int64_t)v;
+    }
+    source = PyDict_GetItemString(arg, "source");
+    if (source != NULL && source != Py_None) {
+        Py_ssize_t n = 0;
+        const char *u = PyUnicode_Check(source) ? PyUnicode_AsUTF8AndSize(source, &n) : NULL;
+        if (u == NULL) {
+            if (!PyErr_Occurred()) {
+                PyErr_SetString(PyExc_TypeError, "metadata source must be a str");
+            }
+            return NULL;
+        }
+        if (n > (Py_ssize_t)BSF_METADATA_SOURCE_MAX) {
+            PyErr_Format(g_bsf_error, "metadata source is %zd bytes of UTF-8, at most %d", n,
+                         (int)BSF_METADATA_SOURCE_MAX);
+            return NULL;
+        }
+        memcpy(m.source, u, (size_t)n);
+        m.source[n] = '\0';
+        m.source_len = (uint8_t)n;
+    }
+    st = bsf_metadata_encode(&m, NULL, 0, &len);
+    if (st != BSF_OK) {
+        return raise_status(st, "cannot encode the metadata frame");
+    }
+    out = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)len);
+    if (out == NULL) {
+        return NULL;
+    }
+    st = bsf_metadata_encode(&m, (uint8_t *)PyBytes_AS_STRING(out), len, &len);
+    if (st != BSF_OK) {
+        Py_DECREF(out);
+        return raise_status(st, "cannot encode the metadata frame");
+    }
+    return out;
+}
+
+/* bsf_metadata_init() of this build as a dict. */
+static PyObject *core_default_metadata(PyObject *mod, PyObject *unused)
+{
+    bsf_metadata_t m;
+    (void)mod;
+    (void)unused;
+    bsf_metadata_init(&m);
+    return metadata_to_dict(&m);
+}
+#endif
 
 static PyObject *core_bspline_eval(PyObject *mod, PyObject *args)
 {
@@ -1088,6 +1306,11 @@ static PyMethodDef core_methods[] = {
      "bspline_eval(ctrl float32 pairs, t float32) -> float32 pairs"},
     {"default_params", core_default_params, METH_VARARGS,
      "default_params(method) -> dict of every parameter"},
+#ifdef BSF_FRAME_TYPE_METADATA
+    {"encode_metadata", core_encode_metadata, METH_O, "encode_metadata(dict) -> frame bytes"},
+    {"default_metadata", core_default_metadata, METH_NOARGS,
+     "bsf_metadata_init() of this build as a dict"},
+#endif
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef core_module = {PyModuleDef_HEAD_INIT,

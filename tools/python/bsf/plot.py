@@ -41,6 +41,8 @@ def plot(
     verts: List[np.ndarray] = []
     poses: List[tuple] = []
     for fr in frames:
+        if not isinstance(fr, Frame):  # metadata frames draw nothing
+            continue
         curves.extend(fr.sample(samples, world=world))
         if vertices:
             verts.append(fr.vertices(world=world))

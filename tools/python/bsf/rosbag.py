@@ -6,8 +6,10 @@ or a ROS 2 bag (its directory, or the ``.db3`` / ``.mcap`` file inside it)
 with the pure-Python ``rosbags`` package, so no ROS installation is needed.
 Each message's own geometry (angle_min, angle_increment) and range limits
 (range_min, range_max) are used, and its header stamp becomes the frame time
-(milliseconds since the Unix epoch, rounded to the nearest ms). LaserScan
-carries no pose, so frames have none.
+(with format version 2: ms since the stream's time origin, the first
+stamp, which the metadata frame carries in µs since the Unix epoch; with
+version 1: ms since the Unix epoch). LaserScan carries no pose, so frames
+have none.
 """
 from __future__ import annotations
 
@@ -158,12 +160,22 @@ def extract_bag(
     """
     import sys
 
-    from . import Extractor, encode
+    from . import QUANT_STEP_DEFAULT, Extractor
+
+    from . import StreamWriter
 
     log = log or sys.stderr
     ex = Extractor(method, timing=timing, **params)
-    written = failed = nbytes = 0
+    written = failed = 0
     dst = sys.stdout.buffer if out == "-" else open(out, "wb")
+    writer = StreamWriter(
+        dst,
+        method,
+        params,
+        quant_step if quant_step is not None else QUANT_STEP_DEFAULT,
+        source=Path(path).name,
+        v1_time_origin_us=0,
+    )
     try:
         for s in scans(path, topic):
             where = f"{path}: {topic} message {s.index}"
@@ -173,26 +185,26 @@ def extract_bag(
                 continue
             rmax = min(s.range_max, range_max) if range_max else s.range_max
             try:
-                fr = ex.extract(
-                    s.ranges,
+                fr = ex.extract(s.ranges, s.angle_min, s.angle_increment, s.range_min, rmax, seq=s.index)
+                writer.write(
+                    fr,
+                    (s.stamp_ns + 500) // 1000,
+                    len(s.ranges),
                     s.angle_min,
                     s.angle_increment,
                     s.range_min,
                     rmax,
-                    seq=s.index,
-                    timestamp_ms=stamp_ms(s.stamp_ns),
+                    no_time=not timing,
                 )
-                data = encode(fr, quant_step)
             except BsfError as e:
                 print(f"{where} skipped: {e}", file=log)
                 failed += 1
                 continue
-            dst.write(data)
             written += 1
-            nbytes += len(data)
     finally:
         if dst is not sys.stdout.buffer:
             dst.close()
         else:
             dst.flush()
+    nbytes = writer.bytes
     return written, failed, nbytes
