@@ -750,7 +750,7 @@ static PyObject *metadata_to_dict(const bsf_metadata_t *m)
         return NULL;
     }
     return Py_BuildValue(
-        "{s(iii)sisdsds{sksksksksk}skdsdsdsdsNsN}", "lib_version", (int)m->lib_version_major,
+        "{s(iii)sisdsds{sksksksksk}sksdsdsdsdsNsN}", "lib_version", (int)m->lib_version_major,
         (int)m->lib_version_minor, (int)m->lib_version_patch, "method_id", (int)m->method,
         "target_rms", (double)m->target_rms, "quant_step", (double)m->quant_step, "caps", "points",
         (unsigned long)m->max_points, "keypoints", (unsigned long)m->max_keypoints, "segments",
@@ -823,7 +823,7 @@ static PyObject *decoder_run(DecoderObject *self, const uint8_t *data, size_t le
         }
         off += used;
         self->since_frame += used;
-        if (r == 1) {
+        if (r > 0) { /* a frame delivered (the return value is its type from format 2 on) */
             /* (frame, its size on the wire counted like `bsf decode`: every
              * byte since the previous frame, skipped ones included) */
             PyObject *t =

@@ -41,6 +41,26 @@ def intel_log():
     return d / "intel.log.gz"
 
 
+def scan_frames(items):
+    """The scan frames of a decoded stream (metadata frames left out)."""
+    import bsf
+
+    return [f for f in items if isinstance(f, bsf.Frame)]
+
+
+def canonical(frames):
+    """Scan frames as bytes without what depends on the stream around them or
+    on the source: time, extraction time, pose, own geometry, metadata."""
+    import dataclasses
+
+    import bsf
+
+    return [
+        bsf.encode(dataclasses.replace(f, pose=None, geometry=None, metadata=None), no_time=True, timestamp_ms=0)
+        for f in scan_frames(frames)
+    ]
+
+
 def run_tool(tool, *args, **kw):
     return subprocess.run([str(tool), *map(str, args)], check=True, capture_output=True, **kw)
 

@@ -14,7 +14,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer as Writer2  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
 import bsf  # noqa: E402
-from conftest import run_tool, synthetic_scan, write_robotlaser_log  # noqa: E402
+from conftest import canonical, run_tool, scan_frames, synthetic_scan, write_robotlaser_log  # noqa: E402
 
 SCAN = "sensor_msgs/msg/LaserScan"
 T0_NS = 1_700_000_000_123_456_789  # header stamps: Nov 2023, sub-ms part to round
@@ -63,14 +63,25 @@ def write_bag(path, kind, scans, topic="/scan", msgtype=SCAN, raw=None):
     return path
 
 
+def _unix_ms(frame):
+    """A frame's absolute time, ms: through the metadata's origin (format 2) or as sent."""
+    if frame.metadata is not None:
+        return round(frame.unix_time_ms)
+    return frame.timestamp_ms
+
+
+def _assert_times(frames, scans):
+    """Each frame's time is its message's header stamp (within the 1 ms the
+    origin's sub-millisecond part can add when times are relative to it)."""
+    want = [(s[5] + 500_000) // 1_000_000 for s in scans]
+    got = [_unix_ms(f) for f in frames]
+    assert len(got) == len(want)
+    slack = 1 if frames and frames[0].metadata is not None else 0
+    assert all(abs(g - w) <= slack for g, w in zip(got, want)), (got[:5], want[:5])
+
+
 def run_py(*args):
     return subprocess.run([sys.executable, "-m", "bsf", *map(str, args)], capture_output=True, text=True)
-
-
-def canonical(frames):
-    """Frame bytes without what differs by source: pose (a bag has none), time
-    and extraction time; sequence numbers kept."""
-    return [bsf.encode(bsf.Frame(f.seq, 0, None, f.features, f.stats, f.quant_step, 0, 1), no_time=True) for f in frames]
 
 
 def synthetic_bag_scans():
@@ -91,9 +102,9 @@ def test_bag_frames_equal_cli_frames(kind, bsf_tool, tmp_path):
     r = run_py("extract", bag, "--topic", "/scan", "-o", out)
     assert r.returncode == 0, r.stderr
     assert "5 scans of /scan" in r.stderr
-    got = bsf.decode(out.read_bytes())
-    # frame time = header stamp, ms since the epoch (rounded); no pose
-    assert [f.timestamp_ms for f in got] == [(s[5] + 500_000) // 1_000_000 for s in scans]
+    got = scan_frames(bsf.decode(out.read_bytes()))
+    # frame time = header stamp (ms since the epoch, or since the metadata's origin); no pose
+    _assert_times(got, scans)
     assert all(f.pose is None for f in got) and [f.seq for f in got] == list(range(5))
     log = tmp_path / "same.log"
     write_robotlaser_log(log, [s[:3] for s in scans], max_range=30.0)
@@ -110,7 +121,7 @@ def test_message_geometry_and_range_limits_are_honoured(tmp_path):
     bag = write_bag(tmp_path / "g.bag", "bag", [(ranges, amin, inc, 0.0, 30.0, T0_NS), near, mirrored, raised_min])
     out = tmp_path / "g.bsf"
     assert run_py("extract", bag, "--topic", "/scan", "-o", out).returncode == 0
-    full, cut, mirror, high = bsf.decode(out.read_bytes())
+    full, cut, mirror, high = scan_frames(bsf.decode(out.read_bytes()))
     valid = np.isfinite(ranges) & (ranges > 0)
     assert full.stats.n_valid == int(np.sum(valid & (ranges < 30.0)))
     assert cut.stats.n_valid == int(np.sum(valid & (ranges < 2.0))) < full.stats.n_valid
@@ -137,9 +148,9 @@ def test_intel_slice_in_a_bag_equals_cli(bsf_tool, intel_log, tmp_path):
     assert r.returncode == 0, r.stderr
     cli = tmp_path / "cli.bsf"
     run_tool(bsf_tool, "extract", intel_log, "--count", 60, "-o", cli)
-    got = bsf.decode(out.read_bytes())
+    got = scan_frames(bsf.decode(out.read_bytes()))
     assert len(got) == 60
-    assert [f.timestamp_ms for f in got] == [(s[5] + 500_000) // 1_000_000 for s in scans]
+    _assert_times(got, scans)
     assert canonical(got) == canonical(bsf.decode(cli.read_bytes()))
 
 
@@ -174,7 +185,7 @@ def test_bad_bags_and_messages(tmp_path):
         out = tmp_path / (kind + ".bsf")
         r = run_py("extract", path, "--topic", "/scan", "-o", out)
         _assert_clean_failure(r, "message 1 skipped: angle_increment is 0", "message 2 skipped: range_max is not finite", "message 4 skipped: cannot decode")
-        assert [f.seq for f in bsf.decode(out.read_bytes())] == [0, 3]
+        assert [f.seq for f in scan_frames(bsf.decode(out.read_bytes()))] == [0, 3]
     # more beams than this build's cap
     big = [(np.ones(bsf.caps["BSF_MAX_POINTS"] + 1, np.float32), 0.0, 0.001, 0.0, 30.0, T0_NS)]
     r = run_py("extract", write_bag(tmp_path / "big.bag", "bag", big), "--topic", "/scan", "-o", tmp_path / "o")

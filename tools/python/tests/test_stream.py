@@ -126,7 +126,39 @@ def test_read_serial_port_loopback():
 def _json_of(frame):
     """The object `bsf decode --json` prints for one frame, from the Python frame."""
     f32 = lambda v: float(np.float32(v))  # noqa: E731
+    if isinstance(frame, bsf.Metadata):
+        return {
+            "metadata": {
+                "bytes": frame.bytes,
+                "version": frame.version,
+                "library": "%d.%d.%d" % frame.lib_version,
+                "method": frame.method,
+                "method_id": frame.method_id,
+                "target_rms": f32(frame.target_rms),
+                "quant_step": f32(frame.quant_step),
+                "caps": dict(frame.caps),
+                "n_beams": frame.n_beams,
+                "angle_min": f32(frame.angle_min),
+                "angle_increment": f32(frame.angle_increment),
+                "range_min": f32(frame.range_min),
+                "range_max": f32(frame.range_max),
+                "time_origin_us": frame.time_origin_us,
+                "source": frame.source,
+            }
+        }
+    v2 = {}
+    if bsf.HAS_METADATA:  # the tool of a version-2 build prints these for every frame
+        s = frame.stats
+        v2 = {
+            "n_beams": s.n_beams or None,
+            "geometry": None if frame.geometry is None else {"angle_min": f32(frame.geometry[0]), "angle_increment": f32(frame.geometry[1])},
+            "cut": s.cut,
+            "n_cut_keypoints": s.n_cut_keypoints,
+            "n_cut_segments": s.n_cut_segments,
+            "n_cut_points": s.n_cut_points,
+        }
     return {
+        **v2,
         "seq": frame.seq,
         "timestamp_ms": frame.timestamp_ms,
         "bytes": frame.bytes,
