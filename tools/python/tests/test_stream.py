@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
 """encode / decode / read, against the C tool's own decoder."""
+import dataclasses
 import io
 import json
 import math
@@ -215,3 +216,31 @@ def test_decode_intel_matches_bsf_decode_json(bsf_tool, intel_log, tmp_path):
     p = tmp_path / "intel.bsf"
     run_tool(bsf_tool, "extract", intel_log, "-o", p)
     assert _check_decode_matches_tool(bsf_tool, p) > 1000
+
+
+def test_metadata_frames_in_stream_order(tmp_path):
+    if not bsf.HAS_METADATA:
+        pytest.skip("this build's stream format (version 1) has no metadata frame")
+    out = io.BytesIO()
+    w = bsf.StreamWriter(out, "falko-sved-pdm", {"pdm_target_rms": 0.02}, 0.002, source="rüm.log", meta_every=2)
+    scans = [synthetic_scan(n=361, seed=i) for i in range(3)] + [synthetic_scan(n=401, seed=3)]
+    for i, (r, a, inc) in enumerate(scans):
+        fr = bsf.extract(r, a, inc, 0.0, 30.0, seq=i, pdm_target_rms=0.02)
+        w.write(fr, 1_700_000_000_000_000 + 250_000 * i, len(r), a, inc, 0.0, 30.0)
+    items = list(bsf.read(io.BytesIO(out.getvalue())))
+    kinds = ["M" if isinstance(x, bsf.Metadata) else "F" for x in items]
+    assert kinds == ["M", "F", "F", "M", "F", "F"]  # first, then every 2 frames
+    m = items[0]
+    assert (m.method, m.source, m.n_beams, m.time_origin_us) == ("falko-sved-pdm", "rüm.log", 361, 1_700_000_000_000_000)
+    assert m.target_rms == pytest.approx(0.02) and m.quant_step == pytest.approx(0.002)
+    assert m.caps["points"] == bsf.caps["BSF_MAX_POINTS"] and m.range_max == 30.0
+    frames = [x for x in items if isinstance(x, bsf.Frame)]
+    assert [f.timestamp_ms for f in frames] == [0, 250, 500, 750]
+    assert frames[2].metadata is items[3] and frames[2].unix_time_ms == 1_700_000_000_500
+    # the 401-beam scan differs from the metadata's 361 beams: it carries its own geometry
+    assert [f.geometry is not None for f in frames] == [False, False, False, True]
+    assert frames[3].stats.n_beams == 401
+    # re-encoding gives the bytes back, metadata included
+    assert b"".join(bsf.encode(x) for x in items) == out.getvalue()
+    with pytest.raises(bsf.BsfError, match="source"):
+        bsf.encode(dataclasses.replace(m, source="x" * 65))
