@@ -216,6 +216,9 @@ static int padding_ok(reader_t *r)
 /* Header extension of a version-2 features frame (FORMAT.md section 3.1). */
 typedef struct {
     uint32_t has_beams;
+    uint32_t has_geometry;
+    float angle_min;
+    float angle_increment;
     uint32_t n_beams;
     uint32_t cut;
     uint32_t n_cut_keypoints;
@@ -223,17 +226,25 @@ typedef struct {
     uint32_t n_cut_points;
 } header_ext_t;
 
+static int get_float(reader_t *r, float *v);
+
 static bsf_status_t get_ext(reader_t *r, uint32_t n_valid, header_ext_t *ext)
 {
-    if (!get_bits(r, 1u, &ext->has_beams) || !get_bits(r, BSF_WIRE_CUT_BITS, &ext->cut)) {
+    if (!get_bits(r, 1u, &ext->has_beams) || !get_bits(r, 1u, &ext->has_geometry) ||
+        !get_bits(r, BSF_WIRE_CUT_BITS, &ext->cut)) {
         return BSF_ERR_FORMAT;
     }
-    if (ext->has_beams == 0u && ext->cut == 0u) {
-        return BSF_ERR_FORMAT; /* an empty extension is not the shortest form */
+    if ((ext->has_beams == 0u && ext->cut == 0u) ||
+        (ext->has_geometry != 0u && ext->has_beams == 0u)) {
+        return BSF_ERR_FORMAT; /* an empty extension, a geometry without its beam count */
     }
     if (ext->has_beams != 0u &&
         (!get_u32(r, BSF_WIRE_K_N_BEAMS, (uint32_t)BSF_MAX_POINTS, &ext->n_beams) ||
          ext->n_beams == 0u || ext->n_beams < n_valid)) {
+        return BSF_ERR_FORMAT;
+    }
+    if (ext->has_geometry != 0u &&
+        (!get_float(r, &ext->angle_min) || !get_float(r, &ext->angle_increment))) {
         return BSF_ERR_FORMAT;
     }
     if (ext->cut != 0u &&
@@ -390,6 +401,9 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
             out->pose_theta = 0.0f;
             out->quant_step = out->metadata.quant_step;
             out->time_us = 0u;
+            out->has_geometry = 0u;
+            out->angle_min = 0.0f;
+            out->angle_increment = 0.0f;
             res->n_features = 0u;
             res->n_ctrl = 0u;
             memset(&res->stats, 0, sizeof res->stats);
@@ -513,9 +527,10 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         sum_points += span + 1u - missing;
         prev_last_beam = last;
     }
-    /* The beam count travels exactly when a feature wraps (one form per
-     * frame), and cut points are valid points outside the features. */
-    if (!padding_ok(&r) || sum_points > n_valid || ext.has_beams != wraps ||
+    /* The beam count travels exactly when a feature wraps or with the
+     * scan's geometry (one form per frame), and cut points are valid points
+     * outside the features. */
+    if (!padding_ok(&r) || sum_points > n_valid || ext.has_beams != (wraps | ext.has_geometry) ||
         ext.n_cut_points > n_valid - sum_points) {
         return BSF_ERR_FORMAT;
     }
@@ -531,6 +546,9 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         out->pose_theta = (float)theta_signed * BSF_WIRE_RAD_PER_THETA;
         out->quant_step = step;
         out->time_us = time_us;
+        out->has_geometry = (uint8_t)ext.has_geometry;
+        out->angle_min = ext.angle_min;
+        out->angle_increment = ext.angle_increment;
         res->n_features = (uint16_t)n_features;
         res->n_ctrl = (uint16_t)n_ctrl;
         memset(&res->stats, 0, sizeof res->stats);

@@ -310,7 +310,9 @@ static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code
         return BSF_ERR_ARG;
     }
     *step_code = (uint32_t)code;
-    if (info->has_pose > 1u) {
+    if (info->has_pose > 1u || info->has_geometry > 1u ||
+        (info->has_geometry != 0u &&
+         (!is_finite_f(info->angle_min) || !is_finite_f(info->angle_increment)))) {
         return BSF_ERR_ARG;
     }
     if (info->has_pose != 0u &&
@@ -347,6 +349,8 @@ static int32_t round_to_int(float v)
     return (int32_t)floorf(v + 0.5f);
 }
 
+static void put_float(writer_t *w, float v);
+
 /* The whole frame through w. It may fail half-way, so every caller runs it
  * in costing and counting mode first and writes only when those passes
  * succeeded. */
@@ -359,6 +363,7 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     int64_t prev_last_beam = -1;
     int64_t prev[2] = {0, 0};
     uint32_t wraps = 0u;
+    int has_beams;
     int has_ext;
     bsf_status_t st;
 
@@ -374,13 +379,17 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     if (st != BSF_OK) {
         return st;
     }
+    if (info->has_geometry != 0u && res->stats.n_beams == 0u) {
+        return BSF_ERR_ARG;
+    }
     step = (float)step_code * BSF_QUANT_STEP_UNIT;
     for (i = 0; i < res->n_features; ++i) {
         if (res->features[i].first_beam > res->features[i].last_beam) {
             wraps = 1u;
         }
     }
-    has_ext = wraps != 0u || res->stats.cut != 0u;
+    has_beams = wraps != 0u || info->has_geometry != 0u;
+    has_ext = has_beams || res->stats.cut != 0u;
 
     block_start(w);
     put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES));
@@ -403,10 +412,15 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         put_bits(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
     }
     if (has_ext) {
-        put_bits(w, wraps, 1u);
+        put_bits(w, has_beams ? 1u : 0u, 1u);
+        put_bits(w, info->has_geometry != 0u ? 1u : 0u, 1u);
         put_bits(w, res->stats.cut, BSF_WIRE_CUT_BITS);
-        if (wraps != 0u) {
+        if (has_beams) {
             put_eg(w, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
+        }
+        if (info->has_geometry != 0u) {
+            put_float(w, info->angle_min);
+            put_float(w, info->angle_increment);
         }
         if (res->stats.cut != 0u) {
             put_eg(w, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
@@ -459,6 +473,9 @@ void bsf_frame_info_init(bsf_frame_info_t *info)
         info->pose_y = 0.0f;
         info->pose_theta = 0.0f;
         info->quant_step = BSF_QUANT_STEP_DEFAULT;
+        info->has_geometry = 0u;
+        info->angle_min = 0.0f;
+        info->angle_increment = 0.0f;
     }
 }
 

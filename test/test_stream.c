@@ -36,9 +36,9 @@ static const uint8_t golden_typical[] = {
     0xef, 0x8c, 0x98, 0x49, 0x8a, 0xd3, 0x80, 0xa6, 0x98, 0x2f, 0x6c, 0x00,
 };
 static const uint8_t golden_wrap_cut[] = {
-    0x04, 0x21, 0x60, 0xf0, 0x24, 0x19, 0x21, 0x16, 0xc8, 0x32, 0x4c, 0x3a, 0x4d, 0x13,
-    0x6d, 0x81, 0x98, 0x60, 0xf1, 0x8b, 0xfc, 0x06, 0x9c, 0xfb, 0xb8, 0xdb, 0x01, 0xa6,
-    0x6f, 0xc7, 0xa0, 0xa7, 0xe0, 0x13, 0x0c, 0x80, 0xc1, 0xc8, 0xce, 0x9e, 0x00,
+    0x04, 0x21, 0x60, 0xf0, 0x24, 0x19, 0x21, 0x16, 0xc8, 0x32, 0x4c, 0x39, 0x26, 0x89,
+    0xb6, 0xc0, 0xcc, 0x30, 0x78, 0xc5, 0xfe, 0x03, 0x4e, 0x7d, 0xdc, 0x6d, 0x80, 0xd3,
+    0x37, 0xe3, 0xd0, 0x53, 0xf0, 0x09, 0x86, 0x40, 0x95, 0xec, 0x43, 0x1e, 0x00,
 };
 static const uint8_t golden_metadata[] = {
     0x18, 0x22, 0xba, 0x78, 0xeb, 0x85, 0x1e, 0x42, 0x29, 0xc9, 0x40, 0x48, 0x09, 0x04, 0x81,
@@ -491,6 +491,9 @@ static void test_worst_case_frame_fits_the_max_size_macro(void)
     res.stats.n_cut_keypoints = BSF_MAX_POINTS;
     res.stats.n_cut_segments = BSF_MAX_POINTS;
     res.stats.n_cut_points = BSF_MAX_POINTS;
+    info.has_geometry = 1u;
+    info.angle_min = -3.0f;
+    info.angle_increment = 0.001f;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
     printf("worst-case test frame: %u bytes (BSF_FRAME_MAX_SIZE %u)\n", (unsigned)n,
            (unsigned)BSF_FRAME_MAX_SIZE);
@@ -651,7 +654,7 @@ static size_t example1_payload(unsigned defect, uint8_t *out)
     w.bits = 0;
     bb_bits(&w, 0x21u, 8u);
     bb_bits(&w, 0u, 1u);                                       /* no pose */
-    bb_bits(&w, defect >= 13u && defect <= 15u ? 1u : 0u, 1u); /* extension */
+    bb_bits(&w, defect >= 13u && defect <= 17u ? 1u : 0u, 1u); /* extension */
     if (defect == 8u) {
         bb_bits(&w, 0u, 30u); /* seq: a zero run too long for 32 bits */
     }
@@ -665,13 +668,29 @@ static size_t example1_payload(unsigned defect, uint8_t *out)
     bb_bits(&w, 8u, 5u);                          /* k_anchor */
     bb_bits(&w, defect == 11u ? 26u : 0u, 5u);    /* k_precision */
     if (defect == 13u) {
-        bb_bits(&w, 0u, 4u); /* an empty extension: no beam count, no cut */
+        bb_bits(&w, 0u, 5u); /* an empty extension: no beam count, no geometry, no cut */
     } else if (defect == 14u) {
-        bb_bits(&w, 1u, 1u); /* a beam count although no feature wraps */
+        bb_bits(&w, 1u, 1u); /* a beam count although no feature wraps, without geometry */
+        bb_bits(&w, 0u, 4u);
+        bb_eg(&w, 360u, 8u);
+    } else if (defect == 16u) {
+        bb_bits(&w, 0u, 1u); /* a geometry without its beam count */
+        bb_bits(&w, 1u, 1u);
+        bb_bits(&w, BSF_CUT_SEGMENTS, 3u);
+        bb_bits(&w, 0x3F800000u, 32u);
+        bb_bits(&w, 0x3C8EFA35u, 32u);
+        bb_eg(&w, 0u, 2u);
+        bb_eg(&w, 1u, 2u);
+        bb_eg(&w, 0u, 4u);
+    } else if (defect == 17u) {
+        bb_bits(&w, 1u, 1u); /* a geometry whose angle is not finite */
+        bb_bits(&w, 1u, 1u);
         bb_bits(&w, 0u, 3u);
         bb_eg(&w, 360u, 8u);
+        bb_bits(&w, 0x7F800000u, 32u);
+        bb_bits(&w, 0x3C8EFA35u, 32u);
     } else if (defect == 15u) {
-        bb_bits(&w, 0u, 1u);
+        bb_bits(&w, 0u, 2u);
         bb_bits(&w, BSF_CUT_SEGMENTS, 3u);
         bb_eg(&w, 0u, 2u);
         bb_eg(&w, 1u, 2u);
@@ -722,7 +741,7 @@ static void test_malformed_fields_are_dropped_and_counted(void)
 {
     uint8_t payload[72];
     unsigned c;
-    for (c = 1; c <= 15u; ++c) {
+    for (c = 1; c <= 17u; ++c) {
         const size_t plen = example1_payload(c, payload);
         const size_t n = reframe(payload, plen, scratch);
         TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u),
@@ -1134,6 +1153,41 @@ static void test_worst_case_metadata_fits_the_max_size_macros(void)
     assert_metadata_equal(&m, &frame.metadata);
 }
 
+static void test_frame_geometry_round_trips_and_is_checked(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    size_t plain = 0;
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, NULL, 0u, &plain));
+    info.has_geometry = 1u;
+    info.angle_min = -1.5577060f;
+    info.angle_increment = 0.0174533f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    res.stats.n_beams = 181u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_TRUE(n > plain + 8u && n <= plain + 11u); /* two floats and a beam count */
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 7u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT8(1u, frame.has_geometry);
+    TEST_ASSERT_EQUAL_MEMORY(&info.angle_min, &frame.angle_min, sizeof(float));
+    TEST_ASSERT_EQUAL_MEMORY(&info.angle_increment, &frame.angle_increment, sizeof(float));
+    TEST_ASSERT_EQUAL_UINT32(181u, frame.result.stats.n_beams);
+    info.angle_increment = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    info.angle_increment = 0.0174533f;
+    info.has_geometry = 2u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    res.stats.n_beams = 170u; /* feature 6 ends at beam 178 */
+    info.has_geometry = 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    /* Without has_geometry the frame says nothing about it. */
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    TEST_ASSERT_EQUAL_UINT8(0u, frame.has_geometry);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -1170,5 +1224,6 @@ int main(void)
     RUN_TEST(test_metadata_field_by_field_and_malformed_fields);
     RUN_TEST(test_stream_decoder_takes_beam_count_from_metadata);
     RUN_TEST(test_worst_case_metadata_fits_the_max_size_macros);
+    RUN_TEST(test_frame_geometry_round_trips_and_is_checked);
     return UNITY_END();
 }

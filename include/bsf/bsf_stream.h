@@ -68,8 +68,8 @@ extern "C" {
 
 /** Largest features frame header (version/type byte, pose and extension
  * flags, seq, time stamp, pose, step, N, extraction time, feature count,
- * control point orders, beam count and cap-cut counters), bits. */
-#define BSF_FRAME_HEADER_MAX_BITS 554u
+ * control point orders, beam count, geometry and cap-cut counters), bits. */
+#define BSF_FRAME_HEADER_MAX_BITS 619u
 /** Largest feature header (kind, point count, vertex mask, beams, E_curve), bits. */
 #define BSF_FRAME_FEATURE_MAX_BITS 211u
 /** Largest size of one distinct control point on the wire (two 26-bit codes), bits. */
@@ -148,9 +148,14 @@ typedef struct {
     float pose_theta;      /**< radians, |theta| <= BSF_POSE_THETA_MAX, sent in 2*pi/65536 units */
     float quant_step;      /**< control point step, metres, [BSF_QUANT_STEP_MIN, _MAX],
                                 rounded to 0.1 mm */
+    uint8_t has_geometry;  /**< 1: this scan's geometry travels in the frame (with
+                                result->stats.n_beams, which must then be >= 1): for a
+                                scan whose geometry differs from the stream's metadata */
+    float angle_min;       /**< radians, finite: angle of beam 0 (with has_geometry) */
+    float angle_increment; /**< radians, finite: between beams (with has_geometry) */
 } bsf_frame_info_t;
 
-/** Fill info with zeros, no pose and quant_step = BSF_QUANT_STEP_DEFAULT. */
+/** Fill info with zeros, no pose, no geometry and quant_step = BSF_QUANT_STEP_DEFAULT. */
 void bsf_frame_info_init(bsf_frame_info_t *info);
 
 /**
@@ -160,7 +165,7 @@ void bsf_frame_info_init(bsf_frame_info_t *info);
  * (two consecutive flagged slots whose values quantise alike) travels once.
  * The cap-cut stats travel when stats.cut is not 0, stats.n_beams when a
  * feature wraps (first_beam > last_beam: beams first_beam .. n_beams - 1,
- * then 0 .. last_beam).
+ * then 0 .. last_beam) or when info->has_geometry is set.
  *
  * @param buf      destination, or NULL to only compute the size.
  * @param cap      size of buf in bytes (ignored when buf is NULL).
@@ -168,8 +173,9 @@ void bsf_frame_info_init(bsf_frame_info_t *info);
  *                 NULL, and on BSF_ERR_BUFFER: the size needed).
  * @return BSF_OK; BSF_ERR_ARG when info, result or out_len is NULL, or a value
  *         cannot be represented: non-finite or out-of-range control point
- *         (|coordinate| / step > BSF_QUANT_MAX_STEPS), pose, quant_step or
- *         E_curve; n_ctrl < 3 or > BSF_MAX_CTRL_PER_FEATURE; control points
+ *         (|coordinate| / step > BSF_QUANT_MAX_STEPS), pose, quant_step,
+ *         E_curve or geometry angles; has_geometry > 1, or 1 with
+ *         stats.n_beams 0; n_ctrl < 3 or > BSF_MAX_CTRL_PER_FEATURE; control points
  *         outside result->n_ctrl; a flagged vertex slot without an equal
  *         partner; beams >= BSF_MAX_POINTS, or >= stats.n_beams when that is
  *         not 0; a wrapping feature (first_beam > last_beam) when
@@ -287,11 +293,12 @@ BSF_NODISCARD bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const b
  * n_ctrl, n_features, time_ns (= time_us * 1000), the cap-cut fields (cut,
  * n_cut_keypoints, n_cut_segments, n_cut_points) and n_beams when known (the
  * frame carries it when a feature wraps through the seam of a full-circle
- * scan; otherwise bsf_decoder_feed() takes it from the last metadata frame it
- * delivered, and bsf_frame_decode() leaves 0). The other stats are 0 (they
- * do not travel). `metadata` is not touched.
+ * scan or with its own geometry; otherwise bsf_decoder_feed() takes it from the last metadata frame
+ * it delivered, and bsf_frame_decode() leaves 0). The other stats are 0 (they do not travel).
+ * `metadata` is not touched.
  *
- * Metadata: `metadata` is filled; seq, timestamp_ms, pose, time_us are 0,
+ * Metadata: `metadata` is filled; seq, timestamp_ms, pose, time_us and the
+ * geometry are 0,
  * quant_step is metadata.quant_step, and result holds no features (counts
  * and stats 0; its arrays are not touched).
  */
@@ -306,6 +313,10 @@ typedef struct {
     float pose_theta;        /**< radians in [-pi, pi) (2*pi/65536 resolution) */
     float quant_step;        /**< metres */
     uint32_t time_us;        /**< extraction time, microseconds (<= 4 294 967) */
+    uint8_t has_geometry;    /**< 1: the frame carries its scan's geometry (below, and
+                                  result.stats.n_beams); 0: the metadata's applies */
+    float angle_min;         /**< radians (with has_geometry) */
+    float angle_increment;   /**< radians (with has_geometry) */
     bsf_result_t result;     /**< features, control points, vertex flags, stats */
     bsf_metadata_t metadata; /**< only for type BSF_FRAME_TYPE_METADATA */
 } bsf_frame_t;

@@ -100,16 +100,20 @@ static void check_equal(const bsf_frame_t *a, const bsf_frame_t *b)
      * delivered frame's time and stats re-encode exactly. */
     FUZZ_CHECK(a->time_us == b->time_us);
     {
-        /* The beam count travels only with a wrapping feature; the stream
-         * decoder may have filled it in from a metadata frame. */
+        /* The beam count travels only with a wrapping feature or the scan's
+         * geometry; the stream decoder may have filled it in from a metadata
+         * frame. */
         bsf_stats_t sa = ra->stats;
         int wraps = 0;
         for (k = 0; k < ra->n_features; ++k) {
             wraps |= ra->features[k].first_beam > ra->features[k].last_beam;
         }
-        if (!wraps) {
+        if (!wraps && !a->has_geometry) {
             sa.n_beams = 0u;
         }
+        FUZZ_CHECK(a->has_geometry == b->has_geometry);
+        FUZZ_CHECK(memcmp(&a->angle_min, &b->angle_min, sizeof(float)) == 0);
+        FUZZ_CHECK(memcmp(&a->angle_increment, &b->angle_increment, sizeof(float)) == 0);
         FUZZ_CHECK(memcmp(&sa, &rb->stats, sizeof sa) == 0);
     }
     FUZZ_CHECK(ra->n_features == rb->n_features && ra->n_ctrl == rb->n_ctrl);
@@ -143,6 +147,9 @@ static void reencode(const bsf_frame_t *fr)
     info.pose_y = fr->pose_y;
     info.pose_theta = fr->pose_theta;
     info.quant_step = fr->quant_step;
+    info.has_geometry = fr->has_geometry;
+    info.angle_min = fr->angle_min;
+    info.angle_increment = fr->angle_increment;
     st = bsf_frame_encode(&info, &fr->result, wire, sizeof wire, &len);
     if (st != BSF_OK) {
         fprintf(stderr, "re-encoding a delivered frame failed: %s\n", bsf_status_str(st));

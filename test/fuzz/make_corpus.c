@@ -111,6 +111,13 @@ int main(int argc, char **argv)
         }
         info.seq = (uint32_t)k;
         info.timestamp_ms = 100u * k;
+        /* frame 1 carries its own geometry (header extension) */
+        info.has_geometry = (uint8_t)(k == 1u);
+        info.angle_min = sc.angle_min;
+        info.angle_increment = sc.angle_increment;
+        if (k == 1u && res.stats.n_beams == 0u) {
+            res.stats.n_beams = (uint32_t)sc.count;
+        }
         info.has_pose = (uint8_t)(k != 1u);
         info.pose_x = (float)x;
         info.pose_y = (float)y;

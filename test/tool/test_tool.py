@@ -178,7 +178,21 @@ open(os.path.join(WORK, "geom.log"), "w").writelines(lines)
 r = run(["extract", "geom.log", "-o", "geom.bsf"], text=True)
 r2, objs = decode_json("geom.bsf")
 beams = [o["metadata"]["n_beams"] for o in objs if "metadata" in o]
-check(r.returncode == 0 and beams == [n, n - 10, n], "a beam count change sends the metadata again (%r)" % beams)
+scans = [o for o in objs if "seq" in o]
+own = [(o["seq"], o["n_beams"]) for o in scans if o["geometry"] is not None]
+check(r.returncode == 0 and beams == [n] and own == [(5, n - 10)] and scans[5]["geometry"]["angle_min"] == meta["angle_min"]
+      and scans[6]["n_beams"] == n, "a scan with another beam count carries its own geometry (%r, %r)" % (beams, own))
+# a range limit change sends the metadata again
+lines = open(os.path.join(WORK, "synth.log")).readlines()
+parts = lines[laser[5]].split()
+parts[5] = "40.0"  # the line's maxrange
+lines[laser[5]] = " ".join(parts) + "\n"
+open(os.path.join(WORK, "range.log"), "w").writelines(lines)
+r = run(["extract", "range.log", "-o", "range.bsf"], text=True)
+r2, objs = decode_json("range.bsf")
+ranges = [o["metadata"]["range_max"] for o in objs if "metadata" in o]
+check(r.returncode == 0 and ranges == [50, 40, 50] and "metadata" in objs[6] and "metadata" in objs[8],
+      "a range limit change sends the metadata again (%r)" % ranges)
 
 # 8. byte-reproducible output, stdin (plain and gzip)
 run(["extract", "synth.log", "--reproducible", "-o", "rep1.bsf"])

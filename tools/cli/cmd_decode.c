@@ -151,6 +151,10 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
         if (r->stats.n_beams != 0u) {
             fprintf(ctx->out, " beams=%lu", (unsigned long)r->stats.n_beams);
         }
+        if (fr->has_geometry) {
+            fprintf(ctx->out, " angle_min=%.9g angle_increment=%.9g", (double)fr->angle_min,
+                    (double)fr->angle_increment);
+        }
         if (r->stats.cut != 0u) {
             fprintf(ctx->out, " cut=%s%s%s(keypoints %lu, segments %lu, points %lu)",
                     (r->stats.cut & BSF_CUT_KEYPOINTS) ? "keypoints," : "",
@@ -192,6 +196,16 @@ static void print_json_features(decode_ctx_t *ctx, const bsf_frame_t *fr, size_t
             (unsigned long)fr->time_us);
     if (r->stats.n_beams != 0u) {
         fprintf(ctx->out, "%lu", (unsigned long)r->stats.n_beams);
+    } else {
+        fputs("null", ctx->out);
+    }
+    fputs(",\"geometry\":", ctx->out);
+    if (fr->has_geometry) {
+        fputs("{\"angle_min\":", ctx->out);
+        print_json_float(ctx->out, fr->angle_min);
+        fputs(",\"angle_increment\":", ctx->out);
+        print_json_float(ctx->out, fr->angle_increment);
+        fputc('}', ctx->out);
     } else {
         fputs("null", ctx->out);
     }

@@ -22,8 +22,10 @@ static const char extract_help[] =
     "\n"
     "The stream starts with a metadata frame (method, parameters, caps, scan geometry,\n"
     "the log's absolute time of timestamp 0, the log's name), sent again whenever the\n"
-    "geometry changes and at least every K scans, so that a receiver joining a live\n"
-    "link learns it within K frames. Frames carry the laser pose and the time in ms\n"
+    "range limits or the time origin change and at least every K scans, so that a\n"
+    "receiver joining a live link learns it within K frames; a scan whose beam count\n"
+    "or angles differ from the metadata carries its own in its frame. Frames carry the laser pose "
+    "and the time in ms\n"
     "since that origin (the log's first scan). A malformed log line is reported as\n"
     "FILE:LINE and skipped; so is a scan whose time is not finite, negative or beyond\n"
     "1e11 s. The summary goes to stderr; progress too, when stderr is a terminal.\n"
@@ -53,12 +55,17 @@ typedef struct {
     unsigned long n_sent;
 } meta_state_t;
 
-static int same_geometry(const bsf_metadata_t *m, const bsf_scan_t *sc)
+/* The beams of sc are where the metadata says (count and angles, bit for bit). */
+static int same_beams(const bsf_metadata_t *m, const bsf_scan_t *sc)
 {
     return m->n_beams == (uint32_t)sc->count &&
            memcmp(&m->angle_min, &sc->angle_min, sizeof(float)) == 0 &&
-           memcmp(&m->angle_increment, &sc->angle_increment, sizeof(float)) == 0 &&
-           memcmp(&m->range_min, &sc->range_min, sizeof(float)) == 0 &&
+           memcmp(&m->angle_increment, &sc->angle_increment, sizeof(float)) == 0;
+}
+
+static int same_ranges(const bsf_metadata_t *m, const bsf_scan_t *sc)
+{
+    return memcmp(&m->range_min, &sc->range_min, sizeof(float)) == 0 &&
            memcmp(&m->range_max, &sc->range_max, sizeof(float)) == 0;
 }
 
@@ -117,6 +124,7 @@ static int run_extract(const extract_opts_t *o)
     FILE *out;
     progress_t prog;
     unsigned long index = 0, done = 0, failed = 0, bad_time = 0, cut = 0, malformed;
+    unsigned long own_geometry = 0;
     unsigned long long bytes = 0;
     bsf_frame_info_t info;
     int r;
@@ -170,9 +178,13 @@ static int run_extract(const extract_opts_t *o)
             ++index;
             continue;
         }
-        /* Metadata first: at the start, when the geometry changes, when the
-         * time goes back before the origin (a new origin), and every K scans. */
-        if (!ms.sent || !same_geometry(&ms.meta, &sc) || t_us < ms.meta.time_origin_us ||
+        /* Metadata first: at the start, when the range limits change, when
+         * the time goes back before the origin (a new origin), and every K
+         * scans. A scan whose beams (count, angles) differ from the metadata
+         * carries its own geometry instead: some logs change the start angle
+         * on every scan, and 10 bytes in the frame cost less than a 60-byte
+         * metadata frame per scan. */
+        if (!ms.sent || !same_ranges(&ms.meta, &sc) || t_us < ms.meta.time_origin_us ||
             ms.frames_since >= o->meta_every) {
             if (ms.sent && t_us < ms.meta.time_origin_us) {
                 fprintf(stderr,
@@ -201,6 +213,12 @@ static int run_extract(const extract_opts_t *o)
                 break;
             }
         }
+        if (g_res.stats.n_beams == 0u) {
+            g_res.stats.n_beams = (uint32_t)sc.count;
+        }
+        info.has_geometry = (uint8_t)(same_beams(&ms.meta, &sc) ? 0u : 1u);
+        info.angle_min = sc.angle_min;
+        info.angle_increment = sc.angle_increment;
         info.seq = (uint32_t)index;
         /* ms since the origin (the first scan): small numbers travel in
          * fewer bytes; the metadata frame carries the absolute origin. */
@@ -223,6 +241,7 @@ static int run_extract(const extract_opts_t *o)
             break;
         }
         cut += g_res.stats.cut != 0u ? 1u : 0u;
+        own_geometry += info.has_geometry;
         ++ms.frames_since;
         bytes += len;
         ++done;
@@ -242,9 +261,11 @@ static int run_extract(const extract_opts_t *o)
     }
     fprintf(stderr,
             "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan, %lu metadata "
-            "frames), %lu cut by a cap, %lu failed, %lu with a bad time, %lu malformed lines\n",
+            "frames, %lu scans with their own geometry), %lu cut by a cap, %lu failed, %lu "
+            "with a bad time, %lu malformed lines\n",
             o->log, done, bsf_method_name(o->method), bytes,
-            done ? (double)bytes / (double)done : 0.0, ms.n_sent, cut, failed, bad_time, malformed);
+            done ? (double)bytes / (double)done : 0.0, ms.n_sent, own_geometry, cut, failed,
+            bad_time, malformed);
     return failed || bad_time ? EXIT_FAIL : 0;
 }
 
