@@ -275,18 +275,18 @@ r = run(["render", "synth.bsf", "-o", "w.svg", "--width", "0"], text=True)
 check(r.returncode == 2, "render --width 0 is refused")
 
 # 14. metrics and render in memory independent of the stream's length:
-#     a 20 MB stream (the whole synthetic stream repeated) stays far below
+#     an 8 MB stream (the whole synthetic stream repeated) stays far below
 #     what keeping every frame would take (about 290 times the stream).
 big = os.path.join(WORK, "big.bsf")
 with open(big, "wb") as f:
-    while f.tell() < 20 * 1000 * 1000:
+    while f.tell() < 8 * 1000 * 1000:
         f.write(raw)
 before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
 r = run(["metrics", "big.bsf"], text=True)
 r2 = run(["render", "big.bsf", "-o", "big.svg"], text=True)
 peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
 check(r.returncode == 0 and r2.returncode == 0 and peak_kb < 80 * 1024,
-      "metrics and render of a 20 MB stream peak at %d KiB (< 80 MiB)" % peak_kb)
+      "metrics and render of an 8 MB stream peak at %d KiB (< 80 MiB)" % peak_kb)
 
 print("%d checks failed" % len(failures) if failures else "all tool checks passed")
 sys.exit(1 if failures else 0)
