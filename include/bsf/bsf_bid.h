@@ -80,7 +80,8 @@ typedef struct {
  *         with out_cap > 0, or the angle increment is zero or not finite;
  *         BSF_ERR_PARAM when bsf_bid_params_check fails; BSF_ERR_CAPACITY when
  *         pts->count > BSF_MAX_POINTS, or more than out_cap keypoints were
- *         found (out then holds the first out_cap, *n_out the total). A beam
+ *         found (out then holds the out_cap strongest, lowest N_q first, ties
+ *         to the lower beam, ascending by beam index; *n_out the total). A beam
  *         whose neighbourhood is too small or cannot be fitted is simply not
  *         a candidate.
  */

@@ -24,16 +24,42 @@ static const char extract_help[] =
     "the log's absolute time of timestamp 0, the log's name), sent again whenever the\n"
     "range limits or the time origin change and at least every K scans, so that a\n"
     "receiver joining a live link learns it within K frames; a scan whose beam count\n"
-    "or angles differ from the metadata carries its own in its frame. Frames carry the laser pose "
-    "and the time in ms\n"
-    "since that origin (the log's first scan). A malformed log line is reported as\n"
-    "FILE:LINE and skipped; so is a scan whose time is not finite, negative or beyond\n"
-    "1e11 s. The summary goes to stderr; progress too, when stderr is a terminal.\n"
-    "Exits 1 when the log holds no laser line or any scan was skipped.\n";
+    "or angles differ from the metadata carries its own in its frame. Frames carry\n"
+    "the laser pose and the time in ms since that origin (the log's first scan).\n"
+    "A malformed log line is reported as FILE:LINE and skipped; so is a scan whose\n"
+    "time is not finite, negative or beyond 1e11 s. A scan with more keypoints,\n"
+    "segments or control points than the library's caps is kept with the features\n"
+    "that fit and reported as cut (not failed). The summary goes to stderr; progress\n"
+    "too, when stderr is a terminal. Exits 1 when the log holds no laser line or any\n"
+    "scan was skipped.\n";
 
 /* Largest log time accepted, seconds since 1970 (year 5138): a larger one is
  * a corrupt field, and its microseconds would not fit the metadata frame. */
 #define EXTRACT_TIME_MAX_S 1e11
+
+/* Scans a cap cut (BSF_OK_CUT): kept and written, counted apart from failures. */
+typedef struct {
+    unsigned long scans, keypoints, segments, points;
+} cut_totals_t;
+
+#define CUT_MESSAGES_MAX 10 /* per-scan lines; the totals cover the rest */
+
+static void note_cut_scan(cut_totals_t *t, const char *log, unsigned long line, unsigned long index,
+                          const bsf_stats_t *s)
+{
+    if (t->scans < CUT_MESSAGES_MAX) {
+        fprintf(stderr,
+                "%s:%lu: scan %lu cut by a cap: %lu keypoints, %lu segments (%lu points) "
+                "left out%s\n",
+                log, line, index, (unsigned long)s->n_cut_keypoints,
+                (unsigned long)s->n_cut_segments, (unsigned long)s->n_cut_points,
+                t->scans + 1u == CUT_MESSAGES_MAX ? " (further cut scans: totals only)" : "");
+    }
+    t->scans++;
+    t->keypoints += s->n_cut_keypoints;
+    t->segments += s->n_cut_segments;
+    t->points += s->n_cut_points;
+}
 
 typedef struct {
     const char *log;
@@ -123,8 +149,9 @@ static int run_extract(const extract_opts_t *o)
     carmen_scan_t rec;
     FILE *out;
     progress_t prog;
-    unsigned long index = 0, done = 0, failed = 0, bad_time = 0, cut = 0, malformed;
+    unsigned long index = 0, done = 0, failed = 0, bad_time = 0, malformed;
     unsigned long own_geometry = 0;
+    cut_totals_t cut;
     unsigned long long bytes = 0;
     bsf_frame_info_t info;
     int r;
@@ -143,6 +170,7 @@ static int run_extract(const extract_opts_t *o)
         return EXIT_FAIL;
     }
     memset(&ms, 0, sizeof ms);
+    memset(&cut, 0, sizeof cut);
     bsf_frame_info_init(&info);
     info.quant_step = (float)o->quant;
     progress_init(&prog);
@@ -171,7 +199,9 @@ static int run_extract(const extract_opts_t *o)
         t_us = llround(rec.timestamp * 1e6);
         sc = scan_of_record(&rec, o->range_max);
         st = bsf_extract(&g_ex, &sc, &g_res);
-        if (st != BSF_OK) {
+        if (st == BSF_OK_CUT) {
+            note_cut_scan(&cut, o->log, rec.line, index, &g_res.stats);
+        } else if (st != BSF_OK) {
             fprintf(stderr, "%s:%lu: scan %lu skipped: %s\n", o->log, rec.line, index,
                     bsf_status_str(st));
             ++failed;
@@ -240,7 +270,6 @@ static int run_extract(const extract_opts_t *o)
             write_failed = 1;
             break;
         }
-        cut += g_res.stats.cut != 0u ? 1u : 0u;
         own_geometry += info.has_geometry;
         ++ms.frames_since;
         bytes += len;
@@ -264,8 +293,14 @@ static int run_extract(const extract_opts_t *o)
             "frames, %lu scans with their own geometry), %lu cut by a cap, %lu failed, %lu "
             "with a bad time, %lu malformed lines\n",
             o->log, done, bsf_method_name(o->method), bytes,
-            done ? (double)bytes / (double)done : 0.0, ms.n_sent, own_geometry, cut, failed,
+            done ? (double)bytes / (double)done : 0.0, ms.n_sent, own_geometry, cut.scans, failed,
             bad_time, malformed);
+    if (cut.scans > 0u) {
+        fprintf(stderr,
+                "%s: the caps left out %lu keypoints, %lu segments and %lu points in %lu scans "
+                "(kept: what fits, largest first; see the README's memory section)\n",
+                o->log, cut.keypoints, cut.segments, cut.points, cut.scans);
+    }
     return failed || bad_time ? EXIT_FAIL : 0;
 }
 
