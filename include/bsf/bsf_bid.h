@@ -29,9 +29,7 @@
 #include "bsf_scan.h"
 #include "bsf_fit.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** BID parameters; start from bsf_bid_params_default(). */
 typedef struct {
@@ -89,8 +87,6 @@ BSF_NODISCARD bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid
                                           bsf_bid_work_t *work, bsf_keypoint_t *out, size_t out_cap,
                                           size_t *n_out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_BID_H */

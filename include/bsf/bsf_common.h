@@ -9,10 +9,10 @@
 #include <stdint.h>
 
 #include "bsf_config.h"
+#include "bsf_abi.h"
+#include "bsf_version.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** Results that must not be ignored (a status that carries an error). */
 #if defined(__GNUC__) || defined(__clang__)
@@ -64,8 +64,6 @@ typedef struct {
 /** Short English name of a status code ("ok", "bad argument", ...); never NULL. */
 const char *bsf_status_str(bsf_status_t status);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_COMMON_H */

@@ -23,9 +23,7 @@
 #include "bsf_segment.h"
 #include "bsf_fit.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** The extraction methods of the paper's Table 1. */
 typedef enum {
@@ -141,8 +139,6 @@ const char *bsf_method_name(bsf_method_t method);
 /** Method from its name; returns BSF_METHOD_COUNT for an unknown name. */
 bsf_method_t bsf_method_from_name(const char *name);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_EXTRACT_H */

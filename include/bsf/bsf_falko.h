@@ -24,9 +24,7 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** FALKO parameters; start from bsf_falko_params_default(). */
 typedef struct {
@@ -102,8 +100,6 @@ BSF_NODISCARD bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_f
                                             bsf_falko_work_t *work, bsf_keypoint_t *out,
                                             size_t out_cap, size_t *n_out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_FALKO_H */

@@ -8,9 +8,7 @@
 
 #include "bsf_common.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** Kind of a feature (paper section 5): with or without a vertex (corner). */
 typedef enum {
@@ -79,8 +77,6 @@ typedef struct {
     bsf_stats_t stats;
 } bsf_result_t;
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_FEATURE_H */

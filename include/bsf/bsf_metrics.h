@@ -19,9 +19,7 @@
 #include "bsf_common.h"
 #include "bsf_feature.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** The inputs a scan's metrics need; all of them travel in the wire format. */
 typedef struct {
@@ -119,8 +117,6 @@ BSF_NODISCARD bsf_status_t bsf_metrics_acc_add(bsf_metrics_acc_t *acc,
 BSF_NODISCARD bsf_status_t bsf_metrics_acc_summary(bsf_metrics_acc_t *acc,
                                                    bsf_metrics_summary_t *out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_METRICS_H */
