@@ -598,25 +598,13 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
 
 /* ---- Metadata frame ------------------------------------------------------ */
 
-/* The library version written by bsf_metadata_init(): the release macros
- * when the headers define them, else the version of this source tree. */
-#ifndef BSF_VERSION_MAJOR
-#define BSF_METADATA_LIB_MAJOR 0u
-#define BSF_METADATA_LIB_MINOR 1u
-#define BSF_METADATA_LIB_PATCH 0u
-#else
-#define BSF_METADATA_LIB_MAJOR BSF_VERSION_MAJOR
-#define BSF_METADATA_LIB_MINOR BSF_VERSION_MINOR
-#define BSF_METADATA_LIB_PATCH BSF_VERSION_PATCH
-#endif
-
 void bsf_metadata_init(bsf_metadata_t *m)
 {
     if (m != NULL) {
         memset(m, 0, sizeof *m);
-        m->lib_version_major = (uint16_t)BSF_METADATA_LIB_MAJOR;
-        m->lib_version_minor = (uint16_t)BSF_METADATA_LIB_MINOR;
-        m->lib_version_patch = (uint16_t)BSF_METADATA_LIB_PATCH;
+        m->lib_version_major = (uint16_t)BSF_VERSION_MAJOR;
+        m->lib_version_minor = (uint16_t)BSF_VERSION_MINOR;
+        m->lib_version_patch = (uint16_t)BSF_VERSION_PATCH;
         m->quant_step = BSF_QUANT_STEP_DEFAULT;
         m->max_points = (uint32_t)BSF_MAX_POINTS;
         m->max_keypoints = (uint32_t)BSF_MAX_KEYPOINTS;

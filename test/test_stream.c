@@ -946,11 +946,9 @@ static void test_metadata_sink_and_init(void)
     TEST_ASSERT_EQUAL_UINT32(BSF_MAX_POINTS, m.max_points);
     TEST_ASSERT_EQUAL_UINT32(BSF_MAX_CTRL_POINTS, m.max_ctrl_points);
     TEST_ASSERT_EQUAL_FLOAT(BSF_QUANT_STEP_DEFAULT, m.quant_step);
-#ifdef BSF_VERSION_MAJOR
     TEST_ASSERT_EQUAL_UINT16(BSF_VERSION_MAJOR, m.lib_version_major);
     TEST_ASSERT_EQUAL_UINT16(BSF_VERSION_MINOR, m.lib_version_minor);
     TEST_ASSERT_EQUAL_UINT16(BSF_VERSION_PATCH, m.lib_version_patch);
-#endif
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metadata_encode(&m, NULL, 0u, &n));
     fx_example_metadata(&m);
     memset(&log, 0, sizeof log);
