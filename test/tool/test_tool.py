@@ -236,6 +236,19 @@ for bad in ["nan", "inf", "1e17", "-5.000"]:
     check(r.returncode == 1 and ("badtime.log:%d" % (laser[2] + 1)) in r.stderr and len(times) == 39
           and max(times) < 10000, "a log time of %s is reported with its line, the scan skipped" % bad)
 
+# a time before the origin starts a new origin (a metadata frame), never a clamped 0
+lines = open(os.path.join(WORK, "synth.log")).readlines()
+parts = lines[laser[10]].split()
+parts[-3] = "999.5"  # before the first scan's 1000.0
+lines[laser[10]] = " ".join(parts) + "\n"
+open(os.path.join(WORK, "backtime.log"), "w").writelines(lines)
+r = run(["extract", "backtime.log", "-o", "backtime.bsf"], text=True)
+r2, objs = decode_json("backtime.bsf")
+origins = [o["metadata"]["time_origin_us"] for o in objs if "metadata" in o]
+after = [o for o in objs if "seq" in o and o["seq"] == 11]
+check(r.returncode == 0 and "time goes back" in r.stderr and origins == [1000000000, 999500000]
+      and after and after[0]["timestamp_ms"] == 1600, "a time before the origin sets a new origin (%r)" % origins)
+
 # 11. a stream cut before its last delimiter still counts that frame's gap
 raw = open(os.path.join(WORK, "rep1.bsf"), "rb").read()
 chunks = raw.split(b"\0")[:-1]
