@@ -109,8 +109,10 @@ def cmd_plot(a: argparse.Namespace) -> int:
         return 1
     from .plot import plot
 
+    from . import Frame
+
     try:
-        frames = list(read(a.input))
+        frames = [f for f in read(a.input) if isinstance(f, Frame)]  # metadata frames draw nothing
     except (BsfError, OSError) as e:
         print(f"bsf: {e}", file=sys.stderr)
         return 1
