@@ -171,7 +171,6 @@ static void print_frame_line(listen_state_t *ls, const bsf_frame_t *fr, size_t b
     }
 }
 
-#ifdef BSF_FRAME_TYPE_METADATA
 /* What produced the stream: a sender repeats it, so a receiver that joins a
  * live link late learns it within a few frames. */
 static void print_metadata_line(const bsf_frame_t *fr, size_t bytes, const bsf_decoder_stats_t *s)
@@ -187,7 +186,6 @@ static void print_metadata_line(const bsf_frame_t *fr, size_t bytes, const bsf_d
            m->source_len ? "\"" : "", m->source_len ? m->source : "none", m->source_len ? "\"" : "",
            bytes, (unsigned long)s->frames_ok, dropped(s));
 }
-#endif
 
 static void note_seq(listen_state_t *ls, uint32_t seq)
 {
@@ -206,12 +204,10 @@ static void note_seq(listen_state_t *ls, uint32_t seq)
 static void deliver(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
                     const bsf_decoder_stats_t *s)
 {
-#ifdef BSF_FRAME_TYPE_METADATA
     if (fr->type == BSF_FRAME_TYPE_METADATA) {
         print_metadata_line(fr, bytes, s);
         return;
     }
-#endif
     ++ls->frames;
     note_seq(ls, fr->seq);
     print_frame_line(ls, fr, bytes, s);

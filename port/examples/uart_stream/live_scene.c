@@ -64,7 +64,6 @@ bsf_status_t live_scene_scan(uint32_t k, bsf_frame_info_t *info, const bsf_resul
     return BSF_OK;
 }
 
-#ifdef BSF_FRAME_TYPE_METADATA
 void live_scene_metadata(bsf_metadata_t *m)
 {
     static const char source[] = "uart_stream: demo office";
@@ -81,4 +80,3 @@ void live_scene_metadata(bsf_metadata_t *m)
     m->source_len = (uint8_t)(sizeof source - 1u);
     memcpy(m->source, source, sizeof source);
 }
-#endif

@@ -43,7 +43,6 @@ bsf_status_t live_scene_start(void);
  */
 bsf_status_t live_scene_scan(uint32_t k, bsf_frame_info_t *info, const bsf_result_t **result);
 
-#ifdef BSF_FRAME_TYPE_METADATA
 /** A metadata frame goes before scan 0 and before every LIVE_SCENE_META_EVERY-th
  *  scan, so a receiver that joins the link late learns what it hears. */
 #define LIVE_SCENE_META_EVERY 20u
@@ -54,7 +53,6 @@ bsf_status_t live_scene_scan(uint32_t k, bsf_frame_info_t *info, const bsf_resul
  * quantisation step, source "uart_stream: demo office", no time origin.
  */
 void live_scene_metadata(bsf_metadata_t *m);
-#endif
 
 #ifdef __cplusplus
 }

@@ -71,7 +71,6 @@ int main(void)
     for (k = 0; st == BSF_OK && k < LIVE_SCENE_SCANS; ++k) {
         bsf_frame_info_t info;
         const bsf_result_t *result = NULL;
-#ifdef BSF_FRAME_TYPE_METADATA
         if (k % LIVE_SCENE_META_EVERY == 0u) {
             static bsf_metadata_t meta;
             live_scene_metadata(&meta);
@@ -80,7 +79,6 @@ int main(void)
                 break;
             }
         }
-#endif
         st = live_scene_scan(k, &info, &result);
         if (st == BSF_OK) {
             st = bsf_frame_encode_sink(&encoder, &info, result, uart_sink, NULL, NULL);
