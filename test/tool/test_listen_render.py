@@ -197,6 +197,8 @@ for line in run(["decode", "dense.bsf"], text=True).stdout.splitlines():
         n_valid = int(line.split(" N=")[1].split()[0])
 check(r.returncode == 0 and n_valid > 100 and dots >= 0.9 * n_valid and robot == 1,
       "a one-scan render shows its points (%d of %d valid beams) and the robot" % (dots, n_valid))
+widths = [float(e.get("stroke-width", "0")) for e in root.iter() if e.get("class") == "points"]
+check(widths and min(widths) >= 3.0, "a one-scan close-up draws its points as dots >= 3 px (%s)" % widths[:1])
 
 intel = os.path.join(SHARED, "data", "intel.log.gz") if SHARED else ""
 if intel and os.path.exists(intel):

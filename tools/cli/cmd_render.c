@@ -193,6 +193,8 @@ static int in_range(uint32_t seq, long lo, long hi)
 /* Raw points are thinned to one per cell of this size (and at least one
  * pixel): a map stays a few megabytes whatever the number of scans. */
 #define RENDER_POINT_CELL_M 0.01
+/* Diameter of a drawn point, metres (kept between 1.8 and 5 pixels). */
+#define RENDER_POINT_DOT_M 0.03
 
 /* The log's scans in the range, as world points: into the bounds (pts NULL)
  * or drawn (thinned) into pts. */
@@ -499,9 +501,9 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     bsf_svg_grid(&svg);
     memset(&pts, 0, sizeof pts);
     if (points_log != NULL) {
-        /* dots a cell wide, between 1.8 and 5 px: visible on a whole map,
+        /* dots 3 cm wide, between 1.8 and 5 px: visible on a whole map,
          * clear on a one-scan close-up */
-        const double dot_px = fmin(5.0, fmax(1.8, RENDER_POINT_CELL_M * svg.px_per_m));
+        const double dot_px = fmin(5.0, fmax(1.8, RENDER_POINT_DOT_M * svg.px_per_m));
         int prc =
             bsf_svg_points_begin(&pts, &svg, RENDER_POINT_CELL_M, dot_px, RENDER_POINT_COLOUR);
         if (prc != 0) {
