@@ -43,9 +43,18 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     p.sved = bsf_sved_params_default();
     p.rpos = bsf_rpos_params_default();
     bsf_pdm_params_default(&p.pdm);
+    p.no_return = bsf_no_return_params_default();
     p.clock = NULL;
     p.clock_user = NULL;
     p.clock_hz = 0u;
+    return p;
+}
+
+bsf_params_t bsf_params_paper(bsf_method_t method)
+{
+    bsf_params_t p = bsf_params_default(method);
+    p.sved = bsf_sved_params_paper();
+    p.no_return.min_run = 0u;
     return p;
 }
 
@@ -55,7 +64,8 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    if (p->clock != NULL && p->clock_hz == 0u) {
+    if ((p->clock != NULL && p->clock_hz == 0u) || !(p->no_return.code >= 0.0f) ||
+        !(p->no_return.code <= 3.402823466e38f)) {
         return BSF_ERR_PARAM;
     }
     switch (p->method) {
@@ -175,16 +185,29 @@ static bsf_status_t segment(bsf_extractor_t *ex)
     bsf_status_t st;
     ex->n_segments = 0u;
     if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
-        return bsf_segment_rpos(&ex->points, &ex->params.rpos, ex->segments, BSF_MAX_SEGMENTS,
-                                &ex->n_segments, NULL);
+        size_t k;
+        size_t b;
+        st = bsf_segment_rpos(&ex->points, &ex->params.rpos, ex->segments, BSF_MAX_SEGMENTS,
+                              &ex->n_segments, NULL);
+        for (b = 0; b < ex->points.count; ++b) {
+            ex->seg_label[b] = (uint16_t)BSF_SEG_NONE;
+        }
+        for (k = 0; st == BSF_OK && k < ex->n_segments; ++k) {
+            for (b = ex->segments[k].first; b <= ex->segments[k].last; ++b) {
+                if (ex->points.valid[b]) {
+                    ex->seg_label[b] = ex->segments[k].first;
+                }
+            }
+        }
+        return st;
     }
-    st = bsf_segment_sved(&ex->points, &ex->params.sved, ex->segments, BSF_MAX_SEGMENTS,
-                          &ex->n_segments, NULL);
+    st = bsf_segment_sved_labelled(&ex->points, &ex->params.sved, ex->segments, BSF_MAX_SEGMENTS,
+                                   ex->seg_label, &ex->n_segments, NULL);
     if (st != BSF_OK) {
         return st;
     }
-    return bsf_segment_classify(ex->segments, ex->n_segments, &ex->points, ex->interest,
-                                ex->n_keypoints);
+    return bsf_segment_classify_labelled(ex->segments, ex->n_segments, &ex->points, ex->seg_label,
+                                         ex->interest, ex->n_keypoints);
 }
 
 /* Gather a segment's valid points into ex->scratch.fit.seg_points and the positions of
@@ -202,8 +225,16 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     while (k < ex->n_keypoints && ex->interest[k] < s->first) {
         ++k;
     }
-    for (b = s->first; b <= s->last; ++b) {
-        if (!ex->points.valid[b]) {
+    /* The segment's beams are those labelled with its first beam; a
+     * wrapping segment (first > last) runs on through beam 0. */
+    for (b = s->first;; b = (b + 1u < ex->points.count) ? b + 1u : 0u) {
+        if (b == 0u && s->first > 0u) {
+            k = 0u; /* wrapped through the seam */
+        }
+        if (ex->seg_label[b] != s->first) {
+            if (b == s->last) {
+                break;
+            }
             continue;
         }
         while (k < ex->n_keypoints && ex->interest[k] < b) {
@@ -214,6 +245,9 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
             ++k;
         }
         ex->scratch.fit.seg_points[n++] = ex->points.pt[b];
+        if (b == s->last) {
+            break;
+        }
     }
     *n_vertex = 0u;
     for (i = 0; i < nv; ++i) {
@@ -305,6 +339,10 @@ bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan, bsf_result
     clock_start(&clk, &ex->params);
 
     st = bsf_scan_to_points(scan, &ex->points);
+    if (st != BSF_OK) {
+        return st;
+    }
+    st = bsf_points_reject_no_return(&ex->points, &ex->params.no_return, NULL);
     if (st != BSF_OK) {
         return st;
     }

@@ -64,3 +64,77 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
     out->angle_increment = scan->angle_increment;
     return BSF_OK;
 }
+
+int bsf_points_full_circle(const bsf_points_t *pts)
+{
+    float inc;
+    float span;
+    if (pts == NULL || pts->count < 3u) {
+        return 0;
+    }
+    inc = fabsf(pts->angle_increment);
+    span = inc * (float)pts->count;
+    return fabsf(span - 2.0f * BSF_PI_F) <= inc;
+}
+
+bsf_no_return_params_t bsf_no_return_params_default(void)
+{
+    bsf_no_return_params_t p;
+    p.code = 0.0f;
+    p.min_run = 3u;
+    return p;
+}
+
+static void invalidate(bsf_points_t *pts, size_t i)
+{
+    pts->pt[i].x = 0.0f;
+    pts->pt[i].y = 0.0f;
+    pts->range[i] = 0.0f;
+    pts->valid[i] = 0u;
+    pts->n_valid--;
+}
+
+bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_params_t *p,
+                                         size_t *n_rejected)
+{
+    size_t i;
+    size_t n = 0;
+    float top = 0.0f;
+    int top_is_code = 0;
+    if (n_rejected != NULL) {
+        *n_rejected = 0;
+    }
+    if (pts == NULL || p == NULL || pts->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_ARG;
+    }
+    if (!is_finite_f(p->code) || p->code < 0.0f) {
+        return BSF_ERR_PARAM;
+    }
+    if (p->min_run > 0u) {
+        /* The largest valid reading, then its longest run of equal beams. */
+        size_t run = 0;
+        for (i = 0; i < pts->count; ++i) {
+            if (pts->valid[i] && pts->range[i] > top) {
+                top = pts->range[i];
+            }
+        }
+        for (i = 0; i < pts->count && top > 0.0f; ++i) {
+            run = (pts->valid[i] && pts->range[i] == top) ? run + 1u : 0u;
+            if (run >= (size_t)p->min_run) {
+                top_is_code = 1;
+                break;
+            }
+        }
+    }
+    for (i = 0; i < pts->count; ++i) {
+        if (pts->valid[i] && ((p->code > 0.0f && pts->range[i] == p->code) ||
+                              (top_is_code && pts->range[i] == top))) {
+            invalidate(pts, i);
+            ++n;
+        }
+    }
+    if (n_rejected != NULL) {
+        *n_rejected = n;
+    }
+    return BSF_OK;
+}

@@ -61,6 +61,46 @@ int bsf_range_is_valid(float r, float range_min, float range_max);
  */
 BSF_NODISCARD bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out);
 
+/**
+ * Do the beams cover the whole circle? True when |angle_increment| * count
+ * is within one |angle_increment| of 2 pi: the first and the last beam are
+ * then neighbours, and the segmentation and FALKO treat the beams as a ring.
+ */
+int bsf_points_full_circle(const bsf_points_t *pts);
+
+/** Parameters of bsf_points_reject_no_return. */
+typedef struct {
+    /** A reading exactly equal to this (after float conversion) is a
+     *  no-return code, metres; 0 = none given. For a sensor whose driver
+     *  codes "no return" as a fixed value (for example 50.0 or 81.91) but
+     *  does not declare it as its maximum range. */
+    float code;
+    /** Auto-detection: the scan's largest reading is a no-return code when
+     *  at least this many consecutive beams hold it bit for bit. 0 = off.
+     *  Default 3: a genuine surface cannot give three equal readings at the
+     *  scan's maximum (a corner's peak is one beam, a wall's foot point is a
+     *  local minimum), while a sensor with its sky or open door in view
+     *  writes its code in runs. */
+    uint16_t min_run;
+} bsf_no_return_params_t;
+
+/** Defaults: code 0 (none), min_run 3. */
+bsf_no_return_params_t bsf_no_return_params_default(void);
+
+/**
+ * Invalidate no-return codes in pts (after bsf_scan_to_points): every valid
+ * reading equal to p->code, and, when p->min_run > 0, every reading equal to
+ * the scan's largest valid reading if min_run consecutive beams hold exactly
+ * that value. Invalidated beams get valid 0, point (0,0), range 0 and leave
+ * n_valid.
+ * @param n_rejected  readings invalidated (may be NULL)
+ * @return BSF_OK; BSF_ERR_ARG for NULL pts or p; BSF_ERR_PARAM for a code
+ *         that is negative or not finite.
+ */
+BSF_NODISCARD bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts,
+                                                       const bsf_no_return_params_t *p,
+                                                       size_t *n_rejected);
+
 #ifdef __cplusplus
 }
 #endif
