@@ -503,6 +503,23 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     min_val = score_max * (long)p->min_score_th / 100L;
     n_peak = bsf_nms_beams(pts, work->score, BSF_NMS_HIGHER_IS_BETTER, (float)min_val,
                            p->nms_radius, work->peak);
+    if (ring && n_peak >= 2u) {
+        /* Suppression does not wrap: of two peaks facing each other across
+         * the seam within the suppression window, keep the stronger (the
+         * first on a tie), as suppression would have. */
+        const size_t lo = work->peak[0];
+        const size_t hi = work->peak[n_peak - 1u];
+        const size_t w_lo = bsf_nms_half_window(pts, lo, p->nms_radius);
+        const size_t w_hi = bsf_nms_half_window(pts, hi, p->nms_radius);
+        if (lo + pts->count - hi <= (w_lo > w_hi ? w_lo : w_hi)) {
+            if (work->score[hi] > work->score[lo]) {
+                for (k = 1; k < n_peak; ++k) {
+                    work->peak[k - 1u] = work->peak[k];
+                }
+            }
+            --n_peak;
+        }
+    }
 
     *n_out = n_peak;
     for (k = 0; k < n_peak && k < out_cap; ++k) {

@@ -23,7 +23,8 @@
  * last and the first beam, so a corner at the seam has neighbours on both
  * sides (FALKOLib clamps the window to the scan; on every scan that does not
  * cover the full circle this port still does, and gives its keypoints).
- * Non-maxima suppression does not wrap.
+ * Of two keypoints facing each other across the seam within the
+ * suppression window, only the stronger is kept.
  */
 #ifndef BSF_FALKO_H
 #define BSF_FALKO_H
