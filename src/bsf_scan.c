@@ -81,7 +81,7 @@ bsf_no_return_params_t bsf_no_return_params_default(void)
 {
     bsf_no_return_params_t p;
     p.code = 0.0f;
-    p.min_run = 3u;
+    p.min_run = 5u;
     return p;
 }
 
@@ -92,6 +92,30 @@ static void invalidate(bsf_points_t *pts, size_t i)
     pts->range[i] = 0.0f;
     pts->valid[i] = 0u;
     pts->n_valid--;
+}
+
+/* Does the run of equal readings [first, last] stand apart from its valid
+ * neighbours on both sides (or have none)? A no-return code does: the
+ * beams beside it hit a surface somewhere else. A surface seen head-on near
+ * the scan's maximum does not: its range changes by centimetres. */
+static int jumps_on_both_sides(const bsf_points_t *pts, size_t first, size_t last, float top)
+{
+    const float jump = 0.1f * top;
+    size_t j;
+    for (j = first; j > 0u; --j) {
+        if (pts->valid[j - 1u]) {
+            if (!(top - pts->range[j - 1u] > jump)) {
+                return 0;
+            }
+            break;
+        }
+    }
+    for (j = last + 1u; j < pts->count; ++j) {
+        if (pts->valid[j]) {
+            return top - pts->range[j] > jump;
+        }
+    }
+    return 1;
 }
 
 bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_params_t *p,
@@ -111,18 +135,18 @@ bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_
         return BSF_ERR_PARAM;
     }
     if (p->min_run > 0u) {
-        /* The largest valid reading, then its longest run of equal beams. */
+        /* The largest valid reading, then its runs of equal beams. */
         size_t run = 0;
         for (i = 0; i < pts->count; ++i) {
             if (pts->valid[i] && pts->range[i] > top) {
                 top = pts->range[i];
             }
         }
-        for (i = 0; i < pts->count && top > 0.0f; ++i) {
+        for (i = 0; i < pts->count && top > 0.0f && !top_is_code; ++i) {
             run = (pts->valid[i] && pts->range[i] == top) ? run + 1u : 0u;
-            if (run >= (size_t)p->min_run) {
-                top_is_code = 1;
-                break;
+            if (run >= (size_t)p->min_run &&
+                (i + 1u == pts->count || !pts->valid[i + 1u] || pts->range[i + 1u] != top)) {
+                top_is_code = jumps_on_both_sides(pts, i + 1u - run, i, top);
             }
         }
     }

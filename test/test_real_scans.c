@@ -221,7 +221,7 @@ static void test_an_isolated_code_needs_the_user_given_value(void)
 static void test_a_genuine_maximum_seen_by_two_beams_stays_valid(void)
 {
     /* The far corner of a square room straight ahead, between two beams: both
-     * see the same (largest) range, which is no run of three. */
+     * see the same (largest) range, which is no run of five. */
     bsf_lidar_t l = bsf_lidar_default(0.0, 0.0, 0.0, 180u, 3.14159265358979);
     bsf_scan_t s;
     bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
@@ -232,6 +232,38 @@ static void test_a_genuine_maximum_seen_by_two_beams_stays_valid(void)
     s = bsf_scene_lidar_scan(&l, ranges);
     extract(&p, &s);
     TEST_ASSERT_EQUAL_UINT32(180u, res.stats.n_valid);
+}
+
+static void test_a_run_of_equal_maxima_next_to_close_readings_is_a_surface(void)
+{
+    /* 60 beams: a bowl whose bottom (beams 27..32) reads exactly 3.50 m, its
+     * sides within centimetres of that, versus the same run beside readings
+     * 2 m nearer (a code seen through an opening). */
+    bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
+    bsf_scan_t s;
+    size_t i;
+    for (i = 0; i < 60u; ++i) {
+        const float off = (float)(i < 27u ? 27u - i : (i > 32u ? i - 32u : 0u));
+        ranges[i] = 3.5f - 0.01f * off;
+    }
+    s.ranges = ranges;
+    s.count = 60u;
+    s.angle_min = -0.5f;
+    s.angle_increment = 0.0174533f;
+    s.range_min = 0.0f;
+    s.range_max = 81.8f;
+    extract(&p, &s);
+    TEST_ASSERT_EQUAL_UINT32(60u, res.stats.n_valid);
+    for (i = 0; i < 60u; ++i) {
+        if (i < 27u || i > 32u) {
+            ranges[i] = 1.5f;
+        }
+    }
+    extract(&p, &s);
+    TEST_ASSERT_EQUAL_UINT32(54u, res.stats.n_valid);
+    p.no_return.min_run = 7u; /* a longer run than this one: not a code */
+    extract(&p, &s);
+    TEST_ASSERT_EQUAL_UINT32(60u, res.stats.n_valid);
 }
 
 /* ---- far ranges ------------------------------------------------------------ */
@@ -679,6 +711,7 @@ int main(void)
     RUN_TEST(test_undeclared_no_return_code_in_runs_is_never_a_point);
     RUN_TEST(test_an_isolated_code_needs_the_user_given_value);
     RUN_TEST(test_a_genuine_maximum_seen_by_two_beams_stays_valid);
+    RUN_TEST(test_a_run_of_equal_maxima_next_to_close_readings_is_a_surface);
     RUN_TEST(test_far_sparse_points_are_not_chained_metres_apart);
     RUN_TEST(test_a_mixed_pixel_at_a_depth_jump_bends_no_feature);
     RUN_TEST(test_a_wall_at_a_grazing_angle_is_no_mixed_pixel);

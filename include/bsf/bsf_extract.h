@@ -63,8 +63,9 @@ typedef struct {
 bsf_params_t bsf_params_default(bsf_method_t method);
 
 /** The paper-faithful configuration of a method: as bsf_params_default but
- *  with the paper's SVED rule (bsf_sved_params_paper) and no no-return
- *  detection beyond range_max. `bsf table1 --paper` uses it. */
+ *  with the paper's SVED rule (bsf_sved_params_paper), no no-return
+ *  detection beyond range_max, and PDM's refinement target at the first
+ *  release's 15 mm (the paper states none). `bsf table1 --paper` uses it. */
 bsf_params_t bsf_params_paper(bsf_method_t method);
 
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for

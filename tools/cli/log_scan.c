@@ -27,7 +27,12 @@ uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 
 int init_extractor(bsf_method_t method)
 {
-    bsf_params_t p = bsf_params_default(method);
+    return init_extractor_config(method, 0);
+}
+
+int init_extractor_config(bsf_method_t method, int paper)
+{
+    bsf_params_t p = paper ? bsf_params_paper(method) : bsf_params_default(method);
     bsf_status_t st;
     p.clock = bsf_port_clock_monotonic_ns;
     p.clock_hz = 1000000000u;

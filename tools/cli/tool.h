@@ -132,6 +132,8 @@ extern uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 
 /** Initialise g_ex for a method with the monotonic clock. 0, or -1 with a message. */
 int init_extractor(bsf_method_t method);
+/** As init_extractor; paper != 0 takes bsf_params_paper (the paper-faithful configuration). */
+int init_extractor_config(bsf_method_t method, int paper);
 
 /* ---- the commands (cmd_*.c) ---------------------------------------------- */
 
