@@ -143,78 +143,6 @@ static float exp_lower_bound(float x)
     return 1.0f + x * (1.0f + x * (0.5f + x * (0.16666667f + x * 0.041666668f)));
 }
 
-bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *params,
-                              bsf_segment_t *out, size_t cap, size_t *n_out,
-                              size_t *n_wasted_points)
-{
-    const bsf_sved_params_t defaults = bsf_sved_params_default();
-    const bsf_sved_params_t *p = params != NULL ? params : &defaults;
-    seg_sink_t sink;
-    bsf_status_t st;
-    float a2;
-    float two_b;
-    bsf_point_t prev = {0.0f, 0.0f};
-    size_t first = 0;
-    size_t last = 0;
-    size_t n_cur = 0;
-    size_t i;
-
-    st = begin(pts, out, cap, n_out, n_wasted_points, &sink);
-    if (st != BSF_OK) {
-        return st;
-    }
-    st = bsf_sved_params_check(p);
-    if (st != BSF_OK) {
-        return BSF_ERR_PARAM;
-    }
-    sink.min_points = p->min_segment_points;
-    /* Compare squared distances: d <= a*exp(b*rho)  <=>  d^2 <= a^2*exp(2*b*rho). */
-    a2 = p->a * p->a;
-    two_b = 2.0f * p->b;
-
-    /* The first valid point opens the first segment; then one pass. */
-    for (i = 0; i < pts->count && !pts->valid[i]; ++i) {
-    }
-    if (i == pts->count) {
-        return finish(&sink, n_out, n_wasted_points);
-    }
-    first = i;
-    last = i;
-    prev = pts->pt[i];
-    n_cur = 1;
-    for (++i; i < pts->count; ++i) {
-        const bsf_point_t q = pts->pt[i];
-        float dx;
-        float dy;
-        float d2;
-        if (!pts->valid[i]) {
-            continue; /* an invalid beam never breaks a segment by itself */
-        }
-        dx = q.x - prev.x;
-        dy = q.y - prev.y;
-        d2 = dx * dx + dy * dy;
-        /* Decide without expf where possible: r(rho) >= a, and the Taylor
-         * polynomial of exp to degree 4 never exceeds exp for x >= 0, so
-         * steps within a^2 * poly(x) join. expf is left for the few steps
-         * near or beyond the threshold. NaN breaks. */
-        if (!(d2 <= a2) && !(d2 <= a2 * exp_lower_bound(two_b * pts->range[i])) &&
-            !(d2 <= a2 * bsf_expf(two_b * pts->range[i]))) {
-            if (!sink_close(&sink, first, last, n_cur)) {
-                return BSF_ERR_CAPACITY;
-            }
-            first = i;
-            n_cur = 0;
-        }
-        ++n_cur;
-        last = i;
-        prev = q;
-    }
-    if (!sink_close(&sink, first, last, n_cur)) {
-        return BSF_ERR_CAPACITY;
-    }
-    return finish(&sink, n_out, n_wasted_points);
-}
-
 /* ---- SVED with look-back, radius cap, mixed pixels and full-circle scans ---- */
 
 /* One open segment of the labelled pass. */
@@ -350,9 +278,11 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
     return 0u;
 }
 
-bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
-                                       bsf_segment_t *out, size_t cap, uint16_t *label,
-                                       size_t *n_out, size_t *n_wasted_points)
+/* Both SVED entry points: with extensions 0, the paper's rule whatever the
+ * extension fields say (checked, then ignored), and no full-circle pass. */
+static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                             bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
+                             size_t *n_out, size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
@@ -367,6 +297,7 @@ bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_p
     float a2;
     float two_b;
     float cap2;
+    int reject_mixed;
     int ring;
 
     st = begin(pts, out, cap, n_out, n_wasted_points, &sink);
@@ -380,9 +311,10 @@ bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_p
     sink.min_points = p->min_segment_points;
     a2 = p->a * p->a;
     two_b = 2.0f * p->b;
-    cap2 = p->radius_max * p->radius_max;
-    slots = 1u + (size_t)p->lookback;
-    ring = bsf_points_full_circle(pts);
+    cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
+    slots = extensions ? 1u + (size_t)p->lookback : 1u;
+    reject_mixed = extensions && p->reject_mixed;
+    ring = extensions && bsf_points_full_circle(pts);
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
@@ -404,7 +336,7 @@ bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_p
         if (!pts->valid[b]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
-        if (p->reject_mixed && is_mixed_pixel(pts, b, ring, a2, two_b, cap2)) {
+        if (reject_mixed && is_mixed_pixel(pts, b, ring, a2, two_b, cap2)) {
             sink.n_wasted++;
             continue;
         }
@@ -485,6 +417,20 @@ bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_p
         sink.out[k] = s;
     }
     return finish(&sink, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                              bsf_segment_t *out, size_t cap, size_t *n_out,
+                              size_t *n_wasted_points)
+{
+    return sved_run(pts, params, out, cap, NULL, 0, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                                       bsf_segment_t *out, size_t cap, uint16_t *label,
+                                       size_t *n_out, size_t *n_wasted_points)
+{
+    return sved_run(pts, params, out, cap, label, 1, n_out, n_wasted_points);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,
@@ -579,32 +525,6 @@ bsf_status_t bsf_segment_rpos(const bsf_points_t *pts, const bsf_rpos_params_t *
     return finish(&sink, n_out, n_wasted_points);
 }
 
-/* First valid beam in [from, to] into *at; 0 when there is none. */
-static int next_valid(const bsf_points_t *pts, size_t from, size_t to, size_t *at)
-{
-    for (; from <= to; ++from) {
-        if (pts->valid[from]) {
-            *at = from;
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* Last valid beam in [from, to] into *at; 0 when there is none. */
-static int prev_valid(const bsf_points_t *pts, size_t from, size_t to, size_t *at)
-{
-    size_t i = to + 1u;
-    while (i > from) {
-        --i;
-        if (pts->valid[i]) {
-            *at = i;
-            return 1;
-        }
-    }
-    return 0;
-}
-
 /* Index of the first interest beam > key (interest is strictly ascending). */
 static size_t upper_bound(const uint16_t *interest, size_t n, size_t key)
 {
@@ -619,54 +539,6 @@ static size_t upper_bound(const uint16_t *interest, size_t n, size_t key)
         }
     }
     return lo;
-}
-
-bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
-                                  const uint16_t *interest_beams, size_t n_interest)
-{
-    size_t k;
-    if (pts == NULL || (segs == NULL && n > 0u) || (interest_beams == NULL && n_interest > 0u)) {
-        return BSF_ERR_ARG;
-    }
-    if (pts->count > (size_t)BSF_MAX_POINTS) {
-        return BSF_ERR_CAPACITY;
-    }
-    for (k = 1; k < n_interest; ++k) {
-        if (interest_beams[k] <= interest_beams[k - 1u]) {
-            return BSF_ERR_ARG;
-        }
-    }
-    for (k = 0; k < n; ++k) {
-        if (segs[k].first > segs[k].last || (size_t)segs[k].last >= pts->count) {
-            return BSF_ERR_ARG;
-        }
-    }
-
-    for (k = 0; k < n; ++k) {
-        bsf_segment_t *s = &segs[k];
-        const size_t first = s->first;
-        const size_t last = s->last;
-        size_t count = 0;
-        size_t v0 = 0;
-        size_t v1 = 0;
-        size_t w0 = 0;
-        size_t w1 = 0;
-        /* Inner interest points lie strictly between the second valid point
-         * (v1) and the last-but-one valid point (w1). */
-        if (next_valid(pts, first, last, &v0) && v0 < last && next_valid(pts, v0 + 1u, last, &v1) &&
-            prev_valid(pts, first, last, &w0) && w0 > first &&
-            prev_valid(pts, first, w0 - 1u, &w1) && v1 < w1) {
-            size_t j = upper_bound(interest_beams, n_interest, v1);
-            for (; j < n_interest && (size_t)interest_beams[j] < w1; ++j) {
-                if (pts->valid[interest_beams[j]]) {
-                    ++count;
-                }
-            }
-        }
-        s->n_interest = (uint8_t)(count > 255u ? 255u : count);
-        s->kind = (uint8_t)(count > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK);
-    }
-    return BSF_OK;
 }
 
 /* Is beam b one of the (strictly ascending) interest beams? */
@@ -733,4 +605,22 @@ bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const 
         s->kind = (uint8_t)(count > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK);
     }
     return BSF_OK;
+}
+
+bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
+                                  const uint16_t *interest_beams, size_t n_interest)
+{
+    size_t k;
+    if (pts == NULL || (segs == NULL && n > 0u) || (interest_beams == NULL && n_interest > 0u)) {
+        return BSF_ERR_ARG;
+    }
+    if (pts->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    for (k = 0; k < n; ++k) {
+        if (segs[k].first > segs[k].last) {
+            return BSF_ERR_ARG; /* no wrapping segments here */
+        }
+    }
+    return bsf_segment_classify_labelled(segs, n, pts, NULL, interest_beams, n_interest);
 }
