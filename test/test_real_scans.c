@@ -409,8 +409,11 @@ static void build_outdoor(void)
 static double outdoor_share(const bsf_params_t *p, size_t *n_features, double *far)
 {
     bsf_scene_rng_t rng;
+    bsf_metrics_acc_t acc;
+    bsf_metrics_summary_t sum;
     size_t good = 0, all = 0;
     int k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, NULL, 0u));
     *far = 0.0;
     bsf_scene_rng_seed(&rng, 5u);
     for (k = 0; k < 24; ++k) {
@@ -427,6 +430,11 @@ static double outdoor_share(const bsf_params_t *p, size_t *n_features, double *f
         s = bsf_scene_lidar_scan(&l, ranges);
         s.range_max = 81.8f;
         extract(p, &s);
+        {
+            bsf_scan_counts_t c;
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_counts(&res, &c));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+        }
         for (i = 0; i < res.n_features; ++i) {
             const double w = worst_point_to_curve(&res.features[i]);
             good += w <= 0.3;
@@ -445,6 +453,9 @@ static double outdoor_share(const bsf_params_t *p, size_t *n_features, double *f
         }
     }
     *n_features = all;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_summary(&acc, &sum));
+    printf("  retrievability %.1f %%, compactness %.3f, accuracy %.4f m\n",
+           100.0 * (double)sum.retrievability, (double)sum.compactness, (double)sum.accuracy);
     return all > 0u ? (double)good / (double)all : 0.0;
 }
 
