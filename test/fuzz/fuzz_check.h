@@ -29,8 +29,10 @@ static inline int fuzz_finite(float v)
 }
 
 /* A result is within the caps, self-consistent and free of NaN/inf. With
- * `ordered`, features must also come in beam order without overlap (the
- * extractor's promise; the wire format itself allows any order). */
+ * `ordered`, features must also come in order of their first beams (the
+ * extractor's promise; the wire format itself allows any order); their runs
+ * may overlap (the segmentation's look-back) and, on a full-circle scan,
+ * wrap through the seam (first_beam > last_beam). */
 static inline void fuzz_check_result(const bsf_result_t *r, int ordered)
 {
     uint32_t sum_points = 0u;
@@ -41,16 +43,18 @@ static inline void fuzz_check_result(const bsf_result_t *r, int ordered)
     FUZZ_CHECK(r->n_ctrl <= BSF_MAX_CTRL_POINTS);
     for (f = 0; f < r->n_features; ++f) {
         const bsf_feature_t *ft = &r->features[f];
-        FUZZ_CHECK(ft->first_beam <= ft->last_beam);
+        const int wraps = ft->first_beam > ft->last_beam;
+        FUZZ_CHECK(!wraps || (ordered && ft->first_beam < r->stats.n_beams));
         FUZZ_CHECK(ft->last_beam < BSF_MAX_POINTS);
-        FUZZ_CHECK(ft->n_points <= ft->last_beam - ft->first_beam + 1u);
+        FUZZ_CHECK(ft->n_points <= (wraps ? r->stats.n_beams - ft->first_beam + ft->last_beam + 1u
+                                          : ft->last_beam - ft->first_beam + 1u));
         FUZZ_CHECK(!ordered || ft->n_points >= 1u); /* the wire format allows 0 */
         FUZZ_CHECK(ft->n_ctrl >= 3u && ft->n_ctrl <= BSF_MAX_CTRL_PER_FEATURE);
         FUZZ_CHECK(ft->ctrl_first == next_ctrl); /* features own consecutive pool slices */
         FUZZ_CHECK(ft->kind <= 1u);
         FUZZ_CHECK(fuzz_finite(ft->e_curve) && ft->e_curve >= 0.0f);
         if (ordered && f > 0u) {
-            FUZZ_CHECK(ft->first_beam > r->features[f - 1u].last_beam);
+            FUZZ_CHECK(ft->first_beam > r->features[f - 1u].first_beam);
         }
         next_ctrl += ft->n_ctrl;
         sum_points += ft->n_points;
