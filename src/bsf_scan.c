@@ -95,18 +95,22 @@ static void invalidate(bsf_points_t *pts, size_t i)
 }
 
 /* Does the run of equal readings [first, last] stand apart from its valid
- * neighbours on both sides (or have none)? A no-return code does: the
- * beams beside it hit a surface somewhere else. A surface seen head-on near
- * the scan's maximum does not: its range changes by centimetres. */
+ * neighbours: at least one, and each one there is reads more than 10 % less?
+ * A no-return code does: the beams beside it hit a surface somewhere else.
+ * A surface seen head-on near the scan's maximum does not: its range changes
+ * by centimetres. A scan of nothing but equal readings has no neighbour to
+ * tell, and stays valid. */
 static int jumps_on_both_sides(const bsf_points_t *pts, size_t first, size_t last, float top)
 {
     const float jump = 0.1f * top;
+    int seen = 0;
     size_t j;
     for (j = first; j > 0u; --j) {
         if (pts->valid[j - 1u]) {
             if (!(top - pts->range[j - 1u] > jump)) {
                 return 0;
             }
+            seen = 1;
             break;
         }
     }
@@ -115,7 +119,7 @@ static int jumps_on_both_sides(const bsf_points_t *pts, size_t first, size_t las
             return top - pts->range[j] > jump;
         }
     }
-    return 1;
+    return seen;
 }
 
 bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_params_t *p,

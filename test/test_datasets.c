@@ -17,6 +17,7 @@
 
 #include "bsf/bsf.h"
 #include "carmen.h"
+#include "shared_dir.h"
 #include "unity.h"
 
 static char data_dir[2048];
@@ -145,11 +146,12 @@ static void test_every_row_stays_within_its_recorded_bounds(void)
 
 int main(void)
 {
-    const char *env = getenv("BSF_SHARED_DIR");
+    char shared_dir[2048];
     char probe_path[4096];
     FILE *probe;
     size_t d;
-    snprintf(data_dir, sizeof data_dir, "%s/data", env != NULL ? env : BSF_SHARED_DIR_DEFAULT);
+    bsf_test_shared_dir(shared_dir, sizeof shared_dir);
+    snprintf(data_dir, sizeof data_dir, "%s/data", shared_dir);
     for (d = 0; d < 4u; ++d) {
         snprintf(probe_path, sizeof probe_path, "%s/%s", data_dir, datasets[d].file);
         probe = fopen(probe_path, "rb");

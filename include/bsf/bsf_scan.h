@@ -8,9 +8,7 @@
 
 #include "bsf_common.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /**
  * One 2D LIDAR scan as the driver delivers it. Beam i points at
@@ -77,17 +75,17 @@ typedef struct {
     float code;
     /** Auto-detection: the scan's largest reading is a no-return code when
      *  at least this many consecutive beams hold it bit for bit and the
-     *  valid beams on either side of that run read more than 10 % less (or
-     *  there are none). 0 = off. Default 5, the shortest kept segment of
+     *  valid beams beside that run (at least one) read more than 10 % less.
+     *  0 = off. Default 5, the shortest kept segment of
      *  the default SVED: a shorter run of far readings cannot make a
      *  feature of its own, and being 10 % away from its neighbours it joins
      *  none of theirs (the radius is capped at 1 m). A genuine surface
      *  rarely does this: a corner's peak is one beam, and a surface seen
      *  head-on near the scan's maximum changes by centimetres beside its
-     *  run. Measured on the four paper logs (their codes lie above the
-     *  declared maximum, so every reading this rule takes is a genuine one):
-     *  0 readings taken; 117 with runs of 3 and no 10 % condition, 23 with
-     *  runs of 3, 4 with runs of 4. */
+     *  run. A scan of nothing but equal readings (a round room from its
+     *  centre, or nothing but sky) is left alone. Measured on the four paper logs (their codes lie
+     * above the declared maximum, so every reading this rule takes is a genuine one): 0 readings
+     * taken; 117 with runs of 3 and no 10 % condition, 23 with runs of 3, 4 with runs of 4. */
     uint16_t min_run;
 } bsf_no_return_params_t;
 
@@ -99,8 +97,8 @@ bsf_no_return_params_t bsf_no_return_params_default(void);
  * reading equal to p->code, and, when p->min_run > 0, every reading equal to
  * the scan's largest valid reading if a run of min_run or more consecutive
  * beams holds exactly that value and stands more than 10 % above its valid
- * neighbours (see bsf_no_return_params_t). Invalidated beams get valid 0, point (0,0), range 0 and
- * leave n_valid.
+ * neighbours, of which it has at least one (see bsf_no_return_params_t). Invalidated beams get
+ * valid 0, point (0,0), range 0 and leave n_valid.
  * @param n_rejected  readings invalidated (may be NULL)
  * @return BSF_OK; BSF_ERR_ARG for NULL pts or p; BSF_ERR_PARAM for a code
  *         that is negative or not finite.
@@ -109,8 +107,6 @@ BSF_NODISCARD bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts,
                                                        const bsf_no_return_params_t *p,
                                                        size_t *n_rejected);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_SCAN_H */
