@@ -33,6 +33,12 @@ int init_extractor(bsf_method_t method)
 int init_extractor_config(bsf_method_t method, int paper)
 {
     bsf_params_t p = paper ? bsf_params_paper(method) : bsf_params_default(method);
+    return init_extractor_params(&p);
+}
+
+int init_extractor_params(const bsf_params_t *params)
+{
+    bsf_params_t p = *params;
     bsf_status_t st;
     p.clock = bsf_port_clock_monotonic_ns;
     p.clock_hz = 1000000000u;

@@ -134,6 +134,8 @@ extern uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 int init_extractor(bsf_method_t method);
 /** As init_extractor; paper != 0 takes bsf_params_paper (the paper-faithful configuration). */
 int init_extractor_config(bsf_method_t method, int paper);
+/** Initialise g_ex with these parameters plus the monotonic clock. 0, or -1 with a message. */
+int init_extractor_params(const bsf_params_t *params);
 
 /* ---- the commands (cmd_*.c) ---------------------------------------------- */
 
