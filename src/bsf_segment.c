@@ -222,6 +222,12 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, float a2,
            r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump;
 }
 
+/* Output order: by first beam, a segment wrapping through the seam last. */
+static uint32_t beam_order_key(const bsf_segment_t *s)
+{
+    return (s->first > s->last ? 0x10000u : 0u) + (uint32_t)s->first;
+}
+
 /* Next beam after b on the pass (wrapping at count). */
 static size_t next_beam(size_t b, size_t count)
 {
@@ -406,11 +412,12 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             return BSF_ERR_CAPACITY;
         }
     }
-    /* Kept segments by first beam (closing order is nearly that already). */
+    /* Kept segments by first beam, one wrapping through the seam last
+     * (closing order is nearly that already). */
     for (j = 1; j < sink.n_out; ++j) {
         const bsf_segment_t s = sink.out[j];
         k = j;
-        while (k > 0u && sink.out[k - 1u].first > s.first) {
+        while (k > 0u && beam_order_key(&sink.out[k - 1u]) > beam_order_key(&s)) {
             sink.out[k] = sink.out[k - 1u];
             --k;
         }
