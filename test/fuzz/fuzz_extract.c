@@ -18,7 +18,8 @@ enum {
     F_RAW_GEOM = 0x04,   /* geometry is raw float bits (else small codes) */
     F_PARAMS = 0x08,     /* segmentation and FALKO parameters follow */
     F_OVER_CAP = 0x10,   /* claim one beam more than BSF_MAX_POINTS */
-    F_ENCODE = 0x20      /* also encode and decode the result */
+    F_ENCODE = 0x20,     /* also encode and decode the result */
+    F_FULL_CIRCLE = 0x40 /* the beams cover the whole circle (seam wrap paths) */
 };
 
 static bsf_extractor_t ex;
@@ -165,6 +166,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     scan.ranges = ranges;
     scan.count = count;
+    if ((flags & F_FULL_CIRCLE) && count > 0u) {
+        scan.angle_increment = 6.2831853f / (float)count;
+    }
 
     memset(&res, 0x5A, sizeof res);
     st = bsf_extract(&ex, &scan, &res);
