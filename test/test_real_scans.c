@@ -548,6 +548,28 @@ static bsf_lidar_t rotate_scan(const bsf_lidar_t *a, const float *from, size_t s
 }
 
 static float scan_a[BSF_MAX_POINTS];
+static uint8_t frame[BSF_FRAME_MAX_SIZE];
+static uint8_t body[BSF_FRAME_MAX_SIZE];
+static bsf_frame_t decoded;
+
+/* The result travels through the wire format with its wrapping run intact. */
+static void assert_frame_carries_the_runs(void)
+{
+    bsf_frame_info_t info;
+    size_t len = 0u;
+    size_t body_len = 0u;
+    size_t i;
+    bsf_frame_info_init(&info);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, frame, sizeof frame, &len));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(frame, len - 1u, body, sizeof body, &body_len));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, body_len, &decoded));
+    TEST_ASSERT_EQUAL_UINT16(res.n_features, decoded.result.n_features);
+    for (i = 0; i < res.n_features; ++i) {
+        TEST_ASSERT_EQUAL_UINT16(res.features[i].first_beam, decoded.result.features[i].first_beam);
+        TEST_ASSERT_EQUAL_UINT16(res.features[i].last_beam, decoded.result.features[i].last_beam);
+        TEST_ASSERT_EQUAL_UINT16(res.features[i].n_points, decoded.result.features[i].n_points);
+    }
+}
 
 /* Distance from sensor-frame (x, y) to the nearest vertex of the result. */
 static double nearest_vertex(double x, double y)
@@ -686,6 +708,7 @@ static void ring_case(size_t n_beams)
     TEST_ASSERT_EQUAL_UINT(n_plain, res.n_features);
     TEST_ASSERT_EQUAL_UINT(1u, n_wrapping());
     same_fits(&l, e_a, truth_a);
+    assert_frame_carries_the_runs();
 }
 
 static void test_full_circle_360_beams_seam_is_invisible(void)
