@@ -18,7 +18,8 @@ enum {
     F_RAW_GEOM = 0x04,   /* geometry is raw float bits (else small codes) */
     F_PARAMS = 0x08,     /* segmentation and FALKO parameters follow */
     F_OVER_CAP = 0x10,   /* claim one beam more than BSF_MAX_POINTS */
-    F_ENCODE = 0x20      /* also encode and decode the result */
+    F_ENCODE = 0x20,     /* also encode and decode the result */
+    F_FULL_CIRCLE = 0x40 /* the beams cover the whole circle (seam wrap paths) */
 };
 
 static bsf_extractor_t ex;
@@ -109,6 +110,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     bsf_status_t st;
     size_t count = 0u;
     size_t n_valid = 0u;
+    size_t n_top = 0u;
+    float top = 0.0f;
     size_t i;
     uint8_t flags;
     if (size == 0u) {
@@ -163,6 +166,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     scan.ranges = ranges;
     scan.count = count;
+    if ((flags & F_FULL_CIRCLE) && count > 0u) {
+        scan.angle_increment = 6.2831853f / (float)count;
+    }
 
     memset(&res, 0x5A, sizeof res);
     st = bsf_extract(&ex, &scan, &res);
@@ -177,9 +183,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(count <= BSF_MAX_POINTS);
     fuzz_check_result(&res, 1);
     for (i = 0; i < count; ++i) {
-        n_valid += (size_t)bsf_range_is_valid(ranges[i], scan.range_min, scan.range_max);
+        if (bsf_range_is_valid(ranges[i], scan.range_min, scan.range_max)) {
+            ++n_valid;
+            top = ranges[i] > top ? ranges[i] : top;
+        }
     }
-    FUZZ_CHECK(res.stats.n_valid == n_valid);
+    for (i = 0; i < count; ++i) {
+        n_top += (size_t)(bsf_range_is_valid(ranges[i], scan.range_min, scan.range_max) &&
+                          ranges[i] == top);
+    }
+    /* No-return detection may invalidate every reading equal to the largest
+     * valid one (runs of at least min_run of them), nothing else. */
+    FUZZ_CHECK(res.stats.n_valid == n_valid ||
+               (res.stats.n_valid == n_valid - n_top && n_top >= ex.params.no_return.min_run &&
+                ex.params.no_return.min_run > 0u));
     FUZZ_CHECK(res.stats.n_keypoints <= BSF_MAX_KEYPOINTS);
     for (i = 0; i < res.n_features; ++i) {
         FUZZ_CHECK(res.features[i].last_beam < count);

@@ -73,7 +73,8 @@ def test_methods_and_parameters():
     loose = bsf.extract(ranges, amin, inc, 0.05, 30.0, pdm_target_rms=0.1)
     tight = bsf.extract(ranges, amin, inc, 0.05, 30.0, pdm_target_rms=0.004)
     assert loose.stats.n_ctrl < tight.stats.n_ctrl
-    assert bsf.default_params()["pdm_target_rms"] == pytest.approx(0.015)
+    assert bsf.default_params()["pdm_target_rms"] == pytest.approx(0.025)
+    assert bsf.default_params()["sved_lookback"] == 4 and bsf.default_params()["no_return_min_run"] == 5
     assert bsf.Extractor(sved_min_segment_points=7).params["sved_min_segment_points"] == 7
 
 
@@ -140,9 +141,12 @@ def test_bsf_error_is_a_value_error_with_status():
 
 def test_a_scan_over_a_cap_keeps_what_fits():
     # 1365 runs of 3 beams alternating between 2 m and 6 m: more segments than
-    # the host cap; the library returns BSF_OK_CUT, which is a result, not an error
+    # the host cap under the paper's segmentation rule (the default look-back
+    # joins every run at one range into one segment); the library returns
+    # BSF_OK_CUT, which is a result, not an error
     r = np.where((np.arange(4096) // 3) % 2 == 0, 2.0, 6.0)
-    fr = bsf.extract(r, -np.pi, 2 * np.pi / 4096, 0.05, 30.0, sved_min_segment_points=3)
+    fr = bsf.extract(r, -np.pi, 2 * np.pi / 4096, 0.05, 30.0, sved_min_segment_points=3,
+                     sved_lookback=0)
     assert fr.stats.cut == 2 and fr.stats.n_cut_segments > 0  # BSF_CUT_SEGMENTS
     assert len(fr.features) == bsf.caps["BSF_MAX_SEGMENTS"]
     assert len(bsf.decode(bsf.encode(fr))[0].features) == len(fr.features)
