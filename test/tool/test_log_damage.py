@@ -20,7 +20,7 @@ import sys
 import zlib
 from concurrent.futures import ThreadPoolExecutor
 
-BSF, WORK = sys.argv[1], sys.argv[2]
+BSF, WORK = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
 SHARED = sys.argv[3] if len(sys.argv) > 3 else ""
 failures = []
 
