@@ -13,9 +13,10 @@
  * no-return codes invalid (or exactly the --range-max given), and
  * bsf_scan_to_points accepts or cleanly refuses it.
  *
- * Input gzip data (starting 1f 8b) is written to a file named *.log.gz, so
- * cut or corrupt gzip streams reach the reader's read-error paths; other
- * input goes to a plain *.log file.
+ * Input starting with 0x1f (gzip data starts 1f 8b) is written to a file
+ * named *.log.gz, so cut or corrupt gzip streams (and non-gzip data under a
+ * .gz name) reach the reader's read-error paths; other input goes to a
+ * plain *.log file.
  */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, unlink, rmdir, access, open_memstream */
 
@@ -111,12 +112,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t i;
     int rc;
     const int is_gzip = size >= 2u && data[0] == 0x1Fu && data[1] == 0x8Bu;
+    /* a first byte of 0x1f goes to the .gz name even without the rest of
+     * the magic: "not gzip data" */
+    const int gz_name = size >= 1u && data[0] == 0x1Fu;
     const char *path;
     if (path_plain[0] == '\0') {
         make_temp();
         atexit(remove_temp);
     }
-    path = is_gzip ? path_gz : path_plain;
+    path = gz_name ? path_gz : path_plain;
     f = fopen(path, "wb");
     FUZZ_CHECK(f != NULL);
     FUZZ_CHECK(fwrite(data, 1, size, f) == size);
@@ -153,6 +157,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FUZZ_CHECK(scan.range_max == s.max_range);
         }
         st = bsf_scan_to_points(&scan, &points);
+        fuzz_check_status(st);
         FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_ARG || st == BSF_ERR_CAPACITY);
         FUZZ_CHECK((st == BSF_ERR_CAPACITY) == (s.count > BSF_MAX_POINTS) || st == BSF_ERR_ARG);
         if (st == BSF_OK) {

@@ -125,6 +125,34 @@ static void check_roundtrip(void)
     }
 }
 
+/* Every feature's curve evaluates to finite points and derivatives along
+ * its length; the basis sums to 1; a NaN parameter is refused, outputs
+ * untouched. */
+static void check_curves(void)
+{
+    static const float ts[4] = {0.0f, 0.37f, 0.5f, 1.0f};
+    size_t f, k;
+    for (f = 0; f < res.n_features; ++f) {
+        const bsf_feature_t *ft = &res.features[f];
+        const bsf_point_t *c = &res.ctrl[ft->ctrl_first];
+        bsf_point_t pt, d1, d2, keep;
+        for (k = 0; k < 4u; ++k) {
+            float u = -1.0f, basis[3], b1[3], b2[3];
+            const size_t span = bsf_bspline_span(ft->n_ctrl, ts[k], &u);
+            FUZZ_CHECK(span <= (size_t)ft->n_ctrl - 3u && u >= 0.0f && u <= 1.0f);
+            bsf_bspline_basis(ft->n_ctrl, span, u, basis, b1, b2);
+            FUZZ_CHECK(fabsf(basis[0] + basis[1] + basis[2] - 1.0f) <= 1e-5f);
+            FUZZ_CHECK(bsf_bspline_eval(c, ft->n_ctrl, ts[k], &pt, &d1, &d2) == BSF_OK);
+            FUZZ_CHECK(fuzz_finite(pt.x) && fuzz_finite(pt.y));
+            FUZZ_CHECK(fuzz_finite(d1.x) && fuzz_finite(d1.y));
+            FUZZ_CHECK(fuzz_finite(d2.x) && fuzz_finite(d2.y));
+        }
+        keep = pt;
+        FUZZ_CHECK(bsf_bspline_eval(c, ft->n_ctrl, NAN, &pt, NULL, NULL) == BSF_ERR_ARG);
+        FUZZ_CHECK(memcmp(&keep, &pt, sizeof pt) == 0);
+    }
+}
+
 /* Stats times: all 0 without a clock; with one, the whole time covers every
  * stage (the fake clock cannot wrap: at most 5 calls of < 2^16 ticks). */
 static void check_times(const bsf_params_t *p)
@@ -269,6 +297,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_PARAM);
     FUZZ_CHECK((st == BSF_OK) == (bsf_params_check(&params) == BSF_OK));
     extractor_ok = st == BSF_OK;
+    fuzz_check_status(st);
+    {
+        /* method names round-trip; unknown methods have none */
+        const char *name = bsf_method_name(params.method);
+        FUZZ_CHECK((name != NULL) == ((unsigned)params.method < (unsigned)BSF_METHOD_COUNT));
+        FUZZ_CHECK(name == NULL || bsf_method_from_name(name) == params.method);
+    }
 
     while (in.n > 0u && count < BSF_MAX_POINTS) {
         if (flags & F_RAW_RANGES) {
@@ -291,6 +326,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     memset(&res, 0x5A, sizeof res);
     st = bsf_extract(&ex, &scan, &res);
+    fuzz_check_status(st);
     if (!extractor_ok) {
         FUZZ_CHECK(st == BSF_ERR_ARG || st == BSF_ERR_PARAM); /* never initialised */
         return 0;
@@ -311,6 +347,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (i = 0; i < res.n_features; ++i) {
         FUZZ_CHECK(res.features[i].last_beam < count);
     }
+    check_curves();
     if (flags & F_ENCODE) {
         check_roundtrip();
     }

@@ -332,6 +332,7 @@ static void fuzz_encoder(const uint8_t *p, size_t n, uint8_t sel)
         }
     }
     st = bsf_frame_encode(&info, &edited, wire, sizeof wire, &len);
+    fuzz_check_status(st);
     FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_ARG || st == BSF_ERR_CAPACITY);
     if (st != BSF_OK) {
         /* the sink variant refuses the same input before writing anything */
@@ -390,6 +391,7 @@ static void fuzz_cobs(const uint8_t *p, size_t n, uint8_t sel)
     size_t k;
     int has_zero = 0;
     const bsf_status_t st = bsf_cobs_decode(p, n, cobs_out, cap, &out_len);
+    fuzz_check_status(st);
     FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_FORMAT || st == BSF_ERR_BUFFER);
     for (k = 0; k < n; ++k) {
         has_zero |= p[k] == 0u;
@@ -429,6 +431,7 @@ static void fuzz_frame_decode(const uint8_t *p, size_t n, uint8_t sel)
     memset(&direct, 0x5A, sizeof direct);
     memset(&again, 0x5A, sizeof again);
     st = bsf_frame_decode(body, n, &direct);
+    fuzz_check_status(st);
     FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_CRC || st == BSF_ERR_VERSION || st == BSF_ERR_FORMAT ||
                st == BSF_ERR_CAPACITY);
     if (n < 5u) {
