@@ -29,8 +29,8 @@
 #include "carmen_bsf.h"
 #include "fuzz_check.h"
 
-static char path_plain[256];
-static char path_gz[256];
+static char path_plain[300];
+static char path_gz[300];
 static bsf_points_t points;
 
 static char dir_path[256];
