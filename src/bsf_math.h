@@ -24,12 +24,13 @@
  * compiler that evaluates float in double or long double (FLT_EVAL_METHOD
  * 1 or 2: GCC on s390x in ISO C mode, x87 without SSE) rounds intermediate
  * results differently and the frames would differ from the host's, so the
- * library refuses to build there rather than give different maps. bsf's
- * CMake adds -fexcess-precision=fast when that is enough (s390x); README,
- * "Portability".
+ * library refuses to build there rather than give different maps. The
+ * flag: -fexcess-precision=fast or -std=gnu99 (GCC, e.g. s390x), -msse2
+ * -mfpmath=sse (32-bit x86). bsf's CMake adds -fexcess-precision=fast when
+ * that is enough; README, "Portability".
  */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
-#error "bsf needs FLT_EVAL_METHOD == 0 (float evaluated in float): build with -fexcess-precision=fast (GCC, e.g. s390x with -std=c99) or -std=gnu99, or -msse2 -mfpmath=sse on 32-bit x86"
+#error "bsf needs FLT_EVAL_METHOD == 0: add -fexcess-precision=fast (GCC) or -mfpmath=sse"
 #endif
 
 /** sin(x), radians. Full accuracy for |x| <= 8192; finite in [-1, 1] for any finite x. */
