@@ -9,6 +9,7 @@
 #define BSF_H
 
 #include "bsf_config.h"
+#include "bsf_version.h"
 #include "bsf_common.h"
 #include "bsf_scan.h"
 #include "bsf_feature.h"

@@ -93,9 +93,10 @@ static bsf_status_t det_frame(const bsf_scan_t *scan, const bsf_frame_info_t *in
     if (st == BSF_OK) {
         st = bsf_extract(&ex, scan, &res);
     }
-    if (st == BSF_OK) {
-        st = bsf_frame_encode(info, &res, wire, sizeof wire, &len);
+    if (st < 0) { /* a cut result (BSF_OK_CUT) is output too */
+        return st;
     }
+    st = bsf_frame_encode(info, &res, wire, sizeof wire, &len);
     if (st != BSF_OK) {
         return st;
     }
