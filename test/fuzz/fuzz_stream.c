@@ -19,8 +19,10 @@
  *       the encoder on a valid reference result edited by the rest (each
  *       edit = 1 byte picking a field + 4 value bytes): every refusal
  *       path, BSF_ERR_BUFFER on short buffers, a sink that aborts.
- * Properties on every decoder run: each delivered frame is within the caps
- * and finite and re-encodes to the same content, the counters add up (every
+ * Properties on every decoder run: each delivered features frame is within
+ * the caps and finite and re-encodes to the same content, each metadata
+ * frame is within its ranges and re-encodes to the same record, the
+ * counters add up (every
  * delimited frame counted exactly once; delivered bytes + skipped bytes +
  * delimiters + the unfinished tail = the bytes fed), and the decoder makes
  * progress on every call.
@@ -50,9 +52,32 @@ static uint8_t cobs_out[2u * BSF_FRAME_BODY_MAX_SIZE + 16u];
 static uint8_t stream[STREAM_CAP];
 static uint8_t long_body[BSF_FRAME_BODY_MAX_SIZE + 8192u + 64u];
 
+/* A delivered metadata frame is within its documented ranges and
+ * re-encodes to a frame that decodes to the same record. */
+static void check_metadata(const bsf_frame_t *fr)
+{
+    const bsf_metadata_t *m = &fr->metadata;
+    size_t len = 0u;
+    size_t used = 0u;
+    FUZZ_CHECK(fr->version == 2u);
+    FUZZ_CHECK(fuzz_finite(m->target_rms) && m->target_rms >= 0.0f);
+    FUZZ_CHECK(fuzz_finite(m->angle_min) && fuzz_finite(m->angle_increment));
+    FUZZ_CHECK(fuzz_finite(m->range_max) && m->range_min >= 0.0f && m->range_max >= m->range_min);
+    FUZZ_CHECK(m->max_points >= 1u && m->max_points <= 65535u && m->n_beams <= 65535u);
+    FUZZ_CHECK(m->source_len <= BSF_METADATA_SOURCE_MAX && m->source[m->source_len] == '\0');
+    FUZZ_CHECK(bsf_metadata_encode(m, wire, sizeof wire, &len) == BSF_OK);
+    FUZZ_CHECK(len <= BSF_METADATA_MAX_SIZE && len <= BSF_FRAME_MAX_SIZE);
+    bsf_decoder_init(&dec2);
+    FUZZ_CHECK(bsf_decoder_feed(&dec2, wire, len, &used, &again) == BSF_FRAME_TYPE_METADATA);
+    FUZZ_CHECK(memcmp(&again.metadata.target_rms, &m->target_rms, sizeof(float)) == 0);
+    FUZZ_CHECK(again.metadata.time_origin_us == m->time_origin_us);
+    FUZZ_CHECK(again.metadata.source_len == m->source_len &&
+               memcmp(again.metadata.source, m->source, m->source_len) == 0);
+}
+
 static void check_frame(const bsf_frame_t *fr)
 {
-    FUZZ_CHECK(fr->version == BSF_FORMAT_VERSION);
+    FUZZ_CHECK(fr->version == 1u || fr->version == BSF_FORMAT_VERSION);
     FUZZ_CHECK(fr->type == BSF_FRAME_TYPE_FEATURES);
     FUZZ_CHECK(fr->has_pose <= 1u);
     FUZZ_CHECK(fuzz_finite(fr->pose_x) && fabsf(fr->pose_x) <= BSF_POSE_XY_MAX);
@@ -104,7 +129,23 @@ static void check_equal(const bsf_frame_t *a, const bsf_frame_t *b)
     /* The decoder refuses a time_us that stats.time_ns cannot hold, so every
      * delivered frame's time and stats re-encode exactly. */
     FUZZ_CHECK(a->time_us == b->time_us);
-    FUZZ_CHECK(memcmp(&ra->stats, &rb->stats, sizeof ra->stats) == 0);
+    {
+        /* The beam count travels only with a wrapping feature or the scan's
+         * geometry; the stream decoder may have filled it in from a metadata
+         * frame. */
+        bsf_stats_t sa = ra->stats;
+        int wraps = 0;
+        for (k = 0; k < ra->n_features; ++k) {
+            wraps |= ra->features[k].first_beam > ra->features[k].last_beam;
+        }
+        if (!wraps && !a->has_geometry) {
+            sa.n_beams = 0u;
+        }
+        FUZZ_CHECK(a->has_geometry == b->has_geometry);
+        FUZZ_CHECK(memcmp(&a->angle_min, &b->angle_min, sizeof(float)) == 0);
+        FUZZ_CHECK(memcmp(&a->angle_increment, &b->angle_increment, sizeof(float)) == 0);
+        FUZZ_CHECK(memcmp(&sa, &rb->stats, sizeof sa) == 0);
+    }
     FUZZ_CHECK(ra->n_features == rb->n_features && ra->n_ctrl == rb->n_ctrl);
     for (k = 0; k < ra->n_features; ++k) {
         const bsf_feature_t *fa = &ra->features[k];
@@ -136,6 +177,9 @@ static void reencode(const bsf_frame_t *fr)
     info.pose_y = fr->pose_y;
     info.pose_theta = fr->pose_theta;
     info.quant_step = fr->quant_step;
+    info.has_geometry = fr->has_geometry;
+    info.angle_min = fr->angle_min;
+    info.angle_increment = fr->angle_increment;
     st = bsf_frame_encode(&info, &fr->result, wire, sizeof wire, &len);
     if (st != BSF_OK) {
         fprintf(stderr, "re-encoding a delivered frame failed: %s\n", bsf_status_str(st));
@@ -144,7 +188,7 @@ static void reencode(const bsf_frame_t *fr)
     FUZZ_CHECK(len >= 2u && len <= BSF_FRAME_MAX_SIZE && wire[len - 1u] == 0u);
     bsf_decoder_init(&dec2);
     got = bsf_decoder_feed(&dec2, wire, len, &used, &again);
-    FUZZ_CHECK(got == 1 && used == len);
+    FUZZ_CHECK(got == (int)BSF_FRAME_TYPE_FEATURES && used == len);
     check_equal(fr, &again);
 }
 
@@ -189,9 +233,16 @@ static void make_reference(void)
     base_info.pose_x = 1.5f;
     base_info.pose_y = -2.25f;
     base_info.pose_theta = 0.5f;
+    /* With its geometry the frame carries its beam count, so a metadata
+     * frame in the garbage before it cannot change what it decodes to. */
+    base.stats.n_beams = 40u;
+    base_info.has_geometry = 1u;
+    base_info.angle_min = -1.0f;
+    base_info.angle_increment = 0.01f;
     FUZZ_CHECK(bsf_frame_encode(&base_info, &base, ref_wire, sizeof ref_wire, &ref_len) == BSF_OK);
     bsf_decoder_init(&dec2);
-    FUZZ_CHECK(bsf_decoder_feed(&dec2, ref_wire, ref_len, &used, &reference) == 1);
+    FUZZ_CHECK(bsf_decoder_feed(&dec2, ref_wire, ref_len, &used, &reference) ==
+               (int)BSF_FRAME_TYPE_FEATURES);
     FUZZ_CHECK(used == ref_len);
 }
 
@@ -203,6 +254,7 @@ static uint32_t feed_and_check(size_t n, size_t chunk, size_t *last_delivered_at
     size_t pos = 0u;
     size_t i;
     uint32_t delivered = 0u;
+    uint32_t metadata = 0u;
     uint32_t delimited = 0u;
     size_t delivered_bytes = 0u;
     size_t nonzero = 0u;
@@ -214,12 +266,14 @@ static uint32_t feed_and_check(size_t n, size_t chunk, size_t *last_delivered_at
         const size_t len = (n - pos < chunk) ? n - pos : chunk;
         size_t used = 0u;
         const int got = bsf_decoder_feed(&dec, stream + pos, len, &used, &frame);
-        FUZZ_CHECK(got == 0 || got == 1);
+        FUZZ_CHECK(got == 0 || got == (int)BSF_FRAME_TYPE_FEATURES ||
+                   got == (int)BSF_FRAME_TYPE_METADATA);
+        FUZZ_CHECK(got == 0 || got == (int)frame.type);
         FUZZ_CHECK(used <= len);
-        FUZZ_CHECK(got == 1 || used == len);
+        FUZZ_CHECK(got != 0 || used == len);
         FUZZ_CHECK(used > 0u); /* progress on every call */
         pos += used;
-        if (got == 1) {
+        if (got != 0) {
             size_t start = pos - 1u; /* the delimiter that ended the frame */
             FUZZ_CHECK(stream[pos - 1u] == 0u);
             while (start > 0u && stream[start - 1u] != 0u) {
@@ -228,8 +282,13 @@ static uint32_t feed_and_check(size_t n, size_t chunk, size_t *last_delivered_at
             delivered_bytes += pos - 1u - start;
             ++delivered;
             *last_delivered_at = pos;
-            check_frame(&frame);
-            reencode(&frame);
+            if (got == (int)BSF_FRAME_TYPE_METADATA) {
+                ++metadata;
+                check_metadata(&frame);
+            } else {
+                check_frame(&frame);
+                reencode(&frame);
+            }
         }
     }
     /* Counters: every non-empty delimited frame is counted exactly once, and
@@ -244,7 +303,8 @@ static uint32_t feed_and_check(size_t n, size_t chunk, size_t *last_delivered_at
             ++tail;
         }
     }
-    FUZZ_CHECK(st->frames_ok == delivered);
+    FUZZ_CHECK(st->frames_ok == delivered); /* metadata frames included */
+    FUZZ_CHECK(st->metadata == metadata);
     FUZZ_CHECK(st->frames_ok + st->bad_crc + st->malformed + st->unsupported_version +
                    st->unknown_type + st->oversize ==
                delimited);
@@ -262,7 +322,7 @@ static void feed_with_reference(size_t n, size_t chunk)
     memcpy(stream + n, ref_wire, ref_len);
     n += ref_len;
     FUZZ_CHECK(feed_and_check(n, chunk, &end) >= 1u);
-    FUZZ_CHECK(end == n);
+    FUZZ_CHECK(end == n && frame.type == BSF_FRAME_TYPE_FEATURES);
     check_equal(&reference, &frame);
 }
 
@@ -355,7 +415,8 @@ static void fuzz_encoder(const uint8_t *p, size_t n, uint8_t sel)
         FUZZ_CHECK(memcmp(wire, wire2, len) == 0);
     }
     bsf_decoder_init(&dec2);
-    FUZZ_CHECK(bsf_decoder_feed(&dec2, wire, len, &used, &again) == 1 && used == len);
+    FUZZ_CHECK(bsf_decoder_feed(&dec2, wire, len, &used, &again) == (int)BSF_FRAME_TYPE_FEATURES);
+    FUZZ_CHECK(used == len);
     check_frame(&again);
     FUZZ_CHECK(again.seq == info.seq && again.timestamp_ms == info.timestamp_ms);
     FUZZ_CHECK(again.has_pose == info.has_pose);
@@ -442,8 +503,12 @@ static void fuzz_frame_decode(const uint8_t *p, size_t n, uint8_t sel)
         FUZZ_CHECK(memcmp(&direct, &again, sizeof direct) == 0);
         return;
     }
-    check_frame(&direct);
-    reencode(&direct);
+    if (direct.type == BSF_FRAME_TYPE_METADATA) {
+        check_metadata(&direct);
+    } else {
+        check_frame(&direct);
+        reencode(&direct);
+    }
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -494,7 +559,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         st = bsf_frame_decode(body, n, &direct);
         FUZZ_CHECK((st == BSF_OK) == (got == 1u));
         if (got == 1u) {
-            check_equal(&frame, &direct);
+            /* one frame from a fresh decoder: nothing to fill in from
+             * earlier metadata, so both decode it the same */
+            FUZZ_CHECK(direct.type == frame.type);
+            if (frame.type == BSF_FRAME_TYPE_FEATURES) {
+                check_equal(&frame, &direct);
+            } else {
+                FUZZ_CHECK(direct.metadata.source_len == frame.metadata.source_len);
+                FUZZ_CHECK(direct.metadata.time_origin_us == frame.metadata.time_origin_us);
+            }
         }
     } else if (mode == 0x40u) {
         /* an oversize frame, then the reference frame */
