@@ -187,6 +187,28 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
     memcpy(out + n, tmp + 3, len - 3u);
     err |= write_file(dir, "extract", "clock.bin", out, n + len - 3u);
 
+    /* extract: 1081 beams of 6-beam blocks alternating 2 m and 6 m (the
+     * harness repeats one period up to the cap): more segments, keypoints
+     * and control points than the caps hold, so the cut paths run */
+    {
+        static const uint8_t methods[3] = {0x30u, 0x31u, 0x70u}; /* FALKO, RPOS, BID */
+        static const char *const names[3] = {"cut_falko.bin", "cut_rpos.bin", "cut_bid.bin"};
+        size_t m;
+        for (m = 0; m < 3u; ++m) {
+            n = 0u;
+            out[n++] = methods[m];
+            out[n++] = (uint8_t)(7u | (8u << 6)); /* angle_min -2.4, increment 0.0045 */
+            out[n++] = (uint8_t)((8u >> 2) | 0x40u);
+            out[n++] = 1u; /* BSF_MAX_POINTS beams */
+            for (i = 0; i < 12u; ++i) {
+                const unsigned mm = i < 6u ? 2000u : 6000u;
+                out[n++] = (uint8_t)(mm & 0xFFu);
+                out[n++] = (uint8_t)(mm >> 8);
+            }
+            err |= write_file(dir, "extract", names[m], out, n);
+        }
+    }
+
     /* carmen: FLASER 180/181/360/361, a long line, gzip whole and cut */
     {
         static const unsigned counts[4] = {180u, 181u, 360u, 361u};
