@@ -15,10 +15,11 @@
  *  0x40 an oversize frame: the rest repeated past BSF_FRAME_BODY_MAX_SIZE
  *       (byte 1 adds up to 8 KiB more), then the reference frame: the long
  *       frame is counted as oversize and skipped, the reference delivered;
- *  0xC0 direct calls: byte 1 picks bsf_cobs_decode, bsf_frame_decode or
- *       the encoder on a valid reference result edited by the rest (each
- *       edit = 1 byte picking a field + 4 value bytes): every refusal
- *       path, BSF_ERR_BUFFER on short buffers, a sink that aborts.
+ *  0xC0 direct calls: byte 1 % 4 picks bsf_cobs_decode, bsf_frame_decode,
+ *       the encoder on a valid reference result edited by the rest, or the
+ *       metadata encoder on edited defaults (each edit = 1 byte picking a
+ *       field + 4 value bytes): every refusal path, BSF_ERR_BUFFER on short
+ *       buffers, a sink that aborts.
  * Properties on every decoder run: each delivered features frame is within
  * the caps and finite and re-encodes to the same content, each metadata
  * frame is within its ranges and re-encodes to the same record, the
@@ -444,6 +445,75 @@ static void fuzz_encoder(const uint8_t *p, size_t n, uint8_t sel)
     }
 }
 
+/* Edits of a metadata record (each edit: 1 byte picking a field, 4 value
+ * bytes), then bsf_metadata_encode and its sink variant: a documented
+ * status, the same from both, BSF_ERR_BUFFER one byte short, and an
+ * accepted record decoding back to the same values. */
+static void fuzz_metadata_encoder(const uint8_t *p, size_t n, uint8_t sel)
+{
+    static bsf_metadata_t m;
+    bsf_encoder_t work;
+    size_t len = 0u, used = 0u, written = 0u;
+    bsf_status_t st;
+    bsf_metadata_init(&m);
+    for (; n >= 5u; p += 5, n -= 5u) {
+        const uint32_t v = take4(p + 1);
+        switch (p[0] % 16u) {
+        case 0: m.method = (uint8_t)v; break;
+        case 1: m.target_rms = as_float(v); break;
+        case 2: m.quant_step = as_float(v); break;
+        case 3: m.max_points = v; break;
+        case 4: m.max_segments = v >> (p[0] >> 4); break;
+        case 5: m.n_beams = v >> (p[0] >> 4); break;
+        case 6: m.angle_min = as_float(v); break;
+        case 7: m.angle_increment = as_float(v); break;
+        case 8: m.range_min = as_float(v); break;
+        case 9: m.range_max = as_float(v); break;
+        case 10: m.has_time_origin = (uint8_t)(v & 1u); break;
+        case 11: m.time_origin_us = (int64_t)(int32_t)v * (int64_t)(1u << (p[0] >> 4)); break;
+        case 12:
+            /* append 4 source bytes */
+            if (m.source_len + 4u <= BSF_METADATA_SOURCE_MAX) {
+                memcpy(m.source + m.source_len, p + 1, 4u);
+                m.source_len = (uint8_t)(m.source_len + 4u);
+            }
+            break;
+        case 13: m.source_len = (uint8_t)v; break;
+        case 14: m.max_ctrl_points = v >> (p[0] >> 4); break;
+        default: m.lib_version_minor = (uint16_t)v; break;
+        }
+    }
+    st = bsf_metadata_encode(&m, wire, sizeof wire, &len);
+    fuzz_check_status(st);
+    FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_ARG);
+    sink_limit = sizeof wire2;
+    sink_got = 0u;
+    if (st != BSF_OK) {
+        FUZZ_CHECK(bsf_metadata_encode_sink(&work, &m, sink, NULL, &written) == st);
+        FUZZ_CHECK(sink_got == 0u);
+        return;
+    }
+    FUZZ_CHECK(len >= 2u && len <= BSF_METADATA_MAX_SIZE && wire[len - 1u] == 0u);
+    FUZZ_CHECK(bsf_metadata_encode(&m, wire2, len - 1u, &used) == BSF_ERR_BUFFER);
+    sink_limit = (size_t)sel * 2u < len ? (size_t)sel * 2u : sizeof wire2;
+    sink_got = 0u;
+    st = bsf_metadata_encode_sink(&work, &m, sink, NULL, &written);
+    if (sink_limit < len) {
+        FUZZ_CHECK(st == BSF_ERR_BUFFER);
+    } else {
+        FUZZ_CHECK(st == BSF_OK && written == len && memcmp(wire, wire2, len) == 0);
+    }
+    bsf_decoder_init(&dec2);
+    FUZZ_CHECK(bsf_decoder_feed(&dec2, wire, len, &used, &again) == (int)BSF_FRAME_TYPE_METADATA);
+    FUZZ_CHECK(used == len);
+    check_metadata(&again);
+    FUZZ_CHECK(again.metadata.method == m.method && again.metadata.n_beams == m.n_beams);
+    FUZZ_CHECK(memcmp(&again.metadata.angle_min, &m.angle_min, sizeof(float)) == 0);
+    FUZZ_CHECK(memcmp(&again.metadata.range_max, &m.range_max, sizeof(float)) == 0);
+    FUZZ_CHECK(again.metadata.source_len == m.source_len &&
+               memcmp(again.metadata.source, m.source, m.source_len) == 0);
+}
+
 /* bsf_cobs_decode on arbitrary bytes with a cap from the input. */
 static void fuzz_cobs(const uint8_t *p, size_t n, uint8_t sel)
 {
@@ -583,10 +653,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_CHECK(dec.stats.oversize == 1u);
     } else if (size >= 1u) {
         const uint8_t sel = data[0];
-        switch (sel % 3u) {
-        case 0: fuzz_cobs(data + 1, size - 1u, (uint8_t)(sel / 3u)); break;
-        case 1: fuzz_frame_decode(data + 1, size - 1u, (uint8_t)(sel / 3u)); break;
-        default: fuzz_encoder(data + 1, size - 1u, (uint8_t)(sel / 3u)); break;
+        switch (sel % 4u) {
+        case 0: fuzz_cobs(data + 1, size - 1u, (uint8_t)(sel / 4u)); break;
+        case 1: fuzz_frame_decode(data + 1, size - 1u, (uint8_t)(sel / 4u)); break;
+        case 2: fuzz_encoder(data + 1, size - 1u, (uint8_t)(sel / 4u)); break;
+        default: fuzz_metadata_encoder(data + 1, size - 1u, (uint8_t)(sel / 4u)); break;
         }
     }
     return 0;

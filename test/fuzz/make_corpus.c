@@ -112,20 +112,20 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
     err |= write_file(dir, "stream", "oversize.bin", out, frame_len + 1u);
     /* stream direct (0xC0): COBS bytes, a body with its CRC fixed, encoder edits */
     out[0] = 0xC0u;
-    out[1] = 1u; /* sel 1 % 3 = 0: bsf_cobs_decode; sel / 3 = 0: tight cap */
+    out[1] = 0u; /* sel % 4 = 0: bsf_cobs_decode; sel / 4 = 0: tight cap */
     memcpy(out + 2, frame, frame_len - 1u);
     err |= write_file(dir, "stream", "direct_cobs.bin", out, frame_len + 1u);
-    out[1] = 3u; /* sel 3 % 3 = 0: bsf_cobs_decode, sel / 3 = 1: large cap */
+    out[1] = 4u; /* sel % 4 = 0: bsf_cobs_decode, sel / 4 = 1: large cap */
     err |= write_file(dir, "stream", "direct_cobs_large.bin", out, frame_len + 1u);
     {
         size_t blen = 0u;
-        out[1] = 4u; /* sel 4 % 3 = 1: bsf_frame_decode, sel / 3 = 1: CRC fixed */
+        out[1] = 5u; /* sel % 4 = 1: bsf_frame_decode, sel / 4 = 1: CRC fixed */
         if (bsf_cobs_decode(frame, frame_len - 1u, out + 2, sizeof out - 2u, &blen) != BSF_OK) {
             return 1;
         }
         err |= write_file(dir, "stream", "direct_decode.bin", out, blen - 4u + 2u);
     }
-    out[1] = 2u + 3u * 40u; /* sel % 3 = 2: encoder; sel / 3 = 40: sink limit 320 bytes */
+    out[1] = 2u + 4u * 40u; /* sel % 4 = 2: encoder; sel / 4 = 40: sink limit 320 bytes */
     err |= write_file(dir, "stream", "direct_encode.bin", out, 2u);
     n = 2u;
     out[n++] = 0x00u; /* pose_x raw */
@@ -137,6 +137,21 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
     out[n++] = 0x0Fu; /* timestamp, has_pose, n_valid, time_ns */
     n = put4(out, n, 0x12345u);
     err |= write_file(dir, "stream", "direct_encode_edits.bin", out, n);
+    n = 0u;
+    out[n++] = 0xC0u;
+    out[n++] = 3u + 4u * 60u; /* sel % 4 = 3: metadata encoder; sink limit 120 bytes */
+    out[n++] = 5u;            /* n_beams 361 */
+    n = put4(out, n, 361u);
+    out[n++] = 6u; /* angle_min */
+    n = put4(out, n, bits_of(-2.4f));
+    out[n++] = 7u; /* angle_increment */
+    n = put4(out, n, bits_of(0.013f));
+    out[n++] = 9u; /* range_max */
+    n = put4(out, n, bits_of(30.0f));
+    out[n++] = 12u; /* source "log1" */
+    memcpy(out + n, "log1", 4u);
+    n += 4u;
+    err |= write_file(dir, "stream", "direct_metadata.bin", out, n);
 
     /* extract: a 1081-beam scan, raw floats, at the cap (F_RAW_RANGES |
      * F_OVER_CAP | F_ENCODE), and the BID method, parameter edits, a clock */
