@@ -43,9 +43,21 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     p.sved = bsf_sved_params_default();
     p.rpos = bsf_rpos_params_default();
     bsf_pdm_params_default(&p.pdm);
+    p.no_return = bsf_no_return_params_default();
     p.clock = NULL;
     p.clock_user = NULL;
     p.clock_hz = 0u;
+    return p;
+}
+
+bsf_params_t bsf_params_paper(bsf_method_t method)
+{
+    bsf_params_t p = bsf_params_default(method);
+    p.sved = bsf_sved_params_paper();
+    p.no_return.min_run = 0u;
+    /* The first release's refinement target, so the paper-faithful rows of
+     * bsf table1 are the numbers that release printed. */
+    p.pdm.target_rms = 0.015f;
     return p;
 }
 
@@ -55,7 +67,8 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    if (p->clock != NULL && p->clock_hz == 0u) {
+    if ((p->clock != NULL && p->clock_hz == 0u) || !(p->no_return.code >= 0.0f) ||
+        !(p->no_return.code <= 3.402823466e38f)) {
         return BSF_ERR_PARAM;
     }
     switch (p->method) {
@@ -245,9 +258,24 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
     bsf_status_t st;
     ex->n_segments = 0u;
     if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
+        size_t k;
+        size_t b;
         st = bsf_segment_rpos(&ex->points, &ex->params.rpos, all, BSF_MAX_POINTS, &n_all, NULL);
+        /* RPOS segments are runs of valid beams: label them so that fitting
+         * gathers every method's segments alike. */
+        for (b = 0; b < ex->points.count; ++b) {
+            ex->seg_label[b] = (uint16_t)BSF_SEG_NONE;
+        }
+        for (k = 0; st == BSF_OK && k < n_all; ++k) {
+            for (b = all[k].first; b <= all[k].last; ++b) {
+                if (ex->points.valid[b]) {
+                    ex->seg_label[b] = all[k].first;
+                }
+            }
+        }
     } else {
-        st = bsf_segment_sved(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS, &n_all, NULL);
+        st = bsf_segment_sved_labelled(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
+                                       ex->seg_label, &n_all, NULL);
     }
     if (st != BSF_OK) {
         return st;
@@ -256,8 +284,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
     if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
         return BSF_OK;
     }
-    return bsf_segment_classify(ex->segments, ex->n_segments, &ex->points, ex->interest,
-                                ex->n_keypoints);
+    return bsf_segment_classify_labelled(ex->segments, ex->n_segments, &ex->points, ex->seg_label,
+                                         ex->interest, ex->n_keypoints);
 }
 
 /* Gather a segment's valid points into ex->scratch.fit.seg_points and the positions of
@@ -275,8 +303,16 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     while (k < ex->n_keypoints && ex->interest[k] < s->first) {
         ++k;
     }
-    for (b = s->first; b <= s->last; ++b) {
-        if (!ex->points.valid[b]) {
+    /* The segment's beams are those labelled with its first beam; a
+     * wrapping segment (first > last) runs on through beam 0. */
+    for (b = s->first;; b = (b + 1u < ex->points.count) ? b + 1u : 0u) {
+        if (b == 0u && s->first > 0u) {
+            k = 0u; /* wrapped through the seam */
+        }
+        if (ex->seg_label[b] != s->first) {
+            if (b == s->last) {
+                break;
+            }
             continue;
         }
         while (k < ex->n_keypoints && ex->interest[k] < b) {
@@ -287,6 +323,9 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
             ++k;
         }
         ex->scratch.fit.seg_points[n++] = ex->points.pt[b];
+        if (b == s->last) {
+            break;
+        }
     }
     *n_vertex = 0u;
     for (i = 0; i < nv; ++i) {
@@ -493,6 +532,10 @@ bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan, bsf_result
     clock_start(&clk, &ex->params);
 
     st = bsf_scan_to_points(scan, &ex->points);
+    if (st != BSF_OK) {
+        return st;
+    }
+    st = bsf_points_reject_no_return(&ex->points, &ex->params.no_return, NULL);
     if (st != BSF_OK) {
         return st;
     }

@@ -37,6 +37,7 @@
 #include "bsf/bsf_falko.h"
 
 #include <math.h>
+#include <stddef.h>
 
 #include "bsf_math.h"
 #include "bsf_nms.h"
@@ -115,9 +116,26 @@ static ball_t make_ball(bsf_point_t c, float r)
     return b;
 }
 
-/* Is beam j a neighbour: valid and within distance r of the apex (step 3)? */
-static int in_ball(const bsf_points_t *pts, size_t j, const ball_t *b)
+/* Window positions are virtual beam indices: on a full-circle scan a window
+ * may run past either end of the scan and continues at the other end (it
+ * spans less than the whole circle); elsewhere it is clamped to the scan, so
+ * every position is a beam index and results are FALKOLib's. */
+static size_t beam_at(const bsf_points_t *pts, ptrdiff_t v)
 {
+    if (v < 0) {
+        return (size_t)(v + (ptrdiff_t)pts->count);
+    }
+    if (v >= (ptrdiff_t)pts->count) {
+        return (size_t)(v - (ptrdiff_t)pts->count);
+    }
+    return (size_t)v;
+}
+
+/* Is window position v a neighbour: valid and within distance r of the apex
+ * (step 3)? */
+static int in_ball(const bsf_points_t *pts, ptrdiff_t v, const ball_t *b)
+{
+    const size_t j = beam_at(pts, v);
     float dx, dy, d2;
     if (!pts->valid[j]) {
         return 0;
@@ -136,9 +154,9 @@ static int in_ball(const bsf_points_t *pts, size_t j, const ball_t *b)
 
 /* A neighbourhood (steps 3, 4 and 6). */
 typedef struct {
-    size_t beg, end;                      /* beam window, inclusive, clamped to the scan */
-    size_t first;                         /* first kept beam (left of the apex) */
-    size_t last;                          /* last kept beam (right of the apex) */
+    ptrdiff_t beg, end;                   /* window positions, inclusive (see beam_at) */
+    ptrdiff_t first;                      /* first kept position (left of the apex) */
+    ptrdiff_t last;                       /* last kept position (right of the apex) */
     int n_left;                           /* kept neighbours before the apex */
     int n_right;                          /* kept neighbours after the apex */
     float sum_lx, sum_ly, sum_rx, sum_ry; /* sums of p - p_apex per side */
@@ -161,16 +179,24 @@ static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv
     return (a < (float)BSF_MAX_POINTS) ? (size_t)(int)a : (size_t)BSF_MAX_POINTS;
 }
 
-static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, neigh_t *nb)
+static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, int ring, neigh_t *nb)
 {
-    nb->beg = (i >= alpha) ? i - alpha : 0u;
-    nb->end = (i + alpha < pts->count) ? i + alpha : pts->count - 1u;
+    if (ring) {
+        /* Wraps, but never reaches round to the apex's other side. */
+        const size_t half = (pts->count - 1u) / 2u;
+        const size_t a = alpha < half ? alpha : half;
+        nb->beg = (ptrdiff_t)i - (ptrdiff_t)a;
+        nb->end = (ptrdiff_t)i + (ptrdiff_t)a;
+        return;
+    }
+    nb->beg = (ptrdiff_t)((i >= alpha) ? i - alpha : 0u);
+    nb->end = (ptrdiff_t)((i + alpha < pts->count) ? i + alpha : pts->count - 1u);
 }
 
 /* The outermost neighbours on each side; 0 when a side has none. */
-static int find_ends(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t *nb)
+static int find_ends(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neigh_t *nb)
 {
-    size_t j = nb->beg;
+    ptrdiff_t j = nb->beg;
     while (j < i && !in_ball(pts, j, b)) {
         ++j;
     }
@@ -190,10 +216,10 @@ static int find_ends(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t
 }
 
 /* Counts and sums of both sides, between the ends found by find_ends. */
-static void count_sides(const bsf_points_t *pts, size_t i, const ball_t *b, neigh_t *nb)
+static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neigh_t *nb)
 {
     const bsf_point_t c = b->c;
-    size_t j;
+    ptrdiff_t j;
     nb->n_left = 0;
     nb->n_right = 0;
     nb->sum_lx = 0.0f;
@@ -202,16 +228,18 @@ static void count_sides(const bsf_points_t *pts, size_t i, const ball_t *b, neig
     nb->sum_ry = 0.0f;
     for (j = nb->first; j < i; ++j) {
         if (in_ball(pts, j, b)) {
+            const bsf_point_t q = pts->pt[beam_at(pts, j)];
             ++nb->n_left;
-            nb->sum_lx += pts->pt[j].x - c.x;
-            nb->sum_ly += pts->pt[j].y - c.y;
+            nb->sum_lx += q.x - c.x;
+            nb->sum_ly += q.y - c.y;
         }
     }
-    for (j = i + 1u; j <= nb->last; ++j) {
+    for (j = i + 1; j <= nb->last; ++j) {
         if (in_ball(pts, j, b)) {
+            const bsf_point_t q = pts->pt[beam_at(pts, j)];
             ++nb->n_right;
-            nb->sum_rx += pts->pt[j].x - c.x;
-            nb->sum_ry += pts->pt[j].y - c.y;
+            nb->sum_rx += q.x - c.x;
+            nb->sum_ry += q.y - c.y;
         }
     }
 }
@@ -220,8 +248,8 @@ static void count_sides(const bsf_points_t *pts, size_t i, const ball_t *b, neig
 static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float b_ratio)
 {
     const bsf_point_t a = pts->pt[i];
-    const bsf_point_t f = pts->pt[nb->first];
-    const bsf_point_t l = pts->pt[nb->last];
+    const bsf_point_t f = pts->pt[beam_at(pts, nb->first)];
+    const bsf_point_t l = pts->pt[beam_at(pts, nb->last)];
     const float lim = r / b_ratio;
     const float bx = l.x - f.x;
     const float by = l.y - f.y;
@@ -238,15 +266,15 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
 /* Steps 3-5 and the sums of step 6 for apex i; 0 when rejected. All
  * rejections are alike, so the cheap ends-and-triangle test runs first and
  * the full count only for its survivors. */
-static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alpha,
+static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
                          const bsf_falko_params_t *p, neigh_t *nb)
 {
     const ball_t b = make_ball(pts->pt[i], r);
-    neigh_window(pts, i, alpha, nb);
-    if (!find_ends(pts, i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
+    neigh_window(pts, i, alpha, ring, nb);
+    if (!find_ends(pts, (ptrdiff_t)i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
         return 0;
     }
-    count_sides(pts, i, &b, nb);
+    count_sides(pts, (ptrdiff_t)i, &b, nb);
     return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
 }
 
@@ -303,12 +331,12 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
     int k = 0;
     int a, b;
     long score = 0;
-    size_t j;
+    ptrdiff_t j;
 
     /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
     for (j = nb->first; j <= nb->last; ++j) {
-        if (j != i && in_ball(pts, j, &ball)) {
-            sector[k++] = (int8_t)sector_of(pts->pt[j], c, theta, width);
+        if (j != (ptrdiff_t)i && in_ball(pts, j, &ball)) {
+            sector[k++] = (int8_t)sector_of(pts->pt[beam_at(pts, j)], c, theta, width);
         }
     }
     /* Ordered pairs: the first of each pair is the one nearer the apex. */
@@ -329,17 +357,17 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
 
 /* Total-least-squares line through beams [from, to] that are neighbours of
  * apex c: unit normal n and offset d with n . x = d. */
-static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball_t *ball, float *nx,
-                     float *ny, float *d)
+static void fit_line(const bsf_points_t *pts, ptrdiff_t from, ptrdiff_t to, const ball_t *ball,
+                     float *nx, float *ny, float *d)
 {
     float sx = 0.0f, sy = 0.0f, sxx = 0.0f, syy = 0.0f, sxy = 0.0f;
     float mx, my, t;
     int n = 0;
-    size_t j;
+    ptrdiff_t j;
     for (j = from; j <= to; ++j) {
         if (in_ball(pts, j, ball)) {
-            sx += pts->pt[j].x;
-            sy += pts->pt[j].y;
+            sx += pts->pt[beam_at(pts, j)].x;
+            sy += pts->pt[beam_at(pts, j)].y;
             ++n;
         }
     }
@@ -348,8 +376,8 @@ static void fit_line(const bsf_points_t *pts, size_t from, size_t to, const ball
     /* Centred moments: no cancellation in float. */
     for (j = from; j <= to; ++j) {
         if (in_ball(pts, j, ball)) {
-            const float dx = pts->pt[j].x - mx;
-            const float dy = pts->pt[j].y - my;
+            const float dx = pts->pt[beam_at(pts, j)].x - mx;
+            const float dy = pts->pt[beam_at(pts, j)].y - my;
             sxx += dx * dx;
             syy += dy * dy;
             sxy += dx * dy;
@@ -369,8 +397,8 @@ static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh
     const bsf_point_t c = ball.c;
     float n1x, n1y, d1, n2x, n2y, d2, det;
     bsf_point_t q;
-    fit_line(pts, nb->first, i, &ball, &n1x, &n1y, &d1);
-    fit_line(pts, i, nb->last, &ball, &n2x, &n2y, &d2);
+    fit_line(pts, nb->first, (ptrdiff_t)i, &ball, &n1x, &n1y, &d1);
+    fit_line(pts, (ptrdiff_t)i, nb->last, &ball, &n2x, &n2y, &d2);
     det = n1x * n2y - n1y * n2x;
     if (fabsf(det) < 1e-7f) {
         return c;
@@ -393,12 +421,12 @@ static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falk
 
 /* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
  * FALKO_REJECTED. */
-static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha,
+static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
                         const bsf_falko_params_t *p, int8_t *sector)
 {
     float theta;
     neigh_t nb;
-    if (!neighbourhood(pts, i, r, alpha, p, &nb)) {
+    if (!neighbourhood(pts, i, r, alpha, ring, p, &nb)) {
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
@@ -414,6 +442,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     long score_max = 0;
     long min_val;
     bsf_status_t st;
+    int ring;
 
     if (n_out != NULL) {
         *n_out = 0;
@@ -433,6 +462,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     if (!finite_f(inc) || inc == 0.0f) {
         return BSF_ERR_ARG;
     }
+    ring = bsf_points_full_circle(pts);
 
     /* Radius and window of every apex first, in a loop without hard branches
      * (the exp, division and conversion latencies of successive beams
@@ -449,8 +479,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     }
     for (i = 0; i < pts->count; ++i) {
         const float r = work->score[i];
-        const float s =
-            (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], p, work->sector) : FALKO_REJECTED;
+        const float s = (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], ring, p, work->sector)
+                                   : FALKO_REJECTED;
         work->score[i] = s;
         if (s > (float)score_max) {
             if (s > (float)FALKO_SCORE_LIMIT) {
@@ -473,6 +503,23 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     min_val = score_max * (long)p->min_score_th / 100L;
     n_peak = bsf_nms_beams(pts, work->score, BSF_NMS_HIGHER_IS_BETTER, (float)min_val,
                            p->nms_radius, work->peak);
+    if (ring && n_peak >= 2u) {
+        /* Suppression does not wrap: of two peaks facing each other across
+         * the seam within the suppression window, keep the stronger (the
+         * first on a tie), as suppression would have. */
+        const size_t lo = work->peak[0];
+        const size_t hi = work->peak[n_peak - 1u];
+        const size_t w_lo = bsf_nms_half_window(pts, lo, p->nms_radius);
+        const size_t w_hi = bsf_nms_half_window(pts, hi, p->nms_radius);
+        if (lo + pts->count - hi <= (w_lo > w_hi ? w_lo : w_hi)) {
+            if (work->score[hi] > work->score[lo]) {
+                for (k = 1; k < n_peak; ++k) {
+                    work->peak[k - 1u] = work->peak[k];
+                }
+            }
+            --n_peak;
+        }
+    }
 
     *n_out = n_peak;
     /* Over the cap, the strongest keypoints are the ones worth keeping. */
@@ -481,7 +528,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, 1.0f / inc), p,
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, 1.0f / inc), ring, p,
                             &nb); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);

@@ -51,7 +51,7 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     p->precision_spacing = 1.0f;
     p->lambda_per_metre = 1e-6f;
     p->rel_tol = 0.01f;
-    p->target_rms = 0.015f;
+    p->target_rms = 0.025f;
     p->max_iterations = 2u;
     p->refine_iterations = 1u;
     p->max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE;

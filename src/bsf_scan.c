@@ -64,3 +64,105 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
     out->angle_increment = scan->angle_increment;
     return BSF_OK;
 }
+
+int bsf_points_full_circle(const bsf_points_t *pts)
+{
+    float inc;
+    float span;
+    if (pts == NULL || pts->count < 3u) {
+        return 0;
+    }
+    inc = fabsf(pts->angle_increment);
+    span = inc * (float)pts->count;
+    return fabsf(span - 2.0f * BSF_PI_F) <= inc;
+}
+
+bsf_no_return_params_t bsf_no_return_params_default(void)
+{
+    bsf_no_return_params_t p;
+    p.code = 0.0f;
+    p.min_run = 5u;
+    return p;
+}
+
+static void invalidate(bsf_points_t *pts, size_t i)
+{
+    pts->pt[i].x = 0.0f;
+    pts->pt[i].y = 0.0f;
+    pts->range[i] = 0.0f;
+    pts->valid[i] = 0u;
+    pts->n_valid--;
+}
+
+/* Does the run of equal readings [first, last] stand apart from its valid
+ * neighbours: at least one, and each one there is reads more than 10 % less?
+ * A no-return code does: the beams beside it hit a surface somewhere else.
+ * A surface seen head-on near the scan's maximum does not: its range changes
+ * by centimetres. A scan of nothing but equal readings has no neighbour to
+ * tell, and stays valid. */
+static int jumps_on_both_sides(const bsf_points_t *pts, size_t first, size_t last, float top)
+{
+    const float jump = 0.1f * top;
+    int seen = 0;
+    size_t j;
+    for (j = first; j > 0u; --j) {
+        if (pts->valid[j - 1u]) {
+            if (!(top - pts->range[j - 1u] > jump)) {
+                return 0;
+            }
+            seen = 1;
+            break;
+        }
+    }
+    for (j = last + 1u; j < pts->count; ++j) {
+        if (pts->valid[j]) {
+            return top - pts->range[j] > jump;
+        }
+    }
+    return seen;
+}
+
+bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_params_t *p,
+                                         size_t *n_rejected)
+{
+    size_t i;
+    size_t n = 0;
+    float top = 0.0f;
+    int top_is_code = 0;
+    if (n_rejected != NULL) {
+        *n_rejected = 0;
+    }
+    if (pts == NULL || p == NULL || pts->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_ARG;
+    }
+    if (!is_finite_f(p->code) || p->code < 0.0f) {
+        return BSF_ERR_PARAM;
+    }
+    if (p->min_run > 0u) {
+        /* The largest valid reading, then its runs of equal beams. */
+        size_t run = 0;
+        for (i = 0; i < pts->count; ++i) {
+            if (pts->valid[i] && pts->range[i] > top) {
+                top = pts->range[i];
+            }
+        }
+        for (i = 0; i < pts->count && top > 0.0f && !top_is_code; ++i) {
+            run = (pts->valid[i] && pts->range[i] == top) ? run + 1u : 0u;
+            if (run >= (size_t)p->min_run &&
+                (i + 1u == pts->count || !pts->valid[i + 1u] || pts->range[i + 1u] != top)) {
+                top_is_code = jumps_on_both_sides(pts, i + 1u - run, i, top);
+            }
+        }
+    }
+    for (i = 0; i < pts->count; ++i) {
+        if (pts->valid[i] && ((p->code > 0.0f && pts->range[i] == p->code) ||
+                              (top_is_code && pts->range[i] == top))) {
+            invalidate(pts, i);
+            ++n;
+        }
+    }
+    if (n_rejected != NULL) {
+        *n_rejected = n;
+    }
+    return BSF_OK;
+}

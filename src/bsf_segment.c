@@ -12,12 +12,26 @@ static int is_finite_f(float v)
     return v == v && fabsf(v) <= 3.402823466e38f;
 }
 
-bsf_sved_params_t bsf_sved_params_default(void)
+bsf_sved_params_t bsf_sved_params_paper(void)
 {
     bsf_sved_params_t p;
     p.a = 0.2f;
     p.b = 0.07f;
     p.min_segment_points = 5u;
+    p.max_gap_beams = 6u;
+    p.radius_max = 0.0f;
+    p.lookback = 0u;
+    p.reject_mixed = 0u;
+    return p;
+}
+
+bsf_sved_params_t bsf_sved_params_default(void)
+{
+    bsf_sved_params_t p = bsf_sved_params_paper();
+    p.lookback = 4u;
+    p.max_gap_beams = 16u;
+    p.radius_max = 1.0f;
+    p.reject_mixed = 1u;
     return p;
 }
 
@@ -41,7 +55,10 @@ bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p)
         return BSF_ERR_ARG;
     }
     if (!is_finite_f(p->a) || !(p->a > 0.0f) || !is_finite_f(p->b) || !(p->b >= 0.0f) ||
-        !min_points_ok(p->min_segment_points)) {
+        !min_points_ok(p->min_segment_points) || p->max_gap_beams < 1u ||
+        p->max_gap_beams > (uint16_t)BSF_MAX_POINTS || !is_finite_f(p->radius_max) ||
+        !(p->radius_max == 0.0f || p->radius_max >= p->a) || p->lookback > BSF_SVED_MAX_LOOKBACK ||
+        p->reject_mixed > 1u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -126,21 +143,168 @@ static float exp_lower_bound(float x)
     return 1.0f + x * (1.0f + x * (0.5f + x * (0.16666667f + x * 0.041666668f)));
 }
 
-bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *params,
-                              bsf_segment_t *out, size_t cap, size_t *n_out,
-                              size_t *n_wasted_points)
+/* ---- SVED with look-back, radius cap, mixed pixels and full-circle scans ---- */
+
+/* One open segment of the labelled pass. */
+typedef struct {
+    size_t first;    /* beam of its first point (its label) */
+    size_t last;     /* beam of its last point */
+    size_t last_pos; /* pass position of its last point */
+    size_t n;        /* points */
+    bsf_point_t end; /* its last point */
+} open_seg_t;
+
+/* Radius test d^2 <= r(rho)^2, r = a*exp(b*rho) capped at sqrt(cap2) when
+ * cap2 > 0. As in bsf_segment_sved, expf only near the threshold; NaN fails. */
+static int within_radius(float d2, float rho, float a2, float two_b, float cap2)
+{
+    if (d2 <= a2) {
+        return 1;
+    }
+    if (cap2 > 0.0f && !(d2 <= cap2)) {
+        return 0;
+    }
+    return d2 <= a2 * exp_lower_bound(two_b * rho) || d2 <= a2 * bsf_expf(two_b * rho);
+}
+
+/* Range of beam i + k (k in -2..2) into *r, wrapping on a ring; 0 when that
+ * beam is outside the scan or invalid. */
+static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, float *r)
+{
+    const size_t n = pts->count;
+    size_t j;
+    if (k < 0) {
+        const size_t back = (size_t)(-k);
+        if (i >= back) {
+            j = i - back;
+        } else if (ring) {
+            j = i + n - back;
+        } else {
+            return 0;
+        }
+    } else {
+        j = i + (size_t)k;
+        if (j >= n) {
+            if (!ring) {
+                return 0;
+            }
+            j -= n;
+        }
+    }
+    if (!pts->valid[j]) {
+        return 0;
+    }
+    *r = pts->range[j];
+    return 1;
+}
+
+/* The mixed-pixel rule documented on bsf_segment_sved_labelled. */
+static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, float a2, float two_b,
+                          float cap2)
+{
+    float r[5];
+    float lo;
+    float hi;
+    float jump;
+    int k;
+    for (k = -2; k <= 2; ++k) {
+        if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
+            return 0;
+        }
+    }
+    lo = r[1] < r[3] ? r[1] : r[3];
+    hi = r[1] < r[3] ? r[3] : r[1];
+    jump = hi - lo;
+    if (!(r[2] > lo && r[2] < hi) || within_radius(jump * jump, r[2], a2, two_b, cap2)) {
+        return 0;
+    }
+    return fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
+           r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump;
+}
+
+/* Output order: by first beam, a segment wrapping through the seam last. */
+static uint32_t beam_order_key(const bsf_segment_t *s)
+{
+    return (s->first > s->last ? 0x10000u : 0u) + (uint32_t)s->first;
+}
+
+/* Next beam after b on the pass (wrapping at count). */
+static size_t next_beam(size_t b, size_t count)
+{
+    return b + 1u < count ? b + 1u : 0u;
+}
+
+/* Close an open segment: keep it or waste it (and unlabel its beams). */
+static int close_open(seg_sink_t *sink, const open_seg_t *s, uint16_t *label, size_t count)
+{
+    if (s->n < (size_t)sink->min_points && label != NULL) {
+        size_t b = s->first;
+        for (;;) {
+            if (label[b] == (uint16_t)s->first) {
+                label[b] = (uint16_t)BSF_SEG_NONE;
+            }
+            if (b == s->last) {
+                break;
+            }
+            b = next_beam(b, count);
+        }
+    }
+    return sink_close(sink, s->first, s->last, s->n);
+}
+
+/* Beam where a full-circle pass starts: the first valid beam (from 0) that
+ * the paper's rule would not join to the valid beam before it on the ring;
+ * 0 when every step joins (one closed loop: then nothing wraps). */
+static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float cap2)
+{
+    size_t prev = pts->count;
+    size_t i;
+    for (i = pts->count; i > 0u; --i) {
+        if (pts->valid[i - 1u]) {
+            prev = i - 1u;
+            break;
+        }
+    }
+    if (prev == pts->count) {
+        return 0u;
+    }
+    for (i = 0; i < pts->count; ++i) {
+        float dx;
+        float dy;
+        if (!pts->valid[i]) {
+            continue;
+        }
+        dx = pts->pt[i].x - pts->pt[prev].x;
+        dy = pts->pt[i].y - pts->pt[prev].y;
+        if (i != prev && !within_radius(dx * dx + dy * dy, pts->range[i], a2, two_b, cap2)) {
+            return i;
+        }
+        prev = i;
+    }
+    return 0u;
+}
+
+/* Both SVED entry points: with extensions 0, the paper's rule whatever the
+ * extension fields say (checked, then ignored), and no full-circle pass. */
+static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                             bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
+                             size_t *n_out, size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
+    open_seg_t open[1u + BSF_SVED_MAX_LOOKBACK];
     seg_sink_t sink;
     bsf_status_t st;
+    size_t slots;
+    size_t n_open = 0;
+    size_t start = 0;
+    size_t j;
+    size_t k;
     float a2;
     float two_b;
-    bsf_point_t prev = {0.0f, 0.0f};
-    size_t first = 0;
-    size_t last = 0;
-    size_t n_cur = 0;
-    size_t i;
+    float cap2;
+    int reject_mixed;
+    int ring;
 
     st = begin(pts, out, cap, n_out, n_wasted_points, &sink);
     if (st != BSF_OK) {
@@ -151,51 +315,129 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
         return BSF_ERR_PARAM;
     }
     sink.min_points = p->min_segment_points;
-    /* Compare squared distances: d <= a*exp(b*rho)  <=>  d^2 <= a^2*exp(2*b*rho). */
     a2 = p->a * p->a;
     two_b = 2.0f * p->b;
+    cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
+    slots = extensions ? 1u + (size_t)p->lookback : 1u;
+    reject_mixed = extensions && p->reject_mixed;
+    ring = extensions && bsf_points_full_circle(pts);
+    if (label != NULL) {
+        for (j = 0; j < pts->count; ++j) {
+            label[j] = (uint16_t)BSF_SEG_NONE;
+        }
+    }
+    if (ring) {
+        start = ring_start(pts, a2, two_b, cap2);
+    }
 
-    /* The first valid point opens the first segment; then one pass. */
-    for (i = 0; i < pts->count && !pts->valid[i]; ++i) {
-    }
-    if (i == pts->count) {
-        return finish(&sink, n_out, n_wasted_points);
-    }
-    first = i;
-    last = i;
-    prev = pts->pt[i];
-    n_cur = 1;
-    for (++i; i < pts->count; ++i) {
-        const bsf_point_t q = pts->pt[i];
-        float dx;
-        float dy;
-        float d2;
-        if (!pts->valid[i]) {
+    for (j = 0; j < pts->count; ++j) {
+        size_t b = start + j;
+        bsf_point_t q;
+        float rho;
+        float best_d2 = 0.0f;
+        size_t best = slots; /* none */
+        if (b >= pts->count) {
+            b -= pts->count;
+        }
+        if (!pts->valid[b]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
-        dx = q.x - prev.x;
-        dy = q.y - prev.y;
-        d2 = dx * dx + dy * dy;
-        /* Decide without expf where possible: r(rho) >= a, and the Taylor
-         * polynomial of exp to degree 4 never exceeds exp for x >= 0, so
-         * steps within a^2 * poly(x) join. expf is left for the few steps
-         * near or beyond the threshold. NaN breaks. */
-        if (!(d2 <= a2) && !(d2 <= a2 * exp_lower_bound(two_b * pts->range[i])) &&
-            !(d2 <= a2 * bsf_expf(two_b * pts->range[i]))) {
-            if (!sink_close(&sink, first, last, n_cur)) {
-                return BSF_ERR_CAPACITY;
-            }
-            first = i;
-            n_cur = 0;
+        if (reject_mixed && is_mixed_pixel(pts, b, ring, a2, two_b, cap2)) {
+            sink.n_wasted++;
+            continue;
         }
-        ++n_cur;
-        last = i;
-        prev = q;
+        q = pts->pt[b];
+        rho = pts->range[b];
+        /* open[0] is the current segment (the paper's only candidate); older
+         * ones expire once their last point is more than max_gap_beams back. */
+        for (k = 0; k < n_open; ++k) {
+            float dx;
+            float dy;
+            float d2;
+            if (k > 0u && j - open[k].last_pos > (size_t)p->max_gap_beams) {
+                size_t m;
+                if (!close_open(&sink, &open[k], label, pts->count)) {
+                    return BSF_ERR_CAPACITY;
+                }
+                for (m = k + 1u; m < n_open; ++m) {
+                    open[m - 1u] = open[m];
+                }
+                --n_open;
+                --k;
+                continue;
+            }
+            dx = q.x - open[k].end.x;
+            dy = q.y - open[k].end.y;
+            d2 = dx * dx + dy * dy;
+            if (within_radius(d2, rho, a2, two_b, cap2) && (best == slots || d2 < best_d2)) {
+                best = k;
+                best_d2 = d2;
+            }
+        }
+        if (best < slots) {
+            open_seg_t s = open[best];
+            s.last = b;
+            s.last_pos = j;
+            s.n++;
+            s.end = q;
+            for (k = best; k > 0u; --k) {
+                open[k] = open[k - 1u];
+            }
+            open[0] = s;
+        } else {
+            if (n_open == slots) {
+                if (!close_open(&sink, &open[n_open - 1u], label, pts->count)) {
+                    return BSF_ERR_CAPACITY;
+                }
+                --n_open;
+            }
+            for (k = n_open; k > 0u; --k) {
+                open[k] = open[k - 1u];
+            }
+            open[0].first = b;
+            open[0].last = b;
+            open[0].last_pos = j;
+            open[0].n = 1u;
+            open[0].end = q;
+            ++n_open;
+        }
+        if (label != NULL) {
+            label[b] = (uint16_t)open[0].first;
+        }
     }
-    if (!sink_close(&sink, first, last, n_cur)) {
-        return BSF_ERR_CAPACITY;
+    /* Close the rest, oldest first. */
+    while (n_open > 0u) {
+        --n_open;
+        if (!close_open(&sink, &open[n_open], label, pts->count)) {
+            return BSF_ERR_CAPACITY;
+        }
+    }
+    /* Kept segments by first beam, one wrapping through the seam last
+     * (closing order is nearly that already). */
+    for (j = 1; j < sink.n_out; ++j) {
+        const bsf_segment_t s = sink.out[j];
+        k = j;
+        while (k > 0u && beam_order_key(&sink.out[k - 1u]) > beam_order_key(&s)) {
+            sink.out[k] = sink.out[k - 1u];
+            --k;
+        }
+        sink.out[k] = s;
     }
     return finish(&sink, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                              bsf_segment_t *out, size_t cap, size_t *n_out,
+                              size_t *n_wasted_points)
+{
+    return sved_run(pts, params, out, cap, NULL, 0, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                                       bsf_segment_t *out, size_t cap, uint16_t *label,
+                                       size_t *n_out, size_t *n_wasted_points)
+{
+    return sved_run(pts, params, out, cap, label, 1, n_out, n_wasted_points);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,
@@ -290,32 +532,6 @@ bsf_status_t bsf_segment_rpos(const bsf_points_t *pts, const bsf_rpos_params_t *
     return finish(&sink, n_out, n_wasted_points);
 }
 
-/* First valid beam in [from, to] into *at; 0 when there is none. */
-static int next_valid(const bsf_points_t *pts, size_t from, size_t to, size_t *at)
-{
-    for (; from <= to; ++from) {
-        if (pts->valid[from]) {
-            *at = from;
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* Last valid beam in [from, to] into *at; 0 when there is none. */
-static int prev_valid(const bsf_points_t *pts, size_t from, size_t to, size_t *at)
-{
-    size_t i = to + 1u;
-    while (i > from) {
-        --i;
-        if (pts->valid[i]) {
-            *at = i;
-            return 1;
-        }
-    }
-    return 0;
-}
-
 /* Index of the first interest beam > key (interest is strictly ascending). */
 static size_t upper_bound(const uint16_t *interest, size_t n, size_t key)
 {
@@ -332,8 +548,22 @@ static size_t upper_bound(const uint16_t *interest, size_t n, size_t key)
     return lo;
 }
 
-bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
-                                  const uint16_t *interest_beams, size_t n_interest)
+/* Is beam b one of the (strictly ascending) interest beams? */
+static int is_interest(const uint16_t *interest, size_t n, size_t b)
+{
+    const size_t j = upper_bound(interest, n, b);
+    return j > 0u && (size_t)interest[j - 1u] == b;
+}
+
+/* Is beam b a point of the segment whose first beam is first? */
+static int is_member(const bsf_points_t *pts, const uint16_t *label, size_t b, size_t first)
+{
+    return label != NULL ? label[b] == (uint16_t)first : pts->valid[b] != 0u;
+}
+
+bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
+                                           const uint16_t *label, const uint16_t *interest_beams,
+                                           size_t n_interest)
 {
     size_t k;
     if (pts == NULL || (segs == NULL && n > 0u) || (interest_beams == NULL && n_interest > 0u)) {
@@ -348,34 +578,56 @@ bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_point
         }
     }
     for (k = 0; k < n; ++k) {
-        if (segs[k].first > segs[k].last || (size_t)segs[k].last >= pts->count) {
+        if ((size_t)segs[k].first >= pts->count || (size_t)segs[k].last >= pts->count) {
             return BSF_ERR_ARG;
         }
     }
-
     for (k = 0; k < n; ++k) {
         bsf_segment_t *s = &segs[k];
-        const size_t first = s->first;
-        const size_t last = s->last;
+        size_t total = 0;
+        size_t pos = 0;
         size_t count = 0;
-        size_t v0 = 0;
-        size_t v1 = 0;
-        size_t w0 = 0;
-        size_t w1 = 0;
-        /* Inner interest points lie strictly between the second valid point
-         * (v1) and the last-but-one valid point (w1). */
-        if (next_valid(pts, first, last, &v0) && v0 < last && next_valid(pts, v0 + 1u, last, &v1) &&
-            prev_valid(pts, first, last, &w0) && w0 > first &&
-            prev_valid(pts, first, w0 - 1u, &w1) && v1 < w1) {
-            size_t j = upper_bound(interest_beams, n_interest, v1);
-            for (; j < n_interest && (size_t)interest_beams[j] < w1; ++j) {
-                if (pts->valid[interest_beams[j]]) {
+        size_t b = s->first;
+        /* Two walks over the run: count the members, then test the inner ones
+         * (not among the first two or the last two). */
+        for (;;) {
+            total += (size_t)is_member(pts, label, b, s->first);
+            if (b == s->last) {
+                break;
+            }
+            b = next_beam(b, pts->count);
+        }
+        for (b = s->first;; b = next_beam(b, pts->count)) {
+            if (is_member(pts, label, b, s->first)) {
+                if (pos >= 2u && pos + 3u <= total && is_interest(interest_beams, n_interest, b)) {
                     ++count;
                 }
+                ++pos;
+            }
+            if (b == s->last) {
+                break;
             }
         }
         s->n_interest = (uint8_t)(count > 255u ? 255u : count);
         s->kind = (uint8_t)(count > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK);
     }
     return BSF_OK;
+}
+
+bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
+                                  const uint16_t *interest_beams, size_t n_interest)
+{
+    size_t k;
+    if (pts == NULL || (segs == NULL && n > 0u) || (interest_beams == NULL && n_interest > 0u)) {
+        return BSF_ERR_ARG;
+    }
+    if (pts->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    for (k = 0; k < n; ++k) {
+        if (segs[k].first > segs[k].last) {
+            return BSF_ERR_ARG; /* no wrapping segments here */
+        }
+    }
+    return bsf_segment_classify_labelled(segs, n, pts, NULL, interest_beams, n_interest);
 }

@@ -43,20 +43,28 @@ typedef uint32_t (*bsf_clock_fn)(void *user);
 /** Runtime parameters; start from bsf_params_default(method). */
 typedef struct {
     bsf_method_t method;
-    bsf_falko_params_t falko; /**< used by FALKO-SVED-PDM */
-    bsf_bid_params_t bid;     /**< used by BID-SVED-PDM */
-    bsf_sved_params_t sved;   /**< used by the two SVED methods */
-    bsf_rpos_params_t rpos;   /**< used by RPOS-LSBA */
-    bsf_pdm_params_t pdm;     /**< used by the two PDM methods */
-    bsf_clock_fn clock;       /**< optional, see bsf_clock_fn */
-    void *clock_user;         /**< passed to clock */
-    uint32_t clock_hz;        /**< ticks per second of clock (> 0 when clock is set) */
+    bsf_falko_params_t falko;         /**< used by FALKO-SVED-PDM */
+    bsf_bid_params_t bid;             /**< used by BID-SVED-PDM */
+    bsf_sved_params_t sved;           /**< used by the two SVED methods */
+    bsf_rpos_params_t rpos;           /**< used by RPOS-LSBA */
+    bsf_pdm_params_t pdm;             /**< used by the two PDM methods */
+    bsf_no_return_params_t no_return; /**< no-return codes, every method (bsf_scan.h) */
+    bsf_clock_fn clock;               /**< optional, see bsf_clock_fn */
+    void *clock_user;                 /**< passed to clock */
+    uint32_t clock_hz;                /**< ticks per second of clock (> 0 when clock is set) */
 } bsf_params_t;
 
-/** Defaults for a method (the parameters the paper and design brief name).
+/** Defaults for a method: what a user gets (segmentation extensions on,
+ *  see bsf_sved_params_default, and no-return detection on).
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
  *  stored, which bsf_extractor_init then refuses. */
 bsf_params_t bsf_params_default(bsf_method_t method);
+
+/** The paper-faithful configuration of a method: as bsf_params_default but
+ *  with the paper's SVED rule (bsf_sved_params_paper), no no-return
+ *  detection beyond range_max, and PDM's refinement target at the first
+ *  release's 15 mm (the paper states none). `bsf table1 --paper` uses it. */
+bsf_params_t bsf_params_paper(bsf_method_t method);
 
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
  *  NULL, BSF_ERR_PARAM for an unknown method or a value out of range. */
@@ -73,6 +81,7 @@ typedef struct {
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
     bsf_segment_t segments[BSF_MAX_SEGMENTS];
+    uint16_t seg_label[BSF_MAX_POINTS]; /**< per beam: first beam of its segment, or BSF_SEG_NONE */
     /** Stage scratch. The corner, segmentation and fitting stages never run
      *  at the same time, so their working memory overlaps (the segments take
      *  no more room than one segment's points, so sizeof is unchanged). */

@@ -17,6 +17,14 @@
  *    collapse to about the middle one (plateau merge).
  * The reference computes in double; this port computes in float. See
  * src/bsf_falko.c for where the two can disagree.
+ *
+ * Full-circle scans (bsf_points_full_circle: the beams cover 2 pi within one
+ * increment): the neighbourhood window wraps through the seam between the
+ * last and the first beam, so a corner at the seam has neighbours on both
+ * sides (FALKOLib clamps the window to the scan; on every scan that does not
+ * cover the full circle this port still does, and gives its keypoints).
+ * Of two keypoints facing each other across the seam within the
+ * suppression window, only the stronger is kept.
  */
 #ifndef BSF_FALKO_H
 #define BSF_FALKO_H

@@ -29,7 +29,11 @@ typedef struct {
      *  first_beam .. stats.n_beams - 1, then 0 .. last_beam. */
     uint16_t first_beam;
     uint16_t last_beam;
-    uint16_t n_points;   /**< valid points assigned to the feature */
+    /** Valid points assigned to the feature. With the default segmentation
+     *   (look-back, bsf_segment.h) the run may also hold beams of other
+     *   features (an occluder in front of a wall), so n_points can be less
+     *   than the valid beams of the run, and runs of features may overlap. */
+    uint16_t n_points;
     uint16_t ctrl_first; /**< index of the first control point in the result pool */
     uint8_t n_ctrl;      /**< stored control points, 3..BSF_MAX_CTRL_PER_FEATURE */
     uint8_t kind;        /**< a bsf_feature_kind_t */

@@ -59,6 +59,54 @@ int bsf_range_is_valid(float r, float range_min, float range_max);
  */
 BSF_NODISCARD bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out);
 
+/**
+ * Do the beams cover the whole circle? True when |angle_increment| * count
+ * is within one |angle_increment| of 2 pi: the first and the last beam are
+ * then neighbours, and the segmentation and FALKO treat the beams as a ring.
+ */
+int bsf_points_full_circle(const bsf_points_t *pts);
+
+/** Parameters of bsf_points_reject_no_return. */
+typedef struct {
+    /** A reading exactly equal to this (after float conversion) is a
+     *  no-return code, metres; 0 = none given. For a sensor whose driver
+     *  codes "no return" as a fixed value (for example 50.0 or 81.91) but
+     *  does not declare it as its maximum range. */
+    float code;
+    /** Auto-detection: the scan's largest reading is a no-return code when
+     *  at least this many consecutive beams hold it bit for bit and the
+     *  valid beams beside that run (at least one) read more than 10 % less.
+     *  0 = off. Default 5, the shortest kept segment of
+     *  the default SVED: a shorter run of far readings cannot make a
+     *  feature of its own, and being 10 % away from its neighbours it joins
+     *  none of theirs (the radius is capped at 1 m). A genuine surface
+     *  rarely does this: a corner's peak is one beam, and a surface seen
+     *  head-on near the scan's maximum changes by centimetres beside its
+     *  run. A scan of nothing but equal readings (a round room from its
+     *  centre, or nothing but sky) is left alone. Measured on the four paper logs (their codes lie
+     * above the declared maximum, so every reading this rule takes is a genuine one): 0 readings
+     * taken; 117 with runs of 3 and no 10 % condition, 23 with runs of 3, 4 with runs of 4. */
+    uint16_t min_run;
+} bsf_no_return_params_t;
+
+/** Defaults: code 0 (none), min_run 5. */
+bsf_no_return_params_t bsf_no_return_params_default(void);
+
+/**
+ * Invalidate no-return codes in pts (after bsf_scan_to_points): every valid
+ * reading equal to p->code, and, when p->min_run > 0, every reading equal to
+ * the scan's largest valid reading if a run of min_run or more consecutive
+ * beams holds exactly that value and stands more than 10 % above its valid
+ * neighbours, of which it has at least one (see bsf_no_return_params_t). Invalidated beams get
+ * valid 0, point (0,0), range 0 and leave n_valid.
+ * @param n_rejected  readings invalidated (may be NULL)
+ * @return BSF_OK; BSF_ERR_ARG for NULL pts or p; BSF_ERR_PARAM for a code
+ *         that is negative or not finite.
+ */
+BSF_NODISCARD bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts,
+                                                       const bsf_no_return_params_t *p,
+                                                       size_t *n_rejected);
+
 BSF_END_DECLS
 
 #endif /* BSF_SCAN_H */

@@ -35,12 +35,41 @@ typedef struct {
     uint8_t n_interest; /**< inner interest points (see bsf_segment_classify), saturates at 255 */
 } bsf_segment_t;
 
-/** SVED parameters. */
+/** "No segment" in a label array (see bsf_segment_sved_labelled). */
+#define BSF_SEG_NONE 0xFFFFu
+
+/**
+ * SVED parameters. The first three are the paper's rule; the last four
+ * extend it and are all off in bsf_sved_params_paper():
+ *  - lookback: besides the current segment, a point may join one of the
+ *    `lookback` most recently extended open segments whose last point lies
+ *    within the radius and at most max_gap_beams beams back (the nearest
+ *    such last point wins). So a thin occluder (a chair leg, a door frame)
+ *    in front of a wall leaves the wall one segment instead of splitting
+ *    it; points inside a segment stay in beam order.
+ *  - radius_max: the radius a * exp(b * rho) is capped at radius_max. The
+ *    paper states a and b for ranges 0.5..30 m; beyond that the exponential
+ *    explodes (3.3 m at 40 m, 13 m at 60 m) and chains sparse far points
+ *    metres apart into one feature.
+ *  - reject_mixed: a mixed pixel (a lone reading between a foreground and a
+ *    background surface at a depth jump, see bsf_segment_sved_labelled)
+ *    joins no segment, so it cannot bend or bridge either surface.
+ */
 typedef struct {
     float a;                     /**< distance threshold at range 0, metres, finite, > 0 */
     float b;                     /**< growth of the threshold with range, 1/metre, finite, >= 0 */
     uint16_t min_segment_points; /**< shortest kept segment, points, 1..BSF_MAX_POINTS */
+    uint16_t max_gap_beams;      /**< rejoin only segments whose last point is at most this
+                                      many beams back, 1..BSF_MAX_POINTS (used when lookback > 0) */
+    float radius_max;            /**< cap on the radius, metres; 0 = no cap (the paper), else
+                                      finite and >= a */
+    uint8_t lookback;     /**< older open segments a point may rejoin, 0..BSF_SVED_MAX_LOOKBACK;
+                               0 = the paper's rule (the current segment only) */
+    uint8_t reject_mixed; /**< 1: mixed pixels join no segment; 0: the paper */
 } bsf_sved_params_t;
+
+/** Largest lookback of bsf_sved_params_t. */
+#define BSF_SVED_MAX_LOOKBACK 8u
 
 /** RPOS parameters. */
 typedef struct {
@@ -49,8 +78,17 @@ typedef struct {
     uint16_t min_segment_points; /**< shortest kept segment, points, 1..BSF_MAX_POINTS */
 } bsf_rpos_params_t;
 
-/** SVED defaults of the paper: a = 0.2 m, b = 0.07 /m, min_segment_points = 5. */
+/**
+ * SVED defaults (what the extractor uses unless told otherwise): the paper's
+ * a = 0.2 m, b = 0.07 /m, min_segment_points = 5, plus lookback 4,
+ * max_gap_beams 16, radius_max 1.0 m and reject_mixed 1 (docs/TABLE1.md has
+ * the measurements behind each value).
+ */
 bsf_sved_params_t bsf_sved_params_default(void);
+
+/** The paper's SVED rule exactly: a = 0.2 m, b = 0.07 /m, min_segment_points
+ *  = 5, lookback 0, radius_max 0 (none), reject_mixed 0. */
+bsf_sved_params_t bsf_sved_params_paper(void);
 
 /** RPOS defaults of the paper: alpha_max = pi/4, eta = 1.5, min_segment_points = 5. */
 bsf_rpos_params_t bsf_rpos_params_default(void);
@@ -70,7 +108,9 @@ BSF_NODISCARD bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p);
 BSF_NODISCARD bsf_status_t bsf_rpos_params_check(const bsf_rpos_params_t *p);
 
 /**
- * SVED segmentation. Walks the beams in order; each valid point joins the
+ * SVED segmentation, the paper's rule whatever the extensions in params say
+ * (they are checked, then ignored; bsf_segment_sved_labelled applies them).
+ * Walks the beams in order; each valid point joins the
  * current segment when its distance to the segment's last point is at most
  * a * exp(b * rho) (rho: its range, metres), else it starts a new segment.
  * Segments with fewer than min_segment_points points are not output; their
@@ -94,6 +134,38 @@ BSF_NODISCARD bsf_status_t bsf_rpos_params_check(const bsf_rpos_params_t *p);
 BSF_NODISCARD bsf_status_t bsf_segment_sved(const bsf_points_t *pts,
                                             const bsf_sved_params_t *params, bsf_segment_t *out,
                                             size_t cap, size_t *n_out, size_t *n_wasted_points);
+
+/**
+ * SVED with every extension of bsf_sved_params_t, and a per-beam label.
+ * With lookback 0, radius_max 0 and reject_mixed 0 the segments are those of
+ * the paper's rule (bsf_segment_sved). With lookback > 0 a segment's beam
+ * run [first, last] may contain beams of other segments (an occluder in
+ * front of a wall), so its members are the beams labelled with its first
+ * beam.
+ *
+ * Mixed pixel: valid beam i whose neighbours i-2..i+2 are valid, whose range
+ * lies strictly between those of beams i-1 and i+1, which jump by
+ * J = |rho(i+1) - rho(i-1)| > the radius at rho(i), while the range steps
+ * i-2 -> i-1 and i+1 -> i+2 are both below J / 4 (two flat surfaces on
+ * either side, unlike a wall seen at a grazing angle whose steps grow
+ * smoothly), and which is more than J / 8 from both neighbours in range.
+ *
+ * Full-circle scans (bsf_points_full_circle): the pass starts after the
+ * widest step between cyclically consecutive valid points, so a surface
+ * crossing the seam between the last and the first beam is one segment; it
+ * is reported with first > last (beams first..count-1 then 0..last).
+ *
+ * @param label  pts->count entries (may be NULL): the first beam of the kept
+ *               segment beam i belongs to, or BSF_SEG_NONE (invalid, wasted,
+ *               mixed pixel)
+ * Other parameters, outputs and return codes as bsf_segment_sved, except
+ * that segments come out ordered by first beam (a wrapping one last).
+ */
+BSF_NODISCARD bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts,
+                                                     const bsf_sved_params_t *params,
+                                                     bsf_segment_t *out, size_t cap,
+                                                     uint16_t *label, size_t *n_out,
+                                                     size_t *n_wasted_points);
 
 /**
  * RPOS segmentation over consecutive VALID points: invalid beams are
@@ -133,6 +205,19 @@ BSF_NODISCARD bsf_status_t bsf_segment_rpos(const bsf_points_t *pts,
 BSF_NODISCARD bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n,
                                                 const bsf_points_t *pts,
                                                 const uint16_t *interest_beams, size_t n_interest);
+
+/**
+ * bsf_segment_classify for segments from bsf_segment_sved_labelled: a
+ * segment's points are the beams labelled with its first beam, and a
+ * segment may wrap (first > last). label NULL means every valid beam of the
+ * run belongs to the segment (then it equals bsf_segment_classify, plus
+ * wrapping). Return codes as bsf_segment_classify (first > last is allowed).
+ */
+BSF_NODISCARD bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n,
+                                                         const bsf_points_t *pts,
+                                                         const uint16_t *label,
+                                                         const uint16_t *interest_beams,
+                                                         size_t n_interest);
 
 BSF_END_DECLS
 

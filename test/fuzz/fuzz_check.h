@@ -36,8 +36,10 @@ static inline int fuzz_finite(float v)
 }
 
 /* A result is within the caps, self-consistent and free of NaN/inf. With
- * `ordered`, features must also come in beam order without overlap (the
- * extractor's promise; the wire format itself allows any order). */
+ * `ordered`, features must also come in order of their first beams, a
+ * wrapping one last (the extractor's promise; the wire format itself allows
+ * any order). Their runs may overlap (the segmentation's look-back) and, on
+ * a full-circle scan, wrap through the seam (first_beam > last_beam). */
 static inline void fuzz_check_result(const bsf_result_t *r, int ordered)
 {
     uint32_t sum_points = 0u;
@@ -48,6 +50,7 @@ static inline void fuzz_check_result(const bsf_result_t *r, int ordered)
     FUZZ_CHECK(r->n_ctrl <= BSF_MAX_CTRL_POINTS);
     for (f = 0; f < r->n_features; ++f) {
         const bsf_feature_t *ft = &r->features[f];
+        const int wraps = ft->first_beam > ft->last_beam;
         /* first_beam > last_beam: the run wraps through the seam of a
          * full-circle scan of stats.n_beams beams. */
         const uint32_t span = ft->first_beam <= ft->last_beam
@@ -62,7 +65,10 @@ static inline void fuzz_check_result(const bsf_result_t *r, int ordered)
         FUZZ_CHECK(ft->kind <= 1u);
         FUZZ_CHECK(fuzz_finite(ft->e_curve) && ft->e_curve >= 0.0f);
         if (ordered && f > 0u) {
-            FUZZ_CHECK(ft->first_beam > r->features[f - 1u].last_beam);
+            const bsf_feature_t *pf = &r->features[f - 1u];
+            /* by first beam, a wrapping feature last */
+            FUZZ_CHECK((pf->first_beam > pf->last_beam ? 0x10000u : 0u) + pf->first_beam <
+                       (wraps ? 0x10000u : 0u) + ft->first_beam);
         }
         next_ctrl += ft->n_ctrl;
         sum_points += ft->n_points;

@@ -13,8 +13,8 @@
  * with F_PARAMS a count byte and that many edits of the method's defaults
  * (1 byte naming a field, 4 value bytes: a raw value when the field byte's
  * bit 7 is set, else a value near the default, so most edits stay in range
- * and reach the code behind the checks); with F_CLOCK 2 bytes of tick step
- * and 4 of clock_hz; with F_OVER_CAP one byte picking a count of
+ * and reach the code behind the checks; field 36 sets a clock hook); with
+ * F_OVER_CAP one byte picking a count of
  * BSF_MAX_POINTS + 1 - (0..3) beams, the ranges given repeated up to it;
  * then the ranges (uint16 millimetres, or raw float bits with F_RAW_RANGES).
  */
@@ -23,14 +23,14 @@
 #include "fuzz_check.h"
 
 enum {
-    F_RPOS = 0x01,       /* method RPOS-LSBA instead of FALKO-SVED-PDM */
-    F_RAW_RANGES = 0x02, /* ranges are raw float bits (else uint16 millimetres) */
-    F_RAW_GEOM = 0x04,   /* geometry is raw float bits (else small codes) */
-    F_PARAMS = 0x08,     /* segmentation and FALKO parameters follow */
-    F_OVER_CAP = 0x10,   /* a count at or just below/above BSF_MAX_POINTS */
-    F_ENCODE = 0x20,     /* also encode and decode the result */
-    F_BID = 0x40,        /* method BID-SVED-PDM (wins over F_RPOS) */
-    F_CLOCK = 0x80       /* a clock hook that advances a fixed step per call */
+    F_RPOS = 0x01,        /* method RPOS-LSBA instead of FALKO-SVED-PDM */
+    F_RAW_RANGES = 0x02,  /* ranges are raw float bits (else uint16 millimetres) */
+    F_RAW_GEOM = 0x04,    /* geometry is raw float bits (else small codes) */
+    F_PARAMS = 0x08,      /* segmentation and FALKO parameters follow */
+    F_OVER_CAP = 0x10,    /* a count at or just below/above BSF_MAX_POINTS */
+    F_ENCODE = 0x20,      /* also encode and decode the result */
+    F_FULL_CIRCLE = 0x40, /* the beams cover the whole circle (seam wrap paths) */
+    F_BID = 0x80          /* method BID-SVED-PDM (wins over F_RPOS) */
 };
 
 static uint32_t clock_now;
@@ -189,7 +189,7 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
     uint32_t iv = raw ? v : (v & 0xFFu);
     memcpy(&fv, &v, sizeof fv);
 #define F(dst) (dst) = raw ? fv : near((dst), v)
-    switch ((field & 0x7Fu) % 36u) {
+    switch ((field & 0x7Fu) % 37u) {
     case 0: F(p->sved.a); break;
     case 1: F(p->sved.b); break;
     case 2: p->sved.min_segment_points = (uint16_t)iv; break;
@@ -228,6 +228,14 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
         F(p->falko.neigh_b);
         F(p->bid.neigh_b);
         break;
+    case 36:
+        /* a clock hook: v's low 16 bits are the ticks per call; clock_hz is
+         * v itself when raw (0 must be refused), else 1 MHz */
+        clock_step = v & 0xFFFFu;
+        p->clock = fake_clock;
+        p->clock_user = &clock_now;
+        p->clock_hz = raw ? v : 1000000u;
+        break;
     default:
         F(p->sved.a);
         F(p->sved.b);
@@ -245,6 +253,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t count = 0u;
     size_t over_cap_count = 0u;
     size_t n_valid = 0u;
+    size_t n_top = 0u;
+    float top = 0.0f;
     size_t i;
     uint8_t flags;
     int extractor_ok;
@@ -283,12 +293,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             edit_param(&params, field, v);
         }
     }
-    if (flags & F_CLOCK) {
-        clock_step = take_u32(&in, 2u);
-        params.clock = fake_clock;
-        params.clock_user = &clock_now;
-        params.clock_hz = take_u32(&in, 4u);
-    }
     if (flags & F_OVER_CAP) {
         over_cap_count = BSF_MAX_POINTS + 1u - (take_u32(&in, 1u) & 3u);
     }
@@ -323,6 +327,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     scan.ranges = ranges;
     scan.count = count;
+    if ((flags & F_FULL_CIRCLE) && count > 0u) {
+        scan.angle_increment = 6.2831853f / (float)count;
+    }
 
     memset(&res, 0x5A, sizeof res);
     st = bsf_extract(&ex, &scan, &res);
@@ -343,9 +350,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(count <= BSF_MAX_POINTS);
     fuzz_check_result(&res, 1);
     for (i = 0; i < count; ++i) {
-        n_valid += (size_t)bsf_range_is_valid(ranges[i], scan.range_min, scan.range_max);
+        if (bsf_range_is_valid(ranges[i], scan.range_min, scan.range_max)) {
+            ++n_valid;
+            top = ranges[i] > top ? ranges[i] : top;
+        }
     }
-    FUZZ_CHECK(res.stats.n_valid == n_valid);
+    for (i = 0; i < count; ++i) {
+        n_top += (size_t)(bsf_range_is_valid(ranges[i], scan.range_min, scan.range_max) &&
+                          ranges[i] == top);
+    }
+    /* No-return detection may invalidate every reading equal to the largest
+     * valid one (runs of at least min_run of them), nothing else. */
+    FUZZ_CHECK(res.stats.n_valid == n_valid ||
+               (res.stats.n_valid == n_valid - n_top && n_top >= ex.params.no_return.min_run &&
+                ex.params.no_return.min_run > 0u));
     FUZZ_CHECK(res.stats.n_keypoints <= BSF_MAX_KEYPOINTS);
     for (i = 0; i < res.n_features; ++i) {
         FUZZ_CHECK(res.features[i].last_beam < count);

@@ -173,7 +173,7 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
         n = put4(out, n, bits_of(ranges[i]));
     }
     err |= write_file(dir, "extract", "cap_raw.bin", out, n);
-    len = extract_input(out, 361u, 0x60u); /* BID + encode, the 361 first beams */
+    len = extract_input(out, 361u, 0xA0u); /* BID + encode, the 361 first beams */
     err |= write_file(dir, "extract", "bid.bin", out, len);
     n = 0u;
     out[n++] = 0x28u; /* F_PARAMS | F_ENCODE */
@@ -192,13 +192,13 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
     memcpy(out + n, tmp + 3, len - 3u); /* the ranges after flags and geometry */
     err |= write_file(dir, "extract", "params.bin", out, n + len - 3u);
     n = 0u;
-    out[n++] = 0xA0u; /* F_CLOCK | F_ENCODE */
+    out[n++] = 0x28u; /* F_PARAMS | F_ENCODE: one edit, the clock hook */
     out[n++] = (uint8_t)(7u | (25u << 6));
     out[n++] = (uint8_t)((25u >> 2) | 0x40u);
-    out[n++] = 0xE8u; /* 1000 ticks per call */
-    out[n++] = 0x03u;
-    n = put4(out, n, 1000000u);
-    len = extract_input(tmp, 361u, 0xA0u);
+    out[n++] = 1u;
+    out[n++] = 36u; /* 1000 ticks per call at 1 MHz */
+    n = put4(out, n, 1000u);
+    len = extract_input(tmp, 361u, 0x28u);
     memcpy(out + n, tmp + 3, len - 3u);
     err |= write_file(dir, "extract", "clock.bin", out, n + len - 3u);
 
@@ -206,7 +206,7 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
      * harness repeats one period up to the cap): more segments, keypoints
      * and control points than the caps hold, so the cut paths run */
     {
-        static const uint8_t methods[3] = {0x30u, 0x31u, 0x70u}; /* FALKO, RPOS, BID */
+        static const uint8_t methods[3] = {0x30u, 0x31u, 0xB0u}; /* FALKO, RPOS, BID */
         static const char *const names[3] = {"cut_falko.bin", "cut_rpos.bin", "cut_bid.bin"};
         size_t m;
         for (m = 0; m < 3u; ++m) {

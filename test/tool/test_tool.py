@@ -328,5 +328,71 @@ cut_frames = [o for o in objs if "seq" in o and o["cut"] != 0]
 check(len(cut_frames) == n_lines and all(o["n_cut_keypoints"] + o["n_cut_segments"] > 0 for o in cut_frames),
       "bsf decode shows each cut scan's cut and counters")
 
+# 8. scans of 4096 beams (a dense 270-degree scanner in a 10 m x 6 m room) are
+#    extracted, not skipped: the tool is built with host-sized caps.
+import math
+
+
+def room_range(angle, x0=4.0, y0=2.5, w=10.0, h=6.0):
+    """Distance from (x0, y0) along `angle` to the walls of the room [0,w]x[0,h]."""
+    c, s_ = math.cos(angle), math.sin(angle)
+    best = 1e9
+    for t in ((w - x0) / c if c > 1e-12 else None, -x0 / c if c < -1e-12 else None,
+              (h - y0) / s_ if s_ > 1e-12 else None, -y0 / s_ if s_ < -1e-12 else None):
+        if t is not None and 0.0 < t < best:
+            best = t
+    return best
+
+
+n_big = 4096
+inc = math.radians(270.0) / n_big
+start = -math.radians(135.0)
+with open(os.path.join(WORK, "big.log"), "w") as f:
+    for k in range(3):
+        rs = " ".join("%.2f" % room_range(start + i * inc + 0.1 * k) for i in range(n_big))
+        f.write("ROBOTLASER1 0 %.9g %.9g %.9g 50.0 0.01 0 %d %s 0 0 0 0 0 0 0 0 0 0 0 0 %d.0 nohost %d.0\n"
+                % (start, n_big * inc, inc, n_big, rs, k, k))
+r = run(["extract", "big.log", "-o", "big.bsf"], text=True)
+check(r.returncode == 0 and "skipped" not in r.stderr and "3 scans extracted" in r.stderr,
+      "bsf extract handles 4096-beam scans (%s)" % r.stderr.strip()[:200])
+r = run(["metrics", "big.bsf"], text=True)
+m = metrics_of(r.stdout)
+check(r.returncode == 0 and m.get("scans", ["0"])[0] == "3" and
+      float(m.get("retrievability", ["0"])[0]) > 90.0,
+      "metrics of the 4096-beam scans: 3 scans, retrievability above 90 %% (%s)" % m.get("retrievability"))
+
+# 9. no-return codes a log does not declare: FLASER lines (no range field) from a
+#    room with an open side, the sensor writing exactly 50.0 for no return.
+def open_room_range(angle):
+    r = room_range(angle, x0=2.0, y0=2.0, w=6.0, h=5.0)
+    c, s_ = math.cos(angle), math.sin(angle)
+    # the wall x = 6 is open between y = 1.5 and y = 3.5
+    return 50.0 if c > 1e-12 and abs(2.0 + r * s_ - 2.5) < 1.0 and abs(2.0 + r * c - 6.0) < 1e-6 else r
+
+
+with open(os.path.join(WORK, "code50.log"), "w") as f:
+    for k in range(2):
+        rs = [open_room_range(-math.pi / 2 + i * math.pi / 180.0) for i in range(180)]
+        f.write("FLASER 180 %s 0 0 0 0 0 0 %d.0 nohost %d.0\n" % (" ".join("%.2f" % v for v in rs), k, k))
+n_code = sum(1 for i in range(180) if open_room_range(-math.pi / 2 + i * math.pi / 180.0) == 50.0)
+
+
+def n_valid_of(args):
+    r = run(["extract", "code50.log", "-o", "code50.bsf"] + args, text=True)
+    d = run(["decode", "code50.bsf", "--json"], text=True)
+    if r.returncode != 0 or d.returncode != 0:
+        return None
+    return [int(line.split('"n_valid":')[1].split(",")[0]) for line in d.stdout.splitlines()
+            if '"n_valid":' in line]
+
+
+check(n_code >= 10 and n_valid_of([]) == [180 - n_code] * 2,
+      "undeclared no-return code 50.0 recognised (%d codes, n_valid %s)" % (n_code, n_valid_of([])))
+check(n_valid_of(["--no-return", "off"]) == [180] * 2, "--no-return off keeps the code readings")
+check(n_valid_of(["--no-return", "off", "--no-return", "50"]) == [180 - n_code] * 2,
+      "--no-return 50 names the code (recognition of runs off)")
+r = run(["extract", "code50.log", "--no-return", "-3"], text=True)
+check(r.returncode != 0 and "--no-return" in r.stderr, "--no-return refuses a negative code")
+
 print("%d checks failed" % len(failures) if failures else "all tool checks passed")
 sys.exit(1 if failures else 0)

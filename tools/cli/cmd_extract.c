@@ -14,6 +14,10 @@ static const char extract_help[] =
     "  --count N        process at most N scans (default: all)\n"
     "  --range-max M    readings >= M metres are invalid (default: the log's declared\n"
     "                   maximum range, capped below the 81.83/81.91 no-return codes)\n"
+    "  --no-return V    the sensor's no-return code: a reading of exactly V metres is\n"
+    "                   never a point; 'off' stops recognising undeclared codes (by\n"
+    "                   default, a run of 5 or more identical readings at the scan's\n"
+    "                   maximum, 10 % above its neighbours, is one); may be repeated\n"
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
     "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
@@ -66,7 +70,9 @@ typedef struct {
     bsf_method_t method;
     long first;
     long count;
-    double range_max; /* <= 0: from the log */
+    double range_max;  /* <= 0: from the log */
+    double no_return;  /* > 0: the sensor's no-return code */
+    int no_return_off; /* 1: no recognition of undeclared codes */
     double quant;
     long meta_every;
     int reproducible;
@@ -157,8 +163,15 @@ static int run_extract(const extract_opts_t *o)
     int r;
     int write_failed = 0;
 
-    if (init_extractor_timed(o->method, !o->reproducible) != 0) {
-        return EXIT_FAIL;
+    {
+        bsf_params_t p = bsf_params_default(o->method);
+        p.no_return.code = (float)o->no_return;
+        if (o->no_return_off) {
+            p.no_return.min_run = 0u;
+        }
+        if (init_extractor_params(&p, !o->reproducible) != 0) {
+            return EXIT_FAIL;
+        }
     }
     rd = open_log(o->log);
     if (rd == NULL) {
@@ -337,6 +350,12 @@ int cmd_extract(int argc, char **argv)
         } else if ((v = opt_value(argc, argv, &i, "--range-max", &err)) != NULL) {
             if (parse_float(v, 1e-3, 1e4, &o.range_max) != 0) {
                 return usage_error("--range-max needs metres > 0, got '%s'", v);
+            }
+        } else if ((v = opt_value(argc, argv, &i, "--no-return", &err)) != NULL) {
+            if (strcmp(v, "off") == 0) {
+                o.no_return_off = 1;
+            } else if (parse_float(v, 1e-3, 1e4, &o.no_return) != 0) {
+                return usage_error("--no-return needs metres > 0 or 'off', got '%s'", v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--quant", &err)) != NULL) {
             if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) !=

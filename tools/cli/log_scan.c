@@ -9,9 +9,9 @@ bsf_extractor_t g_ex;
 bsf_result_t g_res;
 uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 
-int init_extractor_timed(bsf_method_t method, int timed)
+int init_extractor_params(const bsf_params_t *params, int timed)
 {
-    bsf_params_t p = bsf_params_default(method);
+    bsf_params_t p = *params;
     bsf_status_t st;
     if (timed) {
         p.clock = bsf_port_clock_monotonic_ns;
@@ -23,6 +23,18 @@ int init_extractor_timed(bsf_method_t method, int timed)
         return -1;
     }
     return 0;
+}
+
+int init_extractor_timed(bsf_method_t method, int timed)
+{
+    const bsf_params_t p = bsf_params_default(method);
+    return init_extractor_params(&p, timed);
+}
+
+int init_extractor_config(bsf_method_t method, int paper)
+{
+    const bsf_params_t p = paper ? bsf_params_paper(method) : bsf_params_default(method);
+    return init_extractor_params(&p, 1);
 }
 
 int init_extractor(bsf_method_t method)

@@ -148,6 +148,11 @@ extern uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 int init_extractor_timed(bsf_method_t method, int timed);
 /** init_extractor_timed(method, 1). */
 int init_extractor(bsf_method_t method);
+/** As init_extractor; paper != 0 takes bsf_params_paper (the paper-faithful configuration). */
+int init_extractor_config(bsf_method_t method, int paper);
+/** Initialise g_ex with these parameters (plus the monotonic clock when timed).
+ *  0, or -1 with a message. */
+int init_extractor_params(const bsf_params_t *params, int timed);
 /** Metadata of a stream extracted by g_ex from scans like sc at step quant:
  *  this build's caps, g_ex's method and target RMS, sc's geometry; no time
  *  origin, no source. */
