@@ -1,0 +1,271 @@
+/* SPDX-License-Identifier: MIT */
+#include "bsf_truth.h"
+
+#include <math.h>
+#include <string.h>
+
+#define TRUTH_MAX_CORNERS 256
+#define TRUTH_MAX_CREASES 256
+
+void bsf_truth_acc_init(bsf_truth_acc_t *acc)
+{
+    memset(acc, 0, sizeof *acc);
+}
+
+static void hist_add(bsf_truth_hist_t *h, double d)
+{
+    long bin = (long)(d / BSF_TRUTH_BIN);
+    if (bin < 0) {
+        bin = 0;
+    }
+    if (bin > BSF_TRUTH_NBINS) {
+        bin = BSF_TRUTH_NBINS;
+    }
+    h->hist[bin]++;
+    h->sum_sq += d * d;
+    if (d > h->max) {
+        h->max = d;
+    }
+    h->n++;
+}
+
+double bsf_truth_quantile(const bsf_truth_hist_t *h, double q)
+{
+    uint64_t want;
+    uint64_t seen = 0;
+    long b;
+    if (h->n == 0u) {
+        return 0.0;
+    }
+    want = (uint64_t)ceil(q * (double)h->n);
+    if (want < 1u) {
+        want = 1u;
+    }
+    for (b = 0; b <= BSF_TRUTH_NBINS; ++b) {
+        seen += h->hist[b];
+        if (seen >= want) {
+            return b == BSF_TRUTH_NBINS ? h->max : (double)(b + 1) * BSF_TRUTH_BIN;
+        }
+    }
+    return h->max;
+}
+
+/* Where a straight wall meets a circle (world frame): real creases of the
+ * geometry that the corner list does not hold. */
+static size_t creases(const bsf_scene_t *sc, double *xy, size_t cap)
+{
+    size_t n = 0;
+    size_t a;
+    size_t b;
+    for (a = 0; a < sc->n_shapes; ++a) {
+        const bsf_shape_t *s = &sc->shape[a];
+        if (s->kind != BSF_SHAPE_SEGMENT) {
+            continue;
+        }
+        for (b = 0; b < sc->n_shapes; ++b) {
+            const bsf_shape_t *c = &sc->shape[b];
+            const double dx = s->x1 - s->x0;
+            const double dy = s->y1 - s->y0;
+            const double fx = s->x0 - c->x0;
+            const double fy = s->y0 - c->y0;
+            double qa, qb, qc, disc;
+            int k;
+            if (c->kind != BSF_SHAPE_CIRCLE) {
+                continue;
+            }
+            qa = dx * dx + dy * dy;
+            qb = 2.0 * (fx * dx + fy * dy);
+            qc = fx * fx + fy * fy - c->r * c->r;
+            disc = qb * qb - 4.0 * qa * qc;
+            if (disc < 0.0) {
+                continue;
+            }
+            for (k = -1; k <= 1; k += 2) {
+                const double t = (-qb + (double)k * sqrt(disc)) / (2.0 * qa);
+                if (t >= 0.0 && t <= 1.0 && n < cap) {
+                    xy[2u * n] = s->x0 + t * dx;
+                    xy[2u * n + 1u] = s->y0 + t * dy;
+                    ++n;
+                }
+            }
+        }
+    }
+    return n;
+}
+
+/* Each wall of corner c seen over some length (see bsf_truth.h). */
+static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, const float *ranges,
+                      const int16_t *hit_shape)
+{
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const int wall = side == 0 ? c->shape_a : c->shape_b;
+        int hits = 0;
+        double dmin = 1e300;
+        double dmax = 0.0;
+        size_t i;
+        for (i = 0; i < lidar->n_beams; ++i) {
+            double a;
+            double px;
+            double py;
+            double d;
+            if (hit_shape[i] != wall) {
+                continue;
+            }
+            a = lidar->angle_min + (double)i * lidar->angle_increment;
+            px = (double)ranges[i] * cos(a);
+            py = (double)ranges[i] * sin(a);
+            d = hypot(px - c->x, py - c->y);
+            if (d <= BSF_TRUTH_WALL_LEN) {
+                ++hits;
+                dmin = d < dmin ? d : dmin;
+                dmax = d > dmax ? d : dmax;
+            }
+        }
+        if (hits < BSF_TRUTH_MIN_HITS || dmax - dmin < BSF_TRUTH_MIN_SPREAD) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                  const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
+                  size_t bytes, double time_ns)
+{
+    static bsf_scene_corner_t corners[TRUTH_MAX_CORNERS];
+    double crease_xy[2 * TRUTH_MAX_CREASES];
+    size_t n_corners = 0;
+    size_t n_creases;
+    size_t f;
+    size_t k;
+    size_t j;
+
+    if (bsf_scene_corners(scene, lidar, corners, TRUTH_MAX_CORNERS, &n_corners) != BSF_OK) {
+        return -1;
+    }
+    n_creases = creases(scene, crease_xy, TRUTH_MAX_CREASES);
+    for (k = 0; k < n_creases; ++k) {
+        double sx;
+        double sy;
+        bsf_scene_world_to_sensor(&lidar->pose, crease_xy[2u * k], crease_xy[2u * k + 1u], &sx,
+                                  &sy);
+        crease_xy[2u * k] = sx;
+        crease_xy[2u * k + 1u] = sy;
+    }
+
+    /* Recall and position error. */
+    for (k = 0; k < n_corners; ++k) {
+        const bsf_scene_corner_t *c = &corners[k];
+        int band;
+        double best = 1e300;
+        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX || !walls_seen(c, lidar, ranges, hit_shape)) {
+            continue;
+        }
+        band = c->range < 3.0 ? 0 : (c->range < 6.0 ? 1 : 2);
+        acc->visible[band]++;
+        for (j = 0; j < res->n_ctrl; ++j) {
+            if (res->ctrl_is_vertex[j]) {
+                const double d = hypot((double)res->ctrl[j].x - c->x, (double)res->ctrl[j].y - c->y);
+                best = d < best ? d : best;
+            }
+        }
+        if (best <= BSF_TRUTH_MATCH) {
+            acc->found[band]++;
+            hist_add(&acc->vertex_err, best);
+        }
+    }
+
+    /* Precision, and the curves against the true surfaces. */
+    for (f = 0; f < res->n_features; ++f) {
+        const bsf_feature_t *ft = &res->features[f];
+        const bsf_point_t *ctrl = &res->ctrl[ft->ctrl_first];
+        const size_t n_samples = (size_t)BSF_TRUTH_SAMPLES_PER_SPAN * (ft->n_ctrl - 2u);
+        double worst = 0.0;
+        for (j = 0; j < ft->n_ctrl; ++j) {
+            const size_t g = ft->ctrl_first + j;
+            double best = 1e300;
+            int crease = 0;
+            if (!res->ctrl_is_vertex[g] || (j > 0u && res->ctrl_is_vertex[g - 1u])) {
+                continue; /* not a vertex, or its second copy */
+            }
+            for (k = 0; k < n_corners; ++k) {
+                const double d =
+                    hypot((double)res->ctrl[g].x - corners[k].x, (double)res->ctrl[g].y - corners[k].y);
+                best = d < best ? d : best;
+            }
+            for (k = 0; k < n_creases; ++k) {
+                if (hypot((double)res->ctrl[g].x - crease_xy[2u * k],
+                          (double)res->ctrl[g].y - crease_xy[2u * k + 1u]) <= BSF_TRUTH_MATCH) {
+                    crease = 1;
+                }
+            }
+            if (best > BSF_TRUTH_MATCH && crease) {
+                acc->vertices_creases++;
+                continue;
+            }
+            acc->vertices++;
+            if (best <= BSF_TRUTH_MATCH) {
+                acc->vertices_correct++;
+            }
+            ++j; /* skip the second copy */
+        }
+        for (j = 0; j <= n_samples; ++j) {
+            bsf_point_t p;
+            double wx;
+            double wy;
+            double d;
+            if (bsf_bspline_eval(ctrl, ft->n_ctrl, (float)((double)j / (double)n_samples), &p,
+                                 NULL, NULL) != BSF_OK) {
+                continue;
+            }
+            bsf_scene_sensor_to_world(&lidar->pose, (double)p.x, (double)p.y, &wx, &wy);
+            d = bsf_scene_distance_to_surface(scene, wx, wy, NULL);
+            hist_add(&acc->curve, d);
+            worst = d > worst ? d : worst;
+        }
+        acc->features++;
+        if (worst > BSF_TRUTH_STRAY) {
+            acc->features_stray++;
+        }
+    }
+    acc->scans++;
+    acc->n_valid += res->stats.n_valid;
+    acc->n_in_features += res->stats.n_in_features;
+    acc->n_ctrl += res->stats.n_ctrl;
+    acc->bytes += bytes;
+    acc->time_ns += time_ns;
+    return 0;
+}
+
+static double ratio(uint64_t a, uint64_t b)
+{
+    return b > 0u ? (double)a / (double)b : 0.0;
+}
+
+void bsf_truth_summary(const bsf_truth_acc_t *acc, bsf_truth_summary_t *s)
+{
+    uint64_t vis = 0;
+    uint64_t found = 0;
+    int b;
+    memset(s, 0, sizeof *s);
+    for (b = 0; b < BSF_TRUTH_BANDS; ++b) {
+        vis += acc->visible[b];
+        found += acc->found[b];
+        s->recall_band[b] = ratio(acc->found[b], acc->visible[b]);
+    }
+    s->visible = vis;
+    s->recall = ratio(found, vis);
+    s->precision = acc->vertices > 0u ? ratio(acc->vertices_correct, acc->vertices) : 1.0;
+    s->verr_median = bsf_truth_quantile(&acc->vertex_err, 0.5);
+    s->verr_p90 = bsf_truth_quantile(&acc->vertex_err, 0.9);
+    s->verr_max = acc->vertex_err.max;
+    s->curve_rms = acc->curve.n > 0u ? sqrt(acc->curve.sum_sq / (double)acc->curve.n) : 0.0;
+    s->curve_p99 = bsf_truth_quantile(&acc->curve, 0.99);
+    s->curve_max = acc->curve.max;
+    s->stray_share = ratio(acc->features_stray, acc->features);
+    s->gamma = ratio(acc->n_in_features, acc->n_valid);
+    s->eta = ratio(acc->n_ctrl, acc->n_in_features);
+    s->bytes_per_scan = acc->scans > 0u ? (double)acc->bytes / (double)acc->scans : 0.0;
+    s->us_per_scan = acc->scans > 0u ? acc->time_ns / 1000.0 / (double)acc->scans : 0.0;
+}
