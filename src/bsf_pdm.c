@@ -28,6 +28,11 @@
 /* Failed footpoint steps longer than this fraction of a span are halved and
  * retried (far from the curve); shorter ones are only rounding noise. */
 #define PDM_HALVE_MIN 0.05f
+/* Weight of a vertex anchor per data point of the segment: large enough that
+ * the vertex stays within a fraction of a millimetre of its anchor (the
+ * two-line intersection), small enough to keep the float solve well
+ * conditioned. */
+#define PDM_ANCHOR_WEIGHT 100.0f
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -41,6 +46,8 @@ typedef struct {
     float rms;
     uint32_t loaded;
     float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* polyline length of each fragment */
+    const bsf_point_t *anchor;             /* vertex anchors (absolute), or NULL */
+    uint8_t vertex_unknown[BSF_PDM_MAX_VERTICES]; /* unknown index of each vertex */
 } pdm_state_t;
 
 void bsf_pdm_params_default(bsf_pdm_params_t *p)
@@ -110,6 +117,7 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
         if (f + 1u < s->n_frag) {
             t1[f] = (float)stored / n_span;
             t0[f + 1u] = t1[f];
+            s->vertex_unknown[f] = (uint8_t)unknown;
             w->unknown_of[stored++] = (uint8_t)unknown;
             w->unknown_of[stored++] = (uint8_t)unknown++;
         }
@@ -359,6 +367,16 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             r.s21 = weight * c2 * c1;
             r.s22 = weight * c2 * c2;
             sums_flush(w, &r);
+        }
+    }
+    if (s->anchor != NULL) {
+        /* Each vertex is held at its anchor by a stiff spring. */
+        const float weight = PDM_ANCHOR_WEIGHT * (float)s->n;
+        for (k = 0; k + 1u < s->n_frag; ++k) {
+            const size_t u = s->vertex_unknown[k];
+            w->band[u * 3u] += weight;
+            w->rhs_x[u] += weight * (s->anchor[k].x - s->origin.x);
+            w->rhs_y[u] += weight * (s->anchor[k].y - s->origin.y);
         }
     }
     st = bsf_spd_band_solve2(w->band, m, m > 2u ? 2u : m - 1u, w->factor, w->rhs_x, w->rhs_y,
@@ -725,6 +743,16 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
                          bsf_point_t *ctrl_out, uint8_t *is_vertex_out, size_t ctrl_cap,
                          size_t *n_ctrl_out, float *e_curve_out, bsf_pdm_info_t *info_out)
 {
+    return bsf_pdm_fit_anchored(pts, n, vertex_pos, NULL, n_vertex, p, work, ctrl_out,
+                                is_vertex_out, ctrl_cap, n_ctrl_out, e_curve_out, info_out);
+}
+
+bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16_t *vertex_pos,
+                                  const bsf_point_t *vertex_anchor, size_t n_vertex,
+                                  const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                                  bsf_point_t *ctrl_out, uint8_t *is_vertex_out, size_t ctrl_cap,
+                                  size_t *n_ctrl_out, float *e_curve_out, bsf_pdm_info_t *info_out)
+{
     bsf_pdm_params_t defaults;
     pdm_state_t s;
     bsf_pdm_info_t info;
@@ -761,7 +789,14 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     if (st != BSF_OK) {
         return st;
     }
+    if (vertex_anchor != NULL) {
+        st = bsf_fit_check_points(vertex_anchor, n_vertex);
+        if (st != BSF_OK) {
+            return st;
+        }
+    }
     memset(&s, 0, sizeof s);
+    s.anchor = n_vertex > 0u ? vertex_anchor : NULL;
     for (i = 1, f = 0; i < n; ++i) {
         const float d = dist(pts[i - 1u], pts[i]);
         s.frag_len[f] += d;

@@ -59,17 +59,10 @@ static int16_t hits[BSF_MAX_POINTS];
 static bsf_truth_acc_t acc;
 
 static int paper_mode = 0;
-#ifndef BENCH_PAPER_SWITCH
-#define BENCH_PAPER_SWITCH(p) (void)(p)
-#endif
 
 static bsf_params_t make_params(void)
 {
-    bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
-    if (paper_mode) {
-        BENCH_PAPER_SWITCH(p);
-    }
-    return p;
+    return bsf_params_default(paper_mode ? BSF_METHOD_FALKO_SVED_PDM : BSF_METHOD_DEFAULT);
 }
 
 static double now_ns(void)
@@ -278,6 +271,8 @@ int main(int argc, char **argv)
             quick = 1;
         } else if (strcmp(argv[a], "--check") == 0) {
             check = 1;
+        } else if (strcmp(argv[a], "--verbose") == 0) {
+            bsf_truth_verbose = 1;
         } else if (strcmp(argv[a], "--paper") == 0) {
             paper_mode = 1;
         } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
@@ -291,7 +286,7 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[a], "--noise") == 0 && a + 1 < argc) {
             only_noise = strtod(argv[++a], NULL) / 1000.0;
         } else {
-            fprintf(stderr, "usage: %s [--quick] [--check] [--paper] [--poses N] [--scene NAME] "
+            fprintf(stderr, "usage: %s [--quick] [--check] [--verbose] [--paper] [--poses N] [--scene NAME] "
                             "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
                     argv[0]);
             return 2;

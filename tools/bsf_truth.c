@@ -2,10 +2,13 @@
 #include "bsf_truth.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #define TRUTH_MAX_CORNERS 256
 #define TRUTH_MAX_CREASES 256
+
+int bsf_truth_verbose = 0;
 
 void bsf_truth_acc_init(bsf_truth_acc_t *acc)
 {
@@ -50,13 +53,42 @@ double bsf_truth_quantile(const bsf_truth_hist_t *h, double q)
     return h->max;
 }
 
-/* Where a straight wall meets a circle (world frame): real creases of the
- * geometry that the corner list does not hold. */
+/* Where a straight wall meets a circle, or a wall ends on another (world
+ * frame): real creases of the geometry that the corner list does not hold. */
 static size_t creases(const bsf_scene_t *sc, double *xy, size_t cap)
 {
     size_t n = 0;
     size_t a;
     size_t b;
+    /* T-junctions: a wall's end on the inside of another wall. */
+    for (a = 0; a < sc->n_shapes; ++a) {
+        const bsf_shape_t *s = &sc->shape[a];
+        int end;
+        if (s->kind != BSF_SHAPE_SEGMENT) {
+            continue;
+        }
+        for (end = 0; end < 2; ++end) {
+            const double ex = end == 0 ? s->x0 : s->x1;
+            const double ey = end == 0 ? s->y0 : s->y1;
+            for (b = 0; b < sc->n_shapes; ++b) {
+                const bsf_shape_t *o = &sc->shape[b];
+                double dx, dy, t, px, py;
+                if (b == a || o->kind != BSF_SHAPE_SEGMENT) {
+                    continue;
+                }
+                dx = o->x1 - o->x0;
+                dy = o->y1 - o->y0;
+                t = ((ex - o->x0) * dx + (ey - o->y0) * dy) / (dx * dx + dy * dy);
+                px = o->x0 + t * dx - ex;
+                py = o->y0 + t * dy - ey;
+                if (t > 1e-9 && t < 1.0 - 1e-9 && px * px + py * py < 1e-12 && n < cap) {
+                    xy[2u * n] = ex;
+                    xy[2u * n + 1u] = ey;
+                    ++n;
+                }
+            }
+        }
+    }
     for (a = 0; a < sc->n_shapes; ++a) {
         const bsf_shape_t *s = &sc->shape[a];
         if (s->kind != BSF_SHAPE_SEGMENT) {
@@ -207,6 +239,18 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
             acc->vertices++;
             if (best <= BSF_TRUTH_MATCH) {
                 acc->vertices_correct++;
+            } else if (bsf_truth_verbose) {
+                double wx;
+                double wy;
+                int shape = -1;
+                double d;
+                bsf_scene_sensor_to_world(&lidar->pose, (double)res->ctrl[g].x,
+                                          (double)res->ctrl[g].y, &wx, &wy);
+                d = bsf_scene_distance_to_surface(scene, wx, wy, &shape);
+                printf("false vertex at world (%.3f, %.3f), range %.2f m, %.3f m from shape %d, "
+                       "%.3f m from the nearest corner\n",
+                       wx, wy, hypot((double)res->ctrl[g].x, (double)res->ctrl[g].y), d, shape,
+                       best);
             }
             ++j; /* skip the second copy */
         }

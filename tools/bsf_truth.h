@@ -15,7 +15,8 @@
  *    lies within BSF_TRUTH_MATCH of it; recall = found / visible.
  *  - Precision = vertices within BSF_TRUTH_MATCH of any true corner (visible or
  *    not) / vertices, leaving out the vertices that sit where a straight wall
- *    meets a curved one (a real crease, but not a listed corner).
+ *    meets a curved one or ends on another wall (a T-junction): real creases,
+ *    but not listed corners.
  *  - Position error: distance from each found corner to its nearest vertex.
  *  - Curve distance: every feature's curve sampled BSF_TRUTH_SAMPLES_PER_SPAN
  *    times per span, distance of each sample to the nearest true surface.
@@ -63,6 +64,9 @@ typedef struct {
     uint64_t n_valid, n_in_features, n_ctrl, bytes;
     double time_ns;
 } bsf_truth_acc_t;
+
+/** Non-zero: bsf_truth_add prints every false vertex (bench_truth --verbose). */
+extern int bsf_truth_verbose;
 
 void bsf_truth_acc_init(bsf_truth_acc_t *acc);
 

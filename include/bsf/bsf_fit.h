@@ -186,6 +186,21 @@ BSF_NODISCARD bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const u
                                        uint8_t *is_vertex_out, size_t ctrl_cap, size_t *n_ctrl_out,
                                        float *e_curve_out, bsf_pdm_info_t *info_out);
 
+/**
+ * bsf_pdm_fit with each vertex anchored: vertex k is held at vertex_anchor[k]
+ * (metres, same frame as pts) by a stiff spring in every solve, so it stays
+ * at a corner position found by the caller (for instance the intersection of
+ * two wall lines, bsf_lc_detect's keypoint point) instead of drifting with
+ * the points around it. vertex_anchor may be NULL (then this is exactly
+ * bsf_pdm_fit). Anchors must be finite with |x|, |y| <= BSF_FIT_MAX_COORD
+ * (else BSF_ERR_ARG); other arguments and results as bsf_pdm_fit.
+ */
+BSF_NODISCARD bsf_status_t bsf_pdm_fit_anchored(
+    const bsf_point_t *pts, size_t n, const uint16_t *vertex_pos, const bsf_point_t *vertex_anchor,
+    size_t n_vertex, const bsf_pdm_params_t *p, bsf_pdm_work_t *work, bsf_point_t *ctrl_out,
+    uint8_t *is_vertex_out, size_t ctrl_cap, size_t *n_ctrl_out, float *e_curve_out,
+    bsf_pdm_info_t *info_out);
+
 #ifdef __cplusplus
 }
 #endif
