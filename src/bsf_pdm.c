@@ -33,6 +33,8 @@
  * two-line intersection), small enough to keep the float solve well
  * conditioned. */
 #define PDM_ANCHOR_WEIGHT 100.0f
+/* Points on either side that set the local direction of an arc-length step. */
+#define PDM_ARC_REACH 2u
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -45,7 +47,7 @@ typedef struct {
     float lambda;
     float rms;
     uint32_t loaded;
-    float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* polyline length of each fragment */
+    float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* length of each fragment (arc_step) */
     const bsf_point_t *anchor;             /* vertex anchors (absolute), or NULL */
     uint8_t vertex_unknown[BSF_PDM_MAX_VERTICES]; /* unknown index of each vertex */
 } pdm_state_t;
@@ -90,6 +92,27 @@ static float dist(bsf_point_t a, bsf_point_t b)
     const float dx = b.x - a.x;
     const float dy = b.y - a.y;
     return sqrtf(dx * dx + dy * dy);
+}
+
+/* Arc-length step from point i - 1 to point i (both in the fragment a..b),
+ * measured along the local direction of the points (from PDM_ARC_REACH
+ * points before to PDM_ARC_REACH after): range noise across a wall then adds
+ * nothing, where the plain polyline length grows by about the noise at every
+ * step and, where points are denser than the noise (near the sensor, fine
+ * beams), puts the start parameters far off the footpoints. */
+static float arc_step(const bsf_point_t *pts, size_t i, size_t a, size_t b)
+{
+    const size_t lo = i > a + PDM_ARC_REACH ? i - 1u - PDM_ARC_REACH : a;
+    const size_t hi = i + PDM_ARC_REACH < b ? i + PDM_ARC_REACH : b;
+    const float dx = pts[hi].x - pts[lo].x;
+    const float dy = pts[hi].y - pts[lo].y;
+    const float len = sqrtf(dx * dx + dy * dy);
+    const float sx = pts[i].x - pts[i - 1u].x;
+    const float sy = pts[i].y - pts[i - 1u].y;
+    if (!(len > 0.0f)) {
+        return sqrtf(sx * sx + sy * sy);
+    }
+    return fabsf(sx * dx + sy * dy) / len;
 }
 
 /* Control polygon for the current precision counts: unknown index of every
@@ -300,7 +323,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             float t;
             size_t span;
             if (i > a) {
-                arc += dist(s->pts[i - 1u], s->pts[i]);
+                arc += arc_step(s->pts, i, a, b);
             }
             /* Coincident points: fall back to even spacing by index. */
             frac = len > 0.0f ? arc * inv_len : (float)(i - a) / (float)(b - a);
@@ -798,9 +821,10 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
     memset(&s, 0, sizeof s);
     s.anchor = n_vertex > 0u ? vertex_anchor : NULL;
     for (i = 1, f = 0; i < n; ++i) {
-        const float d = dist(pts[i - 1u], pts[i]);
-        s.frag_len[f] += d;
-        length += d;
+        const size_t a = f == 0u ? 0u : vertex_pos[f - 1u];
+        const size_t b = f < n_vertex ? vertex_pos[f] : n - 1u;
+        s.frag_len[f] += arc_step(pts, i, a, b);
+        length += dist(pts[i - 1u], pts[i]);
         if (f < n_vertex && i == vertex_pos[f]) {
             ++f; /* the vertex closes fragment f */
         }

@@ -141,6 +141,28 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
             fprintf(stderr, "bench_truth: encode failed\n");
             return -1;
         }
+        if (bsf_truth_verbose) {
+            printf("pose %ld: (%.3f, %.3f, %.3f)\n", k, x, y, th);
+        }
+        if (getenv("BENCH_TRUTH_DUMP") != NULL && atol(getenv("BENCH_TRUTH_DUMP")) == k) {
+            size_t f2;
+            for (i = 0; i < sen->beams; ++i) {
+                printf("beam %lu range %.4f hit %d\n", (unsigned long)i, (double)ranges[i], hits[i]);
+            }
+            for (f2 = 0; f2 < res.n_features; ++f2) {
+                const bsf_feature_t *ft = &res.features[f2];
+                size_t q;
+                printf("feature %lu beams %u-%u\n", (unsigned long)f2, ft->first_beam, ft->last_beam);
+                for (q = 0; q < ft->n_ctrl; ++q) {
+                    printf("  ctrl %.4f %.4f %u\n", (double)res.ctrl[ft->ctrl_first + q].x,
+                           (double)res.ctrl[ft->ctrl_first + q].y, res.ctrl_is_vertex[ft->ctrl_first + q]);
+                }
+            }
+            for (f2 = 0; f2 < res.stats.n_keypoints; ++f2) {
+                printf("kp %u %.4f %.4f\n", ex.keypoints[f2].index, (double)ex.keypoints[f2].point.x,
+                       (double)ex.keypoints[f2].point.y);
+            }
+        }
         if (bsf_truth_add(&acc, &sc, &lid, clean, hits, &res, bytes, t1 - t0) != 0) {
             return -1;
         }

@@ -269,6 +269,20 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
             worst = d > worst ? d : worst;
         }
         acc->features++;
+        if (worst > BSF_TRUTH_STRAY && bsf_truth_verbose) {
+            size_t nv = 0;
+            double wx, wy, wx1, wy1;
+            for (j = 0; j < ft->n_ctrl; ++j) {
+                nv += res->ctrl_is_vertex[ft->ctrl_first + j];
+            }
+            bsf_scene_sensor_to_world(&lidar->pose, (double)ctrl[0].x, (double)ctrl[0].y, &wx, &wy);
+            bsf_scene_sensor_to_world(&lidar->pose, (double)ctrl[ft->n_ctrl - 1u].x,
+                                      (double)ctrl[ft->n_ctrl - 1u].y, &wx1, &wy1);
+            printf("stray feature: max %.3f m, beams %u-%u, %u points, %u ctrl (%lu vertex slots), "
+                   "E %.4f, world (%.2f,%.2f)-(%.2f,%.2f)\n",
+                   worst, ft->first_beam, ft->last_beam, ft->n_points, ft->n_ctrl,
+                   (unsigned long)nv, (double)ft->e_curve, wx, wy, wx1, wy1);
+        }
         if (worst > BSF_TRUTH_STRAY) {
             acc->features_stray++;
         }
