@@ -210,9 +210,9 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
- * end at hi. Returns 1 and fills *kp (beam index, intersection, ...) for a
+ * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
  * corner, 0 otherwise. */
-static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, bsf_keypoint_t *kp)
+static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_keypoint_t *kp)
 {
     const bsf_lc_params_t *p = c->p;
     const float side2 = p->max_side * p->max_side;
@@ -233,6 +233,20 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, bsf_keypoint_t 
     }
     while (b1 < hi && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
         ++b1;
+    }
+    /* A side cut short by a neighbouring split reaches past it: noise often
+     * splits a corner several times within a few points, and the true apex
+     * must not lose to its own echoes (a side that then crosses another
+     * corner fails the straightness test). */
+    if (apex - a0 < need) {
+        while (a0 > 0u && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
+            --a0;
+        }
+    }
+    if (b1 - apex < need) {
+        while (b1 + 1u < m && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
+            ++b1;
+        }
     }
     if (apex - a0 < need || b1 - apex < need) {
         return 0;
@@ -404,7 +418,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         while (j < nb) {
             const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
             const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-            if (!judge(c, lo, w->brk[j], hi, &kp)) {
+            if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
                 memmove(&w->brk[j], &w->brk[j + 1u], (nb - j - 1u) * sizeof w->brk[0]);
                 --nb;
                 changed = 1;
@@ -416,7 +430,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     for (j = 0; j < nb; ++j) {
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-        if (judge(c, lo, w->brk[j], hi, &kp)) {
+        if (judge(c, lo, w->brk[j], hi, m, &kp)) {
             /* Keep beams strictly ascending (two splits may pick one beam). */
             if (*n_found > 0u && *n_found <= out_cap && out[*n_found - 1u].index >= kp.index) {
                 continue;

@@ -135,6 +135,7 @@ static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, con
         int hits = 0;
         double dmin = 1e300;
         double dmax = 0.0;
+        double d_sorted[64];
         size_t i;
         for (i = 0; i < lidar->n_beams; ++i) {
             double a;
@@ -149,6 +150,9 @@ static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, con
             py = (double)ranges[i] * sin(a);
             d = hypot(px - c->x, py - c->y);
             if (d <= BSF_TRUTH_WALL_LEN) {
+                if (hits < 64) {
+                    d_sorted[hits] = d;
+                }
                 ++hits;
                 dmin = d < dmin ? d : dmin;
                 dmax = d > dmax ? d : dmax;
@@ -156,6 +160,27 @@ static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, con
         }
         if (hits < BSF_TRUTH_MIN_HITS || dmax - dmin < BSF_TRUTH_MIN_SPREAD) {
             return 0;
+        }
+        {
+            /* The first BSF_TRUTH_MIN_HITS hits from the vertex must sample
+             * the wall as a surface: gaps of at most BSF_TRUTH_MAX_GAP. */
+            const int m = hits < 64 ? hits : 64;
+            int u;
+            int v;
+            double prev = 0.0;
+            for (u = 1; u < m; ++u) {
+                const double key = d_sorted[u];
+                for (v = u - 1; v >= 0 && d_sorted[v] > key; --v) {
+                    d_sorted[v + 1] = d_sorted[v];
+                }
+                d_sorted[v + 1] = key;
+            }
+            for (u = 0; u < BSF_TRUTH_MIN_HITS; ++u) {
+                if (d_sorted[u] - prev > BSF_TRUTH_MAX_GAP) {
+                    return 0;
+                }
+                prev = d_sorted[u];
+            }
         }
     }
     return 1;
@@ -205,6 +230,10 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
         if (best <= BSF_TRUTH_MATCH) {
             acc->found[band]++;
             hist_add(&acc->vertex_err, best);
+        } else if (bsf_truth_verbose) {
+            printf("missed corner at world (%.3f, %.3f), range %.2f m, beam %d, angle %.0f deg, "
+                   "nearest vertex %.3f m\n",
+                   c->wx, c->wy, c->range, c->beam, c->angle * 57.29577951, best);
         }
     }
 

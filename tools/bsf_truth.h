@@ -10,7 +10,11 @@
  *    occluded, rays either side hit its two walls), it lies within
  *    BSF_TRUTH_RANGE_MAX of the sensor, and each of its two walls is seen over
  *    some length: at least BSF_TRUTH_MIN_HITS beams hit the wall within
- *    BSF_TRUTH_WALL_LEN of the vertex, spread over at least BSF_TRUTH_MIN_SPREAD.
+ *    BSF_TRUTH_WALL_LEN of the vertex, spread over at least BSF_TRUTH_MIN_SPREAD,
+ *    and the BSF_TRUTH_MIN_HITS hits nearest the vertex sample the wall as a
+ *    surface: no gap above BSF_TRUTH_MAX_GAP from the vertex to the first or
+ *    between them (a wall seen at grazing incidence, one return every half
+ *    metre, is not seen as a wall by any segmentation).
  *  - A vertex (a control point stored twice) "finds" a visible corner when it
  *    lies within BSF_TRUTH_MATCH of it; recall = found / visible.
  *  - Precision = vertices within BSF_TRUTH_MATCH of any true corner (visible or
@@ -35,6 +39,7 @@
 #define BSF_TRUTH_WALL_LEN 1.0
 #define BSF_TRUTH_MIN_HITS 3
 #define BSF_TRUTH_MIN_SPREAD 0.2
+#define BSF_TRUTH_MAX_GAP 0.25
 #define BSF_TRUTH_SAMPLES_PER_SPAN 8
 #define BSF_TRUTH_STRAY 0.05
 /** Range bands of the recall report: [0,3), [3,6), [6,8] metres. */
