@@ -33,8 +33,9 @@
  * two-line intersection), small enough to keep the float solve well
  * conditioned. */
 #define PDM_ANCHOR_WEIGHT 100.0f
-/* Points on either side that set the local direction of an arc-length step. */
-#define PDM_ARC_REACH 2u
+/* Shortest chord that sets the local direction of an arc-length step,
+ * metres: well above range noise, well below the radius of a pillar. */
+#define PDM_ARC_BASE 0.1f
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -87,6 +88,13 @@ bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
     return BSF_OK;
 }
 
+static float dist2_pts(bsf_point_t a, bsf_point_t b)
+{
+    const float dx = b.x - a.x;
+    const float dy = b.y - a.y;
+    return dx * dx + dy * dy;
+}
+
 static float dist(bsf_point_t a, bsf_point_t b)
 {
     const float dx = b.x - a.x;
@@ -94,25 +102,45 @@ static float dist(bsf_point_t a, bsf_point_t b)
     return sqrtf(dx * dx + dy * dy);
 }
 
-/* Arc-length step from point i - 1 to point i (both in the fragment a..b),
- * measured along the local direction of the points (from PDM_ARC_REACH
- * points before to PDM_ARC_REACH after): range noise across a wall then adds
- * nothing, where the plain polyline length grows by about the noise at every
- * step and, where points are denser than the noise (near the sensor, fine
- * beams), puts the start parameters far off the footpoints. */
-static float arc_step(const bsf_point_t *pts, size_t i, size_t a, size_t b)
+/* Cumulative arc length of the points, fragment by fragment (w->arc), where
+ * each step from point i - 1 to point i is measured along the local direction
+ * of the points: the chord between the nearest points at least PDM_ARC_BASE
+ * before point i and after point i - 1 (within the fragment). Range noise
+ * across a wall then adds nothing, where the plain polyline length grows by
+ * about the noise at every step and, where points are denser than the noise
+ * (near the sensor, fine beams), puts the start parameters far off the
+ * footpoints. Both window ends only move forward: linear cost. Returns the
+ * fragment's length. */
+static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
 {
-    const size_t lo = i > a + PDM_ARC_REACH ? i - 1u - PDM_ARC_REACH : a;
-    const size_t hi = i + PDM_ARC_REACH < b ? i + PDM_ARC_REACH : b;
-    const float dx = pts[hi].x - pts[lo].x;
-    const float dy = pts[hi].y - pts[lo].y;
-    const float len = sqrtf(dx * dx + dy * dy);
-    const float sx = pts[i].x - pts[i - 1u].x;
-    const float sy = pts[i].y - pts[i - 1u].y;
-    if (!(len > 0.0f)) {
-        return sqrtf(sx * sx + sy * sy);
+    const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
+    size_t lo = a;
+    size_t hi = a;
+    size_t i;
+    float acc = 0.0f;
+    arc[a] = 0.0f;
+    for (i = a + 1u; i <= b; ++i) {
+        const float sx = pts[i].x - pts[i - 1u].x;
+        const float sy = pts[i].y - pts[i - 1u].y;
+        float dx;
+        float dy;
+        float len;
+        while (lo + 1u < i && dist2_pts(pts[lo + 1u], pts[i]) >= base2) {
+            ++lo;
+        }
+        if (hi < i) {
+            hi = i;
+        }
+        while (hi < b && dist2_pts(pts[hi], pts[i - 1u]) < base2) {
+            ++hi;
+        }
+        dx = pts[hi].x - pts[lo].x;
+        dy = pts[hi].y - pts[lo].y;
+        len = sqrtf(dx * dx + dy * dy);
+        acc += len > 0.0f ? fabsf(sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
+        arc[i] = acc;
     }
-    return fabsf(sx * dx + sy * dy) / len;
+    return acc;
 }
 
 /* Control polygon for the current precision counts: unknown index of every
@@ -314,7 +342,6 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const float range = t1[f] - t0[f];
         const unsigned straight = w->frag_precision[f] == 0u;
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
-        float arc = 0.0f;
         /* The vertex point closing fragment f opens fragment f + 1: it is
          * accumulated once, by the fragment it closes. */
         for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
@@ -322,11 +349,12 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             float u;
             float t;
             size_t span;
-            if (i > a) {
-                arc += arc_step(s->pts, i, a, b);
-            }
             /* Coincident points: fall back to even spacing by index. */
-            frac = len > 0.0f ? arc * inv_len : (float)(i - a) / (float)(b - a);
+            if (i == b) {
+                frac = 1.0f; /* its arc slot belongs to the next fragment */
+            } else {
+                frac = len > 0.0f ? w->arc[i] * inv_len : (float)(i - a) / (float)(b - a);
+            }
             frac = frac > 1.0f ? 1.0f : frac;
             if (straight) {
                 /* A straight fragment at a vertex is not traversed at
@@ -820,14 +848,16 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
     }
     memset(&s, 0, sizeof s);
     s.anchor = n_vertex > 0u ? vertex_anchor : NULL;
-    for (i = 1, f = 0; i < n; ++i) {
+    for (i = 1; i < n; ++i) {
+        length += dist(pts[i - 1u], pts[i]);
+    }
+    for (f = 0; f <= n_vertex; ++f) {
         const size_t a = f == 0u ? 0u : vertex_pos[f - 1u];
         const size_t b = f < n_vertex ? vertex_pos[f] : n - 1u;
-        s.frag_len[f] += arc_step(pts, i, a, b);
-        length += dist(pts[i - 1u], pts[i]);
-        if (f < n_vertex && i == vertex_pos[f]) {
-            ++f; /* the vertex closes fragment f */
-        }
+        /* Arcs are relative to each fragment's first point, so a vertex
+         * point's slot holds 0 (the fragment it opens); the fragment it
+         * closes ends at its length, frag_len. */
+        s.frag_len[f] = fragment_arc(pts, a, b, work->arc);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;
