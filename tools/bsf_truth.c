@@ -296,6 +296,19 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
             d = bsf_scene_distance_to_surface(scene, wx, wy, NULL);
             hist_add(&acc->curve, d);
             worst = d > worst ? d : worst;
+            if (bsf_truth_verbose && d > 0.03) {
+                const size_t span = j / BSF_TRUTH_SAMPLES_PER_SPAN;
+                const size_t ns = ft->n_ctrl - 2u;
+                const int end = span == 0u || span + 1u >= ns;
+                int near_v = 0;
+                size_t q;
+                for (q = span; q < span + 3u && q < ft->n_ctrl; ++q) {
+                    near_v |= res->ctrl_is_vertex[ft->ctrl_first + q];
+                }
+                printf("far sample %.3f m at t %.3f: %s, feature %u ctrl, %u points, beams %u-%u\n", d, (double)j / (double)n_samples,
+                       end ? "end span" : (near_v ? "vertex span" : "inner span"), ft->n_ctrl,
+                       ft->n_points, ft->first_beam, ft->last_beam);
+            }
         }
         acc->features++;
         if (worst > BSF_TRUTH_STRAY && bsf_truth_verbose) {
