@@ -110,7 +110,8 @@ static float dist(bsf_point_t a, bsf_point_t b)
  * about the noise at every step and, where points are denser than the noise
  * (near the sensor, fine beams), puts the start parameters far off the
  * footpoints. Both window ends only move forward: linear cost. Returns the
- * fragment's length. */
+ * fragment's length (<= 0 only for a fragment that folds back on itself,
+ * which the caller then spaces by index). */
 static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
 {
     const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
@@ -137,7 +138,10 @@ static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc
         dx = pts[hi].x - pts[lo].x;
         dy = pts[hi].y - pts[lo].y;
         len = sqrtf(dx * dx + dy * dy);
-        acc += len > 0.0f ? fabsf(sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
+        /* Signed: the noise along the direction then cancels from step to
+         * step instead of piling up (the arc may dip by the noise, which the
+         * start parameters clamp). */
+        acc += len > 0.0f ? (sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
         arc[i] = acc;
     }
     return acc;
@@ -355,7 +359,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             } else {
                 frac = len > 0.0f ? w->arc[i] * inv_len : (float)(i - a) / (float)(b - a);
             }
-            frac = frac > 1.0f ? 1.0f : frac;
+            frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
             if (straight) {
                 /* A straight fragment at a vertex is not traversed at
                  * constant speed: boundary-vertex runs as 1 - (1 - u)^2,
