@@ -4,7 +4,7 @@
 
     mem_report.py [--cc CC --nm NM [--cflags FLAGS]] ... [--points 180,361,1081]
 
-Compiles tools/mem_probe.c (the public headers only) once per
+Compiles tools/scripts/mem_probe.c (the public headers only) once per
 BSF_MAX_POINTS value with each given compiler and reads the sizes from the
 object's symbol table (nm -S), so cross compilers work without running
 anything. Default compilers: the host's cc, and arm-none-eabi-gcc for the
@@ -18,7 +18,7 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+ROOT = os.path.dirname(os.path.dirname(HERE))
 PROBE = os.path.join(HERE, "mem_probe.c")
 PREFIX = "bsf_sizeof_"
 M4F_FLAGS = "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16"

@@ -1,0 +1,178 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * cli_util.c - what every bsf command shares: messages, option parsing,
+ * files and standard streams, progress on a terminal, opening a log.
+ */
+#include "tool.h"
+
+const char *g_cmd = TOOL_NAME;
+
+void fail_msg(const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "%s: ", g_cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+int usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "%s: ", g_cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nTry '%s --help'.\n", g_cmd);
+    return EXIT_USAGE;
+}
+
+double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- argument helpers ----------------------------------------------------- */
+
+int parse_long(const char *s, long lo, long hi, long *out)
+{
+    char *end = NULL;
+    long v;
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (errno != 0 || end == s || *end != '\0' || v < lo || v > hi) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int parse_float(const char *s, double lo, double hi, double *out)
+{
+    char *end = NULL;
+    double v;
+    errno = 0;
+    v = strtod(s, &end);
+    if (errno != 0 || end == s || *end != '\0' || !isfinite(v) || v < lo || v > hi) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* Option value: "--opt=v" or "--opt v". Returns the value or NULL (and sets *err). */
+const char *opt_value(int argc, char **argv, int *i, const char *name, int *err)
+{
+    const size_t n = strlen(name);
+    if (strncmp(argv[*i], name, n) != 0) {
+        return NULL;
+    }
+    if (argv[*i][n] == '=') {
+        return argv[*i] + n + 1;
+    }
+    if (argv[*i][n] != '\0') {
+        return NULL;
+    }
+    if (*i + 1 >= argc) {
+        *err = usage_error("option %s needs a value", name);
+        return NULL;
+    }
+    ++*i;
+    return argv[*i];
+}
+
+int is_help(const char *a)
+{
+    return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0;
+}
+
+/* ---- byte streams ------------------------------------------------------------ */
+
+FILE *open_in(const char *path)
+{
+    FILE *f;
+    if (strcmp(path, "-") == 0) {
+        return stdin;
+    }
+    f = fopen(path, "rb");
+    if (f == NULL) {
+        fail_msg("cannot open %s: %s", path, strerror(errno));
+    }
+    return f;
+}
+
+FILE *open_out(const char *path, int binary)
+{
+    FILE *f;
+    if (strcmp(path, "-") == 0) {
+        if (binary && isatty(fileno(stdout))) {
+            fail_msg("refusing to write a binary stream to a terminal (use -o FILE or a pipe)");
+            return NULL;
+        }
+        return stdout;
+    }
+    f = fopen(path, binary ? "wb" : "w");
+    if (f == NULL) {
+        fail_msg("cannot create %s: %s", path, strerror(errno));
+    }
+    return f;
+}
+
+int close_out(FILE *f, const char *path)
+{
+    int bad = ferror(f);
+    if (f == stdout) {
+        bad |= fflush(f) != 0;
+    } else {
+        bad |= fclose(f) != 0;
+    }
+    if (bad) {
+        fail_msg("write error on %s", path);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- progress ---------------------------------------------------------------- */
+
+void progress_init(progress_t *p)
+{
+    p->enabled = isatty(fileno(stderr));
+    p->t0 = p->last = now_s();
+}
+
+void progress_tick(progress_t *p, unsigned long done, const char *what)
+{
+    double t;
+    if (!p->enabled) {
+        return;
+    }
+    t = now_s();
+    if (t - p->last < 0.25) {
+        return;
+    }
+    p->last = t;
+    fprintf(stderr, "\r%s: %lu scans, %.0f scans/s   ", what, done,
+            (double)done / (t - p->t0 > 1e-9 ? t - p->t0 : 1e-9));
+}
+
+void progress_end(progress_t *p)
+{
+    if (p->enabled) {
+        fputs("\r\033[K", stderr);
+    }
+}
+
+carmen_reader_t *open_log(const char *path)
+{
+    carmen_reader_t *rd;
+    errno = 0;
+    rd = carmen_open(path, stderr);
+    if (rd == NULL) {
+        fail_msg("cannot open log %s: %s", path, errno ? strerror(errno) : "unreadable");
+    }
+    return rd;
+}

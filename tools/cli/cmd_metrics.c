@@ -1,0 +1,64 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * cmd_metrics.c - bsf metrics: the paper's metrics of a stream.
+ */
+#include "tool.h"
+
+static const char metrics_help[] =
+    "Usage: bsf metrics IN\n"
+    "The paper's metrics computed from a bsf stream alone ('-' for stdin):\n"
+    "retrievability, compactness, accuracy, extraction time (mean, median, p99),\n"
+    "features and control points per scan, bytes per scan (median, p95), frames\n"
+    "dropped.\n";
+
+void print_metrics(FILE *f, const char *name, const frame_list_t *l, const dataset_metrics_t *d)
+{
+    fprintf(f, "stream            %s\n", name);
+    fprintf(f, "scans             %lu\n", (unsigned long)d->m.n_scans);
+    fprintf(f, "retrievability    %.2f %%\n", 100.0 * (double)d->m.retrievability);
+    fprintf(f, "compactness       %.4f\n", (double)d->m.compactness);
+    fprintf(f, "accuracy          %.5f m\n", (double)d->m.accuracy);
+    fprintf(f, "time              mean %.1f us, median %.1f us, p99 %.1f us\n",
+            1e6 * (double)d->m.time_mean_s, 1e6 * (double)d->m.time_median_s,
+            1e6 * (double)d->m.time_p99_s);
+    fprintf(f, "features/scan     %.2f\n", (double)d->m.features_per_scan);
+    fprintf(f, "ctrl points/scan  %.2f\n", (double)d->m.ctrl_per_scan);
+    fprintf(f, "bytes/scan        median %zu, p95 %zu, mean %.1f\n", d->bytes_median, d->bytes_p95,
+            d->bytes_mean);
+    fprintf(f,
+            "frames dropped    %lu (bad crc %lu, malformed %lu, unsupported %lu, oversize %lu), "
+            "missing by sequence %lu\n",
+            frames_dropped(&l->stats), (unsigned long)l->stats.bad_crc,
+            (unsigned long)l->stats.malformed, (unsigned long)l->stats.unsupported_version,
+            (unsigned long)l->stats.oversize, l->seq_gaps);
+}
+
+int cmd_metrics(int argc, char **argv)
+{
+    const char *in_path = NULL;
+    frame_list_t l;
+    dataset_metrics_t d;
+    int i;
+    for (i = 1; i < argc; ++i) {
+        if (is_help(argv[i])) {
+            fputs(metrics_help, stdout);
+            return 0;
+        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            return usage_error("unknown option '%s'", argv[i]);
+        } else if (in_path == NULL) {
+            in_path = argv[i];
+        } else {
+            return usage_error("metrics takes one input, got '%s' too", argv[i]);
+        }
+    }
+    if (in_path == NULL) {
+        return usage_error("metrics needs an input stream (or '-')");
+    }
+    if (load_frames(in_path, &l) != 0 || metrics_of_frames(&l, &d) != 0) {
+        frame_list_free(&l);
+        return EXIT_FAIL;
+    }
+    print_metrics(stdout, in_path, &l, &d);
+    frame_list_free(&l);
+    return close_out(stdout, "stdout") == 0 ? 0 : EXIT_FAIL;
+}

@@ -1,0 +1,151 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * tool.h - what the files of the host tool `bsf` share: one command per
+ * cmd_*.c file, the shared command-line and stream helpers in cli_util.c,
+ * stream_io.c and log_scan.c. Host only: libc, stdio, POSIX.
+ */
+#ifndef BSF_TOOL_H
+#define BSF_TOOL_H
+
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bsf/bsf.h"
+#include "bsf/bsf_stream.h"
+#include "bsf_port_clock.h"
+#include "bsf_scene.h"
+#include "bsf_svg.h"
+#include "carmen.h"
+
+#define TOOL_NAME "bsf"
+#define EXIT_USAGE 2
+#define EXIT_FAIL 1
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#if defined(__GNUC__) || defined(__clang__)
+#define BSF_PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#else
+#define BSF_PRINTF_LIKE(f, a)
+#endif
+
+/* ---- cli_util.c: messages, options, files, progress ---------------------- */
+
+/** "bsf CMD", the prefix of every message. */
+extern const char *g_cmd;
+
+/** "bsf CMD: message" on stderr. */
+void fail_msg(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
+/** fail_msg plus a pointer to --help; returns EXIT_USAGE. */
+int usage_error(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
+/** Monotonic time, seconds. */
+double now_s(void);
+/** Whole decimal number in [lo, hi]: 0, or -1 when malformed or out of range. */
+int parse_long(const char *s, long lo, long hi, long *out);
+/** Finite number in [lo, hi]: 0, or -1 when malformed or out of range. */
+int parse_float(const char *s, double lo, double hi, double *out);
+/** Option value: "--opt=v" or "--opt v". Returns the value or NULL (and sets *err). */
+const char *opt_value(int argc, char **argv, int *i, const char *name, int *err);
+/** Is a an -h or --help? */
+int is_help(const char *a);
+/** A file to read, or stdin for "-"; NULL with a message on failure. */
+FILE *open_in(const char *path);
+/** A file to write, or stdout for "-" (refused for a binary stream on a terminal). */
+FILE *open_out(const char *path, int binary);
+/** Flush or close an output, reporting write errors: 0 or -1. */
+int close_out(FILE *f, const char *path);
+
+/** Progress on stderr, only when it is a terminal. */
+typedef struct {
+    int enabled;
+    double t0;
+    double last;
+} progress_t;
+
+void progress_init(progress_t *p);
+void progress_tick(progress_t *p, unsigned long done, const char *what);
+void progress_end(progress_t *p);
+
+/** Open a CARMEN log (plain or .gz); NULL with a message on failure. */
+carmen_reader_t *open_log(const char *path);
+
+/* ---- stream_io.c: decoding a stream, metrics of frames ------------------- */
+
+/** A decoded stream held in memory. */
+typedef struct {
+    bsf_frame_t *frames;
+    size_t *frame_bytes;
+    size_t n;
+    size_t cap;
+    bsf_decoder_stats_t stats;
+    unsigned long seq_gaps; /* frames missing according to sequence numbers */
+} frame_list_t;
+
+void frame_list_free(frame_list_t *l);
+
+/** Called for every decoded frame with its size on the wire; non-zero stops. */
+typedef int (*frame_cb)(void *ctx, const bsf_frame_t *f, size_t bytes);
+
+/** Feed a byte stream through the decoder; on_frame (may be NULL) sees every frame. */
+int decode_stream(FILE *in, const char *name, frame_cb on_frame, void *ctx,
+                  bsf_decoder_stats_t *stats_out, unsigned long *seq_gaps);
+/** Decode a whole stream file ("-": stdin) into l. 0, or -1 with a message. */
+int load_frames(const char *path, frame_list_t *l);
+/** Frames dropped by the decoder (CRC, malformed, version, oversize). */
+unsigned long frames_dropped(const bsf_decoder_stats_t *s);
+/** A result's metric counts (zeros when inconsistent). */
+bsf_scan_counts_t counts_of_result(const bsf_result_t *r);
+/** Nearest-rank percentile p in [0, 1] of v (sorted in place); 0 when n is 0. */
+size_t nearest_rank_size(size_t *v, size_t n, double p);
+
+/** The paper's metrics plus frame sizes over a stream. */
+typedef struct {
+    bsf_metrics_summary_t m;
+    size_t bytes_median;
+    size_t bytes_p95;
+    double bytes_mean;
+} dataset_metrics_t;
+
+int metrics_of_frames(const frame_list_t *l, dataset_metrics_t *out);
+
+/* ---- log_scan.c: log records as scans, the shared extractor -------------- */
+
+/** range_max of a record: opt when > 0, else the log's declared maximum below no-return codes. */
+float scan_range_max(const carmen_scan_t *s, double opt);
+/** A CARMEN record as a bsf scan (ranges point into the record). */
+bsf_scan_t scan_of_record(const carmen_scan_t *s, double range_max_opt);
+
+extern bsf_extractor_t g_ex;
+extern bsf_result_t g_res;
+extern uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
+
+/** Initialise g_ex for a method with the monotonic clock. 0, or -1 with a message. */
+int init_extractor(bsf_method_t method);
+
+/* ---- the commands (cmd_*.c) ---------------------------------------------- */
+
+int cmd_extract(int argc, char **argv);
+int cmd_decode(int argc, char **argv);
+int cmd_metrics(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_table1(int argc, char **argv);
+int cmd_demo(int argc, char **argv);
+
+/** Print the metrics of a stream (cmd_metrics.c; also used by demo). */
+void print_metrics(FILE *f, const char *name, const frame_list_t *l, const dataset_metrics_t *d);
+/** Draw frames lo..hi (seq) as an SVG map, optional raw points and scene (cmd_render.c). */
+int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
+                  const char *points_log, const bsf_scene_t *scene, const char *title);
+
+#endif /* BSF_TOOL_H */
