@@ -21,7 +21,7 @@ int main(int argc, char **argv)
 {
     bsf_scene_t scene;
     bsf_scene_rng_t rng;
-    bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
+    bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT); /* what `bsf extract` uses */
     bsf_metrics_acc_t acc;
     bsf_metrics_summary_t s;
     FILE *f;
