@@ -273,9 +273,8 @@ static bsf_status_t fit_features(bsf_extractor_t *ex, bsf_result_t *res)
             st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
         } else {
             /* LC's keypoint is the walls' intersection: the vertex stays there. */
-            const bsf_point_t *anchor = ex->params.method == BSF_METHOD_LC_SVED_PDM
-                                            ? ex->scratch.fit.vertex_anchor
-                                            : NULL;
+            const bsf_point_t *anchor =
+                ex->params.method == BSF_METHOD_LC_SVED_PDM ? ex->scratch.fit.vertex_anchor : NULL;
             st = bsf_pdm_fit_anchored(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos,
                                       anchor, n_vertex, &ex->params.pdm, &ex->scratch.fit.pdm,
                                       &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl],

@@ -177,8 +177,10 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         return -1.0f;
     }
     d = (-sxz * (syy * n - sy * sy) + sxy * (syz * n - sy * sz) - sx * (syz * sy - syy * sz)) / det;
-    e = (sxx * (-syz * n + sy * sz) + sxz * (sxy * n - sy * sx) + sx * (-sxy * sz + syz * sx)) / det;
-    f = (sxx * (-syy * sz + syz * sy) - sxy * (-sxy * sz + syz * sx) - sxz * (sxy * sy - syy * sx)) /
+    e = (sxx * (-syz * n + sy * sz) + sxz * (sxy * n - sy * sx) + sx * (-sxy * sz + syz * sx)) /
+        det;
+    f = (sxx * (-syy * sz + syz * sy) - sxy * (-sxy * sz + syz * sx) -
+         sxz * (sxy * sy - syy * sx)) /
         det;
     cx = -0.5f * d;
     cy = -0.5f * e;
@@ -206,7 +208,8 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     if (rss_circle < 0.0f) {
         return 1;
     }
-    return l->rss <= c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
+    return l->rss <=
+           c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -248,7 +251,9 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
             ++b1;
         }
     }
-    if (apex - a0 < need || b1 - apex < need) {
+    /* A side that runs to the end of the run may be one point shorter: a
+     * far corner at the edge of what is seen has few points beyond it. */
+    if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
         return 0;
     }
     if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {
@@ -274,7 +279,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         const float s2 = sqrtf(dist2(rel(c, apex + 1u), rel(c, apex)));
         spacing = s2 > spacing ? s2 : spacing;
     }
-    if (!(xx * xx + xy * xy <= (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
+    if (!(xx * xx + xy * xy <=
+          (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
         return 0;
     }
     /* One smooth curve over both sides: the better of a line and a circle. */
@@ -398,8 +404,8 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
 
 /* Corners of one run: split, then merge the splits that are no corner until
  * the survivors all pass. */
-static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out,
-                       size_t out_cap, size_t *n_found)
+static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
+                       size_t *n_found)
 {
     const float sigma = run_noise(c->pts, w->run, m);
     float tol = c->p->split_sigmas * sigma;
@@ -454,7 +460,8 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     if (n_out != NULL) {
         *n_out = 0u;
     }
-    if (pts == NULL || p == NULL || work == NULL || n_out == NULL || (out == NULL && out_cap > 0u)) {
+    if (pts == NULL || p == NULL || work == NULL || n_out == NULL ||
+        (out == NULL && out_cap > 0u)) {
         return BSF_ERR_ARG;
     }
     st = bsf_lc_params_check(p);

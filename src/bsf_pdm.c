@@ -48,8 +48,8 @@ typedef struct {
     float lambda;
     float rms;
     uint32_t loaded;
-    float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* length of each fragment (arc_step) */
-    const bsf_point_t *anchor;             /* vertex anchors (absolute), or NULL */
+    float frag_len[BSF_PDM_MAX_FRAGMENTS];        /* length of each fragment (arc_step) */
+    const bsf_point_t *anchor;                    /* vertex anchors (absolute), or NULL */
     uint8_t vertex_unknown[BSF_PDM_MAX_VERTICES]; /* unknown index of each vertex */
 } pdm_state_t;
 

@@ -40,7 +40,7 @@ extern "C" {
 typedef enum {
     BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM */
     BSF_METHOD_BID_SVED_PDM = 1,   /**< baseline: B-spline interest points (slow), SVED, PDM */
-    BSF_METHOD_RPOS_LSBA = 2, /**< baseline: RPOS segments, 4-point least squares, no corners */
+    BSF_METHOD_RPOS_LSBA = 2,   /**< baseline: RPOS segments, 4-point least squares, no corners */
     BSF_METHOD_LC_SVED_PDM = 3, /**< default: LC line corners, SVED, PDM with anchored vertices */
     BSF_METHOD_COUNT = 4
 } bsf_method_t;

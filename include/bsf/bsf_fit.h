@@ -98,9 +98,9 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {
-    float t[BSF_MAX_POINTS];                    /**< footpoint parameter of each point */
-    float t_prev[BSF_MAX_POINTS];               /**< parameters before the current iteration */
-    float arc[BSF_MAX_POINTS]; /**< arc length of each point from its fragment's first point */
+    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
+    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
+    float arc[BSF_MAX_POINTS];    /**< arc length of each point from its fragment's first point */
     float band[BSF_MAX_CTRL_PER_FEATURE * 3];   /**< normal matrix, lower band (bw 2) */
     float factor[BSF_MAX_CTRL_PER_FEATURE * 3]; /**< its Cholesky factor */
     float rhs_x[BSF_MAX_CTRL_PER_FEATURE];      /**< right-hand sides, then solutions */
@@ -196,11 +196,13 @@ BSF_NODISCARD bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const u
  * bsf_pdm_fit). Anchors must be finite with |x|, |y| <= BSF_FIT_MAX_COORD
  * (else BSF_ERR_ARG); other arguments and results as bsf_pdm_fit.
  */
-BSF_NODISCARD bsf_status_t bsf_pdm_fit_anchored(
-    const bsf_point_t *pts, size_t n, const uint16_t *vertex_pos, const bsf_point_t *vertex_anchor,
-    size_t n_vertex, const bsf_pdm_params_t *p, bsf_pdm_work_t *work, bsf_point_t *ctrl_out,
-    uint8_t *is_vertex_out, size_t ctrl_cap, size_t *n_ctrl_out, float *e_curve_out,
-    bsf_pdm_info_t *info_out);
+BSF_NODISCARD bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n,
+                                                const uint16_t *vertex_pos,
+                                                const bsf_point_t *vertex_anchor, size_t n_vertex,
+                                                const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                                                bsf_point_t *ctrl_out, uint8_t *is_vertex_out,
+                                                size_t ctrl_cap, size_t *n_ctrl_out,
+                                                float *e_curve_out, bsf_pdm_info_t *info_out);
 
 #ifdef __cplusplus
 }

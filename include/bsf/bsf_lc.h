@@ -41,16 +41,16 @@ extern "C" {
 
 /** LC parameters; start from bsf_lc_params_default(). */
 typedef struct {
-    float jump_a;          /**< runs break where consecutive points are farther apart than
-                                jump_a * exp(jump_b * range), metres (0.2, SVED's) */
-    float jump_b;          /**< see jump_a, 1/metres (0.07) */
-    float split_min;       /**< smallest split tolerance, metres (0.02) */
-    float split_sigmas;    /**< split tolerance in estimated noise sigmas (4) */
-    float min_turn;        /**< smallest change of direction at a corner, radians (0.15) */
-    float curve_ratio;     /**< two lines must beat the best smooth curve by this factor (3) */
-    float floor;           /**< residual floor per point, metres (0.003) */
-    float max_side;        /**< length of each side used for the line fits, metres (1.5) */
-    float apex_slack;      /**< extra distance allowed from apex to intersection, metres (0.05) */
+    float jump_a;       /**< runs break where consecutive points are farther apart than
+                             jump_a * exp(jump_b * range), metres (0.2, SVED's) */
+    float jump_b;       /**< see jump_a, 1/metres (0.07) */
+    float split_min;    /**< smallest split tolerance, metres (0.02) */
+    float split_sigmas; /**< split tolerance in estimated noise sigmas (4) */
+    float min_turn;     /**< smallest change of direction at a corner, radians (0.15) */
+    float curve_ratio;  /**< two lines must beat the best smooth curve by this factor (3) */
+    float floor;        /**< residual floor per point, metres (0.003) */
+    float max_side;     /**< length of each side used for the line fits, metres (1.5) */
+    float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
     uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3) */
 } bsf_lc_params_t;
 

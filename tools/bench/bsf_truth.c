@@ -216,14 +216,16 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
         const bsf_scene_corner_t *c = &corners[k];
         int band;
         double best = 1e300;
-        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX || !walls_seen(c, lidar, ranges, hit_shape)) {
+        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX ||
+            !walls_seen(c, lidar, ranges, hit_shape)) {
             continue;
         }
         band = c->range < 3.0 ? 0 : (c->range < 6.0 ? 1 : 2);
         acc->visible[band]++;
         for (j = 0; j < res->n_ctrl; ++j) {
             if (res->ctrl_is_vertex[j]) {
-                const double d = hypot((double)res->ctrl[j].x - c->x, (double)res->ctrl[j].y - c->y);
+                const double d =
+                    hypot((double)res->ctrl[j].x - c->x, (double)res->ctrl[j].y - c->y);
                 best = d < best ? d : best;
             }
         }
@@ -251,8 +253,8 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
                 continue; /* not a vertex, or its second copy */
             }
             for (k = 0; k < n_corners; ++k) {
-                const double d =
-                    hypot((double)res->ctrl[g].x - corners[k].x, (double)res->ctrl[g].y - corners[k].y);
+                const double d = hypot((double)res->ctrl[g].x - corners[k].x,
+                                       (double)res->ctrl[g].y - corners[k].y);
                 best = d < best ? d : best;
             }
             for (k = 0; k < n_creases; ++k) {
@@ -288,8 +290,8 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
             double wx;
             double wy;
             double d;
-            if (bsf_bspline_eval(ctrl, ft->n_ctrl, (float)((double)j / (double)n_samples), &p,
-                                 NULL, NULL) != BSF_OK) {
+            if (bsf_bspline_eval(ctrl, ft->n_ctrl, (float)((double)j / (double)n_samples), &p, NULL,
+                                 NULL) != BSF_OK) {
                 continue;
             }
             bsf_scene_sensor_to_world(&lidar->pose, (double)p.x, (double)p.y, &wx, &wy);
@@ -305,7 +307,8 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
                 for (q = span; q < span + 3u && q < ft->n_ctrl; ++q) {
                     near_v |= res->ctrl_is_vertex[ft->ctrl_first + q];
                 }
-                printf("far sample %.3f m at t %.3f: %s, feature %u ctrl, %u points, beams %u-%u\n", d, (double)j / (double)n_samples,
+                printf("far sample %.3f m at t %.3f: %s, feature %u ctrl, %u points, beams %u-%u\n",
+                       d, (double)j / (double)n_samples,
                        end ? "end span" : (near_v ? "vertex span" : "inner span"), ft->n_ctrl,
                        ft->n_points, ft->first_beam, ft->last_beam);
             }

@@ -89,7 +89,7 @@ double bsf_truth_quantile(const bsf_truth_hist_t *h, double q);
 
 /** Summary numbers of an accumulator. */
 typedef struct {
-    double recall;          /* all bands */
+    double recall; /* all bands */
     double recall_band[BSF_TRUTH_BANDS];
     double precision;
     double verr_median, verr_p90, verr_max;

@@ -143,8 +143,9 @@ int cmd_extract(int argc, char **argv)
         } else if ((v = opt_value(argc, argv, &i, "--method", &err)) != NULL) {
             o.method = bsf_method_from_name(v);
             if (o.method == BSF_METHOD_COUNT) {
-                return usage_error("unknown method '%s' (lc-sved-pdm, falko-sved-pdm, bid-sved-pdm, rpos-lsba)",
-                                   v);
+                return usage_error(
+                    "unknown method '%s' (lc-sved-pdm, falko-sved-pdm, bid-sved-pdm, rpos-lsba)",
+                    v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--first", &err)) != NULL) {
             if (parse_long(v, 0, 1000000000L, &o.first) != 0) {

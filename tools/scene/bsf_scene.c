@@ -588,8 +588,9 @@ void bsf_scene_demo_pose(long k, long n, double *x, double *y, double *theta)
 void bsf_scene_truth_angles(bsf_scene_t *sc)
 {
     /* Counter-clockwise outline; (1.5, 4) and (5, 7.5) are reflex notches. */
-    static const double outline[] = {0.0,  0.0, 10.0, 0.0, 10.0, 3.0, 12.0, 4.5, 12.0, 9.0, 7.0, 9.0,
-                                     5.0,  7.5, 2.0,  9.0, 0.0,  9.0, 0.0,  5.0, 1.5,  4.0, 0.0, 3.0};
+    static const double outline[] = {0.0,  0.0, 10.0, 0.0, 10.0, 3.0, 12.0, 4.5,
+                                     12.0, 9.0, 7.0,  9.0, 5.0,  7.5, 2.0,  9.0,
+                                     0.0,  9.0, 0.0,  5.0, 1.5,  4.0, 0.0,  3.0};
     const double c = cos(SCENE_PI / 6.0);
     const double s = sin(SCENE_PI / 6.0);
     double box[8];
