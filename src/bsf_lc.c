@@ -27,11 +27,13 @@ bsf_lc_params_t bsf_lc_params_default(void)
     p.split_min = 0.02f;
     p.split_sigmas = 4.0f;
     p.min_turn = 0.15f;
-    p.curve_ratio = 3.0f;
+    p.curve_ratio = 10.0f;
     p.floor = 0.003f;
     p.max_side = 1.5f;
     p.apex_slack = 0.05f;
     p.min_side_points = 3u;
+    p.min_side_len = 0.15f;
+    p.max_range = 30.0f;
     return p;
 }
 
@@ -47,8 +49,9 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
         !(p->min_turn > 0.0f && p->min_turn < 1.5707963f) ||
         !(p->curve_ratio > 0.0f && p->curve_ratio <= 1e6f) ||
         !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
-        !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) || p->min_side_points < 2u ||
-        p->min_side_points > 64u) {
+        !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
+        !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
+        p->min_side_points < 2u || p->min_side_points > 64u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -230,6 +233,9 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
     bsf_point_t x;
 
+    if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
+        return 0;
+    }
     c->o = c->pts->pt[c->run[apex]];
     while (a0 > lo && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
         --a0;
@@ -254,6 +260,11 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
     if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
+        return 0;
+    }
+    /* Each side must also be long enough to give its line a direction. */
+    if (dist2(rel(c, a0), rel(c, apex)) < p->min_side_len * p->min_side_len ||
+        dist2(rel(c, b1), rel(c, apex)) < p->min_side_len * p->min_side_len) {
         return 0;
     }
     if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {

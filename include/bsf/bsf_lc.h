@@ -13,7 +13,7 @@
  *  2. judge every split point with the two pieces beside it (each cut to
  *     max_side metres from the apex): fit a total-least-squares line to each
  *     side (the apex left out) and keep the split as a corner only when
- *     - each side has min_side_points points,
+ *     - each side has min_side_points points and reaches min_side_len,
  *     - the lines turn by at least min_turn,
  *     - their intersection lies near the apex (within twice the local beam
  *       spacing plus apex_slack), and
@@ -47,19 +47,22 @@ typedef struct {
     float split_min;    /**< smallest split tolerance, metres (0.02) */
     float split_sigmas; /**< split tolerance in estimated noise sigmas (4) */
     float min_turn;     /**< smallest change of direction at a corner, radians (0.15) */
-    float curve_ratio;  /**< two lines must beat the best smooth curve by this factor (3) */
+    float curve_ratio;  /**< two lines must beat the best smooth curve by this factor (10) */
     float floor;        /**< residual floor per point, metres (0.003) */
     float max_side;     /**< length of each side used for the line fits, metres (1.5) */
     float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
-    uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3) */
+    float min_side_len; /**< length each side must reach from the apex, metres (0.15) */
+    float max_range;    /**< no corner at an apex farther than this, metres (30, FALKO's) */
+    uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3); one
+                                   fewer where a side reaches the end of its run */
 } bsf_lc_params_t;
 
 /** The defaults listed beside each field of bsf_lc_params_t. */
 bsf_lc_params_t bsf_lc_params_default(void);
 
 /** @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM when a value is not
- *  finite or out of range (jump_a, split_min, max_side, curve_ratio > 0;
- *  jump_b, floor, apex_slack >= 0; split_sigmas >= 0; min_turn in (0, pi/2);
+ *  finite or out of range (jump_a, split_min, max_side, curve_ratio, max_range > 0;
+ *  jump_b, floor, apex_slack, min_side_len >= 0; split_sigmas >= 0; min_turn in (0, pi/2);
  *  min_side_points in 2..64). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
