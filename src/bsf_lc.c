@@ -270,12 +270,6 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {
         return 0;
     }
-    /* Each side must be straight: a circle may not explain it much better
-     * than its line (a crease between two curved walls is no wall corner,
-     * and its line intersection would lie off the crease). */
-    if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
-        return 0;
-    }
     cross = la.dx * lb.dy - la.dy * lb.dx;
     if (!(fabsf(cross) >= bsf_sinf(p->min_turn))) {
         return 0;
@@ -306,6 +300,13 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     rss_lines = la.rss + lb.rss;
     if (!(rss_curve > p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor)) {
+        return 0;
+    }
+    /* Each side must be straight: a circle may not explain it much better
+     * than its line (a crease between two curved walls is no wall corner,
+     * and its line intersection would lie off the crease). Last, as the
+     * dearest test. */
+    if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
         return 0;
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
@@ -440,9 +441,40 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                 --nb;
                 changed = 1;
             } else {
+                /* Parked where it lands if this pass turns out final. */
+                if (*n_found + j < out_cap) {
+                    out[*n_found + j] = kp;
+                }
                 ++j;
             }
         }
+    }
+    if (!changed) {
+        /* The last pass judged every survivor with its final neighbours:
+         * its keypoints stand (compacted so beams stay strictly ascending;
+         * two splits may pick one beam). */
+        size_t n = *n_found;
+        for (j = 0; j < nb; ++j) {
+            const size_t parked = *n_found + j;
+            if (parked < out_cap) {
+                kp = out[parked];
+            } else {
+                const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
+                const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
+                if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                    continue; /* cannot happen: same judgement as in the pass */
+                }
+            }
+            if (n > 0u && n <= out_cap && out[n - 1u].index >= kp.index) {
+                continue;
+            }
+            if (n < out_cap) {
+                out[n] = kp;
+            }
+            ++n;
+        }
+        *n_found = n;
+        return;
     }
     for (j = 0; j < nb; ++j) {
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
@@ -493,8 +525,12 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
-            close_run = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]) > r * r;
+            /* r >= jump_a: the exponential is only needed past that. */
+            const float d2 = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]);
+            if (d2 > p->jump_a * p->jump_a) {
+                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
+                close_run = d2 > r * r;
+            }
         }
         if (close_run) {
             if (m >= 2u * (size_t)p->min_side_points + 1u) {
