@@ -222,6 +222,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
 {
     const bsf_lc_params_t *p = c->p;
     const float side2 = p->max_side * p->max_side;
+    const float len2 = p->min_side_len * p->min_side_len;
     const size_t need = p->min_side_points;
     lc_line_t la;
     lc_line_t lb;
@@ -247,12 +248,12 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need) {
+    if (apex - a0 < need || dist2(rel(c, a0), rel(c, apex)) < len2) {
         while (a0 > 0u && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
             --a0;
         }
     }
-    if (b1 - apex < need) {
+    if (b1 - apex < need || dist2(rel(c, b1), rel(c, apex)) < len2) {
         while (b1 + 1u < m && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
             ++b1;
         }
@@ -263,8 +264,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2(rel(c, a0), rel(c, apex)) < p->min_side_len * p->min_side_len ||
-        dist2(rel(c, b1), rel(c, apex)) < p->min_side_len * p->min_side_len) {
+    if (dist2(rel(c, a0), rel(c, apex)) < len2 || dist2(rel(c, b1), rel(c, apex)) < len2) {
         return 0;
     }
     if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {
@@ -414,6 +414,14 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
     return nb;
 }
 
+/* Two keypoints of one run on one corner: beams closer than the points a
+ * side needs, or intersections within apex_slack of each other. */
+static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf_lc_params_t *p)
+{
+    return (size_t)a->index + p->min_side_points >= (size_t)b->index ||
+           dist2(a->point, b->point) <= p->apex_slack * p->apex_slack;
+}
+
 /* Corners of one run: split, then merge the splits that are no corner until
  * the survivors all pass. */
 static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
@@ -425,11 +433,13 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     size_t j;
     unsigned pass;
     int changed = 1;
+    size_t first;
     bsf_keypoint_t kp;
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
     nb = split_run(c->pts, w, m, tol);
+    first = *n_found;
     for (pass = 0; changed && pass < LC_MAX_PASSES; ++pass) {
         changed = 0;
         j = 0;
@@ -465,7 +475,10 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                     continue; /* cannot happen: same judgement as in the pass */
                 }
             }
-            if (n > 0u && n <= out_cap && out[n - 1u].index >= kp.index) {
+            if (n > first && n <= out_cap && too_close(&out[n - 1u], &kp, c->p)) {
+                if (kp.score > out[n - 1u].score) {
+                    out[n - 1u] = kp; /* two splits on one corner: keep the sharper */
+                }
                 continue;
             }
             if (n < out_cap) {
@@ -480,8 +493,12 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
         if (judge(c, lo, w->brk[j], hi, m, &kp)) {
-            /* Keep beams strictly ascending (two splits may pick one beam). */
-            if (*n_found > 0u && *n_found <= out_cap && out[*n_found - 1u].index >= kp.index) {
+            /* Keep beams strictly ascending, one keypoint per corner. */
+            if (*n_found > first && *n_found <= out_cap &&
+                too_close(&out[*n_found - 1u], &kp, c->p)) {
+                if (kp.score > out[*n_found - 1u].score) {
+                    out[*n_found - 1u] = kp;
+                }
                 continue;
             }
             if (*n_found < out_cap) {
