@@ -188,9 +188,10 @@ BSF_NODISCARD bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const u
                                        float *e_curve_out, bsf_pdm_info_t *info_out);
 
 /**
- * bsf_pdm_fit with each vertex anchored: vertex k is held at vertex_anchor[k]
- * (metres, same frame as pts) by a stiff spring in every solve, so it stays
- * at a corner position found by the caller (for instance the intersection of
+ * bsf_pdm_fit with each vertex anchored: vertex k is held near vertex_anchor[k]
+ * (metres, same frame as pts) by a spring as strong as all the points
+ * together in every solve, so it stays (within millimetres) at a corner
+ * position found by the caller (for instance the intersection of
  * two wall lines, bsf_lc_detect's keypoint point) instead of drifting with
  * the points around it. vertex_anchor may be NULL (then this is exactly
  * bsf_pdm_fit). Anchors must be finite with |x|, |y| <= BSF_FIT_MAX_COORD
