@@ -103,64 +103,49 @@ static float dist(bsf_point_t a, bsf_point_t b)
     return sqrtf(dx * dx + dy * dy);
 }
 
-/* Arc length along a fragment a..b, step by step, where each step from point
- * i - 1 to point i is measured along the local direction of the points: the
- * chord between the nearest points at least PDM_ARC_BASE before point i and
- * after point i - 1 (within the fragment). Range noise across a wall then
- * adds nothing, where the plain polyline length grows by about the noise at
- * every step and, where points are denser than the noise (near the sensor,
- * fine beams), puts the start parameters far off the footpoints. Steps are
- * signed: noise along the direction cancels from step to step instead of
- * piling up (the arc may dip by the noise, which the start parameters clamp).
- * Both window ends only move forward: linear cost, no storage. */
-typedef struct {
-    size_t lo, hi;
-    float acc;
-} arc_walk_t;
-
-static void arc_start(arc_walk_t *wk, size_t a)
-{
-    wk->lo = a;
-    wk->hi = a;
-    wk->acc = 0.0f;
-}
-
-/* Arc from the fragment's first point to point i (called for i = a+1 .. b in order). */
-static float arc_next(arc_walk_t *wk, const bsf_point_t *pts, size_t i, size_t b)
+/* Cumulative arc length of the points, fragment by fragment (w->arc), where
+ * each step from point i - 1 to point i is measured along the local direction
+ * of the points: the chord between the nearest points at least PDM_ARC_BASE
+ * before point i and after point i - 1 (within the fragment). Range noise
+ * across a wall then adds nothing, where the plain polyline length grows by
+ * about the noise at every step and, where points are denser than the noise
+ * (near the sensor, fine beams), puts the start parameters far off the
+ * footpoints. Both window ends only move forward: linear cost. Returns the
+ * fragment's length (<= 0 only for a fragment that folds back on itself,
+ * which the caller then spaces by index). */
+static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
 {
     const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
-    const float sx = pts[i].x - pts[i - 1u].x;
-    const float sy = pts[i].y - pts[i - 1u].y;
-    float dx;
-    float dy;
-    float len;
-    while (wk->lo + 1u < i && dist2_pts(pts[wk->lo + 1u], pts[i]) >= base2) {
-        ++wk->lo;
-    }
-    if (wk->hi < i) {
-        wk->hi = i;
-    }
-    while (wk->hi < b && dist2_pts(pts[wk->hi], pts[i - 1u]) < base2) {
-        ++wk->hi;
-    }
-    dx = pts[wk->hi].x - pts[wk->lo].x;
-    dy = pts[wk->hi].y - pts[wk->lo].y;
-    len = sqrtf(dx * dx + dy * dy);
-    wk->acc += len > 0.0f ? (sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
-    return wk->acc;
-}
-
-/* The fragment's whole length by arc_next (<= 0 only for a fragment that
- * folds back on itself, which the start then spaces by index). */
-static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b)
-{
-    arc_walk_t wk;
+    size_t lo = a;
+    size_t hi = a;
     size_t i;
-    arc_start(&wk, a);
+    float acc = 0.0f;
+    arc[a] = 0.0f;
     for (i = a + 1u; i <= b; ++i) {
-        (void)arc_next(&wk, pts, i, b);
+        const float sx = pts[i].x - pts[i - 1u].x;
+        const float sy = pts[i].y - pts[i - 1u].y;
+        float dx;
+        float dy;
+        float len;
+        while (lo + 1u < i && dist2_pts(pts[lo + 1u], pts[i]) >= base2) {
+            ++lo;
+        }
+        if (hi < i) {
+            hi = i;
+        }
+        while (hi < b && dist2_pts(pts[hi], pts[i - 1u]) < base2) {
+            ++hi;
+        }
+        dx = pts[hi].x - pts[lo].x;
+        dy = pts[hi].y - pts[lo].y;
+        len = sqrtf(dx * dx + dy * dy);
+        /* Signed: the noise along the direction then cancels from step to
+         * step instead of piling up (the arc may dip by the noise, which the
+         * start parameters clamp). */
+        acc += len > 0.0f ? (sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
+        arc[i] = acc;
     }
-    return wk.acc;
+    return acc;
 }
 
 /* Control polygon for the current precision counts: unknown index of every
@@ -362,8 +347,6 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const float range = t1[f] - t0[f];
         const unsigned straight = w->frag_precision[f] == 0u;
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
-        arc_walk_t wk;
-        arc_start(&wk, a);
         /* The vertex point closing fragment f opens fragment f + 1: it is
          * accumulated once, by the fragment it closes. */
         for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
@@ -371,12 +354,11 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             float u;
             float t;
             size_t span;
-            const float arc = i > a ? arc_next(&wk, s->pts, i, b) : 0.0f;
             /* Coincident points: fall back to even spacing by index. */
             if (i == b) {
-                frac = 1.0f;
+                frac = 1.0f; /* its arc slot belongs to the next fragment */
             } else {
-                frac = len > 0.0f ? arc * inv_len : (float)(i - a) / (float)(b - a);
+                frac = len > 0.0f ? w->arc[i] * inv_len : (float)(i - a) / (float)(b - a);
             }
             frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
             if (straight) {
@@ -877,7 +859,10 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
     for (f = 0; f <= n_vertex; ++f) {
         const size_t a = f == 0u ? 0u : vertex_pos[f - 1u];
         const size_t b = f < n_vertex ? vertex_pos[f] : n - 1u;
-        s.frag_len[f] = fragment_arc(pts, a, b);
+        /* Arcs are relative to each fragment's first point, so a vertex
+         * point's slot holds 0 (the fragment it opens); the fragment it
+         * closes ends at its length, frag_len. */
+        s.frag_len[f] = fragment_arc(pts, a, b, work->arc);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;

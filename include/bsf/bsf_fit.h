@@ -98,8 +98,9 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {
-    float t[BSF_MAX_POINTS];                    /**< footpoint parameter of each point */
-    float t_prev[BSF_MAX_POINTS];               /**< parameters before the current iteration */
+    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
+    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
+    float arc[BSF_MAX_POINTS];    /**< arc length of each point from its fragment's first point */
     float band[BSF_MAX_CTRL_PER_FEATURE * 3];   /**< normal matrix, lower band (bw 2) */
     float factor[BSF_MAX_CTRL_PER_FEATURE * 3]; /**< its Cholesky factor */
     float rhs_x[BSF_MAX_CTRL_PER_FEATURE];      /**< right-hand sides, then solutions */
