@@ -94,7 +94,7 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
 
 /**
  * Working memory of bsf_pdm_fit, owned by the caller (static or on a task's
- * stack it does not overflow: 10944 bytes at the default caps). Its content
+ * stack it does not overflow: 15268 bytes at the default caps). Its content
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {

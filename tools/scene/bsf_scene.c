@@ -658,8 +658,8 @@ size_t bsf_scene_mixed_pixels(float *ranges, size_t n, float no_return, double j
         return 0u;
     }
     for (i = 0; i + 1u < n; ++i) {
-        const double a = ranges[i];
-        const double b = ranges[i + 1u];
+        const double a = (double)ranges[i];
+        const double b = (double)ranges[i + 1u];
         double w;
         if (ranges[i] == no_return || ranges[i + 1u] == no_return || fabs(a - b) <= jump) {
             continue;
