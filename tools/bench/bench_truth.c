@@ -8,7 +8,9 @@
  *   bench_truth --quick --check  small run that fails (exit 1) when a target is missed (ctest)
  *   options: --poses N, --paper (paper-faithful configuration), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
- *            --scene NAME, --sensor N, --noise MM
+ *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
+ *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
+ *            features and keypoints (for debugging one scan)
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
