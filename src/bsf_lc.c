@@ -422,6 +422,29 @@ static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf
            dist2(a->point, b->point) <= p->apex_slack * p->apex_slack;
 }
 
+/* Append kp, or merge it into the previous keypoint of the same run (from
+ * index first on) when both sit on one corner, keeping the sharper. *last
+ * mirrors the previous keypoint even when out is full, so the count does not
+ * depend on out_cap. */
+static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, bsf_keypoint_t *last,
+                 const bsf_keypoint_t *kp, const bsf_lc_params_t *p)
+{
+    if (*n > first && too_close(last, kp, p)) {
+        if (kp->score > last->score) {
+            *last = *kp;
+            if (*n - 1u < out_cap) {
+                out[*n - 1u] = *kp;
+            }
+        }
+        return;
+    }
+    if (*n < out_cap) {
+        out[*n] = *kp;
+    }
+    *last = *kp;
+    ++*n;
+}
+
 /* Corners of one run: split, then merge the splits that are no corner until
  * the survivors all pass. */
 static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
@@ -435,11 +458,13 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     int changed = 1;
     size_t first;
     bsf_keypoint_t kp;
+    bsf_keypoint_t last;
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
+    memset(&last, 0, sizeof last);
     for (pass = 0; changed && pass < LC_MAX_PASSES; ++pass) {
         changed = 0;
         j = 0;
@@ -461,11 +486,10 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
     if (!changed) {
         /* The last pass judged every survivor with its final neighbours:
-         * its keypoints stand (compacted so beams stay strictly ascending;
-         * two splits may pick one beam). */
-        size_t n = *n_found;
+         * its keypoints stand. */
+        const size_t base = *n_found;
         for (j = 0; j < nb; ++j) {
-            const size_t parked = *n_found + j;
+            const size_t parked = base + j; /* never below the next slot written */
             if (parked < out_cap) {
                 kp = out[parked];
             } else {
@@ -475,36 +499,15 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                     continue; /* cannot happen: same judgement as in the pass */
                 }
             }
-            if (n > first && n <= out_cap && too_close(&out[n - 1u], &kp, c->p)) {
-                if (kp.score > out[n - 1u].score) {
-                    out[n - 1u] = kp; /* two splits on one corner: keep the sharper */
-                }
-                continue;
-            }
-            if (n < out_cap) {
-                out[n] = kp;
-            }
-            ++n;
+            keep(out, out_cap, n_found, first, &last, &kp, c->p);
         }
-        *n_found = n;
         return;
     }
     for (j = 0; j < nb; ++j) {
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
         if (judge(c, lo, w->brk[j], hi, m, &kp)) {
-            /* Keep beams strictly ascending, one keypoint per corner. */
-            if (*n_found > first && *n_found <= out_cap &&
-                too_close(&out[*n_found - 1u], &kp, c->p)) {
-                if (kp.score > out[*n_found - 1u].score) {
-                    out[*n_found - 1u] = kp;
-                }
-                continue;
-            }
-            if (*n_found < out_cap) {
-                out[*n_found] = kp;
-            }
-            ++*n_found;
+            keep(out, out_cap, n_found, first, &last, &kp, c->p);
         }
     }
 }
