@@ -181,7 +181,10 @@ bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid_params_t *p,
 
     n_peak = bsf_nms_beams(pts, work->score, BSF_NMS_LOWER_IS_BETTER, p->t_th, p->nms_radius,
                            work->peak);
-    for (k = 0; k < n_peak && k < out_cap; ++k) {
+    *n_out = n_peak;
+    /* Over the cap, the strongest keypoints are the ones worth keeping. */
+    n_peak = bsf_nms_keep_best(work->score, BSF_NMS_LOWER_IS_BETTER, work->peak, n_peak, out_cap);
+    for (k = 0; k < n_peak; ++k) {
         const size_t b = work->peak[k];
         out[k].index = (uint16_t)b;
         out[k].point = pts->pt[b];
@@ -189,6 +192,5 @@ bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid_params_t *p,
         out[k].radius = p->neigh_a * bsf_expf(p->neigh_b * pts->range[b]);
         out[k].score = work->score[b];
     }
-    *n_out = n_peak;
-    return n_peak > out_cap ? BSF_ERR_CAPACITY : BSF_OK;
+    return *n_out > out_cap ? BSF_ERR_CAPACITY : BSF_OK;
 }

@@ -148,7 +148,22 @@ static void clock_stage(stage_clock_t *c, bsf_stats_t *stats, bsf_stage_t stage)
     c->last = now;
 }
 
-static bsf_status_t detect_corners(bsf_extractor_t *ex)
+/* Over BSF_MAX_KEYPOINTS the detector keeps the strongest (bsf_falko_detect,
+ * bsf_bid_detect) and reports how many it found: keep those and count the
+ * rest as cut. Any other error stands. */
+static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex,
+                                            bsf_stats_t *stats)
+{
+    if (st == BSF_ERR_CAPACITY && ex->n_keypoints > (size_t)BSF_MAX_KEYPOINTS) {
+        stats->cut |= BSF_CUT_KEYPOINTS;
+        stats->n_cut_keypoints = (uint32_t)(ex->n_keypoints - (size_t)BSF_MAX_KEYPOINTS);
+        ex->n_keypoints = BSF_MAX_KEYPOINTS;
+        return BSF_OK;
+    }
+    return st;
+}
+
+static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     bsf_status_t st = BSF_OK;
     size_t i;
@@ -170,6 +185,7 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex)
     case BSF_METHOD_COUNT:
     default: break;
     }
+    st = keep_keypoints_that_fit(st, ex, stats);
     if (st != BSF_OK) {
         ex->n_keypoints = 0u;
         return st;
@@ -185,18 +201,75 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex)
     return BSF_OK;
 }
 
-static bsf_status_t segment(bsf_extractor_t *ex)
+/* Segments of at least min_points points among all[0..n). */
+static size_t count_segments_from(const bsf_segment_t *all, size_t n, uint32_t min_points)
 {
+    size_t c = 0u;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        c += ((uint32_t)all[i].n_points >= min_points) ? 1u : 0u;
+    }
+    return c;
+}
+
+/* Copy the kept segments all[0..n) into ex->segments. Over BSF_MAX_SEGMENTS,
+ * the segments covering the most points win (ties: earlier in segmentation
+ * order), they stay in segmentation order, and the rest are counted as cut. */
+static void keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n,
+                                   bsf_stats_t *stats)
+{
+    const size_t cap = BSF_MAX_SEGMENTS;
+    uint32_t lo = 0u; /* at least cap segments have lo points or more */
+    uint32_t hi = 0xFFFFu;
+    size_t n_above;
+    size_t i;
+    ex->n_segments = 0u;
+    if (n <= cap) {
+        memcpy(ex->segments, all, n * sizeof *all);
+        ex->n_segments = n;
+        return;
+    }
+    while (lo < hi) {
+        const uint32_t mid = (lo + hi + 1u) / 2u;
+        if (count_segments_from(all, n, mid) >= cap) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    n_above = count_segments_from(all, n, lo + 1u);
+    for (i = 0; i < n; ++i) {
+        const uint32_t np = all[i].n_points;
+        if (np > lo || (np == lo && n_above < cap)) {
+            n_above += (np == lo) ? 1u : 0u;
+            ex->segments[ex->n_segments++] = all[i];
+        } else {
+            stats->n_cut_segments++;
+            stats->n_cut_points += np;
+        }
+    }
+    stats->cut |= BSF_CUT_SEGMENTS;
+}
+
+static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
+{
+    /* Every kept segment fits the scratch (one per valid point at most), so
+     * the cap can choose among all of them. */
+    bsf_segment_t *all = ex->scratch.all_segments;
+    size_t n_all = 0u;
     bsf_status_t st;
     ex->n_segments = 0u;
     if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
-        return bsf_segment_rpos(&ex->points, &ex->params.rpos, ex->segments, BSF_MAX_SEGMENTS,
-                                &ex->n_segments, NULL);
+        st = bsf_segment_rpos(&ex->points, &ex->params.rpos, all, BSF_MAX_POINTS, &n_all, NULL);
+    } else {
+        st = bsf_segment_sved(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS, &n_all, NULL);
     }
-    st = bsf_segment_sved(&ex->points, &ex->params.sved, ex->segments, BSF_MAX_SEGMENTS,
-                          &ex->n_segments, NULL);
     if (st != BSF_OK) {
         return st;
+    }
+    keep_segments_that_fit(ex, all, n_all, stats);
+    if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
+        return BSF_OK;
     }
     return bsf_segment_classify(ex->segments, ex->n_segments, &ex->points, ex->interest,
                                 ex->n_keypoints);
@@ -242,66 +315,181 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     return n;
 }
 
-static bsf_status_t fit_features(bsf_extractor_t *ex, bsf_result_t *res)
+/* Fit one segment and append its feature to the result. Returns BSF_OK,
+ * BSF_ERR_BUFFER when the feature table or the control-point pool has no room
+ * left for it, or another error when the fit itself fails (then nothing is
+ * appended). */
+static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf_result_t *res)
+{
+    bsf_feature_t *f;
+    size_t n_vertex = 0u;
+    size_t n_ctrl = 0u;
+    size_t n;
+    float e_curve = 0.0f;
+    bsf_status_t st;
+    const size_t room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
+    const int lsba = ex->params.method == BSF_METHOD_RPOS_LSBA;
+
+    /* No fit when no feature could fit: a feature has at least 3 control
+     * points (4 from LSBA). */
+    if (res->n_features >= BSF_MAX_SEGMENTS || room < (lsba ? 4u : 3u)) {
+        return BSF_ERR_BUFFER;
+    }
+    n = gather_segment(ex, s, &n_vertex);
+    if (lsba) {
+        st = bsf_lsba_fit(ex->scratch.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
+        if (st == BSF_OK) {
+            n_ctrl = 4u;
+            memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
+        }
+    } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
+        st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
+    } else {
+        /* LC's keypoint is the walls' intersection: the vertex stays there. */
+        const bsf_point_t *anchor =
+            ex->params.method == BSF_METHOD_LC_SVED_PDM ? ex->scratch.fit.vertex_anchor : NULL;
+        st = bsf_pdm_fit_anchored(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos, anchor,
+                                  n_vertex, &ex->params.pdm, &ex->scratch.fit.pdm,
+                                  &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl], room,
+                                  &n_ctrl, &e_curve, NULL);
+    }
+    if (st != BSF_OK) {
+        return st;
+    }
+    f = &res->features[res->n_features++];
+    f->first_beam = s->first;
+    f->last_beam = s->last;
+    f->n_points = s->n_points;
+    f->ctrl_first = res->n_ctrl;
+    f->n_ctrl = (uint8_t)n_ctrl;
+    f->kind = s->kind;
+    f->e_curve = e_curve;
+    res->n_ctrl = (uint16_t)(res->n_ctrl + n_ctrl);
+    res->stats.n_in_features += s->n_points;
+    res->stats.n_ctrl += (uint32_t)n_ctrl;
+    return BSF_OK;
+}
+
+/* Index of the segment that comes next when going from most points to
+ * fewest, ties in segment order, after segment `prev` (n_segments to start);
+ * n_segments when there is none left. */
+static size_t next_largest_segment(const bsf_extractor_t *ex, size_t prev)
+{
+    const uint32_t prev_n = prev < ex->n_segments ? ex->segments[prev].n_points : 0x10000u;
+    size_t best = ex->n_segments;
+    size_t i;
+    for (i = 0; i < ex->n_segments; ++i) {
+        const uint32_t np = ex->segments[i].n_points;
+        const int after_prev = np < prev_n || (np == prev_n && i > prev && prev < ex->n_segments);
+        if (after_prev && (best == ex->n_segments || np > ex->segments[best].n_points)) {
+            best = i;
+        }
+    }
+    return best;
+}
+
+/* Reverse v[a..b) and the vertex flags with it. */
+static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
+{
+    while (a + 1u < b) {
+        const bsf_point_t p = res->ctrl[a];
+        const uint8_t v = res->ctrl_is_vertex[a];
+        --b;
+        res->ctrl[a] = res->ctrl[b];
+        res->ctrl_is_vertex[a] = res->ctrl_is_vertex[b];
+        res->ctrl[b] = p;
+        res->ctrl_is_vertex[b] = v;
+        ++a;
+    }
+}
+
+/* Beam order of features: by first beam, one wrapping through the seam of a
+ * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
+static uint32_t beam_order_key(const bsf_feature_t *f)
+{
+    return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
+}
+
+/* Sort the features into beam order and lay their control points out in
+ * that order, as a result fitted in beam order has them. In place. */
+static void put_features_in_beam_order(bsf_result_t *res)
+{
+    size_t i;
+    size_t at = 0u;
+    for (i = 1; i < res->n_features; ++i) {
+        const bsf_feature_t f = res->features[i];
+        size_t j = i;
+        while (j > 0u && beam_order_key(&res->features[j - 1u]) > beam_order_key(&f)) {
+            res->features[j] = res->features[j - 1u];
+            --j;
+        }
+        res->features[j] = f;
+    }
+    for (i = 0; i < res->n_features; ++i) {
+        bsf_feature_t *f = &res->features[i];
+        const size_t from = f->ctrl_first;
+        const size_t n = f->n_ctrl;
+        size_t k;
+        if (from != at) {
+            /* Rotate [at, from + n) so the block moves to `at`; the blocks in
+             * [at, from) (all of later features) move up by n. */
+            reverse_ctrl(res, at, from);
+            reverse_ctrl(res, from, from + n);
+            reverse_ctrl(res, at, from + n);
+            for (k = i + 1u; k < res->n_features; ++k) {
+                if (res->features[k].ctrl_first < from) {
+                    res->features[k].ctrl_first = (uint16_t)(res->features[k].ctrl_first + n);
+                }
+            }
+            f->ctrl_first = (uint16_t)at;
+        }
+        at += n;
+    }
+}
+
+/* The control points or the feature table ran out: start again, fitting
+ * the segments that cover the most points first, so what is left out is
+ * the small stuff. A segment that does not fit is cut; smaller ones may
+ * still fit after it. */
+static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res)
+{
+    size_t si = ex->n_segments;
+    res->n_features = 0u;
+    res->n_ctrl = 0u;
+    res->stats.n_in_features = 0u;
+    res->stats.n_ctrl = 0u;
+    res->stats.n_unfitted = 0u;
+    for (si = next_largest_segment(ex, si); si < ex->n_segments;
+         si = next_largest_segment(ex, si)) {
+        const bsf_segment_t *s = &ex->segments[si];
+        const bsf_status_t st = fit_segment(ex, s, res);
+        if (st == BSF_ERR_BUFFER) {
+            res->stats.cut |=
+                (res->n_features >= BSF_MAX_SEGMENTS) ? BSF_CUT_SEGMENTS : BSF_CUT_CTRL;
+            res->stats.n_cut_segments++;
+            res->stats.n_cut_points += s->n_points;
+        } else if (st != BSF_OK) {
+            res->stats.n_unfitted++; /* its points count as wasted (design 7) */
+        }
+    }
+    put_features_in_beam_order(res);
+}
+
+static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
 {
     size_t si;
-
     for (si = 0; si < ex->n_segments; ++si) {
-        const bsf_segment_t *s = &ex->segments[si];
-        bsf_feature_t *f;
-        size_t n_vertex = 0u;
-        size_t n_ctrl = 0u;
-        size_t room;
-        float e_curve = 0.0f;
-        bsf_status_t st;
-        const size_t n = gather_segment(ex, s, &n_vertex);
-
-        if (res->n_features >= BSF_MAX_SEGMENTS) {
-            return BSF_ERR_CAPACITY;
-        }
-        room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
-        if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
-            if (room < 4u) {
-                return BSF_ERR_CAPACITY;
-            }
-            st = bsf_lsba_fit(ex->scratch.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
-            if (st == BSF_OK) {
-                n_ctrl = 4u;
-                memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
-            }
-        } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
-            st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
-        } else {
-            /* LC's keypoint is the walls' intersection: the vertex stays there. */
-            const bsf_point_t *anchor =
-                ex->params.method == BSF_METHOD_LC_SVED_PDM ? ex->scratch.fit.vertex_anchor : NULL;
-            st = bsf_pdm_fit_anchored(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos,
-                                      anchor, n_vertex, &ex->params.pdm, &ex->scratch.fit.pdm,
-                                      &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl],
-                                      room, &n_ctrl, &e_curve, NULL);
-            if (st == BSF_ERR_BUFFER) {
-                return BSF_ERR_CAPACITY; /* the scan's control-point pool is full */
-            }
+        const bsf_status_t st = fit_segment(ex, &ex->segments[si], res);
+        if (st == BSF_ERR_BUFFER) {
+            fit_largest_first(ex, res);
+            break;
         }
         if (st != BSF_OK) {
             /* Not fitted: its points count as wasted (design 7). */
             res->stats.n_unfitted++;
-            continue;
         }
-        f = &res->features[res->n_features++];
-        f->first_beam = s->first;
-        f->last_beam = s->last;
-        f->n_points = s->n_points;
-        f->ctrl_first = res->n_ctrl;
-        f->n_ctrl = (uint8_t)n_ctrl;
-        f->kind = s->kind;
-        f->e_curve = e_curve;
-        res->n_ctrl = (uint16_t)(res->n_ctrl + n_ctrl);
-        res->stats.n_in_features += s->n_points;
-        res->stats.n_ctrl += (uint32_t)n_ctrl;
     }
     res->stats.n_features = res->n_features;
-    return BSF_OK;
 }
 
 static void clear_result(bsf_result_t *res)
@@ -333,20 +521,18 @@ bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan, bsf_result
     res->stats.n_valid = (uint32_t)ex->points.n_valid;
     clock_stage(&clk, &res->stats, BSF_STAGE_POINTS);
 
-    st = detect_corners(ex);
+    st = detect_corners(ex, &res->stats);
     if (st == BSF_OK) {
         res->stats.n_keypoints = (uint32_t)ex->n_keypoints;
         clock_stage(&clk, &res->stats, BSF_STAGE_CORNERS);
-        st = segment(ex);
-    }
-    if (st == BSF_OK) {
-        clock_stage(&clk, &res->stats, BSF_STAGE_SEGMENTS);
-        st = fit_features(ex, res);
+        st = segment(ex, &res->stats);
     }
     if (st != BSF_OK) {
         clear_result(res);
         return st;
     }
+    clock_stage(&clk, &res->stats, BSF_STAGE_SEGMENTS);
+    fit_features(ex, res);
     clock_stage(&clk, &res->stats, BSF_STAGE_FIT);
-    return BSF_OK;
+    return res->stats.cut != 0u ? BSF_OK_CUT : BSF_OK;
 }

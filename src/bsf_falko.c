@@ -479,7 +479,9 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
                            p->nms_radius, work->peak);
 
     *n_out = n_peak;
-    for (k = 0; k < n_peak && k < out_cap; ++k) {
+    /* Over the cap, the strongest keypoints are the ones worth keeping. */
+    n_peak = bsf_nms_keep_best(work->score, BSF_NMS_HIGHER_IS_BETTER, work->peak, n_peak, out_cap);
+    for (k = 0; k < n_peak; ++k) {
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
@@ -491,5 +493,5 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         out[k].score = (float)score_max - work->score[b];
         out[k].point = p->subbeam ? subbeam_corner(pts, b, &nb, r) : pts->pt[b];
     }
-    return (n_peak > out_cap) ? BSF_ERR_CAPACITY : BSF_OK;
+    return (*n_out > out_cap) ? BSF_ERR_CAPACITY : BSF_OK;
 }

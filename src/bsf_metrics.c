@@ -27,6 +27,10 @@ bsf_status_t bsf_metrics_counts(const bsf_result_t *r, bsf_scan_counts_t *out)
         c.sum_e_curve += r->features[i].e_curve;
     }
     c.time_s = r->stats.time_ns > 0u ? (float)r->stats.time_ns * 1e-9f : -1.0f;
+    c.cut = r->stats.cut;
+    c.n_cut_keypoints = r->stats.n_cut_keypoints;
+    c.n_cut_segments = r->stats.n_cut_segments;
+    c.n_cut_points = r->stats.n_cut_points;
     *out = c;
     return BSF_OK;
 }
@@ -36,7 +40,8 @@ bsf_status_t bsf_metrics_scan(const bsf_scan_counts_t *c, bsf_scan_metrics_t *ou
     bsf_scan_metrics_t m;
 
     if (c == NULL || out == NULL || c->n_in_features > c->n_valid ||
-        !finite_nonneg(c->sum_e_curve) || c->time_s != c->time_s ||
+        c->n_cut_points > c->n_valid - c->n_in_features || !finite_nonneg(c->sum_e_curve) ||
+        c->time_s != c->time_s ||
         (c->n_features == 0u && (c->n_in_features != 0u || c->n_ctrl != 0u))) {
         return BSF_ERR_ARG;
     }
@@ -116,6 +121,10 @@ bsf_status_t bsf_metrics_acc_add(bsf_metrics_acc_t *acc, const bsf_scan_counts_t
     acc->sum_ctrl += counts->n_ctrl;
     acc->sum_points += counts->n_in_features;
     acc->sum_valid += counts->n_valid;
+    acc->n_cut_scans += (counts->cut != 0u) ? 1u : 0u;
+    acc->sum_cut_keypoints += counts->n_cut_keypoints;
+    acc->sum_cut_segments += counts->n_cut_segments;
+    acc->sum_cut_points += counts->n_cut_points;
     return BSF_OK;
 }
 
@@ -194,6 +203,10 @@ bsf_status_t bsf_metrics_acc_summary(bsf_metrics_acc_t *acc, bsf_metrics_summary
         s.features_per_scan = (float)acc->sum_features / (float)acc->n_scans;
         s.ctrl_per_scan = (float)acc->sum_ctrl / (float)acc->n_scans;
     }
+    s.n_cut_scans = acc->n_cut_scans;
+    s.cut_keypoints = acc->sum_cut_keypoints;
+    s.cut_segments = acc->sum_cut_segments;
+    s.cut_points = acc->sum_cut_points;
     if (acc->time_samples != NULL && acc->time_count > 0u) {
         sort_floats(acc->time_samples, acc->time_count);
         s.time_median_s = acc->time_samples[nearest_rank(acc->time_count, 0.5f)];

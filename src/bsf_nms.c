@@ -2,6 +2,7 @@
 #include "bsf_nms.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "bsf_math.h"
 
@@ -162,4 +163,63 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
         peak[n_peak++] = peak[i2];
     }
     return n_peak;
+}
+
+/* A key whose unsigned order is the float order (sign-magnitude to offset
+ * binary), flipped when lower scores are better: a larger key is better. */
+static uint32_t score_key(float v, bsf_nms_order_t order)
+{
+    uint32_t bits;
+    uint32_t key;
+    memcpy(&bits, &v, sizeof bits);
+    key = (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+    return order == BSF_NMS_LOWER_IS_BETTER ? ~key : key;
+}
+
+static size_t count_at_least(const float *score, bsf_nms_order_t order, const uint16_t *peak,
+                             size_t n_peak, uint32_t key)
+{
+    size_t n = 0u;
+    size_t k;
+    for (k = 0; k < n_peak; ++k) {
+        n += (score_key(score[peak[k]], order) >= key) ? 1u : 0u;
+    }
+    return n;
+}
+
+size_t bsf_nms_keep_best(const float *score, bsf_nms_order_t order, uint16_t *peak, size_t n_peak,
+                         size_t cap)
+{
+    uint32_t lo = 0u; /* count_at_least(lo) >= cap holds throughout */
+    uint32_t hi = 0xFFFFFFFFu;
+    size_t n_above;
+    size_t n_kept = 0u;
+    size_t k;
+    if (n_peak <= cap) {
+        return n_peak;
+    }
+    if (cap == 0u) {
+        return 0u;
+    }
+    /* The cap-th best key: the largest key that at least cap peaks reach. */
+    while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2u + 1u;
+        if (count_at_least(score, order, peak, n_peak, mid) >= cap) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    /* Everything better than it, then ties in beam order up to cap. */
+    n_above = (lo == 0xFFFFFFFFu) ? 0u : count_at_least(score, order, peak, n_peak, lo + 1u);
+    for (k = 0; k < n_peak; ++k) {
+        const uint32_t key = score_key(score[peak[k]], order);
+        if (key > lo || (key == lo && n_above < cap)) {
+            if (key == lo) {
+                ++n_above;
+            }
+            peak[n_kept++] = peak[k];
+        }
+    }
+    return n_kept;
 }

@@ -51,4 +51,16 @@ size_t bsf_nms_half_window(const bsf_points_t *pts, size_t i, float radius);
 size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_t order,
                      float threshold, float radius, uint16_t *peak);
 
+/**
+ * Keep the cap best of n_peak peaks (peak[] ascending beam indices, as
+ * bsf_nms_beams leaves them): best by score[peak[k]] in the given order, ties
+ * going to the lower beam index. The kept peaks stay in peak[0..return) in
+ * ascending beam order. Used when a detector finds more keypoints than its
+ * caller has room for, so the strongest corners survive the cap.
+ * Scores must not be NaN. No extra memory; O(32 * n_peak).
+ * @return min(n_peak, cap)
+ */
+size_t bsf_nms_keep_best(const float *score, bsf_nms_order_t order, uint16_t *peak, size_t n_peak,
+                         size_t cap);
+
 #endif /* BSF_NMS_H */

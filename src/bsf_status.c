@@ -5,6 +5,7 @@ const char *bsf_status_str(bsf_status_t status)
 {
     switch (status) {
     case BSF_OK: return "ok";
+    case BSF_OK_CUT: return "ok, output cut to fit the caps";
     case BSF_ERR_ARG: return "bad argument";
     case BSF_ERR_CAPACITY: return "capacity exceeded";
     case BSF_ERR_PARAM: return "parameter out of range";

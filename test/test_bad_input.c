@@ -983,6 +983,7 @@ static bsf_scan_counts_t counts(uint32_t n_valid, uint32_t in_f, uint32_t n_ctrl
                                 float sum_e, float time_s)
 {
     bsf_scan_counts_t c;
+    memset(&c, 0, sizeof c);
     c.n_valid = n_valid;
     c.n_in_features = in_f;
     c.n_ctrl = n_ctrl;

@@ -8,6 +8,7 @@
 
 #include "bsf/bsf.h"
 #include "carmen.h"
+#include "shared_dir.h"
 #include "unity.h"
 
 static char log_path[2048];
@@ -68,10 +69,10 @@ static void test_falko_sved_pdm_on_intel_is_no_worse_than_table_1(void)
 
 int main(void)
 {
-    const char *env = getenv("BSF_SHARED_DIR");
+    char shared_dir[2048];
     FILE *probe;
-    snprintf(log_path, sizeof log_path, "%s/data/intel.log.gz",
-             env != NULL ? env : BSF_SHARED_DIR_DEFAULT);
+    bsf_test_shared_dir(shared_dir, sizeof shared_dir);
+    snprintf(log_path, sizeof log_path, "%s/data/intel.log.gz", shared_dir);
     probe = fopen(log_path, "rb");
     if (probe == NULL) {
         printf("SKIPPED: Intel dataset not found (%s)\n", log_path);

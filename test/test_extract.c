@@ -274,6 +274,7 @@ static void test_retrievability_and_compactness_equal_hand_counts(void)
     /* a straight wall needs the two boundary points and one precision point */
     TEST_ASSERT_EQUAL_UINT32(3u, res.stats.n_ctrl);
     TEST_ASSERT_EQUAL_UINT32(res.features[0].n_ctrl, res.stats.n_ctrl);
+    memset(&c, 0, sizeof c);
     c.n_valid = res.stats.n_valid;
     c.n_in_features = res.stats.n_in_features;
     c.n_ctrl = res.stats.n_ctrl;

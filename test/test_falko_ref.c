@@ -11,6 +11,7 @@
 
 #include "bsf/bsf.h"
 #include "carmen.h"
+#include "shared_dir.h"
 #include "unity.h"
 
 #define REF_MAX_PER_SCAN 64
@@ -183,10 +184,9 @@ static void test_intel_corrected_flaser_matches_falkolib_on_99_percent_of_scans(
 
 int main(void)
 {
-    const char *env = getenv("BSF_SHARED_DIR");
     char probe[4096];
     FILE *f;
-    snprintf(shared_dir, sizeof shared_dir, "%s", env != NULL ? env : BSF_SHARED_DIR_DEFAULT);
+    bsf_test_shared_dir(shared_dir, sizeof shared_dir);
     snprintf(probe, sizeof probe, "%s/ref/falko_intel_keypoints.txt", shared_dir);
     f = fopen(probe, "r");
     if (f == NULL) {

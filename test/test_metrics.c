@@ -18,6 +18,7 @@ static bsf_scan_counts_t counts(uint32_t n_valid, uint32_t in_feat, uint32_t ctr
                                 float sum_e, float t)
 {
     bsf_scan_counts_t c;
+    memset(&c, 0, sizeof c);
     c.n_valid = n_valid;
     c.n_in_features = in_feat;
     c.n_ctrl = ctrl;
@@ -138,7 +139,15 @@ static void test_counts_of_a_result_sum_its_features(void)
     r.features[1].e_curve = 0.02f;
     r.stats.n_valid = 50u;
     r.stats.time_ns = 12000u;
+    r.stats.cut = BSF_CUT_SEGMENTS;
+    r.stats.n_cut_segments = 2u;
+    r.stats.n_cut_points = 7u;
+    r.stats.n_cut_keypoints = 1u;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_counts(&r, &c));
+    TEST_ASSERT_EQUAL_UINT32(BSF_CUT_SEGMENTS, c.cut);
+    TEST_ASSERT_EQUAL_UINT32(2u, c.n_cut_segments);
+    TEST_ASSERT_EQUAL_UINT32(7u, c.n_cut_points);
+    TEST_ASSERT_EQUAL_UINT32(1u, c.n_cut_keypoints);
     TEST_ASSERT_EQUAL_UINT32(50u, c.n_valid);
     TEST_ASSERT_EQUAL_UINT32(42u, c.n_in_features);
     TEST_ASSERT_EQUAL_UINT32(8u, c.n_ctrl);
@@ -152,6 +161,86 @@ static void test_counts_of_a_result_sum_its_features(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_counts(&r, NULL));
 }
 
+/* Issue 17 item 6: 32-bit sums wrapped (ctrl_per_scan 34.8 instead of 512
+ * after 9 M full scans). The accumulator is brought to 8 388 607 full scans
+ * (512 control points each: 2^32 - 512 in total, the last value a 32-bit sum
+ * holds) as 9 M adds would leave it, then more full scans are added. */
+static void test_long_runs_do_not_wrap_the_sums(void)
+{
+    bsf_metrics_acc_t acc;
+    bsf_metrics_summary_t s;
+    const uint32_t full_scans = 8388607u;
+    bsf_scan_counts_t c = counts(1081u, 1000u, 512u, 128u, 1.28f, -1.0f);
+    uint32_t i;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    acc.n_scans = full_scans;
+    acc.sum_ctrl *= full_scans;
+    acc.sum_features *= full_scans;
+    acc.sum_points *= full_scans;
+    acc.sum_valid *= full_scans;
+    for (i = 0; i < 611393u; ++i) { /* to 9 M scans */
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_summary(&acc, &s));
+    TEST_ASSERT_EQUAL_UINT32(9000000u, s.n_scans);
+    TEST_ASSERT_FLOAT_WITHIN(0.01f, 512.0f, s.ctrl_per_scan);
+    TEST_ASSERT_FLOAT_WITHIN(0.01f, 128.0f, s.features_per_scan);
+    TEST_ASSERT_TRUE(acc.sum_valid == (uint64_t)1081u * 9000000u);
+    TEST_ASSERT_TRUE(acc.sum_points == (uint64_t)1000u * 9000000u);
+}
+
+/* Two scans whose counts add up past 2^32 each: every sum holds them. */
+static void test_sums_hold_more_than_32_bits(void)
+{
+    bsf_metrics_acc_t acc;
+    bsf_scan_counts_t c = counts(3000000000u, 2500000000u, 3500000000u, 4000000000u, 0.0f, -1.0f);
+    c.cut = BSF_CUT_SEGMENTS;
+    c.n_cut_segments = 3000000000u;
+    c.n_cut_points = 500000000u;
+    c.n_cut_keypoints = 2200000000u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &c));
+    TEST_ASSERT_TRUE(acc.sum_valid == 6000000000ull);
+    TEST_ASSERT_TRUE(acc.sum_points == 5000000000ull);
+    TEST_ASSERT_TRUE(acc.sum_ctrl == 7000000000ull);
+    TEST_ASSERT_TRUE(acc.sum_features == 8000000000ull);
+    TEST_ASSERT_TRUE(acc.sum_cut_segments == 6000000000ull);
+    TEST_ASSERT_TRUE(acc.sum_cut_points == 1000000000ull);
+    TEST_ASSERT_TRUE(acc.sum_cut_keypoints == 4400000000ull);
+}
+
+/* Cut scans are totalled; their cut points are wasted in Gamma, and counts
+ * that claim more cut points than N has outside features are refused. */
+static void test_cut_scans_are_totalled_and_their_points_wasted(void)
+{
+    bsf_metrics_acc_t acc;
+    bsf_metrics_summary_t s;
+    bsf_scan_metrics_t m;
+    bsf_scan_counts_t whole = counts(100u, 90u, 20u, 4u, 0.04f, -1.0f);
+    bsf_scan_counts_t cut = counts(100u, 60u, 12u, 2u, 0.02f, -1.0f);
+    cut.cut = BSF_CUT_CTRL | BSF_CUT_KEYPOINTS;
+    cut.n_cut_segments = 3u;
+    cut.n_cut_points = 30u;
+    cut.n_cut_keypoints = 5u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_scan(&cut, &m));
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, 0.6f, m.retrievability);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_init(&acc, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &whole));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &cut));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_add(&acc, &cut));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metrics_acc_summary(&acc, &s));
+    TEST_ASSERT_EQUAL_UINT32(3u, s.n_scans);
+    TEST_ASSERT_EQUAL_UINT32(2u, s.n_cut_scans);
+    TEST_ASSERT_TRUE(s.cut_segments == 6u);
+    TEST_ASSERT_TRUE(s.cut_points == 60u);
+    TEST_ASSERT_TRUE(s.cut_keypoints == 10u);
+    TEST_ASSERT_FLOAT_WITHIN(1e-6f, (0.9f + 0.6f + 0.6f) / 3.0f, s.retrievability);
+    cut.n_cut_points = 41u; /* 60 in features + 41 cut > 100 valid */
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_scan(&cut, &m));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -162,5 +251,8 @@ int main(void)
     RUN_TEST(test_time_quantiles_are_nearest_rank);
     RUN_TEST(test_time_array_overflow_is_an_error_not_a_truncation);
     RUN_TEST(test_counts_of_a_result_sum_its_features);
+    RUN_TEST(test_long_runs_do_not_wrap_the_sums);
+    RUN_TEST(test_sums_hold_more_than_32_bits);
+    RUN_TEST(test_cut_scans_are_totalled_and_their_points_wasted);
     return UNITY_END();
 }

@@ -9,12 +9,14 @@
 #define BSF_H
 
 #include "bsf_config.h"
+#include "bsf_version.h"
 #include "bsf_common.h"
 #include "bsf_scan.h"
 #include "bsf_feature.h"
 #include "bsf_metrics.h"
 #include "bsf_segment.h"
 #include "bsf_falko.h"
+#include "bsf_lc.h"
 #include "bsf_bspline.h"
 #include "bsf_fit.h"
 #include "bsf_bid.h"

@@ -29,9 +29,7 @@
 #include "bsf_scan.h"
 #include "bsf_fit.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** BID parameters; start from bsf_bid_params_default(). */
 typedef struct {
@@ -80,7 +78,8 @@ typedef struct {
  *         with out_cap > 0, or the angle increment is zero or not finite;
  *         BSF_ERR_PARAM when bsf_bid_params_check fails; BSF_ERR_CAPACITY when
  *         pts->count > BSF_MAX_POINTS, or more than out_cap keypoints were
- *         found (out then holds the first out_cap, *n_out the total). A beam
+ *         found (out then holds the out_cap strongest, lowest N_q first, ties
+ *         to the lower beam, ascending by beam index; *n_out the total). A beam
  *         whose neighbourhood is too small or cannot be fitted is simply not
  *         a candidate.
  */
@@ -88,8 +87,6 @@ BSF_NODISCARD bsf_status_t bsf_bid_detect(const bsf_points_t *pts, const bsf_bid
                                           bsf_bid_work_t *work, bsf_keypoint_t *out, size_t out_cap,
                                           size_t *n_out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_BID_H */

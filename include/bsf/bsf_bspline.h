@@ -15,9 +15,7 @@
 
 #include "bsf_common.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /**
  * Span that holds parameter t, and t's local coordinate u in [0, 1] inside it.
@@ -62,8 +60,6 @@ void bsf_bspline_basis(size_t n_ctrl, size_t span, float u, float basis[3], floa
 BSF_NODISCARD bsf_status_t bsf_bspline_eval(const bsf_point_t *ctrl, size_t n_ctrl, float t,
                                             bsf_point_t *pt, bsf_point_t *d1, bsf_point_t *d2);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_BSPLINE_H */

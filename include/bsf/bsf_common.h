@@ -9,10 +9,10 @@
 #include <stdint.h>
 
 #include "bsf_config.h"
+#include "bsf_abi.h"
+#include "bsf_version.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** Results that must not be ignored (a status that carries an error). */
 #if defined(__GNUC__) || defined(__clang__)
@@ -24,10 +24,14 @@ extern "C" {
 /**
  * Status of a bsf call: BSF_OK (0) on success, a negative value on error.
  * Functions that return a count return it as a non-negative value.
+ * bsf_extract alone may also return BSF_OK_CUT (1): success, but a
+ * compile-time cap cut the output (see bsf_stats_t.cut). Test `st < 0` for
+ * failure; `st != BSF_OK` also catches a cut scan.
  */
 typedef enum {
     BSF_OK = 0,
-    BSF_ERR_ARG = -1,        /**< NULL pointer or an argument outside its domain */
+    BSF_OK_CUT = 1,   /**< output valid, but the features that did not fit a cap were left out */
+    BSF_ERR_ARG = -1, /**< NULL pointer or an argument outside its domain */
     BSF_ERR_CAPACITY = -2,   /**< input or output larger than a compile-time cap */
     BSF_ERR_PARAM = -3,      /**< runtime parameter out of its documented range */
     BSF_ERR_NUMERIC = -4,    /**< a solve failed (matrix not positive definite after one retry) */
@@ -60,8 +64,6 @@ typedef struct {
 /** Short English name of a status code ("ok", "bad argument", ...); never NULL. */
 const char *bsf_status_str(bsf_status_t status);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_COMMON_H */

@@ -7,8 +7,18 @@
  * cost. Override any cap by defining it before this header is read, either
  * on the compiler command line (-DBSF_MAX_POINTS=361) or in a header of your
  * own named by BSF_CONFIG_HEADER (-DBSF_CONFIG_HEADER='"my_bsf_config.h"'),
- * which is included first. The library and every translation unit that uses
- * its headers must see the same values.
+ * which is included first.
+ *
+ * The library and every translation unit that uses its headers must see the
+ * same values, and the link enforces it: the symbols of the functions that
+ * take caps-sized objects carry the caps (bsf_abi.h), so a program compiled
+ * with other caps (or another BSF_CONFIG_HEADER that sets other caps) than
+ * the library fails to link with an undefined reference to a name such as
+ * bsf_extract_capsP361K64S128F32C512, instead of running and corrupting
+ * memory. Rebuild the library with the program's caps (or the program with
+ * the library's). For that reason each cap must be a plain decimal integer
+ * (361, not 361u, 0x169 or (360 + 1)); a cap may also be a macro that
+ * expands to one.
  */
 #ifndef BSF_CONFIG_H
 #define BSF_CONFIG_H
@@ -58,6 +68,19 @@
 #endif
 #if BSF_MAX_CTRL_POINTS < BSF_MAX_CTRL_PER_FEATURE || BSF_MAX_CTRL_POINTS > 65535
 #error "BSF_MAX_CTRL_POINTS must be in [BSF_MAX_CTRL_PER_FEATURE, 65535]"
+#endif
+
+/* Plain decimal spelling: the caps become part of symbol names (see above).
+ * Appending a 0 to a decimal literal multiplies it by ten; for any other
+ * spelling this comparison fails or does not compile. */
+#define BSF_CONFIG_CAT_(a, b) a##b
+#define BSF_CONFIG_APPEND0_(x) BSF_CONFIG_CAT_(x, 0)
+#if BSF_CONFIG_APPEND0_(BSF_MAX_POINTS) != BSF_MAX_POINTS * 10 ||                                  \
+    BSF_CONFIG_APPEND0_(BSF_MAX_KEYPOINTS) != BSF_MAX_KEYPOINTS * 10 ||                            \
+    BSF_CONFIG_APPEND0_(BSF_MAX_SEGMENTS) != BSF_MAX_SEGMENTS * 10 ||                              \
+    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_PER_FEATURE) != BSF_MAX_CTRL_PER_FEATURE * 10 ||              \
+    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_POINTS) != BSF_MAX_CTRL_POINTS * 10
+#error "bsf caps must be plain decimal integers such as 361 (they become part of symbol names)"
 #endif
 
 #endif /* BSF_CONFIG_H */

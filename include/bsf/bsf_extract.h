@@ -7,7 +7,7 @@
  *   static bsf_result_t res;
  *   bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
  *   if (bsf_extractor_init(&ex, &p) != BSF_OK) { ... }
- *   if (bsf_extract(&ex, &scan, &res) == BSF_OK) { ... res.features ... }
+ *   if (bsf_extract(&ex, &scan, &res) >= 0) { ... res.features ... }  // BSF_OK or BSF_OK_CUT
  *
  * Each stage is also callable on its own (bsf_scan.h, bsf_falko.h,
  * bsf_bid.h, bsf_segment.h, bsf_fit.h).
@@ -24,9 +24,7 @@
 #include "bsf_segment.h"
 #include "bsf_fit.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /**
  * Extraction methods: the three of the paper's Table 1, and bsf's default.
@@ -89,9 +87,11 @@ typedef struct {
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
     bsf_segment_t segments[BSF_MAX_SEGMENTS];
-    /** Stage scratch. The corner stage and the fitting stage never run at
-     *  the same time, so their working memory overlaps. */
+    /** Stage scratch. The corner, segmentation and fitting stages never run
+     *  at the same time, so their working memory overlaps (the segments take
+     *  no more room than one segment's points, so sizeof is unchanged). */
     union {
+        bsf_segment_t all_segments[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
         bsf_falko_work_t falko;
         bsf_lc_work_t lc;
         bsf_bid_work_t bid;
@@ -118,9 +118,32 @@ BSF_NODISCARD bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_par
  * Extract one scan's features into *result (overwritten whole).
  * A segment whose fit fails numerically is dropped and counted in
  * result->stats.n_unfitted (its points are wasted), never output with NaN.
- * @return BSF_OK; BSF_ERR_ARG for NULL or an extractor not initialised, or a
- *         scan refused by bsf_scan_to_points; BSF_ERR_CAPACITY when the scan,
- *         its keypoints, segments or control points exceed a cap. On error
+ *
+ * Caps past the input (bsf_config.h) degrade gracefully and visibly: what
+ * fits is kept, BSF_OK_CUT is returned and result->stats says what was cut.
+ *  - More keypoints than BSF_MAX_KEYPOINTS: the strongest are kept (FALKO:
+ *    highest strength; BID: lowest N_q; ties to the lower beam). A dropped
+ *    keypoint loses a vertex, not points. stats.n_keypoints counts the kept
+ *    ones, stats.n_cut_keypoints the others (BSF_CUT_KEYPOINTS).
+ *  - More kept segments than BSF_MAX_SEGMENTS: the segments covering the most
+ *    points are kept (ties: the earlier in beam order), in beam order
+ *    (BSF_CUT_SEGMENTS).
+ *  - Control points beyond BSF_MAX_CTRL_POINTS: the segments are fitted
+ *    again from the one covering the most points down (ties: beam order);
+ *    a segment whose feature does not fit the room left is cut, a smaller
+ *    one after it may still fit. Features then come out sorted by first
+ *    beam (one wrapping through a full-circle seam last), with their
+ *    control points laid out in that order (BSF_CUT_CTRL).
+ * A cut segment counts in stats.n_cut_segments and its points in
+ * stats.n_cut_points: they are part of N but of no feature, so they are
+ * wasted in retrievability. A cut result never exceeds any cap, so it always
+ * encodes within BSF_FRAME_MAX_SIZE. The cut path costs up to a second fit
+ * of the scan (control-point cut) and a few passes over the segments.
+ *
+ * @return BSF_OK; BSF_OK_CUT (> 0) as above; BSF_ERR_ARG for NULL or an
+ *         extractor not initialised, or a scan refused by bsf_scan_to_points;
+ *         BSF_ERR_CAPACITY when the scan has more than BSF_MAX_POINTS beams
+ *         (input is never truncated) or FALKO's raw score overflows. On error
  *         result holds no features (n_features 0) and zero stats.
  */
 BSF_NODISCARD bsf_status_t bsf_extract(bsf_extractor_t *ex, const bsf_scan_t *scan,
@@ -132,8 +155,6 @@ const char *bsf_method_name(bsf_method_t method);
 /** Method from its name; returns BSF_METHOD_COUNT for an unknown name. */
 bsf_method_t bsf_method_from_name(const char *name);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_EXTRACT_H */

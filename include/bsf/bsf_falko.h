@@ -24,9 +24,7 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** FALKO parameters; start from bsf_falko_params_default(). */
 typedef struct {
@@ -91,18 +89,17 @@ typedef struct {
  *         with out_cap > 0, or the angle increment is zero or not finite;
  *         BSF_ERR_PARAM when bsf_falko_params_check fails; BSF_ERR_CAPACITY
  *         when pts->count > BSF_MAX_POINTS, or more than out_cap keypoints
- *         were found (out then holds the first out_cap of them, *n_out the
- *         total), or a raw score exceeds 2^24 (only possible with huge,
- *         dense neighbourhoods). On the other errors *n_out is 0 (when
- *         n_out is not NULL). A scan with fewer than 2 * neigh_min_points + 1
- *         valid beams gives BSF_OK and no keypoint.
+ *         were found (out then holds the out_cap strongest, lowest raw score
+ *         first, ties to the lower beam, ascending by beam index; *n_out the
+ *         total), or a raw score exceeds 2^24 (only possible with huge, dense
+ *         neighbourhoods). On the other errors *n_out is 0 (when n_out is not
+ *         NULL). A scan with fewer than 2 * neigh_min_points + 1 valid beams
+ *         gives BSF_OK and no keypoint.
  */
 BSF_NODISCARD bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
                                             bsf_falko_work_t *work, bsf_keypoint_t *out,
                                             size_t out_cap, size_t *n_out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_FALKO_H */

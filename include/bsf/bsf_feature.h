@@ -8,9 +8,7 @@
 
 #include "bsf_common.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** Kind of a feature (paper section 5): with or without a vertex (corner). */
 typedef enum {
@@ -59,7 +57,7 @@ typedef struct {
     uint32_t n_in_features;   /**< points in kept features (numerator of retrievability) */
     uint32_t n_ctrl;          /**< stored control points of all features */
     uint32_t n_features;      /**< kept features */
-    uint32_t n_keypoints;     /**< interest points found by the corner stage */
+    uint32_t n_keypoints;     /**< interest points used (found = n_keypoints + n_cut_keypoints) */
     uint32_t n_unfitted;      /**< segments whose fit failed (counted as wasted) */
     uint32_t cut;             /**< BSF_CUT_* bits; 0 when every cap held */
     uint32_t n_cut_keypoints; /**< interest points dropped by the keypoint cap */
@@ -79,8 +77,6 @@ typedef struct {
     bsf_stats_t stats;
 } bsf_result_t;
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_FEATURE_H */

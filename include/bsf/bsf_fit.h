@@ -15,9 +15,7 @@
 
 #include "bsf_common.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** Largest accepted |x| or |y| of an input point, metres. */
 #define BSF_FIT_MAX_COORD 1.0e6f
@@ -205,8 +203,6 @@ BSF_NODISCARD bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n
                                                 size_t ctrl_cap, size_t *n_ctrl_out,
                                                 float *e_curve_out, bsf_pdm_info_t *info_out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_FIT_H */

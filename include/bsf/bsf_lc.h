@@ -35,9 +35,7 @@
 #include "bsf_common.h"
 #include "bsf_scan.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** LC parameters; start from bsf_lc_params_default(). */
 typedef struct {
@@ -89,8 +87,6 @@ BSF_NODISCARD bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_p
                                          bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,
                                          size_t *n_out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_LC_H */

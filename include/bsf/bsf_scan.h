@@ -8,9 +8,7 @@
 
 #include "bsf_common.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /**
  * One 2D LIDAR scan as the driver delivers it. Beam i points at
@@ -61,8 +59,6 @@ int bsf_range_is_valid(float r, float range_min, float range_max);
  */
 BSF_NODISCARD bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_SCAN_H */

@@ -24,9 +24,7 @@
 #include "bsf_feature.h"
 #include "bsf_scan.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /** One kept segment: a run of beams, both ends valid beams. */
 typedef struct {
@@ -136,8 +134,6 @@ BSF_NODISCARD bsf_status_t bsf_segment_classify(bsf_segment_t *segs, size_t n,
                                                 const bsf_points_t *pts,
                                                 const uint16_t *interest_beams, size_t n_interest);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_SEGMENT_H */

@@ -19,9 +19,7 @@
 #include "bsf_common.h"
 #include "bsf_feature.h"
 
-#ifdef __cplusplus
-extern "C" {
-#endif
+BSF_BEGIN_DECLS
 
 /* ---- Format constants ---------------------------------------------------- */
 
@@ -262,8 +260,6 @@ void bsf_decoder_init(bsf_decoder_t *dec);
 BSF_NODISCARD int bsf_decoder_feed(bsf_decoder_t *dec, const uint8_t *data, size_t len,
                                    size_t *consumed, bsf_frame_t *out);
 
-#ifdef __cplusplus
-}
-#endif
+BSF_END_DECLS
 
 #endif /* BSF_STREAM_H */

@@ -75,7 +75,7 @@ bsf_status_t det_run(const float *ranges_in, det_summary_t *out,
             if (st == BSF_OK) {
                 st = bsf_extract(&ex, &scan, &res);
             }
-            if (st != BSF_OK) {
+            if (st < 0) { /* a cut result (BSF_OK_CUT) is output too */
                 return st;
             }
             bsf_frame_info_init(&info);

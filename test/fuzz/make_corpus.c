@@ -100,7 +100,7 @@ int main(int argc, char **argv)
         sc = bsf_scene_lidar_scan(&lid, ranges);
         sc.range_min = 0.05f;
         sc.range_max = 30.0f;
-        if (bsf_extract(&ex, &sc, &res) != BSF_OK) {
+        if (bsf_extract(&ex, &sc, &res) < 0) {
             return 1;
         }
         info.seq = (uint32_t)k;

@@ -55,7 +55,7 @@ check(ok, "demo.svg is well-formed SVG with feature curves")
 log = os.path.join(WORK, "synth.log")
 exp = subprocess.run([SYNTH, log, "40"], capture_output=True, text=True)
 check(exp.returncode == 0, "synth_log writes the log")
-expected = dict(l.split("=") for l in exp.stdout.split())
+expected = dict(l.split("=", 1) for l in exp.stdout.split())
 r = run(["extract", "synth.log", "-o", "synth.bsf"])
 check(r.returncode == 0, "bsf extract on the synthetic log exits 0")
 r = run(["metrics", "synth.bsf"], text=True)
@@ -133,6 +133,28 @@ with open(os.path.join(WORK, "broken.log"), "w") as f:
     f.writelines(lines)
 r = run(["extract", "broken.log", "-o", "broken.bsf"], text=True)
 check(r.returncode == 0 and "broken.log:4" in r.stderr, "malformed line reported as broken.log:4 and skipped")
+
+# 7. a scan that exceeds a cap is kept with what fits and reported as cut, not failed
+exp = subprocess.run([SYNTH, os.path.join(WORK, "clutter.log"), "12", "clutter"], capture_output=True, text=True)
+check(exp.returncode == 0, "synth_log writes the clutter log")
+expected = dict(l.split("=", 1) for l in exp.stdout.split())
+n_cut = int(expected["cut_scans"])
+check(0 < n_cut < 12, "some clutter scans exceed the default keypoint cap (%d of 12)" % n_cut)
+tool_caps = run(["--version"], text=True).stdout.split("caps: ")[-1].split()
+same_caps = ",".join(tool_caps) == expected["caps"]
+if not same_caps:  # a tool built with larger caps cuts fewer (or none) of these scans
+    print("note: the tool's caps (%s) are not the library defaults (%s)" % (" ".join(tool_caps), expected["caps"]))
+r = run(["extract", "clutter.log", "--method", "falko-sved-pdm", "-o", "clutter.bsf"], text=True)
+check(r.returncode == 0 and "12 scans extracted" in r.stderr and " 0 failed" in r.stderr,
+      "bsf extract keeps cut scans, none failed, and exits 0")
+n_lines = r.stderr.count("cut by a cap:")
+check(("%d cut by a cap" % n_lines) in r.stderr, "each cut scan is reported with file:line and counted apart from failures")
+if same_caps:
+    check(n_lines == n_cut and ("left out %s keypoints" % expected["cut_keypoints"]) in r.stderr,
+          "bsf extract reports the %d cut scans and the keypoints the library left out" % n_cut)
+r = run(["metrics", "clutter.bsf"], text=True)
+check(r.returncode == 0 and metrics_of(r.stdout).get("scans", ["?"])[0] == "12",
+      "bsf metrics reads every scan of the cut stream")
 
 print("%d checks failed" % len(failures) if failures else "all tool checks passed")
 sys.exit(1 if failures else 0)

@@ -85,7 +85,7 @@ int cmd_demo(int argc, char **argv)
         sc.range_min = 0.05f;
         sc.range_max = 30.0f;
         st = bsf_extract(&g_ex, &sc, &g_res);
-        if (st == BSF_OK) {
+        if (st >= 0) { /* BSF_OK, or BSF_OK_CUT: what fits the caps */
             info.seq = (uint32_t)k;
             info.timestamp_ms = (uint64_t)(100 * k);
             info.has_pose = 1u;

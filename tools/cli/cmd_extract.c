@@ -20,8 +20,34 @@ static const char extract_help[] =
     "  -h, --help       this help\n"
     "\n"
     "Frames carry the laser pose and the time in ms since the log's first scan.\n"
-    "A malformed log line is reported as FILE:LINE and skipped. The summary goes to\n"
+    "A malformed log line is reported as FILE:LINE and skipped. A scan with more\n"
+    "keypoints, segments or control points than the library's caps is kept with the\n"
+    "features that fit and reported as cut (not failed). The summary goes to\n"
     "stderr; progress too, when stderr is a terminal.\n";
+
+/* Scans a cap cut (BSF_OK_CUT): kept and written, counted apart from failures. */
+typedef struct {
+    unsigned long scans, keypoints, segments, points;
+} cut_totals_t;
+
+#define CUT_MESSAGES_MAX 10 /* per-scan lines; the totals cover the rest */
+
+static void note_cut_scan(cut_totals_t *t, const char *log, unsigned long line, unsigned long index,
+                          const bsf_stats_t *s)
+{
+    if (t->scans < CUT_MESSAGES_MAX) {
+        fprintf(stderr,
+                "%s:%lu: scan %lu cut by a cap: %lu keypoints, %lu segments (%lu points) "
+                "left out%s\n",
+                log, line, index, (unsigned long)s->n_cut_keypoints,
+                (unsigned long)s->n_cut_segments, (unsigned long)s->n_cut_points,
+                t->scans + 1u == CUT_MESSAGES_MAX ? " (further cut scans: totals only)" : "");
+    }
+    t->scans++;
+    t->keypoints += s->n_cut_keypoints;
+    t->segments += s->n_cut_segments;
+    t->points += s->n_cut_points;
+}
 
 typedef struct {
     const char *log;
@@ -40,6 +66,7 @@ static int run_extract(const extract_opts_t *o)
     FILE *out;
     progress_t prog;
     unsigned long index = 0, done = 0, failed = 0, malformed;
+    cut_totals_t cut;
     double t0 = 0.0;
     int have_t0 = 0;
     unsigned long long bytes = 0;
@@ -58,6 +85,7 @@ static int run_extract(const extract_opts_t *o)
         carmen_close(rd);
         return EXIT_FAIL;
     }
+    memset(&cut, 0, sizeof cut);
     bsf_frame_info_init(&info);
     info.quant_step = (float)o->quant;
     progress_init(&prog);
@@ -74,7 +102,9 @@ static int run_extract(const extract_opts_t *o)
         }
         sc = scan_of_record(&rec, o->range_max);
         st = bsf_extract(&g_ex, &sc, &g_res);
-        if (st != BSF_OK) {
+        if (st == BSF_OK_CUT) {
+            note_cut_scan(&cut, o->log, rec.line, index, &g_res.stats);
+        } else if (st != BSF_OK) {
             fprintf(stderr, "%s:%lu: scan %lu skipped: %s\n", o->log, rec.line, index,
                     bsf_status_str(st));
             ++failed;
@@ -118,10 +148,16 @@ static int run_extract(const extract_opts_t *o)
         return EXIT_FAIL;
     }
     fprintf(stderr,
-            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu failed, %lu "
-            "malformed lines\n",
+            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu cut by a cap, "
+            "%lu failed, %lu malformed lines\n",
             o->log, done, bsf_method_name(o->method), bytes,
-            done ? (double)bytes / (double)done : 0.0, failed, malformed);
+            done ? (double)bytes / (double)done : 0.0, cut.scans, failed, malformed);
+    if (cut.scans > 0u) {
+        fprintf(stderr,
+                "%s: the caps left out %lu keypoints, %lu segments and %lu points in %lu scans "
+                "(kept: what fits, largest first; see the README's memory section)\n",
+                o->log, cut.keypoints, cut.segments, cut.points, cut.scans);
+    }
     return failed ? EXIT_FAIL : 0;
 }
 

@@ -103,7 +103,7 @@ static int run_dataset(const char *path, bsf_method_t method, long max_scans, ru
                 break;
             }
         }
-        if (bsf_extract(&g_ex, &sc, &g_res) != BSF_OK) {
+        if (bsf_extract(&g_ex, &sc, &g_res) < 0) { /* a cut scan counts, as a cut (m.n_cut_scans) */
             out->failed++;
             continue;
         }
@@ -231,12 +231,12 @@ int cmd_table1(int argc, char **argv)
                 continue;
             }
             printf("| %s | %s | %.1f (%.1f) | %.3f (%.3f) | %.4f (%.4f) | %.6f (%.5f) | %.1f | "
-                   "%.0f | %lu%s |\n",
+                   "%.0f | %lu%s%s |\n",
                    datasets[d].name, bsf_method_name((bsf_method_t)m),
                    100.0 * (double)rr.m.retrievability, pp[0], (double)rr.m.compactness, pp[1],
                    (double)rr.m.accuracy, pp[2], (double)rr.m.time_mean_s, pp[3],
                    1e6 * (double)rr.m.time_median_s, rr.bytes_median, rr.scans,
-                   rr.failed ? " (some failed)" : "");
+                   rr.failed ? " (some failed)" : "", rr.m.n_cut_scans ? " (some cut)" : "");
             fflush(stdout);
         }
     }

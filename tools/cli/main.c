@@ -36,6 +36,10 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("bsf %s (wire format version %u)\n", BSF_TOOL_VERSION, (unsigned)BSF_FORMAT_VERSION);
+        /* A scan over these is cut (keypoints, segments, control points) or refused (beams). */
+        printf("caps: BSF_MAX_POINTS=%d BSF_MAX_KEYPOINTS=%d BSF_MAX_SEGMENTS=%d "
+               "BSF_MAX_CTRL_POINTS=%d\n",
+               BSF_MAX_POINTS, BSF_MAX_KEYPOINTS, BSF_MAX_SEGMENTS, BSF_MAX_CTRL_POINTS);
         return 0;
     }
     for (i = 0; i < sizeof cmds / sizeof cmds[0]; ++i) {

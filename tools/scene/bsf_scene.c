@@ -583,6 +583,102 @@ void bsf_scene_demo_pose(long k, long n, double *x, double *y, double *theta)
                    8.0 * SCENE_PI * sin(2.0 * SCENE_PI * s) + 1e-9);
 }
 
+/* ---- cluttered rooms ------------------------------------------------------ */
+
+size_t bsf_scene_clutter_shapes(const bsf_scene_clutter_t *c)
+{
+    if (c == NULL) {
+        return 0u;
+    }
+    return (c->n_teeth > 0u ? 4u * c->n_teeth + 2u : 4u) + c->n_posts + 4u * c->n_boxes;
+}
+
+/* One long wall at height y from x = -half_w to +half_w, with n_teeth teeth
+ * standing `depth` towards y = 0; joints computed once so walls share them. */
+static void add_toothed_wall(bsf_scene_t *scene, double half_w, double y, size_t n_teeth,
+                             double depth)
+{
+    const double step = 2.0 * half_w / (double)(2u * n_teeth);
+    const double inward = y > 0.0 ? -depth : depth;
+    size_t k;
+    for (k = 0; k < 2u * n_teeth; ++k) {
+        const double xa = -half_w + step * (double)k;
+        const double xb = (k + 1u == 2u * n_teeth) ? half_w : -half_w + step * (double)(k + 1u);
+        const double ya = (k % 2u == 0u) ? y : y + inward;
+        const double yb = (k % 2u == 0u) ? y + inward : y;
+        (void)bsf_scene_add_segment(scene, xa, ya, xb, yb);
+    }
+}
+
+/* A random object centre inside the room, `margin` from the walls and `clear`
+ * from the origin (tries until one fits; the room is larger than both). */
+static void clutter_place(const bsf_scene_clutter_t *c, double margin, bsf_scene_rng_t *rng,
+                          double *x, double *y)
+{
+    int tries;
+    for (tries = 0; tries < 1000; ++tries) {
+        *x = (2.0 * bsf_scene_rng_uniform(rng) - 1.0) * (c->half_w - margin);
+        *y = (2.0 * bsf_scene_rng_uniform(rng) - 1.0) * (c->half_h - margin);
+        if (*x * *x + *y * *y >= c->clear * c->clear) {
+            return;
+        }
+    }
+    *x = c->half_w - margin; /* a corner of the room: certainly clear */
+    *y = c->half_h - margin;
+}
+
+bsf_status_t bsf_scene_add_clutter_room(bsf_scene_t *scene, const bsf_scene_clutter_t *c,
+                                        bsf_scene_rng_t *rng)
+{
+    const double wall_margin = 0.3 + 0.36; /* a box's half diagonal stays inside */
+    double margin;
+    size_t k;
+    if (scene == NULL || c == NULL || rng == NULL || !finite_d(c->half_w) || !finite_d(c->half_h) ||
+        !(c->half_w > 1.0) || !(c->half_h > 1.0) || !finite_d(c->clear) || !(c->clear >= 0.0) ||
+        (c->n_teeth > 0u && !(c->tooth_depth > 0.0 && c->tooth_depth < 0.5 * c->half_h))) {
+        return BSF_ERR_ARG;
+    }
+    if (bsf_scene_clutter_shapes(c) > BSF_SCENE_MAX_SHAPES - scene->n_shapes) {
+        return BSF_ERR_CAPACITY;
+    }
+    margin = wall_margin + (c->n_teeth > 0u ? c->tooth_depth : 0.0);
+    if (c->n_teeth == 0u) {
+        (void)bsf_scene_add_rect_room(scene, -c->half_w, -c->half_h, c->half_w, c->half_h);
+    } else {
+        add_toothed_wall(scene, c->half_w, -c->half_h, c->n_teeth, c->tooth_depth);
+        add_toothed_wall(scene, c->half_w, c->half_h, c->n_teeth, c->tooth_depth);
+        (void)bsf_scene_add_segment(scene, c->half_w, -c->half_h, c->half_w, c->half_h);
+        (void)bsf_scene_add_segment(scene, -c->half_w, c->half_h, -c->half_w, -c->half_h);
+    }
+    for (k = 0; k < c->n_posts; ++k) {
+        double x;
+        double y;
+        const double r = 0.03 + 0.09 * bsf_scene_rng_uniform(rng);
+        clutter_place(c, margin, rng, &x, &y);
+        (void)bsf_scene_add_circle(scene, x, y, r);
+    }
+    for (k = 0; k < c->n_boxes; ++k) {
+        double x;
+        double y;
+        const double half = 0.5 * (0.2 + 0.3 * bsf_scene_rng_uniform(rng));
+        const double a = 2.0 * SCENE_PI * bsf_scene_rng_uniform(rng);
+        const double ux = half * cos(a);
+        const double uy = half * sin(a);
+        double xy[8];
+        clutter_place(c, margin, rng, &x, &y);
+        xy[0] = x + ux - uy;
+        xy[1] = y + uy + ux;
+        xy[2] = x - ux - uy;
+        xy[3] = y - uy + ux;
+        xy[4] = x - ux + uy;
+        xy[5] = y - uy - ux;
+        xy[6] = x + ux + uy;
+        xy[7] = y + uy - ux;
+        (void)bsf_scene_add_polyline(scene, xy, 4u, 1);
+    }
+    return BSF_OK;
+}
+
 /* ---- ground-truth benchmark scenes ---------------------------------------- */
 
 void bsf_scene_truth_angles(bsf_scene_t *sc)

@@ -251,6 +251,38 @@ void bsf_scene_demo_office(bsf_scene_t *scene);
  */
 void bsf_scene_demo_pose(long k, long n, double *x, double *y, double *theta);
 
+/**
+ * A cluttered room for cap tests and cap sizing: a rectangle centred on the
+ * origin whose two long walls (top and bottom) may carry zig-zag shelving
+ * (each tooth two edges, each joint a corner), plus round posts (chair and
+ * table legs) and square boxes at random places, sizes and headings.
+ */
+typedef struct {
+    double half_w;      /**< half the room's width (x), metres, > 1 */
+    double half_h;      /**< half the room's height (y), metres, > 1 */
+    size_t n_teeth;     /**< zig-zag teeth along each long wall (0: straight walls) */
+    double tooth_depth; /**< how far a tooth stands into the room, metres (> 0 when n_teeth > 0) */
+    size_t n_posts;     /**< round posts, radius 0.03..0.12 m */
+    size_t n_boxes;     /**< square boxes, side 0.2..0.5 m */
+    double clear;       /**< no object centre within this distance of the origin, metres */
+} bsf_scene_clutter_t;
+
+/** Shapes a cluttered room takes in a scene: 4 * n_teeth + 2 walls (4 when
+ *  straight), one per post, four per box. */
+size_t bsf_scene_clutter_shapes(const bsf_scene_clutter_t *c);
+
+/**
+ * Add a cluttered room (see bsf_scene_clutter_t). Objects are drawn from rng
+ * uniformly over the room, at least 0.3 m inside the walls and `clear` from
+ * the origin (where the sensor stands); they may overlap one another.
+ * Compile the scene with a larger BSF_SCENE_MAX_SHAPES for dense clutter.
+ * @return BSF_OK; BSF_ERR_ARG for NULL, a room half size <= 1 m, a tooth depth
+ *         that is not in (0, half_h / 2) with teeth, or a negative clear;
+ *         BSF_ERR_CAPACITY when the shapes do not fit (scene left unchanged).
+ */
+bsf_status_t bsf_scene_add_clutter_room(bsf_scene_t *scene, const bsf_scene_clutter_t *c,
+                                        bsf_scene_rng_t *rng);
+
 /* ---- ground-truth benchmark scenes (bench_truth, test_truth) ------------- */
 
 /**

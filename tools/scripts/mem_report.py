@@ -3,6 +3,7 @@
 """RAM cost of bsf's caller-owned objects for several beam caps.
 
     mem_report.py [--cc CC --nm NM [--cflags FLAGS]] ... [--points 180,361,1081]
+                  [--define BSF_MAX_SEGMENTS=256 ...]
 
 Compiles tools/scripts/mem_probe.c (the public headers only) once per
 BSF_MAX_POINTS value with each given compiler and reads the sizes from the
@@ -24,10 +25,10 @@ PREFIX = "bsf_sizeof_"
 M4F_FLAGS = "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16"
 
 
-def sizes(cc, nm, cflags, points, workdir):
+def sizes(cc, nm, cflags, points, workdir, defines=()):
     obj = os.path.join(workdir, "probe_%d.o" % points)
     cmd = [cc] + cflags.split() + ["-std=c99", "-c", "-I", os.path.join(ROOT, "include"),
-                                   "-DBSF_MAX_POINTS=%d" % points, PROBE, "-o", obj]
+                                   "-DBSF_MAX_POINTS=%d" % points] + ["-D" + d for d in defines] + [PROBE, "-o", obj]
     subprocess.run(cmd, check=True)
     out = subprocess.run([nm, "-S", "-p", obj], check=True, capture_output=True, text=True).stdout
     result = {}
@@ -44,6 +45,8 @@ def main():
     ap.add_argument("--nm", action="append", default=[])
     ap.add_argument("--cflags", action="append", default=[])
     ap.add_argument("--points", default="180,361,1081")
+    ap.add_argument("--define", action="append", default=[],
+                    help="another cap for every size, e.g. BSF_MAX_SEGMENTS=256 (repeatable)")
     a = ap.parse_args()
     targets = []
     if a.cc:
@@ -58,10 +61,11 @@ def main():
     points = [int(p) for p in a.points.split(",")]
     with tempfile.TemporaryDirectory() as work:
         for label, cc, nm, cflags in targets:
-            table = {p: sizes(cc, nm, cflags, p, work) for p in points}
+            table = {p: sizes(cc, nm, cflags, p, work, a.define) for p in points}
             names = list(table[points[0]].keys())
-            print("sizeof, bytes (%s, %s): BSF_MAX_POINTS = %s; other caps default"
-                  % (label, cc, ", ".join(str(p) for p in points)))
+            print("sizeof, bytes (%s, %s): BSF_MAX_POINTS = %s; %s"
+                  % (label, cc, ", ".join(str(p) for p in points),
+                     ", ".join(a.define) if a.define else "other caps default"))
             for n in names:
                 cells = "".join("%9d (%5.1f KiB)" % (table[p][n], table[p][n] / 1024.0) for p in points)
                 print("  %-20s%s" % (n, cells))

@@ -99,6 +99,12 @@ def main():
     rc = 0
     for root in a.root or ["bsf_extract"]:
         if root not in size:
+            # Functions that take caps-sized objects carry the caps in their
+            # symbol (include/bsf/bsf_abi.h): bsf_extract_capsP1081K64...
+            caps = [t for t in size if re.match(re.escape(root) + r"_capsP\d+K\d+S\d+F\d+C\d+$", t)]
+            if len(caps) == 1:
+                root = caps[0]
+        if root not in size:
             print("stack_report.py: %s not found in the call graphs" % root)
             rc = 1
             continue

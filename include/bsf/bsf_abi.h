@@ -1,0 +1,87 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * bsf_abi.h - what the library exports and the caps guard on its symbols.
+ * Included by every public header; nothing here costs anything at run time.
+ *
+ * Export: a shared libbsf is built with hidden visibility, and only what the
+ * public headers declare between BSF_BEGIN_DECLS and BSF_END_DECLS is
+ * exported, so internal helpers (bsf_sinf, bsf_nms_beams, ...) never become
+ * part of the ABI. A new public header must wrap its declarations in them.
+ *
+ * Caps guard: the layout of bsf_points_t, bsf_result_t, bsf_extractor_t, the
+ * work structs, bsf_frame_t and the coder states follows from the caps in
+ * bsf_config.h. A program compiled with other caps than the library it links
+ * would hand the library objects of the wrong size, and the library would
+ * write past their end. To make that impossible, every function that takes
+ * such an object is renamed here: its symbol carries the caps, e.g.
+ * bsf_extract_capsP1081K64S128F32C512 with the default caps. Both the library
+ * and the program see this header, so when their caps agree the names
+ * match, and when they differ the program fails to link with
+ *     undefined reference to `bsf_extract_capsP361K64S128F32C512'
+ * which names the caps the program was compiled with (P: BSF_MAX_POINTS,
+ * K: BSF_MAX_KEYPOINTS, S: BSF_MAX_SEGMENTS, F: BSF_MAX_CTRL_PER_FEATURE,
+ * C: BSF_MAX_CTRL_POINTS); `nm libbsf.a | grep _caps` shows the library's.
+ * Source code keeps calling bsf_extract(); only the symbol differs. This is
+ * why the caps must be written as plain decimal numbers (bsf_config.h checks
+ * it). A new public function taking a caps-sized object must be added below.
+ */
+#ifndef BSF_ABI_H
+#define BSF_ABI_H
+
+#include "bsf_config.h"
+
+/* ---- Export --------------------------------------------------------------- */
+
+/* BSF_BUILDING_SHARED is set by the build when it makes a shared libbsf with
+ * -fvisibility=hidden; for users and static builds this is plain extern "C". */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(BSF_BUILDING_SHARED)
+#define BSF_VISIBILITY_PUSH_ _Pragma("GCC visibility push(default)")
+#define BSF_VISIBILITY_POP_ _Pragma("GCC visibility pop")
+#else
+#define BSF_VISIBILITY_PUSH_
+#define BSF_VISIBILITY_POP_
+#endif
+
+#ifdef __cplusplus
+#define BSF_BEGIN_DECLS                                                                            \
+    extern "C" {                                                                                   \
+    BSF_VISIBILITY_PUSH_
+#define BSF_END_DECLS                                                                              \
+    BSF_VISIBILITY_POP_                                                                            \
+    }
+#else
+/** Opens the public declarations of a header: exported, C linkage. */
+#define BSF_BEGIN_DECLS BSF_VISIBILITY_PUSH_
+/** Closes what BSF_BEGIN_DECLS opened. */
+#define BSF_END_DECLS BSF_VISIBILITY_POP_
+#endif
+
+/* ---- Caps guard ----------------------------------------------------------- */
+
+#define BSF_CAPS_PASTE_(fn, p, k, s, f, c) fn##_capsP##p##K##k##S##s##F##f##C##c
+#define BSF_CAPS_EXPAND_(fn, p, k, s, f, c) BSF_CAPS_PASTE_(fn, p, k, s, f, c)
+/** The symbol of function fn for the caps of this translation unit. */
+#define BSF_CAPS_NAME(fn)                                                                          \
+    BSF_CAPS_EXPAND_(fn, BSF_MAX_POINTS, BSF_MAX_KEYPOINTS, BSF_MAX_SEGMENTS,                      \
+                     BSF_MAX_CTRL_PER_FEATURE, BSF_MAX_CTRL_POINTS)
+
+/* Every public function whose arguments include a caps-sized object. */
+#define bsf_scan_to_points BSF_CAPS_NAME(bsf_scan_to_points)
+#define bsf_falko_detect BSF_CAPS_NAME(bsf_falko_detect)
+#define bsf_lc_detect BSF_CAPS_NAME(bsf_lc_detect)
+#define bsf_bid_detect BSF_CAPS_NAME(bsf_bid_detect)
+#define bsf_segment_sved BSF_CAPS_NAME(bsf_segment_sved)
+#define bsf_segment_rpos BSF_CAPS_NAME(bsf_segment_rpos)
+#define bsf_segment_classify BSF_CAPS_NAME(bsf_segment_classify)
+#define bsf_pdm_fit BSF_CAPS_NAME(bsf_pdm_fit)
+#define bsf_pdm_fit_anchored BSF_CAPS_NAME(bsf_pdm_fit_anchored)
+#define bsf_extractor_init BSF_CAPS_NAME(bsf_extractor_init)
+#define bsf_extract BSF_CAPS_NAME(bsf_extract)
+#define bsf_metrics_counts BSF_CAPS_NAME(bsf_metrics_counts)
+#define bsf_frame_encode BSF_CAPS_NAME(bsf_frame_encode)
+#define bsf_frame_encode_sink BSF_CAPS_NAME(bsf_frame_encode_sink)
+#define bsf_frame_decode BSF_CAPS_NAME(bsf_frame_decode)
+#define bsf_decoder_init BSF_CAPS_NAME(bsf_decoder_init)
+#define bsf_decoder_feed BSF_CAPS_NAME(bsf_decoder_feed)
+
+#endif /* BSF_ABI_H */
