@@ -205,6 +205,143 @@ static bsf_status_t get_ctrl(reader_t *r, const uint32_t k_ctrl[BSF_WIRE_N_CLASS
     return BSF_OK;
 }
 
+/* Only zero padding up to the end of the last byte may follow. */
+static int padding_ok(reader_t *r)
+{
+    uint32_t pad;
+    return 8u * r->len - r->bit_pos < 8u &&
+           get_bits(r, (unsigned)(8u * r->len - r->bit_pos), &pad) && pad == 0u;
+}
+
+/* Header extension of a version-2 features frame (FORMAT.md section 3.1). */
+typedef struct {
+    uint32_t has_beams;
+    uint32_t has_geometry;
+    float angle_min;
+    float angle_increment;
+    uint32_t n_beams;
+    uint32_t cut;
+    uint32_t n_cut_keypoints;
+    uint32_t n_cut_segments;
+    uint32_t n_cut_points;
+} header_ext_t;
+
+static int get_float(reader_t *r, float *v);
+
+static bsf_status_t get_ext(reader_t *r, uint32_t n_valid, header_ext_t *ext)
+{
+    if (!get_bits(r, 1u, &ext->has_beams) || !get_bits(r, 1u, &ext->has_geometry) ||
+        !get_bits(r, BSF_WIRE_CUT_BITS, &ext->cut)) {
+        return BSF_ERR_FORMAT;
+    }
+    if ((ext->has_beams == 0u && ext->cut == 0u) ||
+        (ext->has_geometry != 0u && ext->has_beams == 0u)) {
+        return BSF_ERR_FORMAT; /* an empty extension, a geometry without its beam count */
+    }
+    if (ext->has_beams != 0u &&
+        (!get_u32(r, BSF_WIRE_K_N_BEAMS, (uint32_t)BSF_MAX_POINTS, &ext->n_beams) ||
+         ext->n_beams == 0u || ext->n_beams < n_valid)) {
+        return BSF_ERR_FORMAT;
+    }
+    if (ext->has_geometry != 0u &&
+        (!get_float(r, &ext->angle_min) || !get_float(r, &ext->angle_increment))) {
+        return BSF_ERR_FORMAT;
+    }
+    if (ext->cut != 0u &&
+        (!get_u32(r, BSF_WIRE_K_CUT_KEYPOINTS, (uint32_t)BSF_MAX_POINTS, &ext->n_cut_keypoints) ||
+         !get_u32(r, BSF_WIRE_K_CUT_SEGMENTS, (uint32_t)BSF_MAX_POINTS, &ext->n_cut_segments) ||
+         !get_u32(r, BSF_WIRE_K_CUT_POINTS, n_valid, &ext->n_cut_points))) {
+        return BSF_ERR_FORMAT;
+    }
+    return BSF_OK;
+}
+
+/* A float sent as its IEEE-754 binary32 bit pattern; 0 when not finite. */
+static int get_float(reader_t *r, float *v)
+{
+    uint32_t hi;
+    uint32_t lo;
+    uint32_t u;
+    if (!get_bits(r, 16u, &hi) || !get_bits(r, 16u, &lo)) {
+        return 0;
+    }
+    u = (hi << 16) | lo;
+    if ((u & 0x7F800000u) == 0x7F800000u) {
+        return 0; /* infinity or NaN */
+    }
+    memcpy(v, &u, sizeof *v);
+    return 1;
+}
+
+static int get_cap(reader_t *r, unsigned k, uint32_t *v)
+{
+    return get_u32(r, k, BSF_WIRE_META_U16_MAX, v) && *v >= 1u;
+}
+
+/* Metadata payload after byte 0 (see write_metadata in the encoder). */
+static bsf_status_t parse_metadata(reader_t *r, bsf_metadata_t *out)
+{
+    bsf_metadata_t m;
+    uint32_t v[3];
+    uint32_t method;
+    uint32_t step_code;
+    uint32_t has_origin;
+    uint32_t source_len;
+    uint32_t i;
+    int64_t origin = 0;
+
+    memset(&m, 0, sizeof m);
+    for (i = 0; i < 3u; ++i) {
+        if (!get_u32(r, BSF_WIRE_K_LIB_VERSION, BSF_WIRE_META_U16_MAX, &v[i])) {
+            return BSF_ERR_FORMAT;
+        }
+    }
+    if (!get_u32(r, BSF_WIRE_K_METHOD, BSF_WIRE_METHOD_MAX, &method) ||
+        !get_float(r, &m.target_rms) || !(m.target_rms >= 0.0f) ||
+        !get_u32(r, BSF_WIRE_K_STEP, BSF_WIRE_STEP_CODE_MAX, &step_code) || step_code == 0u ||
+        !get_cap(r, BSF_WIRE_K_CAP_POINTS, &m.max_points) ||
+        !get_cap(r, BSF_WIRE_K_CAP_KEYPOINTS, &m.max_keypoints) ||
+        !get_cap(r, BSF_WIRE_K_CAP_SEGMENTS, &m.max_segments) ||
+        !get_cap(r, BSF_WIRE_K_CAP_CTRL_PER_FEATURE, &m.max_ctrl_per_feature) ||
+        !get_cap(r, BSF_WIRE_K_CAP_CTRL_POINTS, &m.max_ctrl_points) ||
+        !get_u32(r, BSF_WIRE_K_META_N_BEAMS, BSF_WIRE_META_U16_MAX, &m.n_beams) ||
+        !get_float(r, &m.angle_min) || !get_float(r, &m.angle_increment) ||
+        !get_float(r, &m.range_min) || !get_float(r, &m.range_max) || !(m.range_min >= 0.0f) ||
+        !(m.range_max >= m.range_min) || !get_bits(r, 1u, &has_origin)) {
+        return BSF_ERR_FORMAT;
+    }
+    if (has_origin != 0u &&
+        !get_signed(r, BSF_WIRE_K_TIME_ORIGIN, BSF_METADATA_TIME_ORIGIN_MAX, &origin)) {
+        return BSF_ERR_FORMAT;
+    }
+    if (!get_u32(r, BSF_WIRE_K_SOURCE_LEN, BSF_METADATA_SOURCE_MAX, &source_len)) {
+        return BSF_ERR_FORMAT;
+    }
+    for (i = 0; i < source_len; ++i) {
+        uint32_t c;
+        if (!get_bits(r, 8u, &c)) {
+            return BSF_ERR_FORMAT;
+        }
+        m.source[i] = (char)c;
+    }
+    if (!bsf_wire_source_ok((const uint8_t *)m.source, source_len) || !padding_ok(r)) {
+        return BSF_ERR_FORMAT;
+    }
+    if (out != NULL) {
+        m.lib_version_major = (uint16_t)v[0];
+        m.lib_version_minor = (uint16_t)v[1];
+        m.lib_version_patch = (uint16_t)v[2];
+        m.method = (uint8_t)method;
+        m.quant_step = (float)step_code * BSF_QUANT_STEP_UNIT;
+        m.has_time_origin = (uint8_t)has_origin;
+        m.time_origin_us = origin;
+        m.source_len = (uint8_t)source_len;
+        m.source[source_len] = '\0';
+        *out = m;
+    }
+    return BSF_OK;
+}
+
 /*
  * Parse a payload whose CRC has been checked. With out == NULL it only
  * validates; with out it writes, and then cannot fail (same bytes).
@@ -214,7 +351,12 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
     reader_t r;
     bsf_result_t *res = out != NULL ? &out->result : NULL;
     uint8_t b0;
+    uint32_t version;
+    uint32_t type;
     uint32_t has_pose;
+    uint32_t has_ext = 0u;
+    header_ext_t ext;
+    uint32_t beam_limit;
     uint32_t seq;
     uint64_t timestamp;
     int64_t pose[2] = {0, 0};
@@ -225,24 +367,52 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
     uint32_t n_features;
     uint32_t k_ctrl[BSF_WIRE_N_CLASSES];
     uint32_t i;
-    uint32_t pad;
     float step;
     size_t n_ctrl = 0;
     uint32_t sum_points = 0;
     int64_t prev_last_beam = -1;
     int64_t prev[2] = {0, 0};
+    uint32_t wraps = 0u;
 
     if (len < 1u) {
         return BSF_ERR_FORMAT;
     }
     b0 = p[0];
-    if ((b0 >> 4) != BSF_FORMAT_VERSION || (b0 & 0x0Fu) != BSF_FRAME_TYPE_FEATURES) {
+    version = (uint32_t)b0 >> 4;
+    type = b0 & 0x0Fu;
+    if (version < BSF_FORMAT_VERSION_MIN || version > BSF_FORMAT_VERSION ||
+        (type != BSF_FRAME_TYPE_FEATURES && (version < 2u || type != BSF_FRAME_TYPE_METADATA))) {
         return BSF_ERR_VERSION;
     }
     r.p = p + 1;
     r.len = len - 1u;
     r.bit_pos = 0;
-    if (!get_bits(&r, 1u, &has_pose) || !get_u32(&r, BSF_WIRE_K_SEQ, UINT32_MAX, &seq) ||
+    memset(&ext, 0, sizeof ext);
+    if (type == BSF_FRAME_TYPE_METADATA) {
+        const bsf_status_t st = parse_metadata(&r, out != NULL ? &out->metadata : NULL);
+        if (st == BSF_OK && out != NULL) {
+            out->version = (uint8_t)version;
+            out->type = (uint8_t)type;
+            out->seq = 0u;
+            out->timestamp_ms = 0u;
+            out->has_pose = 0u;
+            out->pose_x = 0.0f;
+            out->pose_y = 0.0f;
+            out->pose_theta = 0.0f;
+            out->quant_step = out->metadata.quant_step;
+            out->time_us = 0u;
+            out->has_geometry = 0u;
+            out->angle_min = 0.0f;
+            out->angle_increment = 0.0f;
+            res->n_features = 0u;
+            res->n_ctrl = 0u;
+            memset(&res->stats, 0, sizeof res->stats);
+        }
+        return st;
+    }
+    /* Version 1 has no extension flag: it is version 2 with the flag 0. */
+    if (!get_bits(&r, 1u, &has_pose) || (version >= 2u && !get_bits(&r, 1u, &has_ext)) ||
+        !get_u32(&r, BSF_WIRE_K_SEQ, UINT32_MAX, &seq) ||
         !get_eg(&r, BSF_WIRE_K_TIMESTAMP, UINT64_MAX, &timestamp)) {
         return BSF_ERR_FORMAT;
     }
@@ -265,6 +435,13 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
             return BSF_ERR_FORMAT;
         }
     }
+    if (has_ext != 0u) {
+        const bsf_status_t st = get_ext(&r, n_valid, &ext);
+        if (st != BSF_OK) {
+            return st;
+        }
+    }
+    beam_limit = ext.has_beams != 0u ? ext.n_beams : (uint32_t)BSF_MAX_POINTS;
     step = (float)step_code * BSF_QUANT_STEP_UNIT;
 
     for (i = 0; i < n_features; ++i) {
@@ -278,6 +455,7 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         uint32_t n_f;
         int64_t gap;
         int64_t first;
+        int64_t last;
         bsf_status_t st;
 
         if (!get_bits(&r, 1u, &kind) || !get_u32(&r, BSF_WIRE_K_M, 62u, &m) ||
@@ -306,8 +484,18 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
             return BSF_ERR_FORMAT;
         }
         first = prev_last_beam + 1 + gap;
-        if (first < 0 || first + (int64_t)span >= (int64_t)BSF_MAX_POINTS) {
+        /* A run past the last beam wraps through the seam (only when the
+         * frame carries the beam count): span < n_beams keeps last < first. */
+        if (first < 0 || first >= (int64_t)beam_limit || span >= beam_limit) {
             return BSF_ERR_FORMAT;
+        }
+        last = first + (int64_t)span;
+        if (last >= (int64_t)beam_limit) {
+            if (ext.has_beams == 0u) {
+                return BSF_ERR_FORMAT;
+            }
+            last -= (int64_t)ext.n_beams;
+            wraps = 1u;
         }
         if (!get_u32(&r, BSF_WIRE_K_MISSING, span + 1u, &missing) ||
             !get_u32(&r, BSF_WIRE_K_E_CURVE, BSF_WIRE_E_CURVE_CODE_MAX, &e_code)) {
@@ -328,7 +516,7 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         if (res != NULL) {
             bsf_feature_t *f = &res->features[i];
             f->first_beam = (uint16_t)first;
-            f->last_beam = (uint16_t)(first + (int64_t)span);
+            f->last_beam = (uint16_t)last;
             f->n_points = (uint16_t)(span + 1u - missing);
             f->ctrl_first = (uint16_t)n_ctrl;
             f->n_ctrl = (uint8_t)n_f;
@@ -337,17 +525,19 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         }
         n_ctrl += n_f;
         sum_points += span + 1u - missing;
-        prev_last_beam = first + (int64_t)span;
+        prev_last_beam = last;
     }
-    /* Only zero padding up to the end of the last byte may follow. */
-    if (8u * r.len - r.bit_pos >= 8u || !get_bits(&r, (unsigned)(8u * r.len - r.bit_pos), &pad) ||
-        pad != 0u || sum_points > n_valid) {
+    /* The beam count travels exactly when a feature wraps or with the
+     * scan's geometry (one form per frame), and cut points are valid points
+     * outside the features. */
+    if (!padding_ok(&r) || sum_points > n_valid || ext.has_beams != (wraps | ext.has_geometry) ||
+        ext.n_cut_points > n_valid - sum_points) {
         return BSF_ERR_FORMAT;
     }
     if (out != NULL) {
         const int32_t theta_signed = theta >= 32768u ? (int32_t)theta - 65536 : (int32_t)theta;
-        out->version = (uint8_t)(b0 >> 4);
-        out->type = (uint8_t)(b0 & 0x0Fu);
+        out->version = (uint8_t)version;
+        out->type = (uint8_t)type;
         out->seq = seq;
         out->timestamp_ms = timestamp;
         out->has_pose = (uint8_t)has_pose;
@@ -356,6 +546,9 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         out->pose_theta = (float)theta_signed * BSF_WIRE_RAD_PER_THETA;
         out->quant_step = step;
         out->time_us = time_us;
+        out->has_geometry = (uint8_t)ext.has_geometry;
+        out->angle_min = ext.angle_min;
+        out->angle_increment = ext.angle_increment;
         res->n_features = (uint16_t)n_features;
         res->n_ctrl = (uint16_t)n_ctrl;
         memset(&res->stats, 0, sizeof res->stats);
@@ -364,6 +557,11 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         res->stats.n_ctrl = (uint32_t)n_ctrl;
         res->stats.n_features = n_features;
         res->stats.time_ns = time_us * 1000u; /* time_us <= BSF_WIRE_TIME_US_MAX: no overflow */
+        res->stats.n_beams = ext.n_beams;
+        res->stats.cut = ext.cut;
+        res->stats.n_cut_keypoints = ext.n_cut_keypoints;
+        res->stats.n_cut_segments = ext.n_cut_segments;
+        res->stats.n_cut_points = ext.n_cut_points;
     }
     return BSF_OK;
 }
@@ -404,6 +602,7 @@ void bsf_decoder_init(bsf_decoder_t *dec)
 {
     if (dec != NULL) {
         frame_reset(dec);
+        dec->meta_n_beams = 0u;
         memset(&dec->stats, 0, sizeof dec->stats);
     }
 }
@@ -416,6 +615,22 @@ static void append(bsf_decoder_t *dec, uint8_t b)
     }
     dec->body[dec->len++] = b;
     dec->crc = bsf_crc32c(dec->crc, &b, 1u);
+}
+
+/* The beam count of the last metadata frame, for a features frame that
+ * does not carry its own, when it is consistent with the frame. */
+static void fill_n_beams(bsf_result_t *res, uint32_t n_beams)
+{
+    uint32_t i;
+    if (n_beams == 0u || res->stats.n_valid > n_beams) {
+        return;
+    }
+    for (i = 0; i < res->n_features; ++i) {
+        if (res->features[i].last_beam >= n_beams) {
+            return;
+        }
+    }
+    res->stats.n_beams = n_beams;
 }
 
 /* A delimiter arrived: deliver the frame or count why not. */
@@ -434,9 +649,16 @@ static int end_frame(bsf_decoder_t *dec, bsf_frame_t *out)
         const bsf_status_t s = decode_checked(dec->body, dec->len, out);
         if (s == BSF_OK) {
             ++st->frames_ok;
-            delivered = 1;
+            delivered = out->type;
+            if (out->type == BSF_FRAME_TYPE_METADATA) {
+                ++st->metadata;
+                dec->meta_n_beams = out->metadata.n_beams;
+            } else if (out->result.stats.n_beams == 0u) {
+                fill_n_beams(&out->result, dec->meta_n_beams);
+            }
         } else if (s == BSF_ERR_VERSION) {
-            if ((dec->body[0] >> 4) != BSF_FORMAT_VERSION) {
+            const unsigned version = (unsigned)(dec->body[0] >> 4);
+            if (version < BSF_FORMAT_VERSION_MIN || version > BSF_FORMAT_VERSION) {
                 ++st->unsupported_version;
             } else {
                 ++st->unknown_type;
@@ -463,9 +685,12 @@ int bsf_decoder_feed(bsf_decoder_t *dec, const uint8_t *data, size_t len, size_t
     for (i = 0; i < len; ++i) {
         const uint8_t b = data[i];
         if (b == 0u) {
-            if (dec->raw_len != 0u && end_frame(dec, out)) {
-                *consumed = i + 1u;
-                return 1;
+            if (dec->raw_len != 0u) {
+                const int type = end_frame(dec, out);
+                if (type != 0) {
+                    *consumed = i + 1u;
+                    return type;
+                }
             }
             continue;
         }

@@ -194,17 +194,29 @@ static int quantise_point(bsf_point_t p, float step, int32_t q[2])
  * must be followed by a flagged partner with the same quantised value;
  * the pair is one vertex, bit j of *mask for unique point j.
  */
+/* Beams minus one of a feature's run: last - first, or through the seam of
+ * a full-circle scan of n_beams beams when first > last. */
+static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
+{
+    if (f->first_beam > f->last_beam) {
+        return n_beams - f->first_beam + f->last_beam;
+    }
+    return (uint32_t)(f->last_beam - f->first_beam);
+}
+
 static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f, float step,
                                  uint32_t *n_unique, uint64_t *mask)
 {
     const size_t n = f->n_ctrl;
+    const uint32_t n_beams = res->stats.n_beams;
+    const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
     size_t s = 0;
     uint32_t j = 0;
 
     if (f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
-        (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam > f->last_beam ||
-        f->last_beam >= (uint32_t)BSF_MAX_POINTS ||
-        f->n_points > (uint32_t)(f->last_beam - f->first_beam) + 1u ||
+        (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
+        f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
+        f->n_points > feature_span(f, n_beams) + 1u ||
         !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX)) {
         return BSF_ERR_ARG;
     }
@@ -298,7 +310,9 @@ static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code
         return BSF_ERR_ARG;
     }
     *step_code = (uint32_t)code;
-    if (info->has_pose > 1u) {
+    if (info->has_pose > 1u || info->has_geometry > 1u ||
+        (info->has_geometry != 0u &&
+         (!is_finite_f(info->angle_min) || !is_finite_f(info->angle_increment)))) {
         return BSF_ERR_ARG;
     }
     if (info->has_pose != 0u &&
@@ -309,10 +323,33 @@ static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code
     return BSF_OK;
 }
 
+/* The scan statistics that travel in the header's extension (FORMAT.md
+ * section 3.1): the beam count must stay within the caps, the cut counters
+ * go with a non-zero cut and stay within the scan. */
+static bsf_status_t check_stats(const bsf_stats_t *st)
+{
+    const uint32_t cut_bits = BSF_CUT_KEYPOINTS | BSF_CUT_SEGMENTS | BSF_CUT_CTRL;
+    if (st->n_valid > (uint32_t)BSF_MAX_POINTS || st->n_beams > (uint32_t)BSF_MAX_POINTS ||
+        (st->n_beams != 0u && st->n_valid > st->n_beams) || (st->cut & ~cut_bits) != 0u) {
+        return BSF_ERR_ARG;
+    }
+    if (st->cut == 0u) {
+        return (st->n_cut_keypoints | st->n_cut_segments | st->n_cut_points) == 0u ? BSF_OK
+                                                                                   : BSF_ERR_ARG;
+    }
+    if (st->n_cut_keypoints > (uint32_t)BSF_MAX_POINTS ||
+        st->n_cut_segments > (uint32_t)BSF_MAX_POINTS || st->n_cut_points > st->n_valid) {
+        return BSF_ERR_ARG;
+    }
+    return BSF_OK;
+}
+
 static int32_t round_to_int(float v)
 {
     return (int32_t)floorf(v + 0.5f);
 }
+
+static void put_float(writer_t *w, float v);
 
 /* The whole frame through w. It may fail half-way, so every caller runs it
  * in costing and counting mode first and writes only when those passes
@@ -325,6 +362,9 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     uint32_t sum_points = 0;
     int64_t prev_last_beam = -1;
     int64_t prev[2] = {0, 0};
+    uint32_t wraps = 0u;
+    int has_beams;
+    int has_ext;
     bsf_status_t st;
 
     if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS ||
@@ -335,14 +375,26 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     if (st != BSF_OK) {
         return st;
     }
-    if (res->stats.n_valid > (uint32_t)BSF_MAX_POINTS) {
+    st = check_stats(&res->stats);
+    if (st != BSF_OK) {
+        return st;
+    }
+    if (info->has_geometry != 0u && res->stats.n_beams == 0u) {
         return BSF_ERR_ARG;
     }
     step = (float)step_code * BSF_QUANT_STEP_UNIT;
+    for (i = 0; i < res->n_features; ++i) {
+        if (res->features[i].first_beam > res->features[i].last_beam) {
+            wraps = 1u;
+        }
+    }
+    has_beams = wraps != 0u || info->has_geometry != 0u;
+    has_ext = has_beams || res->stats.cut != 0u;
 
     block_start(w);
     put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES));
     put_bits(w, info->has_pose != 0u ? 1u : 0u, 1u);
+    put_bits(w, has_ext ? 1u : 0u, 1u);
     put_eg(w, info->seq, BSF_WIRE_K_SEQ);
     put_eg(w, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
@@ -359,6 +411,23 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
         put_bits(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
     }
+    if (has_ext) {
+        put_bits(w, has_beams ? 1u : 0u, 1u);
+        put_bits(w, info->has_geometry != 0u ? 1u : 0u, 1u);
+        put_bits(w, res->stats.cut, BSF_WIRE_CUT_BITS);
+        if (has_beams) {
+            put_eg(w, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
+        }
+        if (info->has_geometry != 0u) {
+            put_float(w, info->angle_min);
+            put_float(w, info->angle_increment);
+        }
+        if (res->stats.cut != 0u) {
+            put_eg(w, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
+            put_eg(w, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
+            put_eg(w, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
+        }
+    }
 
     for (i = 0; i < res->n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
@@ -371,7 +440,7 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         if (st != BSF_OK) {
             return st;
         }
-        span = (uint32_t)(f->last_beam - f->first_beam);
+        span = feature_span(f, res->stats.n_beams);
         sum_points += f->n_points;
         put_bits(w, f->kind, 1u);
         put_eg(w, n_unique - 2u, BSF_WIRE_K_M);
@@ -386,7 +455,8 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         put_ctrl(w, res, f, step, prev);
         prev_last_beam = f->last_beam;
     }
-    if (sum_points > res->stats.n_valid) {
+    if (sum_points > res->stats.n_valid ||
+        res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
     finish(w);
@@ -403,6 +473,9 @@ void bsf_frame_info_init(bsf_frame_info_t *info)
         info->pose_y = 0.0f;
         info->pose_theta = 0.0f;
         info->quant_step = BSF_QUANT_STEP_DEFAULT;
+        info->has_geometry = 0u;
+        info->angle_min = 0.0f;
+        info->angle_increment = 0.0f;
     }
 }
 
@@ -514,6 +587,166 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
     w.sink = sink;
     w.ctx = ctx;
     st = write_frame(&w, info, result);
+    if (written != NULL) {
+        *written = w.pos;
+    }
+    if (st == BSF_OK && w.failed) {
+        st = BSF_ERR_BUFFER;
+    }
+    return st;
+}
+
+/* ---- Metadata frame ------------------------------------------------------ */
+
+void bsf_metadata_init(bsf_metadata_t *m)
+{
+    if (m != NULL) {
+        memset(m, 0, sizeof *m);
+        m->lib_version_major = (uint16_t)BSF_VERSION_MAJOR;
+        m->lib_version_minor = (uint16_t)BSF_VERSION_MINOR;
+        m->lib_version_patch = (uint16_t)BSF_VERSION_PATCH;
+        m->quant_step = BSF_QUANT_STEP_DEFAULT;
+        m->max_points = (uint32_t)BSF_MAX_POINTS;
+        m->max_keypoints = (uint32_t)BSF_MAX_KEYPOINTS;
+        m->max_segments = (uint32_t)BSF_MAX_SEGMENTS;
+        m->max_ctrl_per_feature = (uint32_t)BSF_MAX_CTRL_PER_FEATURE;
+        m->max_ctrl_points = (uint32_t)BSF_MAX_CTRL_POINTS;
+    }
+}
+
+static uint32_t float_bits(float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+static void put_float(writer_t *w, float v)
+{
+    const uint32_t u = float_bits(v);
+    put_bits(w, u >> 16, 16u);
+    put_bits(w, u & 0xFFFFu, 16u);
+}
+
+static int cap_ok(uint32_t v)
+{
+    return v >= 1u && v <= BSF_WIRE_META_U16_MAX;
+}
+
+static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
+{
+    float code;
+    if (!is_finite_f(m->quant_step)) {
+        return BSF_ERR_ARG;
+    }
+    code = floorf(m->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
+        return BSF_ERR_ARG;
+    }
+    *step_code = (uint32_t)code;
+    if (!is_finite_f(m->target_rms) || !(m->target_rms >= 0.0f) || !cap_ok(m->max_points) ||
+        !cap_ok(m->max_keypoints) || !cap_ok(m->max_segments) || !cap_ok(m->max_ctrl_per_feature) ||
+        !cap_ok(m->max_ctrl_points) || m->n_beams > BSF_WIRE_META_U16_MAX ||
+        !is_finite_f(m->angle_min) || !is_finite_f(m->angle_increment) ||
+        !is_finite_f(m->range_min) || !is_finite_f(m->range_max) || !(m->range_min >= 0.0f) ||
+        !(m->range_max >= m->range_min) || m->has_time_origin > 1u ||
+        (m->has_time_origin != 0u && (m->time_origin_us > BSF_METADATA_TIME_ORIGIN_MAX ||
+                                      m->time_origin_us < -BSF_METADATA_TIME_ORIGIN_MAX)) ||
+        m->source_len > BSF_METADATA_SOURCE_MAX ||
+        !bsf_wire_source_ok((const uint8_t *)m->source, m->source_len)) {
+        return BSF_ERR_ARG;
+    }
+    return BSF_OK;
+}
+
+/* The whole metadata frame through w (FORMAT.md section 3.6). */
+static bsf_status_t write_metadata(writer_t *w, const bsf_metadata_t *m)
+{
+    uint32_t step_code;
+    unsigned i;
+    const bsf_status_t st = check_metadata(m, &step_code);
+    if (st != BSF_OK) {
+        return st;
+    }
+    block_start(w);
+    put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA));
+    put_eg(w, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
+    put_eg(w, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
+    put_eg(w, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
+    put_eg(w, m->method, BSF_WIRE_K_METHOD);
+    put_float(w, m->target_rms);
+    put_eg(w, step_code, BSF_WIRE_K_STEP);
+    put_eg(w, m->max_points, BSF_WIRE_K_CAP_POINTS);
+    put_eg(w, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
+    put_eg(w, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
+    put_eg(w, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
+    put_eg(w, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
+    put_eg(w, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
+    put_float(w, m->angle_min);
+    put_float(w, m->angle_increment);
+    put_float(w, m->range_min);
+    put_float(w, m->range_max);
+    put_bits(w, m->has_time_origin != 0u ? 1u : 0u, 1u);
+    if (m->has_time_origin != 0u) {
+        put_seg(w, m->time_origin_us, BSF_WIRE_K_TIME_ORIGIN);
+    }
+    put_eg(w, m->source_len, BSF_WIRE_K_SOURCE_LEN);
+    for (i = 0; i < m->source_len; ++i) {
+        put_bits(w, (uint8_t)m->source[i], 8u);
+    }
+    finish(w);
+    return BSF_OK;
+}
+
+bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap, size_t *out_len)
+{
+    writer_t w;
+    bsf_status_t st;
+
+    if (m == NULL || out_len == NULL) {
+        return BSF_ERR_ARG;
+    }
+    writer_init(&w);
+    st = write_metadata(&w, m);
+    if (st != BSF_OK) {
+        *out_len = 0u;
+        return st;
+    }
+    *out_len = w.pos;
+    if (buf == NULL) {
+        return BSF_OK;
+    }
+    if (w.pos > cap) {
+        return BSF_ERR_BUFFER;
+    }
+    writer_init(&w);
+    w.buf = buf;
+    w.cap = cap;
+    return write_metadata(&w, m);
+}
+
+bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const bsf_metadata_t *m,
+                                      bsf_sink_fn sink, void *ctx, size_t *written)
+{
+    writer_t w;
+    uint32_t step_code;
+    bsf_status_t st;
+
+    if (written != NULL) {
+        *written = 0u;
+    }
+    if (work == NULL || m == NULL || sink == NULL) {
+        return BSF_ERR_ARG;
+    }
+    st = check_metadata(m, &step_code);
+    if (st != BSF_OK) {
+        return st;
+    }
+    writer_init(&w);
+    w.work = work;
+    w.sink = sink;
+    w.ctx = ctx;
+    st = write_metadata(&w, m);
     if (written != NULL) {
         *written = w.pos;
     }

@@ -6,6 +6,7 @@
 #ifndef BSF_WIRE_H
 #define BSF_WIRE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 /* Exp-Golomb orders of the fixed-parameter fields (FORMAT.md section 3). */
@@ -21,6 +22,26 @@
 #define BSF_WIRE_K_SPAN 3u
 #define BSF_WIRE_K_MISSING 0u
 #define BSF_WIRE_K_E_CURVE 4u
+/* Header extension (format version 2): beam count and cap-cut counters. */
+#define BSF_WIRE_CUT_BITS 3u
+#define BSF_WIRE_K_N_BEAMS 8u
+#define BSF_WIRE_K_CUT_KEYPOINTS 2u
+#define BSF_WIRE_K_CUT_SEGMENTS 2u
+#define BSF_WIRE_K_CUT_POINTS 4u
+
+/* Metadata frame (format version 2, type 2). */
+#define BSF_WIRE_K_LIB_VERSION 1u
+#define BSF_WIRE_K_METHOD 0u
+#define BSF_WIRE_K_CAP_POINTS 8u
+#define BSF_WIRE_K_CAP_KEYPOINTS 4u
+#define BSF_WIRE_K_CAP_SEGMENTS 4u
+#define BSF_WIRE_K_CAP_CTRL_PER_FEATURE 2u
+#define BSF_WIRE_K_CAP_CTRL_POINTS 6u
+#define BSF_WIRE_K_META_N_BEAMS 8u
+#define BSF_WIRE_K_TIME_ORIGIN 40u
+#define BSF_WIRE_K_SOURCE_LEN 3u
+#define BSF_WIRE_META_U16_MAX 65535u
+#define BSF_WIRE_METHOD_MAX 255u
 
 /* Control point value classes, each with its own per-frame order 0..25. */
 #define BSF_WIRE_CLASS_FIRST 0u  /* first point of a feature */
@@ -90,6 +111,56 @@ static inline unsigned bsf_wire_bitlen(uint64_t v)
 static inline unsigned bsf_wire_eg_bits(uint64_t v, unsigned k)
 {
     return 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
+}
+
+/*
+ * A metadata source name: well-formed UTF-8 (RFC 3629: shortest form, no
+ * surrogates, at most U+10FFFF) without control characters (C0, DEL, C1),
+ * so that it prints safely. Returns 1 when s[0..len-1] is acceptable.
+ */
+static inline int bsf_wire_source_ok(const uint8_t *s, size_t len)
+{
+    size_t i = 0;
+    while (i < len) {
+        const uint8_t b = s[i];
+        uint32_t cp;
+        size_t n;
+        size_t j;
+        if (b < 0x80u) {
+            if (b < 0x20u || b == 0x7Fu) {
+                return 0;
+            }
+            ++i;
+            continue;
+        }
+        if (b >= 0xC2u && b <= 0xDFu) {
+            n = 1u;
+            cp = b & 0x1Fu;
+        } else if (b >= 0xE0u && b <= 0xEFu) {
+            n = 2u;
+            cp = b & 0x0Fu;
+        } else if (b >= 0xF0u && b <= 0xF4u) {
+            n = 3u;
+            cp = b & 0x07u;
+        } else {
+            return 0; /* continuation byte, overlong lead C0/C1, or above U+10FFFF */
+        }
+        if (len - i <= n) {
+            return 0;
+        }
+        for (j = 1u; j <= n; ++j) {
+            if ((s[i + j] & 0xC0u) != 0x80u) {
+                return 0;
+            }
+            cp = (cp << 6) | (s[i + j] & 0x3Fu);
+        }
+        if ((n == 2u && cp < 0x800u) || (n == 3u && cp < 0x10000u) || cp > 0x10FFFFu ||
+            (cp >= 0xD800u && cp <= 0xDFFFu) || (cp >= 0x80u && cp <= 0x9Fu)) {
+            return 0;
+        }
+        i += n + 1u;
+    }
+    return 1;
 }
 
 #endif /* BSF_WIRE_H */

@@ -140,6 +140,55 @@ void fx_example_typical(bsf_frame_info_t *info, bsf_result_t *res)
     build(res, defs, 6, 176, 912345u);
 }
 
+void fx_example_wrap_cut(bsf_frame_info_t *info, bsf_result_t *res)
+{
+    static const fx_feature_def_t defs[2] = {
+        {100,
+         140,
+         39,
+         0,
+         0.0040f,
+         3,
+         {{-0.700f, 1.200f}, {-1.100f, 0.600f}, {-1.600f, 0.100f}},
+         {0}},
+        {350, 9, 20, 0, 0.0060f, 3, {{2.000f, -0.300f}, {2.010f, 0.000f}, {2.000f, 0.300f}}, {0}},
+    };
+    bsf_frame_info_init(info);
+    info->seq = 7u;
+    info->timestamp_ms = 25u;
+    build(res, defs, 2, 300, 0);
+    res->stats.n_beams = 360u;
+    res->stats.cut = BSF_CUT_SEGMENTS;
+    res->stats.n_cut_segments = 2u;
+    res->stats.n_cut_points = 11u;
+}
+
+void fx_example_metadata(bsf_metadata_t *m)
+{
+    static const char source[] = "intel.log.gz";
+    memset(m, 0, sizeof *m);
+    m->lib_version_major = 0u;
+    m->lib_version_minor = 1u;
+    m->lib_version_patch = 0u;
+    m->method = 0u;
+    m->target_rms = 0.015f;
+    m->quant_step = 0.005f;
+    m->max_points = 1081u;
+    m->max_keypoints = 64u;
+    m->max_segments = 128u;
+    m->max_ctrl_per_feature = 32u;
+    m->max_ctrl_points = 512u;
+    m->n_beams = 180u;
+    m->angle_min = -1.5707964f;
+    m->angle_increment = 0.017453292f;
+    m->range_min = 0.0f;
+    m->range_max = 81.91f;
+    m->has_time_origin = 1u;
+    m->time_origin_us = 1066286502361000LL;
+    m->source_len = (uint8_t)(sizeof source - 1u);
+    memcpy(m->source, source, sizeof source);
+}
+
 /* A wall from p in direction angle, length len, split at n_vertex corners
  * (turns of 60-120 degrees), sampled into n_ctrl control points of which
  * the corners are doubled. Returns the stored count. */

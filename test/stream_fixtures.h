@@ -26,6 +26,13 @@ void fx_example_minimal(bsf_frame_info_t *info, bsf_result_t *res);
 /** FORMAT.md example 2: a typical scan, 6 features, 26 control points, 2 vertices, with pose. */
 void fx_example_typical(bsf_frame_info_t *info, bsf_result_t *res);
 
+/** FORMAT.md example 3: a 360-beam full-circle scan with a feature that
+ *  wraps through the seam and two segments cut by a cap. */
+void fx_example_wrap_cut(bsf_frame_info_t *info, bsf_result_t *res);
+
+/** FORMAT.md example 4: the metadata frame of an Intel stream. */
+void fx_example_metadata(bsf_metadata_t *m);
+
 /**
  * A random plausible result: 1..max_features walls of 0.5-5 m within 8 m,
  * 3..20 control points per feature, some vertices, beams in order over a

@@ -1461,9 +1461,9 @@ static void test_frame_decode_refuses_short_corrupt_and_unknown_frames_untouched
     TEST_ASSERT_EQUAL_INT(BSF_ERR_CRC, bsf_frame_decode(bytes, blen, &frame));
     bytes[3] ^= 0x10u;
     {
-        /* version 2, with a CRC that matches */
+        /* a version after BSF_FORMAT_VERSION, with a CRC that matches */
         uint32_t crc;
-        bytes[0] = (uint8_t)((2u << 4) | BSF_FRAME_TYPE_FEATURES);
+        bytes[0] = (uint8_t)(((BSF_FORMAT_VERSION + 1u) << 4) | BSF_FRAME_TYPE_FEATURES);
         crc = bsf_crc32c(0u, bytes, blen - 4u);
         bytes[blen - 4u] = (uint8_t)crc;
         bytes[blen - 3u] = (uint8_t)(crc >> 8);

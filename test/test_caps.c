@@ -130,6 +130,11 @@ static void assert_frame_carries_the_result(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(frame, len - 1u, body, sizeof body, &body_len));
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, body_len, &decoded));
     TEST_ASSERT_EQUAL_UINT16(res.n_features, decoded.result.n_features);
+    /* the cut travels in the frame's header extension (FORMAT.md 3.1) */
+    TEST_ASSERT_EQUAL_UINT32(res.stats.cut, decoded.result.stats.cut);
+    TEST_ASSERT_EQUAL_UINT32(res.stats.n_cut_keypoints, decoded.result.stats.n_cut_keypoints);
+    TEST_ASSERT_EQUAL_UINT32(res.stats.n_cut_segments, decoded.result.stats.n_cut_segments);
+    TEST_ASSERT_EQUAL_UINT32(res.stats.n_cut_points, decoded.result.stats.n_cut_points);
     for (i = 0; i < res.n_features; ++i) {
         TEST_ASSERT_EQUAL_UINT16(res.features[i].first_beam, decoded.result.features[i].first_beam);
         TEST_ASSERT_EQUAL_UINT16(res.features[i].n_points, decoded.result.features[i].n_points);

@@ -22,18 +22,34 @@ static uint8_t buf[BSF_FRAME_MAX_SIZE + 16u];
 static uint8_t body[BSF_FRAME_BODY_MAX_SIZE + 16u];
 static uint8_t scratch[BSF_FRAME_MAX_SIZE + 16u];
 
-/* docs/FORMAT.md, example 1 and example 2 (byte for byte). */
+/* docs/FORMAT.md, examples 1 to 4 (byte for byte). */
 static const uint8_t golden_minimal[] = {
-    0x04, 0x11, 0x40, 0x20, 0x01, 0x05, 0x42, 0xa9, 0x05, 0x42, 0x0e, 0xc6, 0x1b,
-    0xe9, 0x48, 0x72, 0x14, 0x87, 0x22, 0x15, 0x42, 0xc9, 0xc6, 0x33, 0x00,
+    0x04, 0x21, 0x20, 0x10, 0x01, 0x05, 0x21, 0x54, 0x82, 0xa1, 0x0f, 0x63, 0x0d,
+    0xf4, 0xa4, 0x39, 0x0a, 0x43, 0x91, 0x0a, 0x80, 0xa6, 0x38, 0x80, 0x6c, 0x00,
 };
 static const uint8_t golden_typical[] = {
-    0x56, 0x11, 0x97, 0x4b, 0x56, 0x01, 0xc2, 0x94, 0xc1, 0x8d, 0x5e, 0x35, 0x11, 0x09, 0xe0, 0x1d,
-    0x82, 0x8e, 0x71, 0x10, 0xa2, 0xb5, 0xca, 0x63, 0x4f, 0x2f, 0x28, 0x37, 0x65, 0xca, 0x51, 0x07,
-    0xd4, 0x79, 0x50, 0x44, 0xed, 0x09, 0x06, 0x78, 0x10, 0x11, 0xcc, 0xa6, 0xf6, 0x6e, 0xd7, 0x65,
-    0x2d, 0x80, 0xd6, 0x92, 0x41, 0x2b, 0x4c, 0x8d, 0xd6, 0x10, 0x5c, 0x15, 0xb0, 0x2c, 0x21, 0x48,
-    0x67, 0xf5, 0x27, 0x41, 0xd3, 0xf3, 0x17, 0x96, 0x10, 0x89, 0xb0, 0x98, 0x8d, 0xd5, 0x8c, 0x1f,
-    0xdf, 0x19, 0x30, 0x93, 0x15, 0xa7, 0x05, 0xd7, 0x3f, 0x0a, 0x14, 0x00,
+    0x05, 0x21, 0x8b, 0xa5, 0xab, 0x56, 0xe1, 0x4a, 0x60, 0xc6, 0xaf, 0x1a, 0x88, 0x84, 0xf0, 0x0e,
+    0xc1, 0x47, 0x38, 0x88, 0x51, 0x5a, 0xe5, 0x31, 0xa7, 0x97, 0x94, 0x1b, 0xb2, 0xe5, 0x28, 0x83,
+    0xea, 0x3c, 0xa8, 0x22, 0x76, 0x84, 0x83, 0x3c, 0x08, 0x08, 0xe6, 0x53, 0x7b, 0x37, 0x6b, 0xb2,
+    0x96, 0xc0, 0x6b, 0x49, 0x20, 0x95, 0xa6, 0x46, 0xeb, 0x08, 0x2e, 0x0a, 0xd8, 0x16, 0x10, 0xa4,
+    0x33, 0xfa, 0x93, 0xa0, 0xe9, 0xf9, 0x8b, 0xcb, 0x08, 0x44, 0xd8, 0x4c, 0x46, 0xea, 0xc6, 0x0f,
+    0xef, 0x8c, 0x98, 0x49, 0x8a, 0xd3, 0x80, 0xa6, 0x98, 0x2f, 0x6c, 0x00,
+};
+static const uint8_t golden_wrap_cut[] = {
+    0x04, 0x21, 0x60, 0xf0, 0x24, 0x19, 0x21, 0x16, 0xc8, 0x32, 0x4c, 0x39, 0x26, 0x89,
+    0xb6, 0xc0, 0xcc, 0x30, 0x78, 0xc5, 0xfe, 0x03, 0x4e, 0x7d, 0xdc, 0x6d, 0x80, 0xd3,
+    0x37, 0xe3, 0xd0, 0x53, 0xf0, 0x09, 0x86, 0x40, 0x95, 0xec, 0x43, 0x1e, 0x00,
+};
+static const uint8_t golden_metadata[] = {
+    0x18, 0x22, 0xba, 0x78, 0xeb, 0x85, 0x1e, 0x42, 0x29, 0xc9, 0x40, 0x48, 0x09, 0x04, 0x81,
+    0xb4, 0xbf, 0xc9, 0x0f, 0xdb, 0x3c, 0x8e, 0xfa, 0x35, 0x01, 0x01, 0x01, 0x1e, 0x42, 0xa3,
+    0xd1, 0xec, 0x80, 0x1e, 0x52, 0x41, 0x61, 0x9d, 0xbd, 0x41, 0x46, 0x96, 0xe7, 0x46, 0x56,
+    0xc2, 0xe6, 0xc6, 0xf6, 0x72, 0xe6, 0x77, 0xa0, 0x4a, 0x01, 0x0e, 0x01, 0x00,
+};
+/* Example 1 as format version 1 wrote it: the decoder still reads it. */
+static const uint8_t golden_minimal_v1[] = {
+    0x04, 0x11, 0x40, 0x20, 0x01, 0x05, 0x42, 0xa9, 0x05, 0x42, 0x0e, 0xc6, 0x1b,
+    0xe9, 0x48, 0x72, 0x14, 0x87, 0x22, 0x15, 0x42, 0xc9, 0xc6, 0x33, 0x00,
 };
 
 void setUp(void)
@@ -58,10 +74,12 @@ static unsigned feed_all(const uint8_t *data, size_t len, size_t chunk)
         while (off < n) {
             size_t used = 0;
             const int r = bsf_decoder_feed(&dec, data + pos + off, n - off, &used, &frame);
-            TEST_ASSERT_TRUE(r == 0 || r == 1);
+            TEST_ASSERT_TRUE(r == 0 || r == (int)BSF_FRAME_TYPE_FEATURES ||
+                             r == (int)BSF_FRAME_TYPE_METADATA);
+            TEST_ASSERT_TRUE(r == 0 || r == (int)frame.type);
             TEST_ASSERT_TRUE(used <= n - off);
             off += used;
-            frames += (unsigned)r;
+            frames += r != 0 ? 1u : 0u;
         }
         pos += n;
     }
@@ -465,6 +483,17 @@ static void test_worst_case_frame_fits_the_max_size_macro(void)
     }
     res.stats.n_valid = BSF_MAX_POINTS;
     res.stats.time_ns = UINT32_MAX;
+    /* The header extension at its largest: a wrap, every cut counter full. */
+    res.features[BSF_MAX_SEGMENTS - 1u].first_beam = BSF_MAX_POINTS - 1u;
+    res.features[BSF_MAX_SEGMENTS - 1u].last_beam = 0u;
+    res.stats.n_beams = BSF_MAX_POINTS;
+    res.stats.cut = BSF_CUT_KEYPOINTS | BSF_CUT_SEGMENTS | BSF_CUT_CTRL;
+    res.stats.n_cut_keypoints = BSF_MAX_POINTS;
+    res.stats.n_cut_segments = BSF_MAX_POINTS;
+    res.stats.n_cut_points = BSF_MAX_POINTS;
+    info.has_geometry = 1u;
+    info.angle_min = -3.0f;
+    info.angle_increment = 0.001f;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
     printf("worst-case test frame: %u bytes (BSF_FRAME_MAX_SIZE %u)\n", (unsigned)n,
            (unsigned)BSF_FRAME_MAX_SIZE);
@@ -472,6 +501,8 @@ static void test_worst_case_frame_fits_the_max_size_macro(void)
     TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 700u));
     TEST_ASSERT_EQUAL_UINT16(BSF_MAX_CTRL_POINTS, frame.result.n_ctrl);
     TEST_ASSERT_FLOAT_WITHIN(0.0001f, far, frame.result.ctrl[0].x);
+    TEST_ASSERT_EQUAL_UINT32(BSF_MAX_POINTS, frame.result.stats.n_cut_points);
+    TEST_ASSERT_EQUAL_UINT16(0u, frame.result.features[BSF_MAX_SEGMENTS - 1u].last_beam);
 }
 
 /* ---- Stream decoder ---- */
@@ -558,15 +589,23 @@ static void test_unknown_version_and_type_are_counted_and_skipped(void)
     uint8_t payload[64];
     const size_t len = golden_payload(golden_minimal, sizeof golden_minimal, payload);
     size_t n;
-    payload[0] = 0x21; /* version 2 */
+    payload[0] = 0x31; /* version 3 */
     n = reframe(payload, len, scratch);
     TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
     TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.unsupported_version);
-    payload[0] = 0x12; /* version 1, type 2 */
+    payload[0] = 0x01; /* version 0 */
+    n = reframe(payload, len, scratch);
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(2u, dec.stats.unsupported_version);
+    payload[0] = 0x12; /* version 1 has no metadata type */
     n = reframe(payload, len, scratch);
     TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
     TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.unknown_type);
-    payload[0] = 0x11;
+    payload[0] = 0x23; /* version 2, type 3 */
+    n = reframe(payload, len, scratch);
+    TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(2u, dec.stats.unknown_type);
+    payload[0] = 0x21;
     n = reframe(payload, len, scratch);
     TEST_ASSERT_EQUAL_UINT32(1u, feed_all(scratch, n, 64u));
     TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.malformed);
@@ -574,7 +613,7 @@ static void test_unknown_version_and_type_are_counted_and_skipped(void)
 
 /* A payload written field by field (FORMAT.md section 3), MSB first. */
 typedef struct {
-    uint8_t byte[64];
+    uint8_t byte[160];
     size_t bits;
 } bitbuf_t;
 
@@ -599,7 +638,7 @@ static void bb_eg(bitbuf_t *w, uint64_t v, unsigned k)
     }
     bb_bits(w, 0u, n);
     bb_bits(w, u, n + 1u);
-    bb_bits(w, v & ((1u << k) - 1u), k);
+    bb_bits(w, v & (((uint64_t)1u << k) - 1u), k);
 }
 
 static void bb_seg(bitbuf_t *w, int64_t v, unsigned k)
@@ -613,8 +652,9 @@ static size_t example1_payload(unsigned defect, uint8_t *out)
     bitbuf_t w;
     size_t len;
     w.bits = 0;
-    bb_bits(&w, 0x11u, 8u);
-    bb_bits(&w, 0u, 1u); /* no pose */
+    bb_bits(&w, 0x21u, 8u);
+    bb_bits(&w, 0u, 1u);                                       /* no pose */
+    bb_bits(&w, defect >= 13u && defect <= 17u ? 1u : 0u, 1u); /* extension */
     if (defect == 8u) {
         bb_bits(&w, 0u, 30u); /* seq: a zero run too long for 32 bits */
     }
@@ -627,9 +667,38 @@ static size_t example1_payload(unsigned defect, uint8_t *out)
     bb_bits(&w, 8u, 5u);                          /* k_first */
     bb_bits(&w, 8u, 5u);                          /* k_anchor */
     bb_bits(&w, defect == 11u ? 26u : 0u, 5u);    /* k_precision */
-    bb_bits(&w, 0u, 1u);                          /* bleak */
-    bb_eg(&w, defect == 5u ? 0u : 1u, 1u);        /* m - 2 */
-    bb_bits(&w, defect == 9u ? 1u : 0u, 1u);      /* vertex mask follows */
+    if (defect == 13u) {
+        bb_bits(&w, 0u, 5u); /* an empty extension: no beam count, no geometry, no cut */
+    } else if (defect == 14u) {
+        bb_bits(&w, 1u, 1u); /* a beam count although no feature wraps, without geometry */
+        bb_bits(&w, 0u, 4u);
+        bb_eg(&w, 360u, 8u);
+    } else if (defect == 16u) {
+        bb_bits(&w, 0u, 1u); /* a geometry without its beam count */
+        bb_bits(&w, 1u, 1u);
+        bb_bits(&w, BSF_CUT_SEGMENTS, 3u);
+        bb_bits(&w, 0x3F800000u, 32u);
+        bb_bits(&w, 0x3C8EFA35u, 32u);
+        bb_eg(&w, 0u, 2u);
+        bb_eg(&w, 1u, 2u);
+        bb_eg(&w, 0u, 4u);
+    } else if (defect == 17u) {
+        bb_bits(&w, 1u, 1u); /* a geometry whose angle is not finite */
+        bb_bits(&w, 1u, 1u);
+        bb_bits(&w, 0u, 3u);
+        bb_eg(&w, 360u, 8u);
+        bb_bits(&w, 0x7F800000u, 32u);
+        bb_bits(&w, 0x3C8EFA35u, 32u);
+    } else if (defect == 15u) {
+        bb_bits(&w, 0u, 2u);
+        bb_bits(&w, BSF_CUT_SEGMENTS, 3u);
+        bb_eg(&w, 0u, 2u);
+        bb_eg(&w, 1u, 2u);
+        bb_eg(&w, 1u, 4u); /* a cut point although all 20 valid points are in features */
+    }
+    bb_bits(&w, 0u, 1u);                     /* bleak */
+    bb_eg(&w, defect == 5u ? 0u : 1u, 1u);   /* m - 2 */
+    bb_bits(&w, defect == 9u ? 1u : 0u, 1u); /* vertex mask follows */
     if (defect == 9u) {
         bb_bits(&w, 0u, 3u); /* a mask without any vertex */
     }
@@ -672,7 +741,7 @@ static void test_malformed_fields_are_dropped_and_counted(void)
 {
     uint8_t payload[72];
     unsigned c;
-    for (c = 1; c <= 12u; ++c) {
+    for (c = 1; c <= 17u; ++c) {
         const size_t plen = example1_payload(c, payload);
         const size_t n = reframe(payload, plen, scratch);
         TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u),
@@ -723,6 +792,400 @@ static void test_bad_crc_is_dropped_and_the_next_frame_decodes(void)
     TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.frames_ok);
 }
 
+/* ---- Format version 1, header extension, wrapping features, metadata ---- */
+
+static void test_version_1_frames_still_decode(void)
+{
+    bsf_frame_info_t info;
+    fx_example_minimal(&info, &res);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_minimal_v1, sizeof golden_minimal_v1, 3u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT8(1u, frame.version);
+    TEST_ASSERT_EQUAL_UINT8(BSF_FRAME_TYPE_FEATURES, frame.type);
+    /* The same scan in version 2 costs one flag bit (here one byte, as the
+     * version-1 frame ended exactly on a byte boundary). */
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_minimal_v1 + 1u, sizeof golden_minimal);
+    TEST_ASSERT_EQUAL_UINT8(2u, golden_minimal[1] >> 4);
+}
+
+static void test_golden_wrap_cut_frame_carries_seam_and_cut(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    fx_example_wrap_cut(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_wrap_cut, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_wrap_cut, buf, sizeof golden_wrap_cut);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_wrap_cut, sizeof golden_wrap_cut, 4u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT16(350u, frame.result.features[1].first_beam);
+    TEST_ASSERT_EQUAL_UINT16(9u, frame.result.features[1].last_beam);
+    TEST_ASSERT_EQUAL_UINT32(360u, frame.result.stats.n_beams);
+    TEST_ASSERT_EQUAL_UINT32(BSF_CUT_SEGMENTS, frame.result.stats.cut);
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.result.stats.n_cut_keypoints);
+    TEST_ASSERT_EQUAL_UINT32(2u, frame.result.stats.n_cut_segments);
+    TEST_ASSERT_EQUAL_UINT32(11u, frame.result.stats.n_cut_points);
+    /* Decoded and encoded again: the same bytes. */
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_frame_encode(&info, &frame.result, scratch, sizeof scratch, &n));
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_wrap_cut, scratch, sizeof golden_wrap_cut);
+}
+
+static void test_cut_alone_and_wrap_alone_round_trip(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    size_t plain = 0;
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, NULL, 0u, &plain));
+    res.stats.cut = BSF_CUT_KEYPOINTS | BSF_CUT_CTRL;
+    res.stats.n_cut_keypoints = 5u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_TRUE(n > plain && n <= plain + 3u);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 13u));
+    TEST_ASSERT_EQUAL_UINT32(BSF_CUT_KEYPOINTS | BSF_CUT_CTRL, frame.result.stats.cut);
+    TEST_ASSERT_EQUAL_UINT32(5u, frame.result.stats.n_cut_keypoints);
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.result.stats.n_beams); /* no wrap, no metadata */
+
+    fx_example_wrap_cut(&info, &res);
+    res.stats.cut = 0u;
+    res.stats.n_cut_segments = 0u;
+    res.stats.n_cut_points = 0u;
+    res.features[1].first_beam = 359u; /* one beam before the seam, 11 after */
+    res.features[1].last_beam = 10u;
+    res.features[1].n_points = 12u;
+    res.stats.n_in_features = 39u + 12u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.result.stats.cut);
+    TEST_ASSERT_EQUAL_UINT32(360u, frame.result.stats.n_beams);
+}
+
+static void test_encoder_refuses_inconsistent_seam_and_cut_stats(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    unsigned c;
+    for (c = 0; c < 9u; ++c) {
+        fx_example_wrap_cut(&info, &res);
+        switch (c) {
+        case 0: res.stats.n_beams = 0u; break;   /* a wrap needs the beam count */
+        case 1: res.stats.n_beams = 350u; break; /* first beam outside the scan */
+        case 2: res.features[0].last_beam = 360u; break;
+        case 3: res.stats.cut = 0x8u; break;          /* not a BSF_CUT_* bit */
+        case 4: res.stats.cut = 0u; break;            /* counters without a cut */
+        case 5: res.stats.n_cut_points = 242u; break; /* 300 valid, 59 in features */
+        case 6: res.stats.n_cut_segments = BSF_MAX_POINTS + 1u; break;
+        case 7: res.stats.n_beams = 299u; break;        /* fewer beams than valid readings */
+        default: res.features[1].n_points = 22u; break; /* the run has 20 beams */
+        }
+        TEST_ASSERT_EQUAL_INT_MESSAGE(BSF_ERR_ARG,
+                                      bsf_frame_encode(&info, &res, buf, sizeof buf, &n), "case");
+    }
+    fx_example_wrap_cut(&info, &res);
+    res.stats.n_cut_points = 241u; /* every valid point outside the features */
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+}
+
+/* Every field of two metadata records equal, floats bit for bit. */
+static void assert_metadata_equal(const bsf_metadata_t *a, const bsf_metadata_t *b)
+{
+    TEST_ASSERT_EQUAL_UINT16(a->lib_version_major, b->lib_version_major);
+    TEST_ASSERT_EQUAL_UINT16(a->lib_version_minor, b->lib_version_minor);
+    TEST_ASSERT_EQUAL_UINT16(a->lib_version_patch, b->lib_version_patch);
+    TEST_ASSERT_EQUAL_UINT8(a->method, b->method);
+    TEST_ASSERT_EQUAL_MEMORY(&a->target_rms, &b->target_rms, sizeof(float));
+    TEST_ASSERT_FLOAT_WITHIN(1e-7f, a->quant_step, b->quant_step);
+    TEST_ASSERT_EQUAL_UINT32(a->max_points, b->max_points);
+    TEST_ASSERT_EQUAL_UINT32(a->max_keypoints, b->max_keypoints);
+    TEST_ASSERT_EQUAL_UINT32(a->max_segments, b->max_segments);
+    TEST_ASSERT_EQUAL_UINT32(a->max_ctrl_per_feature, b->max_ctrl_per_feature);
+    TEST_ASSERT_EQUAL_UINT32(a->max_ctrl_points, b->max_ctrl_points);
+    TEST_ASSERT_EQUAL_UINT32(a->n_beams, b->n_beams);
+    TEST_ASSERT_EQUAL_MEMORY(&a->angle_min, &b->angle_min, sizeof(float));
+    TEST_ASSERT_EQUAL_MEMORY(&a->angle_increment, &b->angle_increment, sizeof(float));
+    TEST_ASSERT_EQUAL_MEMORY(&a->range_min, &b->range_min, sizeof(float));
+    TEST_ASSERT_EQUAL_MEMORY(&a->range_max, &b->range_max, sizeof(float));
+    TEST_ASSERT_EQUAL_UINT8(a->has_time_origin, b->has_time_origin);
+    TEST_ASSERT_TRUE(a->time_origin_us == b->time_origin_us);
+    TEST_ASSERT_EQUAL_UINT8(a->source_len, b->source_len);
+    TEST_ASSERT_EQUAL_MEMORY(a->source, b->source, a->source_len);
+    TEST_ASSERT_EQUAL_HEX8(0, b->source[b->source_len]);
+}
+
+static void test_golden_metadata_frame_round_trips_bit_exact(void)
+{
+    bsf_metadata_t m;
+    size_t n = 0;
+    fx_example_metadata(&m);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metadata_encode(&m, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_metadata, (uint32_t)n);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_metadata, buf, sizeof golden_metadata);
+    TEST_ASSERT_TRUE(n <= BSF_METADATA_MAX_SIZE);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(golden_metadata, sizeof golden_metadata, 5u));
+    TEST_ASSERT_EQUAL_UINT8(BSF_FRAME_TYPE_METADATA, frame.type);
+    TEST_ASSERT_EQUAL_UINT8(2u, frame.version);
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.metadata);
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.frames_ok);
+    TEST_ASSERT_EQUAL_UINT16(0u, frame.result.n_features);
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.seq);
+    /* Every field, floats bit for bit. */
+    assert_metadata_equal(&m, &frame.metadata);
+    TEST_ASSERT_EQUAL_STRING("intel.log.gz", frame.metadata.source);
+}
+
+static void test_metadata_sink_and_init(void)
+{
+    static bsf_encoder_t work;
+    bsf_metadata_t m;
+    sink_log_t log;
+    size_t n = 0;
+    size_t written = 0;
+    bsf_metadata_init(&m);
+    TEST_ASSERT_EQUAL_UINT32(BSF_MAX_POINTS, m.max_points);
+    TEST_ASSERT_EQUAL_UINT32(BSF_MAX_CTRL_POINTS, m.max_ctrl_points);
+    TEST_ASSERT_EQUAL_FLOAT(BSF_QUANT_STEP_DEFAULT, m.quant_step);
+    TEST_ASSERT_EQUAL_UINT16(BSF_VERSION_MAJOR, m.lib_version_major);
+    TEST_ASSERT_EQUAL_UINT16(BSF_VERSION_MINOR, m.lib_version_minor);
+    TEST_ASSERT_EQUAL_UINT16(BSF_VERSION_PATCH, m.lib_version_patch);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metadata_encode(&m, NULL, 0u, &n));
+    fx_example_metadata(&m);
+    memset(&log, 0, sizeof log);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metadata_encode_sink(&work, &m, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_metadata, (uint32_t)written);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_metadata, scratch, sizeof golden_metadata);
+    memset(&log, 0, sizeof log);
+    log.fail_after = 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_metadata_encode_sink(&work, &m, record_sink, &log, &written));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER,
+                          bsf_metadata_encode(&m, buf, sizeof golden_metadata - 1u, &n));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_metadata, (uint32_t)n);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metadata_encode(NULL, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metadata_encode_sink(&work, &m, NULL, &log, &written));
+}
+
+static void test_metadata_encoder_refuses_bad_fields(void)
+{
+    static const char *const bad_names[] = {
+        "a\nb",             /* control character */
+        "\xC3",             /* cut short */
+        "\xC0\xAF",         /* overlong */
+        "\xED\xA0\x80",     /* surrogate */
+        "\xF4\x90\x80\x80", /* above U+10FFFF */
+        "\xC2\x85",         /* C1 control */
+        "\x7F",             /* DEL */
+    };
+    bsf_metadata_t m;
+    size_t n = 0;
+    unsigned c;
+    for (c = 0; c < 14u; ++c) {
+        fx_example_metadata(&m);
+        switch (c) {
+        case 0: m.range_max = NAN; break;
+        case 1: m.angle_min = INFINITY; break;
+        case 2: m.range_min = -0.1f; break;
+        case 3: m.range_max = m.range_min - 1.0f; break;
+        case 4: m.target_rms = -0.001f; break;
+        case 5: m.quant_step = 0.0f; break;
+        case 6: m.max_segments = 0u; break;
+        case 7: m.max_ctrl_points = 65536u; break;
+        case 8: m.n_beams = 65536u; break;
+        case 9: m.time_origin_us = BSF_METADATA_TIME_ORIGIN_MAX + 1LL; break;
+        case 10: m.source_len = BSF_METADATA_SOURCE_MAX + 1u; break;
+        case 11: m.has_time_origin = 2u; break;
+        case 12: m.angle_increment = NAN; break;
+        default: m.time_origin_us = -BSF_METADATA_TIME_ORIGIN_MAX - 1LL; break;
+        }
+        TEST_ASSERT_EQUAL_INT_MESSAGE(BSF_ERR_ARG, bsf_metadata_encode(&m, buf, sizeof buf, &n),
+                                      "case");
+    }
+    for (c = 0; c < sizeof bad_names / sizeof bad_names[0]; ++c) {
+        fx_example_metadata(&m);
+        m.source_len = (uint8_t)strlen(bad_names[c]);
+        memcpy(m.source, bad_names[c], m.source_len);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(BSF_ERR_ARG, bsf_metadata_encode(&m, buf, sizeof buf, &n),
+                                      "name");
+    }
+    fx_example_metadata(&m);
+    m.source_len = 14u;
+    memcpy(m.source, "caf\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80", 14u); /* 2-, 3-, 4-byte forms */
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metadata_encode(&m, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    assert_metadata_equal(&m, &frame.metadata);
+}
+
+static void bb_float(bitbuf_t *w, uint32_t bits)
+{
+    bb_bits(w, bits, 32u);
+}
+
+/* Example 4 of FORMAT.md written field by field, with one defect (0: none). */
+static size_t metadata_payload(unsigned defect, uint8_t *out)
+{
+    static const char name[] = "intel.log.gz";
+    bitbuf_t w;
+    size_t len;
+    size_t i;
+    w.bits = 0;
+    bb_bits(&w, 0x22u, 8u);
+    bb_eg(&w, 0u, 1u); /* library 0.1.0 */
+    bb_eg(&w, 1u, 1u);
+    bb_eg(&w, 0u, 1u);
+    bb_eg(&w, 0u, 0u);                                      /* method 0 */
+    bb_float(&w, defect == 1u ? 0x7FC00000u : 0x3C75C28Fu); /* target RMS 0.015 (1: NaN) */
+    bb_eg(&w, 50u, 4u);                                     /* step 5 mm */
+    bb_eg(&w, 1081u, 8u);
+    bb_eg(&w, 64u, 4u);
+    bb_eg(&w, defect == 2u ? 0u : 128u, 4u); /* 2: a cap of 0 */
+    bb_eg(&w, 32u, 2u);
+    bb_eg(&w, 512u, 6u);
+    bb_eg(&w, 180u, 8u);                                    /* beams */
+    bb_float(&w, 0xBFC90FDBu);                              /* angle_min -pi/2 */
+    bb_float(&w, 0x3C8EFA35u);                              /* increment pi/180 */
+    bb_float(&w, defect == 3u ? 0x42A3D70Au : 0x00000000u); /* range_min (3: above range_max) */
+    bb_float(&w, 0x42A3D1ECu);                              /* range_max 81.91 */
+    bb_bits(&w, 1u, 1u);                                    /* time origin follows */
+    bb_seg(&w, 1066286502361000LL, 40u);
+    bb_eg(&w, defect == 4u ? 65u : 12u, 3u); /* name length (4: too long) */
+    for (i = 0; i < 12u; ++i) {
+        bb_bits(&w, defect == 5u && i == 3u ? 0x0Au : (uint8_t)name[i], 8u); /* 5: a newline */
+    }
+    if (defect == 6u) {
+        bb_bits(&w, 1u, 1u); /* a set padding bit */
+    }
+    len = (w.bits + 7u) / 8u;
+    if (defect == 7u) {
+        w.byte[len++] = 0u; /* trailing byte */
+    }
+    memcpy(out, w.byte, len);
+    return len;
+}
+
+static void test_metadata_field_by_field_and_malformed_fields(void)
+{
+    uint8_t golden[160];
+    uint8_t built[160];
+    unsigned c;
+    const size_t len = golden_payload(golden_metadata, sizeof golden_metadata, golden);
+    TEST_ASSERT_EQUAL_UINT32(len, metadata_payload(0u, built));
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden, built, len);
+    for (c = 1; c <= 7u; ++c) {
+        const size_t plen = metadata_payload(c, built);
+        const size_t n = reframe(built, plen, scratch);
+        TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, feed_all(scratch, n, 64u), "malformed delivered");
+        TEST_ASSERT_EQUAL_UINT32(c, dec.stats.malformed);
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, dec.stats.metadata);
+}
+
+static void test_stream_decoder_takes_beam_count_from_metadata(void)
+{
+    bsf_frame_info_t info;
+    bsf_metadata_t m;
+    size_t used = 0;
+    size_t n = 0;
+    fx_example_metadata(&m);
+    memcpy(buf, golden_metadata, sizeof golden_metadata);
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf + sizeof golden_metadata,
+                                                   sizeof buf - sizeof golden_metadata, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_FRAME_TYPE_METADATA,
+                          bsf_decoder_feed(&dec, buf, sizeof golden_metadata + n, &used, &frame));
+    TEST_ASSERT_EQUAL_UINT32(sizeof golden_metadata, (uint32_t)used);
+    TEST_ASSERT_EQUAL_INT(BSF_FRAME_TYPE_FEATURES,
+                          bsf_decoder_feed(&dec, buf + used, n, &used, &frame));
+    TEST_ASSERT_EQUAL_UINT32(180u, frame.result.stats.n_beams);
+    TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.metadata);
+    TEST_ASSERT_EQUAL_UINT32(2u, dec.stats.frames_ok);
+    /* The one-shot decoder keeps no state: 0 = unknown. */
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_cobs_decode(buf + sizeof golden_metadata, n - 1u, body, sizeof body, &used));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, used, &frame));
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.result.stats.n_beams);
+    /* A beam count that the frame's beams exceed is not applied. */
+    fx_example_wrap_cut(&info, &res);
+    res.features[1].first_beam = 200u;
+    res.features[1].last_beam = 219u;
+    res.stats.n_beams = 0u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.result.stats.n_beams);
+    /* bsf_decoder_init forgets the metadata. */
+    bsf_decoder_init(&dec);
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.result.stats.n_beams);
+}
+
+static void test_worst_case_metadata_fits_the_max_size_macros(void)
+{
+    bsf_metadata_t m;
+    size_t n = 0;
+    unsigned i;
+    memset(&m, 0, sizeof m);
+    m.lib_version_major = 65535u;
+    m.lib_version_minor = 65535u;
+    m.lib_version_patch = 65535u;
+    m.method = 255u;
+    m.target_rms = 1.0f;
+    m.quant_step = 1.0f;
+    m.max_points = m.max_keypoints = m.max_segments = 65535u;
+    m.max_ctrl_per_feature = m.max_ctrl_points = m.n_beams = 65535u;
+    m.range_max = 1.0f;
+    m.has_time_origin = 1u;
+    m.time_origin_us = -BSF_METADATA_TIME_ORIGIN_MAX;
+    m.source_len = BSF_METADATA_SOURCE_MAX;
+    for (i = 0; i < BSF_METADATA_SOURCE_MAX; i += 4u) {
+        memcpy(&m.source[i], "\xF4\x8F\xBF\xBF", 4u); /* U+10FFFF */
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_metadata_encode(&m, buf, sizeof buf, &n));
+    printf("worst-case metadata frame: %u bytes (BSF_METADATA_MAX_SIZE %u)\n", (unsigned)n,
+           (unsigned)BSF_METADATA_MAX_SIZE);
+    TEST_ASSERT_TRUE(n <= BSF_METADATA_MAX_SIZE);
+    TEST_ASSERT_TRUE(n + 3u >= BSF_METADATA_MAX_SIZE); /* the bound is tight */
+    TEST_ASSERT_TRUE(BSF_METADATA_MAX_SIZE <= BSF_FRAME_MAX_SIZE);
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 100u));
+    assert_metadata_equal(&m, &frame.metadata);
+}
+
+static void test_frame_geometry_round_trips_and_is_checked(void)
+{
+    bsf_frame_info_t info;
+    size_t n = 0;
+    size_t plain = 0;
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, NULL, 0u, &plain));
+    info.has_geometry = 1u;
+    info.angle_min = -1.5577060f;
+    info.angle_increment = 0.0174533f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    res.stats.n_beams = 181u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_TRUE(n > plain + 8u && n <= plain + 11u); /* two floats and a beam count */
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 7u));
+    assert_round_trip(&info, &res, &frame);
+    TEST_ASSERT_EQUAL_UINT8(1u, frame.has_geometry);
+    TEST_ASSERT_EQUAL_MEMORY(&info.angle_min, &frame.angle_min, sizeof(float));
+    TEST_ASSERT_EQUAL_MEMORY(&info.angle_increment, &frame.angle_increment, sizeof(float));
+    TEST_ASSERT_EQUAL_UINT32(181u, frame.result.stats.n_beams);
+    info.angle_increment = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    info.angle_increment = 0.0174533f;
+    info.has_geometry = 2u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    res.stats.n_beams = 170u; /* feature 6 ends at beam 178 */
+    info.has_geometry = 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    /* Without has_geometry the frame says nothing about it. */
+    fx_example_typical(&info, &res);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+    TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+    TEST_ASSERT_EQUAL_UINT8(0u, frame.has_geometry);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -749,5 +1212,16 @@ int main(void)
     RUN_TEST(test_malformed_fields_are_dropped_and_counted);
     RUN_TEST(test_extraction_time_beyond_time_ns_range_is_refused);
     RUN_TEST(test_bad_crc_is_dropped_and_the_next_frame_decodes);
+    RUN_TEST(test_version_1_frames_still_decode);
+    RUN_TEST(test_golden_wrap_cut_frame_carries_seam_and_cut);
+    RUN_TEST(test_cut_alone_and_wrap_alone_round_trip);
+    RUN_TEST(test_encoder_refuses_inconsistent_seam_and_cut_stats);
+    RUN_TEST(test_golden_metadata_frame_round_trips_bit_exact);
+    RUN_TEST(test_metadata_sink_and_init);
+    RUN_TEST(test_metadata_encoder_refuses_bad_fields);
+    RUN_TEST(test_metadata_field_by_field_and_malformed_fields);
+    RUN_TEST(test_stream_decoder_takes_beam_count_from_metadata);
+    RUN_TEST(test_worst_case_metadata_fits_the_max_size_macros);
+    RUN_TEST(test_frame_geometry_round_trips_and_is_checked);
     return UNITY_END();
 }

@@ -23,10 +23,20 @@ BSF_BEGIN_DECLS
 
 /* ---- Format constants ---------------------------------------------------- */
 
-/** Format version written by this encoder (upper nibble of payload byte 0). */
-#define BSF_FORMAT_VERSION 1u
+/** Format version written by this encoder (upper nibble of payload byte 0).
+ *  The decoder also reads version-1 feature frames (FORMAT.md section 5). */
+#define BSF_FORMAT_VERSION 2u
+/** Oldest format version the decoder still reads (features frames only). */
+#define BSF_FORMAT_VERSION_MIN 1u
 /** Frame type "features of one scan" (lower nibble of payload byte 0). */
 #define BSF_FRAME_TYPE_FEATURES 1u
+/** Frame type "stream metadata" (version 2): what produced the stream. */
+#define BSF_FRAME_TYPE_METADATA 2u
+
+/** Longest source name of a metadata frame, bytes of UTF-8 (no terminator). */
+#define BSF_METADATA_SOURCE_MAX 64u
+/** Largest |time origin| of a metadata frame, microseconds (2^62 - 1). */
+#define BSF_METADATA_TIME_ORIGIN_MAX 4611686018427387903LL
 
 /** Quantisation step of control points: unit on the wire is 0.1 mm. */
 #define BSF_QUANT_STEP_UNIT 0.0001f
@@ -54,9 +64,10 @@ BSF_BEGIN_DECLS
 #error "bsf_stream.h: the wire-format size bounds need smaller caps"
 #endif
 
-/** Largest frame header (version/type byte, pose flag, seq, time stamp, pose,
- * step, N, extraction time, feature count, control point orders), bits. */
-#define BSF_FRAME_HEADER_MAX_BITS 433u
+/** Largest features frame header (version/type byte, pose and extension
+ * flags, seq, time stamp, pose, step, N, extraction time, feature count,
+ * control point orders, beam count, geometry and cap-cut counters), bits. */
+#define BSF_FRAME_HEADER_MAX_BITS 619u
 /** Largest feature header (kind, point count, vertex mask, beams, E_curve), bits. */
 #define BSF_FRAME_FEATURE_MAX_BITS 211u
 /** Largest size of one distinct control point on the wire (two 26-bit codes), bits. */
@@ -64,14 +75,29 @@ BSF_BEGIN_DECLS
 /** Size of the CRC-32C trailer, bytes. */
 #define BSF_FRAME_CRC_SIZE 4u
 
-/** Largest payload + CRC ("frame body", before COBS), bytes, for the caps. */
-#define BSF_FRAME_BODY_MAX_SIZE                                                                    \
+/** Largest features payload + CRC (before COBS), bytes, for the caps. */
+#define BSF_FEATURES_BODY_MAX_SIZE                                                                 \
     ((BSF_FRAME_HEADER_MAX_BITS + BSF_FRAME_FEATURE_MAX_BITS * (unsigned)BSF_MAX_SEGMENTS +        \
       BSF_FRAME_CTRL_MAX_BITS * (unsigned)BSF_MAX_CTRL_POINTS + 7u) /                              \
          8u +                                                                                      \
      BSF_FRAME_CRC_SIZE)
 
-/** Largest encoded frame on the wire (COBS body + 0x00 delimiter), bytes. */
+/** Largest metadata payload without its source name (version/type byte,
+ * library version, method, target RMS, step, five caps, geometry, time
+ * origin, name length), bits; each name byte adds 8. */
+#define BSF_METADATA_FIXED_MAX_BITS 568u
+/** Largest metadata payload + CRC (before COBS), bytes (independent of the caps). */
+#define BSF_METADATA_BODY_MAX_SIZE                                                                 \
+    ((BSF_METADATA_FIXED_MAX_BITS + 8u * BSF_METADATA_SOURCE_MAX + 7u) / 8u + BSF_FRAME_CRC_SIZE)
+/** Largest encoded metadata frame on the wire, bytes. */
+#define BSF_METADATA_MAX_SIZE (BSF_COBS_MAX_SIZE(BSF_METADATA_BODY_MAX_SIZE) + 1u)
+
+/** Largest payload + CRC ("frame body", before COBS) of any frame type, bytes. */
+#define BSF_FRAME_BODY_MAX_SIZE                                                                    \
+    (BSF_FEATURES_BODY_MAX_SIZE > BSF_METADATA_BODY_MAX_SIZE ? BSF_FEATURES_BODY_MAX_SIZE          \
+                                                             : BSF_METADATA_BODY_MAX_SIZE)
+
+/** Largest encoded frame of any type on the wire (COBS body + 0x00 delimiter), bytes. */
 #define BSF_FRAME_MAX_SIZE (BSF_COBS_MAX_SIZE(BSF_FRAME_BODY_MAX_SIZE) + 1u)
 
 /* ---- Building blocks ----------------------------------------------------- */
@@ -112,16 +138,22 @@ BSF_NODISCARD bsf_status_t bsf_cobs_decode(const uint8_t *in, size_t len, uint8_
 /** What a frame carries besides the features. */
 typedef struct {
     uint32_t seq;          /**< sequence number (wraps), for loss detection */
-    uint64_t timestamp_ms; /**< scan time, milliseconds since the sender's epoch */
+    uint64_t timestamp_ms; /**< scan time, milliseconds since the stream's time origin
+                                (bsf_metadata_t.time_origin_us) */
     uint8_t has_pose;      /**< 1: pose_* are sent (laser pose in the world frame) */
     float pose_x;          /**< metres, |x| <= BSF_POSE_XY_MAX, sent in 1 mm units */
     float pose_y;          /**< metres, |y| <= BSF_POSE_XY_MAX, sent in 1 mm units */
     float pose_theta;      /**< radians, |theta| <= BSF_POSE_THETA_MAX, sent in 2*pi/65536 units */
     float quant_step;      /**< control point step, metres, [BSF_QUANT_STEP_MIN, _MAX],
                                 rounded to 0.1 mm */
+    uint8_t has_geometry;  /**< 1: this scan's geometry travels in the frame (with
+                                result->stats.n_beams, which must then be >= 1): for a
+                                scan whose geometry differs from the stream's metadata */
+    float angle_min;       /**< radians, finite: angle of beam 0 (with has_geometry) */
+    float angle_increment; /**< radians, finite: between beams (with has_geometry) */
 } bsf_frame_info_t;
 
-/** Fill info with zeros, no pose and quant_step = BSF_QUANT_STEP_DEFAULT. */
+/** Fill info with zeros, no pose, no geometry and quant_step = BSF_QUANT_STEP_DEFAULT. */
 void bsf_frame_info_init(bsf_frame_info_t *info);
 
 /**
@@ -129,6 +161,9 @@ void bsf_frame_info_init(bsf_frame_info_t *info);
  * Only the first result->n_features features are read; each one's control
  * points are result->ctrl[ctrl_first .. ctrl_first + n_ctrl - 1]. A vertex
  * (two consecutive flagged slots whose values quantise alike) travels once.
+ * The cap-cut stats travel when stats.cut is not 0, stats.n_beams when a
+ * feature wraps (first_beam > last_beam: beams first_beam .. n_beams - 1,
+ * then 0 .. last_beam) or when info->has_geometry is set.
  *
  * @param buf      destination, or NULL to only compute the size.
  * @param cap      size of buf in bytes (ignored when buf is NULL).
@@ -136,12 +171,18 @@ void bsf_frame_info_init(bsf_frame_info_t *info);
  *                 NULL, and on BSF_ERR_BUFFER: the size needed).
  * @return BSF_OK; BSF_ERR_ARG when info, result or out_len is NULL, or a value
  *         cannot be represented: non-finite or out-of-range control point
- *         (|coordinate| / step > BSF_QUANT_MAX_STEPS), pose, quant_step or
- *         E_curve; n_ctrl < 3 or > BSF_MAX_CTRL_PER_FEATURE; control points
+ *         (|coordinate| / step > BSF_QUANT_MAX_STEPS), pose, quant_step,
+ *         E_curve or geometry angles; has_geometry > 1, or 1 with
+ *         stats.n_beams 0; n_ctrl < 3 or > BSF_MAX_CTRL_PER_FEATURE; control points
  *         outside result->n_ctrl; a flagged vertex slot without an equal
- *         partner; beams out of order within a feature, >= BSF_MAX_POINTS, or
- *         n_points > last - first + 1; kind > 1; stats.n_valid >
- *         BSF_MAX_POINTS or smaller than the points in features;
+ *         partner; beams >= BSF_MAX_POINTS, or >= stats.n_beams when that is
+ *         not 0; a wrapping feature (first_beam > last_beam) when
+ *         stats.n_beams is 0; n_points above the beams of the run; kind > 1;
+ *         stats.n_valid > BSF_MAX_POINTS, above a non-zero stats.n_beams or
+ *         smaller than the points in features; stats.cut with bits other
+ *         than BSF_CUT_*, cut counters that are not 0 while cut is 0, or
+ *         n_cut_keypoints / n_cut_segments above BSF_MAX_POINTS or
+ *         n_cut_points above the valid points outside the features;
  *         BSF_ERR_CAPACITY when n_features > BSF_MAX_SEGMENTS or n_ctrl >
  *         BSF_MAX_CTRL_POINTS; BSF_ERR_BUFFER when buf is not NULL and cap is
  *         smaller than the frame (nothing is claimed written). The input is
@@ -179,28 +220,103 @@ BSF_NODISCARD bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_
                                                  const bsf_result_t *result, bsf_sink_fn sink,
                                                  void *ctx, size_t *written);
 
+/* ---- Metadata frame ------------------------------------------------------- */
+
+/**
+ * What produced a stream (frame type BSF_FRAME_TYPE_METADATA, FORMAT.md
+ * section 3.6): a sender writes one at the start of a stream, again whenever
+ * a field changes, and at least every few frames so that a receiver joining
+ * a live link learns it soon. Floats travel as their exact IEEE-754 binary32
+ * bit patterns. Start from bsf_metadata_init().
+ */
+typedef struct {
+    uint16_t lib_version_major; /**< library that encoded the stream */
+    uint16_t lib_version_minor;
+    uint16_t lib_version_patch;
+    uint8_t method;         /**< bsf_method_t of the extraction (0..255; unknown values are kept) */
+    float target_rms;       /**< PDM refinement target, metres, finite and >= 0 (0: not used) */
+    float quant_step;       /**< control point step, metres, as in bsf_frame_info_t */
+    uint32_t max_points;    /**< sender's caps that bound its frames (BSF_MAX_POINTS ...), */
+    uint32_t max_keypoints; /**< each 1..65535 */
+    uint32_t max_segments;  /**< */
+    uint32_t max_ctrl_per_feature; /**< */
+    uint32_t max_ctrl_points;      /**< */
+    uint32_t n_beams;              /**< beams per scan, 0..65535; 0: geometry unknown */
+    float angle_min;               /**< radians, angle of beam 0, finite */
+    float angle_increment;         /**< radians between beams (may be negative), finite */
+    float range_min;               /**< metres, finite, >= 0 */
+    float range_max;               /**< metres, finite, >= range_min */
+    uint8_t has_time_origin;       /**< 1: time_origin_us is known */
+    int64_t time_origin_us;        /**< Unix time, microseconds, of frame timestamp 0;
+                                        |value| <= BSF_METADATA_TIME_ORIGIN_MAX */
+    uint8_t source_len;            /**< bytes in source, 0..BSF_METADATA_SOURCE_MAX (0: none) */
+    char source[BSF_METADATA_SOURCE_MAX + 1u]; /**< source name, well-formed UTF-8 without
+                                                    control characters; NUL-terminated when
+                                                    decoded (the encoder reads source_len bytes) */
+} bsf_metadata_t;
+
+/** Fill m with this library's version, this build's caps, the default step,
+ *  method 0, target_rms 0, unknown geometry, no time origin and no source. */
+void bsf_metadata_init(bsf_metadata_t *m);
+
+/**
+ * Encode a metadata frame, like bsf_frame_encode() (buf may be NULL to get
+ * the size; at most BSF_METADATA_MAX_SIZE bytes).
+ *
+ * @return BSF_OK; BSF_ERR_ARG when m or out_len is NULL or a field is out
+ *         of its documented range (a non-finite float, range_min < 0 or
+ *         > range_max, a cap of 0 or above 65535, n_beams above 65535, a
+ *         step outside [BSF_QUANT_STEP_MIN, _MAX], a time origin too large,
+ *         source_len above BSF_METADATA_SOURCE_MAX, a source that is not
+ *         well-formed UTF-8 or holds a control character); BSF_ERR_BUFFER
+ *         when buf is not NULL and cap is too small.
+ */
+BSF_NODISCARD bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap,
+                                               size_t *out_len);
+
+/** Encode a metadata frame to a sink, like bsf_frame_encode_sink(). */
+BSF_NODISCARD bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const bsf_metadata_t *m,
+                                                    bsf_sink_fn sink, void *ctx, size_t *written);
+
 /* ---- Decoder -------------------------------------------------------------- */
 
 /**
- * One decoded frame. `result` holds the features as the encoder saw them:
- * control points dequantised (within half a step of the originals),
- * vertices expanded to two flagged copies, ctrl_first the running sum of
- * n_ctrl, E_curve in 0.5 mm steps; result.stats carries n_valid,
- * n_in_features, n_ctrl, n_features and time_ns (= time_us * 1000), the
- * other stats are 0 (they do not travel).
+ * One decoded frame: features (type BSF_FRAME_TYPE_FEATURES) or metadata
+ * (BSF_FRAME_TYPE_METADATA).
+ *
+ * Features: `result` holds the features as the encoder saw them: control
+ * points dequantised (within half a step of the originals), vertices
+ * expanded to two flagged copies, ctrl_first the running sum of n_ctrl,
+ * E_curve in 0.5 mm steps; result.stats carries n_valid, n_in_features,
+ * n_ctrl, n_features, time_ns (= time_us * 1000), the cap-cut fields (cut,
+ * n_cut_keypoints, n_cut_segments, n_cut_points) and n_beams when known (the
+ * frame carries it when a feature wraps through the seam of a full-circle
+ * scan or with its own geometry; otherwise bsf_decoder_feed() takes it from the last metadata frame
+ * it delivered, and bsf_frame_decode() leaves 0). The other stats are 0 (they do not travel).
+ * `metadata` is not touched.
+ *
+ * Metadata: `metadata` is filled; seq, timestamp_ms, pose, time_us and the
+ * geometry are 0,
+ * quant_step is metadata.quant_step, and result holds no features (counts
+ * and stats 0; its arrays are not touched).
  */
 typedef struct {
-    uint8_t version;       /**< format version (BSF_FORMAT_VERSION) */
-    uint8_t type;          /**< frame type (BSF_FRAME_TYPE_FEATURES) */
-    uint32_t seq;          /**< sequence number */
-    uint64_t timestamp_ms; /**< milliseconds since the sender's epoch */
-    uint8_t has_pose;      /**< 1 when pose_* are valid */
-    float pose_x;          /**< metres (1 mm resolution) */
-    float pose_y;          /**< metres (1 mm resolution) */
-    float pose_theta;      /**< radians in [-pi, pi) (2*pi/65536 resolution) */
-    float quant_step;      /**< metres */
-    uint32_t time_us;      /**< extraction time, microseconds (<= 4 294 967) */
-    bsf_result_t result;   /**< features, control points, vertex flags, stats */
+    uint8_t version;         /**< format version of the frame (1 or 2) */
+    uint8_t type;            /**< BSF_FRAME_TYPE_FEATURES or BSF_FRAME_TYPE_METADATA */
+    uint32_t seq;            /**< sequence number */
+    uint64_t timestamp_ms;   /**< milliseconds since the stream's time origin (metadata) */
+    uint8_t has_pose;        /**< 1 when pose_* are valid */
+    float pose_x;            /**< metres (1 mm resolution) */
+    float pose_y;            /**< metres (1 mm resolution) */
+    float pose_theta;        /**< radians in [-pi, pi) (2*pi/65536 resolution) */
+    float quant_step;        /**< metres */
+    uint32_t time_us;        /**< extraction time, microseconds (<= 4 294 967) */
+    uint8_t has_geometry;    /**< 1: the frame carries its scan's geometry (below, and
+                                  result.stats.n_beams); 0: the metadata's applies */
+    float angle_min;         /**< radians (with has_geometry) */
+    float angle_increment;   /**< radians (with has_geometry) */
+    bsf_result_t result;     /**< features, control points, vertex flags, stats */
+    bsf_metadata_t metadata; /**< only for type BSF_FRAME_TYPE_METADATA */
 } bsf_frame_t;
 
 /**
@@ -209,7 +325,8 @@ typedef struct {
  *
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers; BSF_ERR_CRC when the CRC
  *         does not match (or len < 5); BSF_ERR_VERSION for a version other
- *         than BSF_FORMAT_VERSION or an unknown frame type; BSF_ERR_FORMAT for
+ *         than 1 or 2, or a type this decoder does not know (version 1: type
+ *         1 only; version 2: types 1 and 2); BSF_ERR_FORMAT for
  *         any malformed or out-of-range field (including an extraction time
  *         above 4 294 967 us, which bsf_stats_t.time_ns cannot hold), a
  *         truncated code, non-zero padding or a trailing byte;
@@ -224,6 +341,7 @@ typedef struct {
     uint32_t malformed;           /**< dropped: COBS error, malformed field, over the caps */
     uint32_t unsupported_version; /**< dropped: version this decoder does not know */
     uint32_t unknown_type;        /**< skipped: known version, unknown frame type */
+    uint32_t metadata;            /**< metadata frames delivered (included in frames_ok) */
     uint32_t oversize;            /**< dropped: longer than BSF_FRAME_BODY_MAX_SIZE */
     uint32_t bytes_skipped;       /**< bytes of all dropped frames (delimiters excluded) */
 } bsf_decoder_stats_t;
@@ -237,10 +355,12 @@ typedef struct {
     uint8_t block_left;                    /**< data bytes left in the current COBS block */
     uint8_t block_code;                    /**< code of the current block (0: none yet) */
     uint8_t overflow;                      /**< 1: current frame too long, skipping it */
+    uint32_t meta_n_beams; /**< beam count of the last metadata frame delivered (0: none) */
     bsf_decoder_stats_t stats;
 } bsf_decoder_t;
 
-/** Reset dec to "between frames" with zero counters. dec must not be NULL. */
+/** Reset dec to "between frames" with zero counters and no metadata seen.
+ *  dec must not be NULL. */
 void bsf_decoder_init(bsf_decoder_t *dec);
 
 /**
@@ -251,11 +371,15 @@ void bsf_decoder_init(bsf_decoder_t *dec);
  * counts as a frame boundary; a 0x00 always ends a frame, so after garbage
  * or lost bytes the decoder is back in step at the next delimiter. Empty
  * frames (0x00 0x00) are ignored. *out is written only for a delivered frame.
+ * A features frame that does not carry its beam count gets, in
+ * result.stats.n_beams, the n_beams of the last metadata frame delivered
+ * (when its features and N fit in that many beams).
  *
  * @param consumed receives the number of bytes of data used (<= len).
- * @return 1 when a frame was delivered into *out, 0 when all of data was
- *         consumed without completing one, BSF_ERR_ARG for NULL pointers
- *         (data may be NULL when len is 0).
+ * @return the type of the frame delivered into *out: BSF_FRAME_TYPE_FEATURES
+ *         (1) or BSF_FRAME_TYPE_METADATA (2), equal to out->type; 0 when all
+ *         of data was consumed without completing a frame; BSF_ERR_ARG for
+ *         NULL pointers (data may be NULL when len is 0).
  */
 BSF_NODISCARD int bsf_decoder_feed(bsf_decoder_t *dec, const uint8_t *data, size_t len,
                                    size_t *consumed, bsf_frame_t *out);

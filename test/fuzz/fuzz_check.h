@@ -41,9 +41,14 @@ static inline void fuzz_check_result(const bsf_result_t *r, int ordered)
     FUZZ_CHECK(r->n_ctrl <= BSF_MAX_CTRL_POINTS);
     for (f = 0; f < r->n_features; ++f) {
         const bsf_feature_t *ft = &r->features[f];
-        FUZZ_CHECK(ft->first_beam <= ft->last_beam);
+        /* first_beam > last_beam: the run wraps through the seam of a
+         * full-circle scan of stats.n_beams beams. */
+        const uint32_t span = ft->first_beam <= ft->last_beam
+                                  ? (uint32_t)(ft->last_beam - ft->first_beam)
+                                  : r->stats.n_beams - ft->first_beam + ft->last_beam;
+        FUZZ_CHECK(ft->first_beam <= ft->last_beam || r->stats.n_beams > ft->first_beam);
         FUZZ_CHECK(ft->last_beam < BSF_MAX_POINTS);
-        FUZZ_CHECK(ft->n_points <= ft->last_beam - ft->first_beam + 1u);
+        FUZZ_CHECK(ft->n_points <= span + 1u);
         FUZZ_CHECK(!ordered || ft->n_points >= 1u); /* the wire format allows 0 */
         FUZZ_CHECK(ft->n_ctrl >= 3u && ft->n_ctrl <= BSF_MAX_CTRL_PER_FEATURE);
         FUZZ_CHECK(ft->ctrl_first == next_ctrl); /* features own consecutive pool slices */

@@ -22,9 +22,32 @@ static uint8_t wire[BSF_FRAME_MAX_SIZE];
 static uint8_t body[BSF_FRAME_BODY_MAX_SIZE + 4u];
 static uint8_t framed[BSF_COBS_MAX_SIZE(BSF_FRAME_BODY_MAX_SIZE + 4u) + 1u];
 
+/* A delivered metadata frame is within its documented ranges and
+ * re-encodes to a frame that decodes to the same record. */
+static void check_metadata(const bsf_frame_t *fr)
+{
+    const bsf_metadata_t *m = &fr->metadata;
+    size_t len = 0u;
+    size_t used = 0u;
+    FUZZ_CHECK(fr->version == 2u);
+    FUZZ_CHECK(fuzz_finite(m->target_rms) && m->target_rms >= 0.0f);
+    FUZZ_CHECK(fuzz_finite(m->angle_min) && fuzz_finite(m->angle_increment));
+    FUZZ_CHECK(fuzz_finite(m->range_max) && m->range_min >= 0.0f && m->range_max >= m->range_min);
+    FUZZ_CHECK(m->max_points >= 1u && m->max_points <= 65535u && m->n_beams <= 65535u);
+    FUZZ_CHECK(m->source_len <= BSF_METADATA_SOURCE_MAX && m->source[m->source_len] == '\0');
+    FUZZ_CHECK(bsf_metadata_encode(m, wire, sizeof wire, &len) == BSF_OK);
+    FUZZ_CHECK(len <= BSF_METADATA_MAX_SIZE && len <= BSF_FRAME_MAX_SIZE);
+    bsf_decoder_init(&dec2);
+    FUZZ_CHECK(bsf_decoder_feed(&dec2, wire, len, &used, &again) == BSF_FRAME_TYPE_METADATA);
+    FUZZ_CHECK(memcmp(&again.metadata.target_rms, &m->target_rms, sizeof(float)) == 0);
+    FUZZ_CHECK(again.metadata.time_origin_us == m->time_origin_us);
+    FUZZ_CHECK(again.metadata.source_len == m->source_len &&
+               memcmp(again.metadata.source, m->source, m->source_len) == 0);
+}
+
 static void check_frame(const bsf_frame_t *fr)
 {
-    FUZZ_CHECK(fr->version == BSF_FORMAT_VERSION);
+    FUZZ_CHECK(fr->version == 1u || fr->version == BSF_FORMAT_VERSION);
     FUZZ_CHECK(fr->type == BSF_FRAME_TYPE_FEATURES);
     FUZZ_CHECK(fr->has_pose <= 1u);
     FUZZ_CHECK(fuzz_finite(fr->pose_x) && fabsf(fr->pose_x) <= BSF_POSE_XY_MAX);
@@ -76,7 +99,23 @@ static void check_equal(const bsf_frame_t *a, const bsf_frame_t *b)
     /* The decoder refuses a time_us that stats.time_ns cannot hold, so every
      * delivered frame's time and stats re-encode exactly. */
     FUZZ_CHECK(a->time_us == b->time_us);
-    FUZZ_CHECK(memcmp(&ra->stats, &rb->stats, sizeof ra->stats) == 0);
+    {
+        /* The beam count travels only with a wrapping feature or the scan's
+         * geometry; the stream decoder may have filled it in from a metadata
+         * frame. */
+        bsf_stats_t sa = ra->stats;
+        int wraps = 0;
+        for (k = 0; k < ra->n_features; ++k) {
+            wraps |= ra->features[k].first_beam > ra->features[k].last_beam;
+        }
+        if (!wraps && !a->has_geometry) {
+            sa.n_beams = 0u;
+        }
+        FUZZ_CHECK(a->has_geometry == b->has_geometry);
+        FUZZ_CHECK(memcmp(&a->angle_min, &b->angle_min, sizeof(float)) == 0);
+        FUZZ_CHECK(memcmp(&a->angle_increment, &b->angle_increment, sizeof(float)) == 0);
+        FUZZ_CHECK(memcmp(&sa, &rb->stats, sizeof sa) == 0);
+    }
     FUZZ_CHECK(ra->n_features == rb->n_features && ra->n_ctrl == rb->n_ctrl);
     for (k = 0; k < ra->n_features; ++k) {
         const bsf_feature_t *fa = &ra->features[k];
@@ -108,6 +147,9 @@ static void reencode(const bsf_frame_t *fr)
     info.pose_y = fr->pose_y;
     info.pose_theta = fr->pose_theta;
     info.quant_step = fr->quant_step;
+    info.has_geometry = fr->has_geometry;
+    info.angle_min = fr->angle_min;
+    info.angle_increment = fr->angle_increment;
     st = bsf_frame_encode(&info, &fr->result, wire, sizeof wire, &len);
     if (st != BSF_OK) {
         fprintf(stderr, "re-encoding a delivered frame failed: %s\n", bsf_status_str(st));
@@ -116,7 +158,7 @@ static void reencode(const bsf_frame_t *fr)
     FUZZ_CHECK(len >= 2u && len <= BSF_FRAME_MAX_SIZE && wire[len - 1u] == 0u);
     bsf_decoder_init(&dec2);
     got = bsf_decoder_feed(&dec2, wire, len, &used, &again);
-    FUZZ_CHECK(got == 1 && used == len);
+    FUZZ_CHECK(got == (int)BSF_FRAME_TYPE_FEATURES && used == len);
     check_equal(fr, &again);
 }
 
@@ -155,12 +197,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const size_t n = (size - pos < chunk) ? size - pos : chunk;
         size_t used = 0u;
         const int got = bsf_decoder_feed(&dec, data + pos, n, &used, &frame);
-        FUZZ_CHECK(got == 0 || got == 1);
+        FUZZ_CHECK(got == 0 || got == (int)BSF_FRAME_TYPE_FEATURES ||
+                   got == (int)BSF_FRAME_TYPE_METADATA);
+        FUZZ_CHECK(got == 0 || got == (int)frame.type);
         FUZZ_CHECK(used <= n);
-        FUZZ_CHECK(got == 1 || used == n);
+        FUZZ_CHECK(got != 0 || used == n);
         FUZZ_CHECK(used > 0u); /* progress on every call */
         pos += used;
-        if (got == 1) {
+        if (got == (int)BSF_FRAME_TYPE_METADATA) {
+            check_metadata(&frame);
+        } else if (got == (int)BSF_FRAME_TYPE_FEATURES) {
             check_frame(&frame);
             reencode(&frame);
         }

@@ -103,8 +103,21 @@ int main(int argc, char **argv)
         if (bsf_extract(&ex, &sc, &res) < 0) {
             return 1;
         }
+        if (k == 2u && res.stats.n_valid > res.stats.n_in_features) {
+            /* a scan cut by a cap: the header extension's counters */
+            res.stats.cut = BSF_CUT_SEGMENTS;
+            res.stats.n_cut_segments = 1u;
+            res.stats.n_cut_points = res.stats.n_valid - res.stats.n_in_features;
+        }
         info.seq = (uint32_t)k;
         info.timestamp_ms = 100u * k;
+        /* frame 1 carries its own geometry (header extension) */
+        info.has_geometry = (uint8_t)(k == 1u);
+        info.angle_min = sc.angle_min;
+        info.angle_increment = sc.angle_increment;
+        if (k == 1u && res.stats.n_beams == 0u) {
+            res.stats.n_beams = (uint32_t)sc.count;
+        }
         info.has_pose = (uint8_t)(k != 1u);
         info.pose_x = (float)x;
         info.pose_y = (float)y;
@@ -132,6 +145,38 @@ int main(int argc, char **argv)
         n = extract_input(buf, lid.n_beams, (uint8_t)(k == 2u ? 0x21u : 0x20u));
         snprintf(name, sizeof name, "scan_%u.bin", (unsigned)k);
         err |= write_file(dir, "extract", name, buf, n);
+    }
+    {
+        /* a metadata frame, raw and as a payload */
+        bsf_metadata_t meta;
+        size_t len = 0u;
+        size_t blen = 0u;
+        bsf_metadata_init(&meta);
+        meta.target_rms = 0.015f;
+        meta.n_beams = 361u;
+        meta.angle_min = -2.4f;
+        meta.angle_increment = 0.013f;
+        meta.range_min = 0.05f;
+        meta.range_max = 30.0f;
+        meta.has_time_origin = 1u;
+        meta.time_origin_us = 1066286502361000LL;
+        memcpy(meta.source, "demo.log\xC3\xA9", 10u);
+        meta.source_len = 10u;
+        if (bsf_metadata_encode(&meta, wire, sizeof wire, &len) != BSF_OK) {
+            return 1;
+        }
+        buf[0] = 7u;
+        memcpy(buf + 1, wire, len);
+        err |= write_file(dir, "stream", "metadata.bin", buf, len + 1u);
+        buf[0] = 0x80u;
+        if (bsf_cobs_decode(wire, len - 1u, buf + 1, sizeof buf - 1u, &blen) != BSF_OK) {
+            return 1;
+        }
+        err |= write_file(dir, "stream", "metadata_payload.bin", buf, blen - 4u + 1u);
+        /* the stream as bsf extract writes it: metadata, then frames */
+        memmove(all + len, all, all_len < sizeof all - len ? all_len : sizeof all - len);
+        memcpy(all, wire, len);
+        all_len = all_len + len < sizeof all ? all_len + len : sizeof all;
     }
     buf[0] = 63u;
     memcpy(buf + 1, all, all_len < sizeof buf - 1u ? all_len : sizeof buf - 1u);

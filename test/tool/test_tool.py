@@ -134,7 +134,174 @@ with open(os.path.join(WORK, "broken.log"), "w") as f:
 r = run(["extract", "broken.log", "-o", "broken.bsf"], text=True)
 check(r.returncode == 0 and "broken.log:4" in r.stderr, "malformed line reported as broken.log:4 and skipped")
 
-# 7. a scan that exceeds a cap is kept with what fits and reported as cut, not failed
+# 7. the stream says what it is: a metadata frame first, with the log's
+#    absolute time origin and geometry, repeated every K scans.
+import gzip
+import json
+import resource
+import select
+import time
+
+
+def decode_json(path):
+    r = run(["decode", path, "--json"], text=True)
+    return r, [json.loads(l) for l in r.stdout.strip().splitlines()]
+
+
+r, objs = decode_json("synth.bsf")
+check(r.returncode == 0 and "metadata" in objs[0], "extract writes a metadata frame first")
+meta = objs[0].get("metadata", {})
+first_time = float([l for l in open(os.path.join(WORK, "synth.log")) if l.startswith("ROBOTLASER1")][0].split()[-3])
+check(meta.get("time_origin_us") == round(first_time * 1e6), "metadata carries the log's absolute time origin (%r)" % meta.get("time_origin_us"))
+check(meta.get("source") == "synth.log" and meta.get("method") == "falko-sved-pdm" and meta.get("n_beams", 0) > 0
+      and meta.get("caps", {}).get("points", 0) > 0 and meta.get("quant_step") == 0.00499999989,
+      "metadata: source, method, beams, caps, step")
+scans = [o for o in objs if "seq" in o]
+check(scans and scans[0]["timestamp_ms"] == 0 and scans[-1]["timestamp_ms"] == round((len(scans) - 1) * 100),
+      "frame times are ms since the origin")
+r = run(["decode", "synth.bsf"], text=True)
+check(r.stdout.startswith("metadata library=") and "time_origin=1970-01-01T00:16:40" in r.stdout, "decode prints the metadata as text")
+r = run(["extract", "synth.log", "--meta-every", "7", "-o", "meta7.bsf"], text=True)
+r2, objs = decode_json("meta7.bsf")
+positions = [i for i, o in enumerate(objs) if "metadata" in o]
+check(r.returncode == 0 and len(positions) == (40 + 6) // 7 and all(b - a == 8 for a, b in zip(positions, positions[1:])),
+      "--meta-every 7 repeats the metadata every 7 scans (%r)" % positions)
+# a geometry change sends the metadata again
+lines = open(os.path.join(WORK, "synth.log")).readlines()
+laser = [i for i, l in enumerate(lines) if l.startswith("ROBOTLASER1")]
+parts = lines[laser[5]].split()
+n = int(parts[8])
+parts[8] = str(n - 10)
+del parts[9 + n - 10:9 + n]
+lines[laser[5]] = " ".join(parts) + "\n"
+open(os.path.join(WORK, "geom.log"), "w").writelines(lines)
+r = run(["extract", "geom.log", "-o", "geom.bsf"], text=True)
+r2, objs = decode_json("geom.bsf")
+beams = [o["metadata"]["n_beams"] for o in objs if "metadata" in o]
+scans = [o for o in objs if "seq" in o]
+own = [(o["seq"], o["n_beams"]) for o in scans if o["geometry"] is not None]
+check(r.returncode == 0 and beams == [n] and own == [(5, n - 10)] and scans[5]["geometry"]["angle_min"] == meta["angle_min"]
+      and scans[6]["n_beams"] == n, "a scan with another beam count carries its own geometry (%r, %r)" % (beams, own))
+# a range limit change sends the metadata again
+lines = open(os.path.join(WORK, "synth.log")).readlines()
+parts = lines[laser[5]].split()
+parts[5] = "40.0"  # the line's maxrange
+lines[laser[5]] = " ".join(parts) + "\n"
+open(os.path.join(WORK, "range.log"), "w").writelines(lines)
+r = run(["extract", "range.log", "-o", "range.bsf"], text=True)
+r2, objs = decode_json("range.bsf")
+ranges = [o["metadata"]["range_max"] for o in objs if "metadata" in o]
+check(r.returncode == 0 and ranges == [50, 40, 50] and "metadata" in objs[6] and "metadata" in objs[8],
+      "a range limit change sends the metadata again (%r)" % ranges)
+
+# 8. byte-reproducible output, stdin (plain and gzip)
+run(["extract", "synth.log", "--reproducible", "-o", "rep1.bsf"])
+run(["extract", "synth.log", "--reproducible", "-o", "rep2.bsf"])
+a = open(os.path.join(WORK, "rep1.bsf"), "rb").read()
+check(a != b"" and a == open(os.path.join(WORK, "rep2.bsf"), "rb").read(), "two --reproducible runs give identical bytes")
+r, objs = decode_json("rep1.bsf")
+check(all(o["time_us"] == 0 for o in objs if "seq" in o), "--reproducible frames carry no measured time")
+log_bytes = open(os.path.join(WORK, "synth.log"), "rb").read()
+frames_of = lambda objs: [o for o in objs if "seq" in o]
+for name, data in [("plain", log_bytes), ("gzip", gzip.compress(log_bytes))]:
+    p = subprocess.run([BSF, "extract", "-", "--reproducible", "-o", "stdin.bsf"], cwd=WORK, input=data, capture_output=True)
+    r2, objs2 = decode_json("stdin.bsf")
+    check(p.returncode == 0 and frames_of(objs2) == frames_of(objs), "extract - reads a %s log from stdin" % name)
+
+# 9. the tool refuses what it cannot read
+open(os.path.join(WORK, "text.txt"), "w").write("this is not a stream\n")
+for cmd in (["decode", "text.txt"], ["metrics", "text.txt"], ["render", "text.txt", "-o", "t.svg"]):
+    r = run(cmd, text=True)
+    check(r.returncode == 1 and "no valid bsf frame" in r.stderr and "21 bytes skipped" in r.stderr,
+          "%s of a text file exits 1 and says how many bytes were skipped" % cmd[0])
+open(os.path.join(WORK, "empty.bsf"), "wb").close()
+r = run(["decode", "empty.bsf"], text=True)
+check(r.returncode == 0 and "frames ok 0" in r.stdout, "decode of an empty stream exits 0")
+for cmd in (["decode", "."], ["metrics", "."], ["render", ".", "-o", "d.svg"], ["extract", ".", "-o", "d.bsf"]):
+    r = run(cmd, text=True)
+    check(r.returncode == 1 and "is a directory" in r.stderr, "%s of a directory: a clear message" % cmd[0])
+r = run(["extract", "text.txt", "-o", "nolaser.bsf"], text=True)
+check(r.returncode == 1 and "no laser line" in r.stderr, "extract of a log without laser lines exits 1")
+
+# 10. timestamps that do not fit are reported, never sent as 0 or 2^63
+for bad in ["nan", "inf", "1e17", "-5.000"]:
+    lines = open(os.path.join(WORK, "synth.log")).readlines()
+    parts = lines[laser[2]].split()
+    parts[-3] = bad
+    lines[laser[2]] = " ".join(parts) + "\n"
+    open(os.path.join(WORK, "badtime.log"), "w").writelines(lines)
+    r = run(["extract", "badtime.log", "-o", "badtime.bsf"], text=True)
+    r2, objs = decode_json("badtime.bsf")
+    times = [o["timestamp_ms"] for o in objs if "seq" in o]
+    check(r.returncode == 1 and ("badtime.log:%d" % (laser[2] + 1)) in r.stderr and len(times) == 39
+          and max(times) < 10000, "a log time of %s is reported with its line, the scan skipped" % bad)
+
+# a time before the origin starts a new origin (a metadata frame), never a clamped 0
+lines = open(os.path.join(WORK, "synth.log")).readlines()
+parts = lines[laser[10]].split()
+parts[-3] = "999.5"  # before the first scan's 1000.0
+lines[laser[10]] = " ".join(parts) + "\n"
+open(os.path.join(WORK, "backtime.log"), "w").writelines(lines)
+r = run(["extract", "backtime.log", "-o", "backtime.bsf"], text=True)
+r2, objs = decode_json("backtime.bsf")
+origins = [o["metadata"]["time_origin_us"] for o in objs if "metadata" in o]
+after = [o for o in objs if "seq" in o and o["seq"] == 11]
+check(r.returncode == 0 and "time goes back" in r.stderr and origins == [1000000000, 999500000]
+      and after and after[0]["timestamp_ms"] == 1600, "a time before the origin sets a new origin (%r)" % origins)
+
+# 11. a stream cut before its last delimiter still counts that frame's gap
+raw = open(os.path.join(WORK, "rep1.bsf"), "rb").read()
+chunks = raw.split(b"\0")[:-1]
+kept = chunks[:5] + chunks[6:7]  # metadata, seq 0..3, (seq 4 lost), seq 5
+cut = b"\0".join(kept)  # no delimiter after the last frame, the one after the gap
+open(os.path.join(WORK, "cut.bsf"), "wb").write(cut)
+r = run(["decode", "cut.bsf"], text=True)
+check(r.returncode == 0 and "seq=5 " in r.stdout and "missing by sequence 1" in r.stdout,
+      "the last frame without its delimiter is delivered and its gap counted")
+r = run(["metrics", "cut.bsf"], text=True)
+check("missing by sequence 1" in r.stdout, "metrics counts it too")
+
+# 12. decode - on a live pipe prints each frame as soon as its delimiter arrives
+p = subprocess.Popen([BSF, "decode", "-"], cwd=WORK, stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+first = raw.index(b"\0", raw.index(b"\0") + 1) + 1  # metadata and the first scan
+p.stdin.write(raw[:first])
+p.stdin.flush()
+got = b""
+deadline = time.time() + 10.0
+while got.count(b"\n") < 2 and time.time() < deadline:
+    ready, _, _ = select.select([p.stdout], [], [], 0.2)
+    if ready:
+        chunk = os.read(p.stdout.fileno(), 4096)
+        if not chunk:
+            break
+        got += chunk
+check(got.startswith(b"metadata ") and b"seq=0 " in got, "decode - prints a frame before the pipe closes")
+p.stdin.write(raw[first:])
+p.stdin.close()
+rest = p.stdout.read()
+check(p.wait() == 0 and b"frames ok 41" in rest, "decode - then finishes the stream")
+
+# 13. render --width
+r = run(["render", "synth.bsf", "-o", "w.svg", "--width", "800"], text=True)
+check(r.returncode == 0 and 'width="800' in open(os.path.join(WORK, "w.svg")).read(), "render --width 800")
+r = run(["render", "synth.bsf", "-o", "w.svg", "--width", "0"], text=True)
+check(r.returncode == 2, "render --width 0 is refused")
+
+# 14. metrics and render in memory independent of the stream's length:
+#     an 8 MB stream (the whole synthetic stream repeated) stays far below
+#     what keeping every frame would take (about 290 times the stream).
+big = os.path.join(WORK, "big.bsf")
+with open(big, "wb") as f:
+    while f.tell() < 8 * 1000 * 1000:
+        f.write(raw)
+before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+r = run(["metrics", "big.bsf"], text=True)
+r2 = run(["render", "big.bsf", "-o", "big.svg"], text=True)
+peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+check(r.returncode == 0 and r2.returncode == 0 and peak_kb < 80 * 1024,
+      "metrics and render of an 8 MB stream peak at %d KiB (< 80 MiB)" % peak_kb)
+
+# 15. a scan that exceeds a cap is kept with what fits and reported as cut, not failed
 exp = subprocess.run([SYNTH, os.path.join(WORK, "clutter.log"), "12", "clutter"], capture_output=True, text=True)
 check(exp.returncode == 0, "synth_log writes the clutter log")
 expected = dict(l.split("=", 1) for l in exp.stdout.split())
@@ -155,6 +322,11 @@ if same_caps:
 r = run(["metrics", "clutter.bsf"], text=True)
 check(r.returncode == 0 and metrics_of(r.stdout).get("scans", ["?"])[0] == "12",
       "bsf metrics reads every scan of the cut stream")
+check(("cut by a cap      %d scans" % n_lines) in r.stdout, "the cut travels in the stream: bsf metrics reports the cut scans")
+r, objs = decode_json("clutter.bsf")
+cut_frames = [o for o in objs if "seq" in o and o["cut"] != 0]
+check(len(cut_frames) == n_lines and all(o["n_cut_keypoints"] + o["n_cut_segments"] > 0 for o in cut_frames),
+      "bsf decode shows each cut scan's cut and counters")
 
 print("%d checks failed" % len(failures) if failures else "all tool checks passed")
 sys.exit(1 if failures else 0)

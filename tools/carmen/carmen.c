@@ -11,6 +11,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #ifdef BSF_HAVE_ZLIB
 #include <zlib.h>
@@ -60,12 +61,23 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
     }
     strcpy(r->path, path);
 #ifdef BSF_HAVE_ZLIB
-    r->gz = gzopen(path, "rb");
+    /* "-": standard input, plain or gzip (gzdopen reads both). */
+    r->gz = strcmp(path, "-") == 0 ? gzdopen(dup(STDIN_FILENO), "rb") : gzopen(path, "rb");
     if (r->gz == NULL) {
         carmen_close(r);
         return NULL;
     }
 #else
+    if (strcmp(path, "-") == 0) {
+        /* standard input through gzip -dcf, which passes plain text as is */
+        r->file = popen("gzip -dcf", "r");
+        r->piped = 1;
+        if (r->file == NULL) {
+            carmen_close(r);
+            return NULL;
+        }
+        return r;
+    }
     r->file = fopen(path, "rb");
     if (r->file == NULL) {
         carmen_close(r);

@@ -63,7 +63,8 @@ typedef struct {
 typedef struct carmen_reader carmen_reader_t;
 
 /**
- * Open a log. `err` receives the reports of malformed lines (NULL: silent).
+ * Open a log ("-": standard input, plain or gzip). `err` receives the
+ * reports of malformed lines (NULL: silent).
  * Returns NULL when the file cannot be opened (errno tells why) or memory
  * runs out.
  */

@@ -5,6 +5,8 @@
  */
 #include "tool.h"
 
+#include <sys/stat.h>
+
 const char *g_cmd = TOOL_NAME;
 
 void fail_msg(const char *fmt, ...)
@@ -91,11 +93,25 @@ int is_help(const char *a)
 
 /* ---- byte streams ------------------------------------------------------------ */
 
+/* 1 (with a message) when path names a directory. */
+static int is_directory(const char *path, const char *what)
+{
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        fail_msg("%s is a directory, not %s", path, what);
+        return 1;
+    }
+    return 0;
+}
+
 FILE *open_in(const char *path)
 {
     FILE *f;
     if (strcmp(path, "-") == 0) {
         return stdin;
+    }
+    if (is_directory(path, "a bsf stream")) {
+        return NULL;
     }
     f = fopen(path, "rb");
     if (f == NULL) {
@@ -169,6 +185,9 @@ void progress_end(progress_t *p)
 carmen_reader_t *open_log(const char *path)
 {
     carmen_reader_t *rd;
+    if (strcmp(path, "-") != 0 && is_directory(path, "a CARMEN log")) {
+        return NULL;
+    }
     errno = 0;
     rd = carmen_open(path, stderr);
     if (rd == NULL) {

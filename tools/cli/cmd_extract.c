@@ -6,8 +6,8 @@
 
 static const char extract_help[] =
     "Usage: bsf extract LOG [options]\n"
-    "Extract B-spline features from every laser scan of a CARMEN log (plain or .gz)\n"
-    "and write them as a bsf stream (docs/FORMAT.md).\n"
+    "Extract B-spline features from every laser scan of a CARMEN log (plain or .gz;\n"
+    "'-' reads standard input) and write them as a bsf stream (docs/FORMAT.md).\n"
     "\n"
     "  --method M       lc-sved-pdm (default), falko-sved-pdm (the paper's, FALKOLib keypoints),\n"
     "                   bid-sved-pdm or rpos-lsba\n"
@@ -16,14 +16,27 @@ static const char extract_help[] =
     "  --range-max M    readings >= M metres are invalid (default: the log's declared\n"
     "                   maximum range, capped below the 81.83/81.91 no-return codes)\n"
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
+    "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
+    "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
-    "Frames carry the laser pose and the time in ms since the log's first scan.\n"
-    "A malformed log line is reported as FILE:LINE and skipped. A scan with more\n"
-    "keypoints, segments or control points than the library's caps is kept with the\n"
-    "features that fit and reported as cut (not failed). The summary goes to\n"
-    "stderr; progress too, when stderr is a terminal.\n";
+    "The stream starts with a metadata frame (method, parameters, caps, scan geometry,\n"
+    "the log's absolute time of timestamp 0, the log's name), sent again whenever the\n"
+    "range limits or the time origin change and at least every K scans, so that a\n"
+    "receiver joining a live link learns it within K frames; a scan whose beam count\n"
+    "or angles differ from the metadata carries its own in its frame. Frames carry\n"
+    "the laser pose and the time in ms since that origin (the log's first scan).\n"
+    "A malformed log line is reported as FILE:LINE and skipped; so is a scan whose\n"
+    "time is not finite, negative or beyond 1e11 s. A scan with more keypoints,\n"
+    "segments or control points than the library's caps is kept with the features\n"
+    "that fit and reported as cut (not failed). The summary goes to stderr; progress\n"
+    "too, when stderr is a terminal. Exits 1 when the log holds no laser line or any\n"
+    "scan was skipped.\n";
+
+/* Largest log time accepted, seconds since 1970 (year 5138): a larger one is
+ * a corrupt field, and its microseconds would not fit the metadata frame. */
+#define EXTRACT_TIME_MAX_S 1e11
 
 /* Scans a cap cut (BSF_OK_CUT): kept and written, counted apart from failures. */
 typedef struct {
@@ -56,24 +69,96 @@ typedef struct {
     long count;
     double range_max; /* <= 0: from the log */
     double quant;
+    long meta_every;
+    int reproducible;
     const char *out;
 } extract_opts_t;
 
+/* The stream's current metadata and when it was last sent. */
+typedef struct {
+    bsf_metadata_t meta;
+    int sent;
+    long frames_since;
+    unsigned long n_sent;
+} meta_state_t;
+
+/* The beams of sc are where the metadata says (count and angles, bit for bit). */
+static int same_beams(const bsf_metadata_t *m, const bsf_scan_t *sc)
+{
+    return m->n_beams == (uint32_t)sc->count &&
+           memcmp(&m->angle_min, &sc->angle_min, sizeof(float)) == 0 &&
+           memcmp(&m->angle_increment, &sc->angle_increment, sizeof(float)) == 0;
+}
+
+static int same_ranges(const bsf_metadata_t *m, const bsf_scan_t *sc)
+{
+    return memcmp(&m->range_min, &sc->range_min, sizeof(float)) == 0 &&
+           memcmp(&m->range_max, &sc->range_max, sizeof(float)) == 0;
+}
+
+/* The log's file name as the source (at most BSF_METADATA_SOURCE_MAX bytes). */
+static void set_source(bsf_metadata_t *m, const char *log)
+{
+    const char *base = strrchr(log, '/');
+    size_t n;
+    base = base != NULL ? base + 1 : log;
+    if (strcmp(log, "-") == 0) {
+        m->source_len = 0u;
+        return;
+    }
+    n = strlen(base);
+    if (n > BSF_METADATA_SOURCE_MAX) {
+        n = BSF_METADATA_SOURCE_MAX;
+        while (n > 0u && ((unsigned char)base[n] & 0xC0u) == 0x80u) {
+            --n; /* do not cut a UTF-8 sequence */
+        }
+    }
+    memcpy(m->source, base, n);
+    m->source[n] = '\0';
+    m->source_len = (uint8_t)n;
+}
+
+static int write_metadata(meta_state_t *ms, FILE *out, const char *out_name,
+                          unsigned long long *bytes)
+{
+    size_t len = 0;
+    bsf_status_t st = bsf_metadata_encode(&ms->meta, g_frame_buf, sizeof g_frame_buf, &len);
+    if (st == BSF_ERR_ARG && ms->meta.source_len > 0u) {
+        ms->meta.source_len = 0u; /* a file name that is not clean UTF-8 is left out */
+        ms->meta.source[0] = '\0';
+        st = bsf_metadata_encode(&ms->meta, g_frame_buf, sizeof g_frame_buf, &len);
+    }
+    if (st != BSF_OK) {
+        fail_msg("cannot encode the metadata frame: %s", bsf_status_str(st));
+        return -1;
+    }
+    if (fwrite(g_frame_buf, 1, len, out) != len) {
+        fail_msg("write error on %s", out_name);
+        return -1;
+    }
+    *bytes += len;
+    ms->sent = 1;
+    ms->frames_since = 0;
+    ++ms->n_sent;
+    return 0;
+}
+
 static int run_extract(const extract_opts_t *o)
 {
+    static meta_state_t ms;
     carmen_reader_t *rd;
     carmen_scan_t rec;
     FILE *out;
     progress_t prog;
-    unsigned long index = 0, done = 0, failed = 0, malformed;
+    unsigned long index = 0, done = 0, failed = 0, bad_time = 0, malformed;
+    unsigned long own_geometry = 0;
     cut_totals_t cut;
-    double t0 = 0.0;
-    int have_t0 = 0;
     unsigned long long bytes = 0;
     bsf_frame_info_t info;
     int r;
+    int write_failed = 0;
 
-    if (init_extractor(o->method) != 0) {
+    if (init_extractor_timed(o->method, !o->reproducible) != 0) {
         return EXIT_FAIL;
     }
     rd = open_log(o->log);
@@ -85,6 +170,7 @@ static int run_extract(const extract_opts_t *o)
         carmen_close(rd);
         return EXIT_FAIL;
     }
+    memset(&ms, 0, sizeof ms);
     memset(&cut, 0, sizeof cut);
     bsf_frame_info_init(&info);
     info.quant_step = (float)o->quant;
@@ -93,6 +179,7 @@ static int run_extract(const extract_opts_t *o)
         bsf_scan_t sc;
         bsf_status_t st;
         size_t len = 0;
+        long long t_us;
         if ((long)index < o->first) {
             ++index;
             continue;
@@ -100,6 +187,17 @@ static int run_extract(const extract_opts_t *o)
         if (o->count >= 0 && (long)done >= o->count) {
             break;
         }
+        if (!(isfinite(rec.timestamp) && rec.timestamp >= 0.0 &&
+              rec.timestamp <= EXTRACT_TIME_MAX_S)) {
+            fprintf(stderr,
+                    "%s:%lu: scan %lu skipped: its time %g s is not a time bsf can carry "
+                    "(finite, 0 .. %g s)\n",
+                    o->log, rec.line, index, rec.timestamp, EXTRACT_TIME_MAX_S);
+            ++bad_time;
+            ++index;
+            continue;
+        }
+        t_us = llround(rec.timestamp * 1e6);
         sc = scan_of_record(&rec, o->range_max);
         st = bsf_extract(&g_ex, &sc, &g_res);
         if (st == BSF_OK_CUT) {
@@ -111,15 +209,51 @@ static int run_extract(const extract_opts_t *o)
             ++index;
             continue;
         }
-        info.seq = (uint32_t)index;
-        /* ms since the log's first scan: small numbers travel in fewer
-         * bytes, and the metrics never need absolute time. */
-        if (!have_t0) {
-            t0 = rec.timestamp;
-            have_t0 = 1;
+        /* Metadata first: at the start, when the range limits change, when
+         * the time goes back before the origin (a new origin), and every K
+         * scans. A scan whose beams (count, angles) differ from the metadata
+         * carries its own geometry instead: some logs change the start angle
+         * on every scan, and 10 bytes in the frame cost less than a 60-byte
+         * metadata frame per scan. */
+        if (!ms.sent || !same_ranges(&ms.meta, &sc) || t_us < ms.meta.time_origin_us ||
+            ms.frames_since >= o->meta_every) {
+            if (ms.sent && t_us < ms.meta.time_origin_us) {
+                fprintf(stderr,
+                        "%s:%lu: scan %lu: time goes back %.6f s before the stream's time "
+                        "origin; a metadata frame sets a new origin\n",
+                        o->log, rec.line, index, 1e-6 * (double)(ms.meta.time_origin_us - t_us));
+            }
+            if (!ms.sent || t_us < ms.meta.time_origin_us) {
+                fill_metadata(&ms.meta, &sc, info.quant_step);
+                set_source(&ms.meta, o->log);
+                ms.meta.has_time_origin = 1u;
+                ms.meta.time_origin_us = t_us;
+            } else {
+                const int64_t origin = ms.meta.time_origin_us;
+                char source[BSF_METADATA_SOURCE_MAX + 1u];
+                const uint8_t source_len = ms.meta.source_len;
+                memcpy(source, ms.meta.source, sizeof source);
+                fill_metadata(&ms.meta, &sc, info.quant_step);
+                memcpy(ms.meta.source, source, sizeof source);
+                ms.meta.source_len = source_len;
+                ms.meta.has_time_origin = 1u;
+                ms.meta.time_origin_us = origin;
+            }
+            if (write_metadata(&ms, out, o->out, &bytes) != 0) {
+                write_failed = 1;
+                break;
+            }
         }
-        info.timestamp_ms =
-            (rec.timestamp > t0) ? (uint64_t)llround((rec.timestamp - t0) * 1000.0) : 0u;
+        if (g_res.stats.n_beams == 0u) {
+            g_res.stats.n_beams = (uint32_t)sc.count;
+        }
+        info.has_geometry = (uint8_t)(same_beams(&ms.meta, &sc) ? 0u : 1u);
+        info.angle_min = sc.angle_min;
+        info.angle_increment = sc.angle_increment;
+        info.seq = (uint32_t)index;
+        /* ms since the origin (the first scan): small numbers travel in
+         * fewer bytes; the metadata frame carries the absolute origin. */
+        info.timestamp_ms = (uint64_t)((t_us - ms.meta.time_origin_us + 500) / 1000);
         info.has_pose = 1u;
         info.pose_x = (float)rec.laser_pose.x;
         info.pose_y = (float)rec.laser_pose.y;
@@ -134,8 +268,11 @@ static int run_extract(const extract_opts_t *o)
         }
         if (fwrite(g_frame_buf, 1, len, out) != len) {
             fail_msg("write error on %s", o->out);
+            write_failed = 1;
             break;
         }
+        own_geometry += info.has_geometry;
+        ++ms.frames_since;
         bytes += len;
         ++done;
         ++index;
@@ -144,21 +281,28 @@ static int run_extract(const extract_opts_t *o)
     progress_end(&prog);
     malformed = carmen_malformed_count(rd);
     carmen_close(rd);
-    if (close_out(out, o->out) != 0 || r < 0) {
+    if (close_out(out, o->out) != 0 || r < 0 || write_failed) {
+        return EXIT_FAIL;
+    }
+    if (index == 0u) {
+        fail_msg("%s: no laser line (FLASER or ROBOTLASER1) in the log%s", o->log,
+                 malformed ? " that could be read" : "");
         return EXIT_FAIL;
     }
     fprintf(stderr,
-            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan), %lu cut by a cap, "
-            "%lu failed, %lu malformed lines\n",
+            "%s: %lu scans extracted with %s, %llu bytes (%.1f per scan, %lu metadata "
+            "frames, %lu scans with their own geometry), %lu cut by a cap, %lu failed, %lu "
+            "with a bad time, %lu malformed lines\n",
             o->log, done, bsf_method_name(o->method), bytes,
-            done ? (double)bytes / (double)done : 0.0, cut.scans, failed, malformed);
+            done ? (double)bytes / (double)done : 0.0, ms.n_sent, own_geometry, cut.scans, failed,
+            bad_time, malformed);
     if (cut.scans > 0u) {
         fprintf(stderr,
                 "%s: the caps left out %lu keypoints, %lu segments and %lu points in %lu scans "
                 "(kept: what fits, largest first; see the README's memory section)\n",
                 o->log, cut.keypoints, cut.segments, cut.points, cut.scans);
     }
-    return failed ? EXIT_FAIL : 0;
+    return failed || bad_time ? EXIT_FAIL : 0;
 }
 
 int cmd_extract(int argc, char **argv)
@@ -170,6 +314,7 @@ int cmd_extract(int argc, char **argv)
     o.method = BSF_METHOD_DEFAULT;
     o.count = -1;
     o.quant = (double)BSF_QUANT_STEP_DEFAULT;
+    o.meta_every = 64;
     o.out = "-";
     for (i = 1; i < argc; ++i) {
         const char *v;
@@ -201,6 +346,12 @@ int cmd_extract(int argc, char **argv)
                 return usage_error("--quant needs metres in [%g, %g], got '%s'",
                                    (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, v);
             }
+        } else if ((v = opt_value(argc, argv, &i, "--meta-every", &err)) != NULL) {
+            if (parse_long(v, 1, 1000000000L, &o.meta_every) != 0) {
+                return usage_error("--meta-every needs a count >= 1, got '%s'", v);
+            }
+        } else if (strcmp(argv[i], "--reproducible") == 0) {
+            o.reproducible = 1;
         } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
             o.out = v;
         } else if (err) {

@@ -9,7 +9,10 @@ static const char render_help[] =
     "Draw the stream's B-spline features in the world frame (poses from the\n"
     "stream), vertices as squares, with a scale bar. --scans keeps the frames with\n"
     "sequence numbers K..L; --points draws those scans' raw points from LOG\n"
-    "underneath (same sequence numbering: the n-th laser scan of the log).\n";
+    "underneath (same sequence numbering: the n-th laser scan of the log).\n"
+    "--width sets the drawing's width in pixels (default 1600). The stream is read\n"
+    "several times (a pipe is spooled to a temporary file), so memory does not grow\n"
+    "with its length. Exits 1 when a non-empty input holds no valid frame.\n";
 
 typedef struct {
     double x, y, c, s;
@@ -58,64 +61,99 @@ static void for_each_curve_sample(const bsf_frame_t *fr, sample_fn fn, void *ctx
     }
 }
 
-/* Curve samples gathered for robust map bounds: a few stray features (a
- * reflection, a bad pose) must not shrink the whole map to a corner. */
+/*
+ * Robust map bounds: the central 99 % of the curve samples in x and in y, so
+ * that a few stray features (a reflection, a bad pose) do not shrink the map
+ * to a corner. Memory must not grow with the stream, so instead of keeping
+ * every sample the stream is read twice: once for the extremes and the
+ * count, once into a fine histogram per axis between them; a quantile is
+ * then known to one bin (a millionth of the extent), and the bounds are
+ * rounded outwards to whole bins.
+ */
+#define BOUNDS_BINS (1u << 20)
+
 typedef struct {
-    double *x, *y;
-    size_t n, cap;
-    int oom;
-} samples_t;
+    int pass; /* 0: extremes, 1: histograms */
+    double min[2], max[2];
+    unsigned long long n;
+    uint32_t *hist[2];
+    long lo, hi;           /* sequence range drawn */
+    unsigned long frames;  /* features frames in range */
+    unsigned long no_pose; /* of which without a pose */
+    uint32_t max_seq;      /* largest sequence number in the stream */
+    int have_seq;
+} bounds_ctx_t;
 
-static void bounds_sample(void *ctx, int new_curve, double wx, double wy)
+static size_t bin_of(const bounds_ctx_t *b, int axis, double v)
 {
-    samples_t *s = (samples_t *)ctx;
+    const double w = b->max[axis] - b->min[axis];
+    double t = w > 0.0 ? (v - b->min[axis]) / w : 0.0;
+    size_t i;
+    if (t < 0.0) {
+        t = 0.0;
+    }
+    i = (size_t)(t * (double)BOUNDS_BINS);
+    return i < BOUNDS_BINS ? i : BOUNDS_BINS - 1u;
+}
+
+static void bounds_sample(void *vctx, int new_curve, double wx, double wy)
+{
+    bounds_ctx_t *b = (bounds_ctx_t *)vctx;
     (void)new_curve;
-    if (s->oom) {
-        return;
-    }
-    if (s->n == s->cap) {
-        const size_t cap = s->cap ? 2u * s->cap : 4096u;
-        double *nx = (double *)realloc(s->x, cap * sizeof *nx);
-        double *ny = nx ? (double *)realloc(s->y, cap * sizeof *ny) : NULL;
-        if (nx != NULL) {
-            s->x = nx;
+    if (b->pass == 0) {
+        if (b->n == 0u) {
+            b->min[0] = b->max[0] = wx;
+            b->min[1] = b->max[1] = wy;
         }
-        if (ny == NULL) {
-            s->oom = 1;
-            return;
-        }
-        s->y = ny;
-        s->cap = cap;
+        b->min[0] = wx < b->min[0] ? wx : b->min[0];
+        b->max[0] = wx > b->max[0] ? wx : b->max[0];
+        b->min[1] = wy < b->min[1] ? wy : b->min[1];
+        b->max[1] = wy > b->max[1] ? wy : b->max[1];
+        ++b->n;
+    } else {
+        ++b->hist[0][bin_of(b, 0, wx)];
+        ++b->hist[1][bin_of(b, 1, wy)];
     }
-    s->x[s->n] = wx;
-    s->y[s->n] = wy;
-    s->n++;
 }
 
-static int cmp_double(const void *a, const void *b)
+/* The bin holding the sample of 0-based rank r. */
+static size_t bin_of_rank(const uint32_t *hist, unsigned long long r)
 {
-    const double x = *(const double *)a;
-    const double y = *(const double *)b;
-    return (x > y) - (x < y);
+    unsigned long long seen = 0;
+    size_t i;
+    for (i = 0; i < BOUNDS_BINS; ++i) {
+        seen += hist[i];
+        if (seen > r) {
+            return i;
+        }
+    }
+    return BOUNDS_BINS - 1u;
 }
 
-/* Bounds holding the central 99 % of the samples in x and in y, widened by
- * 5 %; all of them when there are few. */
-static void robust_bounds(samples_t *s, bsf_bounds_t *b)
+static double bin_edge(const bounds_ctx_t *b, int axis, size_t i)
 {
-    size_t lo, hi;
+    return b->min[axis] + (b->max[axis] - b->min[axis]) * (double)i / (double)BOUNDS_BINS;
+}
+
+static void robust_bounds(const bounds_ctx_t *b, bsf_bounds_t *out)
+{
+    const unsigned long long lo = b->n >= 1000u ? b->n / 200u : 0u;
+    const unsigned long long hi = b->n - 1u - lo;
+    double x0 = b->min[0], x1 = b->max[0], y0 = b->min[1], y1 = b->max[1];
     double mx, my;
-    if (s->n == 0) {
+    if (b->n == 0u) {
         return;
     }
-    qsort(s->x, s->n, sizeof *s->x, cmp_double);
-    qsort(s->y, s->n, sizeof *s->y, cmp_double);
-    lo = s->n >= 1000u ? s->n / 200u : 0u;
-    hi = s->n - 1u - lo;
-    mx = 0.05 * (s->x[hi] - s->x[lo]);
-    my = 0.05 * (s->y[hi] - s->y[lo]);
-    bsf_bounds_add(b, s->x[lo] - mx, s->y[lo] - my);
-    bsf_bounds_add(b, s->x[hi] + mx, s->y[hi] + my);
+    if (lo > 0u) {
+        x0 = bin_edge(b, 0, bin_of_rank(b->hist[0], lo));
+        x1 = bin_edge(b, 0, bin_of_rank(b->hist[0], hi) + 1u);
+        y0 = bin_edge(b, 1, bin_of_rank(b->hist[1], lo));
+        y1 = bin_edge(b, 1, bin_of_rank(b->hist[1], hi) + 1u);
+    }
+    mx = 0.05 * (x1 - x0);
+    my = 0.05 * (y1 - y0);
+    bsf_bounds_add(out, x0 - mx, y0 - my);
+    bsf_bounds_add(out, x1 + mx, y1 + my);
 }
 
 typedef struct {
@@ -141,8 +179,8 @@ static int in_range(uint32_t seq, long lo, long hi)
     return (long)seq >= lo && (hi < 0 || (long)seq <= hi);
 }
 
-static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi, const frame_list_t *l,
-                           bsf_bounds_t *bounds)
+static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
+                           const bounds_ctx_t *frames, bsf_bounds_t *bounds)
 {
     carmen_reader_t *rd = open_log(log);
     carmen_scan_t rec;
@@ -157,7 +195,7 @@ static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi, co
         const float rmax = scan_range_max(&rec, 0.0);
         const double th = rec.laser_pose.theta;
         if (!in_range((uint32_t)index, lo, hi) ||
-            (l->n && hi < 0 && index > l->frames[l->n - 1].seq)) {
+            (frames->have_seq && hi < 0 && index > frames->max_seq)) {
             ++index;
             if (hi >= 0 && (long)index > hi) {
                 break;
@@ -246,35 +284,109 @@ static void draw_scene(bsf_svg_t *svg, const bsf_scene_t *scene, bsf_bounds_t *b
     }
 }
 
-int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
-                  const char *points_log, const bsf_scene_t *scene, const char *title)
+/* Pass over the stream: bounds (extremes, then histograms), curves, vertices. */
+typedef enum { PASS_EXTREMES, PASS_HISTOGRAM, PASS_CURVES, PASS_VERTICES } render_pass_t;
+
+typedef struct {
+    render_pass_t pass;
+    bounds_ctx_t *b;
+    draw_ctx_t *dc;
+} render_ctx_t;
+
+static void draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
 {
+    const pose2_t pose = pose_of(fr);
+    size_t k;
+    for (k = 0; k + 1u < fr->result.n_ctrl; ++k) {
+        if (fr->result.ctrl_is_vertex[k] && fr->result.ctrl_is_vertex[k + 1u]) {
+            double wx, wy;
+            to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx, &wy);
+            bsf_svg_square(svg, wx, wy, 2.5, "#d02020");
+            ++k;
+        }
+    }
+}
+
+static int render_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
+{
+    render_ctx_t *rc = (render_ctx_t *)vctx;
+    (void)bytes;
+    if (fr->type != BSF_FRAME_TYPE_FEATURES) {
+        return 0;
+    }
+    if (rc->pass == PASS_EXTREMES) {
+        rc->b->max_seq = (!rc->b->have_seq || fr->seq > rc->b->max_seq) ? fr->seq : rc->b->max_seq;
+        rc->b->have_seq = 1;
+    }
+    if (!in_range(fr->seq, rc->b->lo, rc->b->hi)) {
+        return 0;
+    }
+    switch (rc->pass) {
+    case PASS_EXTREMES:
+        ++rc->b->frames;
+        rc->b->no_pose += fr->has_pose ? 0u : 1u;
+        /* fall through */
+    case PASS_HISTOGRAM: for_each_curve_sample(fr, bounds_sample, rc->b); break;
+    case PASS_CURVES: for_each_curve_sample(fr, draw_sample, rc->dc); break;
+    default: draw_vertices(rc->dc->svg, fr); break;
+    }
+    return 0;
+}
+
+static int render_pass(FILE *in, const char *in_name, render_ctx_t *rc, render_pass_t pass)
+{
+    stream_summary_t sum;
+    rc->pass = pass;
+    rc->b->pass = pass == PASS_EXTREMES ? 0 : 1;
+    if (rewind_input(in, in_name) != 0) {
+        return -1;
+    }
+    return decode_stream(in, in_name, render_frame, rc, &sum);
+}
+
+int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, long hi,
+                  const char *points_log, const bsf_scene_t *scene, const char *title,
+                  double width_px)
+{
+    static bounds_ctx_t bc;
     bsf_bounds_t b;
     bsf_svg_t svg;
     draw_ctx_t dc;
+    render_ctx_t rc;
     FILE *out;
-    size_t i, k;
-    unsigned long drawn = 0, no_pose = 0;
     char legend[160];
+    int failed;
 
+    memset(&bc, 0, sizeof bc);
+    bc.lo = lo;
+    bc.hi = hi;
+    rc.b = &bc;
+    rc.dc = &dc;
     bsf_bounds_init(&b);
-    {
-        samples_t smp;
-        memset(&smp, 0, sizeof smp);
-        for (i = 0; i < l->n; ++i) {
-            if (in_range(l->frames[i].seq, lo, hi)) {
-                for_each_curve_sample(&l->frames[i], bounds_sample, &smp);
-            }
-        }
-        robust_bounds(&smp, &b);
-        free(smp.x);
-        free(smp.y);
-        if (smp.oom) {
+    if (render_pass(in, in_name, &rc, PASS_EXTREMES) != 0) {
+        return -1;
+    }
+    if (bc.n >= 1000u) {
+        bc.hist[0] = (uint32_t *)calloc(BOUNDS_BINS, sizeof(uint32_t));
+        bc.hist[1] = (uint32_t *)calloc(BOUNDS_BINS, sizeof(uint32_t));
+        failed = bc.hist[0] == NULL || bc.hist[1] == NULL;
+        if (failed) {
             fail_msg("out of memory");
+        } else {
+            failed = render_pass(in, in_name, &rc, PASS_HISTOGRAM) != 0;
+        }
+        if (!failed) {
+            robust_bounds(&bc, &b);
+        }
+        free(bc.hist[0]);
+        free(bc.hist[1]);
+        if (failed) {
             return -1;
         }
+    } else {
+        robust_bounds(&bc, &b);
     }
-    if (b.empty && points_log != NULL && draw_log_points(NULL, points_log, lo, hi, l, &b) != 0) {
+    if (b.empty && points_log != NULL && draw_log_points(NULL, points_log, lo, hi, &bc, &b) != 0) {
         return -1;
     }
     if (scene != NULL) {
@@ -284,14 +396,14 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
     if (out == NULL) {
         return -1;
     }
-    if (bsf_svg_begin(&svg, out, &b, 1600.0, title) != 0) {
+    if (bsf_svg_begin(&svg, out, &b, width_px, title) != 0) {
         fail_msg("write error on %s", out_path);
         if (out != stdout) {
             fclose(out);
         }
         return -1;
     }
-    if (points_log != NULL && draw_log_points(&svg, points_log, lo, hi, l, NULL) != 0) {
+    if (points_log != NULL && draw_log_points(&svg, points_log, lo, hi, &bc, NULL) != 0) {
         if (out != stdout) {
             fclose(out);
         }
@@ -302,43 +414,22 @@ int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
     }
     dc.svg = &svg;
     dc.open = 0;
-    for (i = 0; i < l->n; ++i) {
-        const bsf_frame_t *fr = &l->frames[i];
-        if (!in_range(fr->seq, lo, hi)) {
-            continue;
-        }
-        ++drawn;
-        no_pose += fr->has_pose ? 0u : 1u;
-        for_each_curve_sample(fr, draw_sample, &dc);
-    }
+    failed = render_pass(in, in_name, &rc, PASS_CURVES) != 0;
     if (dc.open) {
         bsf_svg_path_end(&svg, "#1f5fbf", 1.6);
     }
     /* vertices on top */
-    for (i = 0; i < l->n; ++i) {
-        const bsf_frame_t *fr = &l->frames[i];
-        const pose2_t pose = pose_of(fr);
-        if (!in_range(fr->seq, lo, hi)) {
-            continue;
-        }
-        for (k = 0; k + 1u < fr->result.n_ctrl; ++k) {
-            if (fr->result.ctrl_is_vertex[k] && fr->result.ctrl_is_vertex[k + 1u]) {
-                double wx, wy;
-                to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx,
-                         &wy);
-                bsf_svg_square(&svg, wx, wy, 2.5, "#d02020");
-                ++k;
-            }
-        }
+    if (!failed) {
+        failed = render_pass(in, in_name, &rc, PASS_VERTICES) != 0;
     }
     snprintf(legend, sizeof legend, "%lu scans; blue: B-spline features; red squares: vertices%s",
-             drawn, points_log ? "; grey: raw points" : (scene ? "; grey: true walls" : ""));
-    if (bsf_svg_end(&svg, legend) != 0 || close_out(out, out_path) != 0) {
+             bc.frames, points_log ? "; grey: raw points" : (scene ? "; grey: true walls" : ""));
+    if (bsf_svg_end(&svg, legend) != 0 || close_out(out, out_path) != 0 || failed) {
         return -1;
     }
-    if (no_pose) {
+    if (bc.no_pose) {
         fprintf(stderr, "%s: %lu frames carry no pose; drawn in the sensor frame\n", g_cmd,
-                no_pose);
+                bc.no_pose);
     }
     return 0;
 }
@@ -347,7 +438,8 @@ int cmd_render(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL, *points = NULL;
     long lo = 0, hi = -1;
-    frame_list_t l;
+    double width = 1600.0;
+    FILE *in;
     int i, err = 0, rc;
     for (i = 1; i < argc; ++i) {
         const char *v;
@@ -362,6 +454,10 @@ int cmd_render(int argc, char **argv)
             }
         } else if ((v = opt_value(argc, argv, &i, "--points", &err)) != NULL) {
             points = v;
+        } else if ((v = opt_value(argc, argv, &i, "--width", &err)) != NULL) {
+            if (parse_float(v, 100.0, 20000.0, &width) != 0) {
+                return usage_error("--width needs pixels in [100, 20000], got '%s'", v);
+            }
         } else if (err) {
             return err;
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
@@ -378,14 +474,14 @@ int cmd_render(int argc, char **argv)
     if (in_path == NULL || out_path == NULL) {
         return usage_error("render needs an input stream and -o MAP.svg");
     }
-    if (load_frames(in_path, &l) != 0) {
-        frame_list_free(&l);
+    in = open_seekable(in_path);
+    if (in == NULL) {
         return EXIT_FAIL;
     }
-    rc = write_map_svg(out_path, &l, lo, hi, points, NULL, in_path);
+    rc = write_map_svg(out_path, in, in_path, lo, hi, points, NULL, in_path, width);
+    close_in(in);
     if (rc == 0) {
-        fprintf(stderr, "%s: wrote %s (%zu frames in the stream)\n", g_cmd, out_path, l.n);
+        fprintf(stderr, "%s: wrote %s\n", g_cmd, out_path);
     }
-    frame_list_free(&l);
     return rc == 0 ? 0 : EXIT_FAIL;
 }

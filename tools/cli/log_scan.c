@@ -25,16 +25,36 @@ bsf_extractor_t g_ex;
 bsf_result_t g_res;
 uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 
-int init_extractor(bsf_method_t method)
+int init_extractor_timed(bsf_method_t method, int timed)
 {
     bsf_params_t p = bsf_params_default(method);
     bsf_status_t st;
-    p.clock = bsf_port_clock_monotonic_ns;
-    p.clock_hz = 1000000000u;
+    if (timed) {
+        p.clock = bsf_port_clock_monotonic_ns;
+        p.clock_hz = 1000000000u;
+    }
     st = bsf_extractor_init(&g_ex, &p);
     if (st != BSF_OK) {
         fail_msg("cannot initialise the extractor: %s", bsf_status_str(st));
         return -1;
     }
     return 0;
+}
+
+int init_extractor(bsf_method_t method)
+{
+    return init_extractor_timed(method, 1);
+}
+
+void fill_metadata(bsf_metadata_t *m, const bsf_scan_t *sc, float quant)
+{
+    bsf_metadata_init(m);
+    m->method = (uint8_t)g_ex.params.method;
+    m->target_rms = g_ex.params.pdm.target_rms;
+    m->quant_step = quant;
+    m->n_beams = (uint32_t)sc->count;
+    m->angle_min = sc->angle_min;
+    m->angle_increment = sc->angle_increment;
+    m->range_min = sc->range_min;
+    m->range_max = sc->range_max;
 }

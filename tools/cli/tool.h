@@ -82,42 +82,57 @@ carmen_reader_t *open_log(const char *path);
 
 /* ---- stream_io.c: decoding a stream, metrics of frames ------------------- */
 
-/** A decoded stream held in memory. */
+/** What decoding a whole stream found. */
 typedef struct {
-    bsf_frame_t *frames;
-    size_t *frame_bytes;
-    size_t n;
-    size_t cap;
     bsf_decoder_stats_t stats;
-    unsigned long seq_gaps; /* frames missing according to sequence numbers */
-} frame_list_t;
+    unsigned long seq_gaps;            /**< features frames missing according to sequence numbers */
+    unsigned long long bytes_in;       /**< bytes read */
+    unsigned long n_scans;             /**< features frames delivered */
+    unsigned long n_metadata;          /**< metadata frames delivered */
+    unsigned long long metadata_bytes; /**< their bytes on the wire */
+    int have_seq;                      /**< internal: a sequence number was seen */
+    uint32_t last_seq;                 /**< internal: the last one */
+} stream_summary_t;
 
-void frame_list_free(frame_list_t *l);
-
-/** Called for every decoded frame with its size on the wire; non-zero stops. */
+/** Called for every decoded frame (features and metadata: check f->type)
+ *  with its own size on the wire (delimiter included); non-zero stops. */
 typedef int (*frame_cb)(void *ctx, const bsf_frame_t *f, size_t bytes);
 
-/** Feed a byte stream through the decoder; on_frame (may be NULL) sees every frame. */
-int decode_stream(FILE *in, const char *name, frame_cb on_frame, void *ctx,
-                  bsf_decoder_stats_t *stats_out, unsigned long *seq_gaps);
-/** Decode a whole stream file ("-": stdin) into l. 0, or -1 with a message. */
-int load_frames(const char *path, frame_list_t *l);
+/**
+ * Feed a byte stream through the decoder, read(2) by read(2) on in's
+ * descriptor (a pipe delivers each frame as soon as its delimiter arrives;
+ * do not read from in through stdio before). 0, or -1 with a message on a
+ * read error, a callback error, or when non-empty input holds no valid frame.
+ */
+int decode_stream(FILE *in, const char *name, frame_cb on_frame, void *ctx, stream_summary_t *sum);
+/** An input that can be read twice: a file as is, a pipe spooled to a
+ *  temporary file ("-": stdin). NULL with a message on failure. */
+FILE *open_seekable(const char *path);
+/** Back to the start of an input from open_seekable: 0, or -1 with a message. */
+int rewind_input(FILE *in, const char *name);
+/** Close an input unless it is stdin. */
+void close_in(FILE *in);
 /** Frames dropped by the decoder (CRC, malformed, version, oversize). */
 unsigned long frames_dropped(const bsf_decoder_stats_t *s);
 /** A result's metric counts (zeros when inconsistent). */
 bsf_scan_counts_t counts_of_result(const bsf_result_t *r);
+
 /** Nearest-rank percentile p in [0, 1] of v (sorted in place); 0 when n is 0. */
 size_t nearest_rank_size(size_t *v, size_t n, double p);
 
-/** The paper's metrics plus frame sizes over a stream. */
+/** The paper's metrics plus frame sizes and cap cuts over a stream. */
 typedef struct {
     bsf_metrics_summary_t m;
     size_t bytes_median;
     size_t bytes_p95;
     double bytes_mean;
+    unsigned long n_cut_scans; /**< scans whose frame says a cap cut them */
+    unsigned long long cut_keypoints, cut_segments, cut_points;
 } dataset_metrics_t;
 
-int metrics_of_frames(const frame_list_t *l, dataset_metrics_t *out);
+/** Metrics of a whole stream in memory independent of its length (exact
+ *  medians from counting histograms). 0, or -1 with a message. */
+int metrics_of_stream(FILE *in, const char *name, dataset_metrics_t *out, stream_summary_t *sum);
 
 /* ---- log_scan.c: log records as scans, the shared extractor -------------- */
 
@@ -130,8 +145,15 @@ extern bsf_extractor_t g_ex;
 extern bsf_result_t g_res;
 extern uint8_t g_frame_buf[BSF_FRAME_MAX_SIZE];
 
-/** Initialise g_ex for a method with the monotonic clock. 0, or -1 with a message. */
+/** Initialise g_ex for a method with the monotonic clock (or none when
+ *  reproducible: frames then carry extraction time 0). 0, or -1 with a message. */
+int init_extractor_timed(bsf_method_t method, int timed);
+/** init_extractor_timed(method, 1). */
 int init_extractor(bsf_method_t method);
+/** Metadata of a stream extracted by g_ex from scans like sc at step quant:
+ *  this build's caps, g_ex's method and target RMS, sc's geometry; no time
+ *  origin, no source. */
+void fill_metadata(bsf_metadata_t *m, const bsf_scan_t *sc, float quant);
 
 /* ---- the commands (cmd_*.c) ---------------------------------------------- */
 
@@ -143,9 +165,13 @@ int cmd_table1(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 
 /** Print the metrics of a stream (cmd_metrics.c; also used by demo). */
-void print_metrics(FILE *f, const char *name, const frame_list_t *l, const dataset_metrics_t *d);
-/** Draw frames lo..hi (seq) as an SVG map, optional raw points and scene (cmd_render.c). */
-int write_map_svg(const char *out_path, const frame_list_t *l, long lo, long hi,
-                  const char *points_log, const bsf_scene_t *scene, const char *title);
+void print_metrics(FILE *f, const char *name, const stream_summary_t *s,
+                   const dataset_metrics_t *d);
+/** Draw frames lo..hi (seq) of a stream as an SVG map width_px wide, optional
+ *  raw points and scene (cmd_render.c). in must come from open_seekable (it
+ *  is read several times, so memory does not grow with the stream). */
+int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, long hi,
+                  const char *points_log, const bsf_scene_t *scene, const char *title,
+                  double width_px);
 
 #endif /* BSF_TOOL_H */

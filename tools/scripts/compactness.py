@@ -75,15 +75,26 @@ def deflate_size(data):
     return len(c.compress(data) + c.flush())
 
 
-def bsf_frame_sizes(bsf, log, count, quant):
-    """Sizes of the frames `bsf extract` writes (each up to and including its 0x00)."""
+def bsf_frame_sizes(bsf, log, count, quant, metadata=None):
+    """Sizes of the scan frames `bsf extract` writes (each up to and including
+    its 0x00). Metadata frames (payload byte 0 of type 2, the byte after the
+    first COBS code) are left out; their sizes go to the list `metadata`."""
     cmd = [bsf, "extract", log, "-o", "-"]
     if count is not None:
         cmd += ["--count", str(count)]
     if quant is not None:
         cmd += ["--quant", str(quant)]
     out = subprocess.run(cmd, check=True, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL).stdout
-    return [len(f) + 1 for f in out.split(b"\x00") if f]
+    sizes = []
+    for f in out.split(b"\x00"):
+        if not f:
+            continue
+        if len(f) > 1 and f[1] & 0x0F == 2:
+            if metadata is not None:
+                metadata.append(len(f) + 1)
+            continue
+        sizes.append(len(f) + 1)
+    return sizes
 
 
 def p95(values):
@@ -104,9 +115,9 @@ def main():
                     help="also measure bsf frames at these steps (metres)")
     args = ap.parse_args()
 
-    print("| dataset | scans | bsf frame median / p95 | raw | xz per scan median / p95 "
-          "| deflate per scan median / p95 |")
-    print("|---|---|---|---|---|---|")
+    print("| dataset | scans | bsf frame median / p95 | metadata per scan | raw "
+          "| xz per scan median / p95 | deflate per scan median / p95 |")
+    print("|---|---|---|---|---|---|---|")
     for name, fname, count in DATASETS:
         if args.only and name not in args.only:
             continue
@@ -115,19 +126,20 @@ def main():
             print("SKIPPED: %s not found" % log, file=sys.stderr)
             continue
         raws = [raw_bytes(r) for r in read_ranges(log, count)]
-        frames = bsf_frame_sizes(args.bsf, log, count, None)
+        meta = []
+        frames = bsf_frame_sizes(args.bsf, log, count, None, meta)
         if len(frames) != len(raws):
             print("note: %s: %d frames for %d scans" % (name, len(frames), len(raws)),
                   file=sys.stderr)
         raw_len = [len(r) for r in raws]
         xz = [xz_size(r) for r in raws]
         dfl = [deflate_size(r) for r in raws]
-        print("| %s | %d | **%g** / %d | %g | %g / %d | %g / %d |" %
-              (name, len(frames), med(frames), p95(frames), med(raw_len), med(xz), p95(xz),
-               med(dfl), p95(dfl)))
+        print("| %s | %d | **%g** / %d | %.2f | %g | %g / %d | %g / %d |" %
+              (name, len(frames), med(frames), p95(frames), sum(meta) / max(1, len(frames)),
+               med(raw_len), med(xz), p95(xz), med(dfl), p95(dfl)))
         for q in args.quant or []:
             sizes = bsf_frame_sizes(args.bsf, log, count, q)
-            print("|   %s at step %g mm | %d | %g / %d | | | |" %
+            print("|   %s at step %g mm | %d | %g / %d | | | | |" %
                   (name, q * 1000.0, len(sizes), med(sizes), p95(sizes)))
     return 0
 

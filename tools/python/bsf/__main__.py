@@ -1,0 +1,162 @@
+# SPDX-License-Identifier: MIT
+"""Command line: ``python -m bsf extract|plot ...`` (``--help`` on each)."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import List, Optional
+
+from . import METHODS, QUANT_STEP_DEFAULT, BsfError, read
+
+BAG_SUFFIXES = (".bag", ".db3", ".mcap")
+
+
+def _is_bag(path: str) -> bool:
+    return path.endswith(BAG_SUFFIXES) or (os.path.isdir(path) and os.path.isfile(os.path.join(path, "metadata.yaml")))
+
+
+def _param(text: str) -> tuple:
+    name, sep, value = text.partition("=")
+    if not sep:
+        raise argparse.ArgumentTypeError(f"--param needs NAME=VALUE, got {text!r}")
+    try:
+        v: object = int(value)
+    except ValueError:
+        try:
+            v = float(value)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"--param {name}: {value!r} is not a number") from None
+    return name, v
+
+
+def cmd_extract(a: argparse.Namespace) -> int:
+    params = dict(a.param or [])
+    if _is_bag(a.input):
+        if not a.topic:
+            print("bsf: extract of a ROS bag needs --topic (e.g. --topic /scan)", file=sys.stderr)
+            return 2
+        from .rosbag import BagError, extract_bag
+
+        try:
+            n, failed, nbytes = extract_bag(
+                a.input,
+                a.topic,
+                a.output,
+                a.method,
+                quant_step=a.quant,
+                range_max=a.range_max,
+                timing=not a.no_time,
+                **params,
+            )
+        except (BagError, BsfError, TypeError, OSError) as e:
+            print(f"bsf: {e}", file=sys.stderr)
+            return 1
+        print(
+            f"{a.input}: {n} scans of {a.topic} extracted with {a.method}, {nbytes} bytes, {failed} refused",
+            file=sys.stderr,
+        )
+        if n == 0 and failed == 0:
+            print(f"bsf: {a.input}: no message on {a.topic}", file=sys.stderr)
+            return 1
+        return 1 if failed else 0
+    # Anything else is read as a CARMEN log, as `bsf extract` does.
+    errors: List[str] = []
+    n = nbytes = 0
+    try:
+        dst = sys.stdout.buffer if a.output == "-" else open(a.output, "wb")
+    except OSError as e:
+        print(f"bsf: {e}", file=sys.stderr)
+        return 1
+    from . import StreamWriter, _log_frames, _round_us
+
+    writer = StreamWriter(dst, a.method, params, a.quant, source=os.path.basename(a.input))
+    try:
+        for scan, rmax, fr in _log_frames(a.input, a.method, a.first, a.count, a.range_max, not a.no_time, errors, params):
+            writer.write(
+                fr,
+                _round_us(scan.timestamp),
+                len(scan.ranges),
+                scan.angle_min,
+                scan.angle_increment,
+                0.0,
+                rmax,
+                no_time=a.no_time,
+            )
+        n, nbytes = writer.frames, writer.bytes
+    except (BsfError, TypeError, OSError) as e:
+        print(f"bsf: {e}", file=sys.stderr)
+        return 1
+    finally:
+        if dst is sys.stdout.buffer:
+            dst.flush()
+        else:
+            dst.close()
+    for e in errors:
+        print(e, file=sys.stderr)
+    print(f"{a.input}: {n} scans extracted with {a.method}, {nbytes} bytes, {len(errors)} failed", file=sys.stderr)
+    return 1 if errors else 0
+
+
+def cmd_plot(a: argparse.Namespace) -> int:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("bsf: plot needs matplotlib: pip install './tools/python[plot]'", file=sys.stderr)
+        return 1
+    from .plot import plot
+
+    from . import Frame
+
+    try:
+        frames = [f for f in read(a.input) if isinstance(f, Frame)]  # metadata frames draw nothing
+    except (BsfError, OSError) as e:
+        print(f"bsf: {e}", file=sys.stderr)
+        return 1
+    ax = plot(frames, world=not a.sensor)
+    ax.set_title(f"{os.path.basename(a.input)}: {len(frames)} frames")
+    ax.figure.savefig(a.output, dpi=a.dpi, bbox_inches="tight")
+    plt.close(ax.figure)
+    print(f"{a.output}: {len(frames)} frames drawn", file=sys.stderr)
+    return 0
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m bsf", description="bsf from Python: ROS bags and CARMEN logs to bsf streams, plots.")
+    sub = p.add_subparsers(dest="command", required=True)
+    e = sub.add_parser(
+        "extract",
+        help="extract features from a ROS bag (LaserScan topic) or a CARMEN log into a bsf stream",
+        description="INPUT is a ROS 1 .bag, a ROS 2 bag (directory, .db3 or .mcap) or a CARMEN log (plain or .gz).",
+    )
+    e.add_argument("input", metavar="INPUT")
+    e.add_argument("--topic", help="LaserScan topic of a bag, e.g. /scan")
+    e.add_argument("-o", dest="output", default="-", help="output stream ('-': stdout, the default)")
+    e.add_argument("--method", choices=METHODS, default="falko-sved-pdm")
+    e.add_argument("--quant", type=float, default=QUANT_STEP_DEFAULT, help="control point step, metres (0.005)")
+    e.add_argument("--range-max", type=float, default=None, help="readings >= M metres are invalid (bags: lowers each message's own limit)")
+    e.add_argument("--first", type=int, default=0, help="CARMEN: skip the first K scans")
+    e.add_argument("--count", type=int, default=None, help="CARMEN: at most N scans")
+    e.add_argument("--no-time", action="store_true", help="send 0 as extraction time (byte-reproducible output)")
+    e.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", help="parameter override, e.g. pdm_target_rms=0.02")
+    e.set_defaults(func=cmd_extract)
+    pl = sub.add_parser("plot", help="draw a bsf stream to an image (needs matplotlib)")
+    pl.add_argument("input", metavar="IN", help="bsf stream ('-': stdin)")
+    pl.add_argument("-o", dest="output", required=True, help="image file (.png, .svg, .pdf)")
+    pl.add_argument("--sensor", action="store_true", help="sensor frame instead of the world frame")
+    pl.add_argument("--dpi", type=int, default=150)
+    pl.set_defaults(func=cmd_plot)
+    a = p.parse_args(argv)
+    try:
+        return int(a.func(a))
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
