@@ -261,7 +261,8 @@ static int method_of(PyObject *name, bsf_method_t *out)
     }
     *out = bsf_method_from_name(s);
     if (*out == BSF_METHOD_COUNT) {
-        PyErr_Format(g_bsf_error, "unknown method %R (lc-sved-pdm, falko-sved-pdm, bid-sved-pdm or rpos-lsba)",
+        PyErr_Format(g_bsf_error,
+                     "unknown method %R (lc-sved-pdm, falko-sved-pdm, bid-sved-pdm or rpos-lsba)",
                      name);
         return -1;
     }
