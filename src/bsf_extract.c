@@ -9,6 +9,7 @@ static const char *const method_names[BSF_METHOD_COUNT] = {
     "falko-sved-pdm",
     "bid-sved-pdm",
     "rpos-lsba",
+    "lc-sved-pdm",
 };
 
 const char *bsf_method_name(bsf_method_t method)
@@ -39,6 +40,7 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     memset(&p, 0, sizeof p);
     p.method = method;
     p.falko = bsf_falko_params_default();
+    p.lc = bsf_lc_params_default();
     p.bid = bsf_bid_params_default();
     p.sved = bsf_sved_params_default();
     p.rpos = bsf_rpos_params_default();
@@ -74,6 +76,15 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
     switch (p->method) {
     case BSF_METHOD_FALKO_SVED_PDM:
         st = bsf_falko_params_check(&p->falko);
+        if (st == BSF_OK) {
+            st = bsf_sved_params_check(&p->sved);
+        }
+        if (st == BSF_OK) {
+            st = bsf_pdm_params_check(&p->pdm);
+        }
+        break;
+    case BSF_METHOD_LC_SVED_PDM:
+        st = bsf_lc_params_check(&p->lc);
         if (st == BSF_OK) {
             st = bsf_sved_params_check(&p->sved);
         }
@@ -174,6 +185,10 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
     case BSF_METHOD_FALKO_SVED_PDM:
         st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->scratch.falko, ex->keypoints,
                               BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+        break;
+    case BSF_METHOD_LC_SVED_PDM:
+        st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
+                           BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
     case BSF_METHOD_BID_SVED_PDM:
         st = bsf_bid_detect(&ex->points, &ex->params.bid, &ex->scratch.bid, ex->keypoints,
@@ -319,6 +334,7 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
             ++k; /* an interest beam on an invalid reading is no vertex */
         }
         if (k < ex->n_keypoints && ex->interest[k] == b) {
+            ex->scratch.fit.vertex_anchor[nv] = ex->keypoints[k].point;
             ex->scratch.fit.vertex_pos[nv++] = (uint16_t)n;
             ++k;
         }
@@ -331,6 +347,7 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     for (i = 0; i < nv; ++i) {
         if (ex->scratch.fit.vertex_pos[i] >= 2u &&
             (size_t)ex->scratch.fit.vertex_pos[i] + 3u <= n) {
+            ex->scratch.fit.vertex_anchor[*n_vertex] = ex->scratch.fit.vertex_anchor[i];
             ex->scratch.fit.vertex_pos[(*n_vertex)++] = ex->scratch.fit.vertex_pos[i];
         }
     }
@@ -367,9 +384,13 @@ static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf
     } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
         st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
     } else {
-        st = bsf_pdm_fit(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos, n_vertex,
-                         &ex->params.pdm, &ex->scratch.fit.pdm, &res->ctrl[res->n_ctrl],
-                         &res->ctrl_is_vertex[res->n_ctrl], room, &n_ctrl, &e_curve, NULL);
+        /* LC's keypoint is the walls' intersection: the vertex stays there. */
+        const bsf_point_t *anchor =
+            ex->params.method == BSF_METHOD_LC_SVED_PDM ? ex->scratch.fit.vertex_anchor : NULL;
+        st = bsf_pdm_fit_anchored(ex->scratch.fit.seg_points, n, ex->scratch.fit.vertex_pos, anchor,
+                                  n_vertex, &ex->params.pdm, &ex->scratch.fit.pdm,
+                                  &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl], room,
+                                  &n_ctrl, &e_curve, NULL);
     }
     if (st != BSF_OK) {
         return st;

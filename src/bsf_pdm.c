@@ -28,6 +28,15 @@
 /* Failed footpoint steps longer than this fraction of a span are halved and
  * retried (far from the curve); shorter ones are only rounding noise. */
 #define PDM_HALVE_MIN 0.05f
+/* Weight of a vertex anchor per data point of the segment: the anchor
+ * weighs as much as all the points together, so a vertex stays within a few
+ * millimetres of the two-line intersection (vertex error on the ground-truth
+ * scenes as with a stiff pin, measured 1 to 100) yet the data may still
+ * nudge it (slightly fewer control points on the four logs than a pin). */
+#define PDM_ANCHOR_WEIGHT 1.0f
+/* Shortest chord that sets the local direction of an arc-length step,
+ * metres: well above range noise, well below the radius of a pillar. */
+#define PDM_ARC_BASE 0.1f
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -40,7 +49,9 @@ typedef struct {
     float lambda;
     float rms;
     uint32_t loaded;
-    float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* polyline length of each fragment */
+    float frag_len[BSF_PDM_MAX_FRAGMENTS];        /* length of each fragment (arc_step) */
+    const bsf_point_t *anchor;                    /* vertex anchors (absolute), or NULL */
+    uint8_t vertex_unknown[BSF_PDM_MAX_VERTICES]; /* unknown index of each vertex */
 } pdm_state_t;
 
 void bsf_pdm_params_default(bsf_pdm_params_t *p)
@@ -78,11 +89,63 @@ bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
     return BSF_OK;
 }
 
+static float dist2_pts(bsf_point_t a, bsf_point_t b)
+{
+    const float dx = b.x - a.x;
+    const float dy = b.y - a.y;
+    return dx * dx + dy * dy;
+}
+
 static float dist(bsf_point_t a, bsf_point_t b)
 {
     const float dx = b.x - a.x;
     const float dy = b.y - a.y;
     return sqrtf(dx * dx + dy * dy);
+}
+
+/* Cumulative arc length of the points, fragment by fragment (w->arc), where
+ * each step from point i - 1 to point i is measured along the local direction
+ * of the points: the chord between the nearest points at least PDM_ARC_BASE
+ * before point i and after point i - 1 (within the fragment). Range noise
+ * across a wall then adds nothing, where the plain polyline length grows by
+ * about the noise at every step and, where points are denser than the noise
+ * (near the sensor, fine beams), puts the start parameters far off the
+ * footpoints. Both window ends only move forward: linear cost. Returns the
+ * fragment's length (<= 0 only for a fragment that folds back on itself,
+ * which the caller then spaces by index). */
+static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
+{
+    const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
+    size_t lo = a;
+    size_t hi = a;
+    size_t i;
+    float acc = 0.0f;
+    arc[a] = 0.0f;
+    for (i = a + 1u; i <= b; ++i) {
+        const float sx = pts[i].x - pts[i - 1u].x;
+        const float sy = pts[i].y - pts[i - 1u].y;
+        float dx;
+        float dy;
+        float len;
+        while (lo + 1u < i && dist2_pts(pts[lo + 1u], pts[i]) >= base2) {
+            ++lo;
+        }
+        if (hi < i) {
+            hi = i;
+        }
+        while (hi < b && dist2_pts(pts[hi], pts[i - 1u]) < base2) {
+            ++hi;
+        }
+        dx = pts[hi].x - pts[lo].x;
+        dy = pts[hi].y - pts[lo].y;
+        len = sqrtf(dx * dx + dy * dy);
+        /* Signed: the noise along the direction then cancels from step to
+         * step instead of piling up (the arc may dip by the noise, which the
+         * start parameters clamp). */
+        acc += len > 0.0f ? (sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
+        arc[i] = acc;
+    }
+    return acc;
 }
 
 /* Control polygon for the current precision counts: unknown index of every
@@ -110,6 +173,7 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
         if (f + 1u < s->n_frag) {
             t1[f] = (float)stored / n_span;
             t0[f + 1u] = t1[f];
+            s->vertex_unknown[f] = (uint8_t)unknown;
             w->unknown_of[stored++] = (uint8_t)unknown;
             w->unknown_of[stored++] = (uint8_t)unknown++;
         }
@@ -283,7 +347,6 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const float range = t1[f] - t0[f];
         const unsigned straight = w->frag_precision[f] == 0u;
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
-        float arc = 0.0f;
         /* The vertex point closing fragment f opens fragment f + 1: it is
          * accumulated once, by the fragment it closes. */
         for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
@@ -291,12 +354,13 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             float u;
             float t;
             size_t span;
-            if (i > a) {
-                arc += dist(s->pts[i - 1u], s->pts[i]);
-            }
             /* Coincident points: fall back to even spacing by index. */
-            frac = len > 0.0f ? arc * inv_len : (float)(i - a) / (float)(b - a);
-            frac = frac > 1.0f ? 1.0f : frac;
+            if (i == b) {
+                frac = 1.0f; /* its arc slot belongs to the next fragment */
+            } else {
+                frac = len > 0.0f ? w->arc[i] * inv_len : (float)(i - a) / (float)(b - a);
+            }
+            frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
             if (straight) {
                 /* A straight fragment at a vertex is not traversed at
                  * constant speed: boundary-vertex runs as 1 - (1 - u)^2,
@@ -359,6 +423,16 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             r.s21 = weight * c2 * c1;
             r.s22 = weight * c2 * c2;
             sums_flush(w, &r);
+        }
+    }
+    if (s->anchor != NULL) {
+        /* Each vertex is held near its anchor by a spring. */
+        const float weight = PDM_ANCHOR_WEIGHT * (float)s->n;
+        for (k = 0; k + 1u < s->n_frag; ++k) {
+            const size_t u = s->vertex_unknown[k];
+            w->band[u * 3u] += weight;
+            w->rhs_x[u] += weight * (s->anchor[k].x - s->origin.x);
+            w->rhs_y[u] += weight * (s->anchor[k].y - s->origin.y);
         }
     }
     st = bsf_spd_band_solve2(w->band, m, m > 2u ? 2u : m - 1u, w->factor, w->rhs_x, w->rhs_y,
@@ -725,6 +799,16 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
                          bsf_point_t *ctrl_out, uint8_t *is_vertex_out, size_t ctrl_cap,
                          size_t *n_ctrl_out, float *e_curve_out, bsf_pdm_info_t *info_out)
 {
+    return bsf_pdm_fit_anchored(pts, n, vertex_pos, NULL, n_vertex, p, work, ctrl_out,
+                                is_vertex_out, ctrl_cap, n_ctrl_out, e_curve_out, info_out);
+}
+
+bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16_t *vertex_pos,
+                                  const bsf_point_t *vertex_anchor, size_t n_vertex,
+                                  const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                                  bsf_point_t *ctrl_out, uint8_t *is_vertex_out, size_t ctrl_cap,
+                                  size_t *n_ctrl_out, float *e_curve_out, bsf_pdm_info_t *info_out)
+{
     bsf_pdm_params_t defaults;
     pdm_state_t s;
     bsf_pdm_info_t info;
@@ -761,14 +845,24 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     if (st != BSF_OK) {
         return st;
     }
-    memset(&s, 0, sizeof s);
-    for (i = 1, f = 0; i < n; ++i) {
-        const float d = dist(pts[i - 1u], pts[i]);
-        s.frag_len[f] += d;
-        length += d;
-        if (f < n_vertex && i == vertex_pos[f]) {
-            ++f; /* the vertex closes fragment f */
+    if (vertex_anchor != NULL) {
+        st = bsf_fit_check_points(vertex_anchor, n_vertex);
+        if (st != BSF_OK) {
+            return st;
         }
+    }
+    memset(&s, 0, sizeof s);
+    s.anchor = n_vertex > 0u ? vertex_anchor : NULL;
+    for (i = 1; i < n; ++i) {
+        length += dist(pts[i - 1u], pts[i]);
+    }
+    for (f = 0; f <= n_vertex; ++f) {
+        const size_t a = f == 0u ? 0u : vertex_pos[f - 1u];
+        const size_t b = f < n_vertex ? vertex_pos[f] : n - 1u;
+        /* Arcs are relative to each fragment's first point, so a vertex
+         * point's slot holds 0 (the fragment it opens); the fragment it
+         * closes ends at its length, frag_len. */
+        s.frag_len[f] = fragment_arc(pts, a, b, work->arc);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;

@@ -19,19 +19,32 @@
 #include "bsf_scan.h"
 #include "bsf_feature.h"
 #include "bsf_falko.h"
+#include "bsf_lc.h"
 #include "bsf_bid.h"
 #include "bsf_segment.h"
 #include "bsf_fit.h"
 
 BSF_BEGIN_DECLS
 
-/** The extraction methods of the paper's Table 1. */
+/**
+ * Extraction methods: the three of the paper's Table 1, and bsf's default.
+ * FALKO-SVED-PDM is the paper's proposal with FALKOLib-identical keypoints
+ * (the paper-faithful configuration). LC-SVED-PDM replaces FALKO by LC, bsf's
+ * line-corner detector (bsf_lc.h), and holds each PDM vertex at LC's two-line
+ * intersection: it finds the corners FALKO misses (FALKO's neighbourhood and
+ * its per-scan relative score hide most corners beyond 3 m and lone corners)
+ * and places them where the walls meet (docs/GROUND_TRUTH.md has the numbers).
+ */
 typedef enum {
-    BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM (default) */
+    BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM */
     BSF_METHOD_BID_SVED_PDM = 1,   /**< baseline: B-spline interest points (slow), SVED, PDM */
-    BSF_METHOD_RPOS_LSBA = 2, /**< baseline: RPOS segments, 4-point least squares, no corners */
-    BSF_METHOD_COUNT = 3
+    BSF_METHOD_RPOS_LSBA = 2,   /**< baseline: RPOS segments, 4-point least squares, no corners */
+    BSF_METHOD_LC_SVED_PDM = 3, /**< default: LC line corners, SVED, PDM with anchored vertices */
+    BSF_METHOD_COUNT = 4
 } bsf_method_t;
+
+/** The method a user gets unless they choose: LC-SVED-PDM. */
+#define BSF_METHOD_DEFAULT BSF_METHOD_LC_SVED_PDM
 
 /**
  * A clock for the time metric: returns a free-running 32-bit tick count
@@ -44,10 +57,11 @@ typedef uint32_t (*bsf_clock_fn)(void *user);
 typedef struct {
     bsf_method_t method;
     bsf_falko_params_t falko;         /**< used by FALKO-SVED-PDM */
+    bsf_lc_params_t lc;               /**< used by LC-SVED-PDM */
     bsf_bid_params_t bid;             /**< used by BID-SVED-PDM */
-    bsf_sved_params_t sved;           /**< used by the two SVED methods */
+    bsf_sved_params_t sved;           /**< used by the three SVED methods */
     bsf_rpos_params_t rpos;           /**< used by RPOS-LSBA */
-    bsf_pdm_params_t pdm;             /**< used by the two PDM methods */
+    bsf_pdm_params_t pdm;             /**< used by the three PDM methods */
     bsf_no_return_params_t no_return; /**< no-return codes, every method (bsf_scan.h) */
     bsf_clock_fn clock;               /**< optional, see bsf_clock_fn */
     void *clock_user;                 /**< passed to clock */
@@ -88,10 +102,12 @@ typedef struct {
     union {
         bsf_segment_t all_segments[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
         bsf_falko_work_t falko;
+        bsf_lc_work_t lc;
         bsf_bid_work_t bid;
         struct {
             bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
             uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, positions in seg_points */
+            bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC-SVED-PDM) */
             bsf_pdm_work_t pdm;
         } fit;
     } scratch;

@@ -95,12 +95,13 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
 
 /**
  * Working memory of bsf_pdm_fit, owned by the caller (static or on a task's
- * stack it does not overflow: 10944 bytes at the default caps). Its content
+ * stack it does not overflow: 15268 bytes at the default caps). Its content
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {
-    float t[BSF_MAX_POINTS];                    /**< footpoint parameter of each point */
-    float t_prev[BSF_MAX_POINTS];               /**< parameters before the current iteration */
+    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
+    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
+    float arc[BSF_MAX_POINTS];    /**< arc length of each point from its fragment's first point */
     float band[BSF_MAX_CTRL_PER_FEATURE * 3];   /**< normal matrix, lower band (bw 2) */
     float factor[BSF_MAX_CTRL_PER_FEATURE * 3]; /**< its Cholesky factor */
     float rhs_x[BSF_MAX_CTRL_PER_FEATURE];      /**< right-hand sides, then solutions */
@@ -186,6 +187,24 @@ BSF_NODISCARD bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const u
                                        bsf_pdm_work_t *work, bsf_point_t *ctrl_out,
                                        uint8_t *is_vertex_out, size_t ctrl_cap, size_t *n_ctrl_out,
                                        float *e_curve_out, bsf_pdm_info_t *info_out);
+
+/**
+ * bsf_pdm_fit with each vertex anchored: vertex k is held near vertex_anchor[k]
+ * (metres, same frame as pts) by a spring as strong as all the points
+ * together in every solve, so it stays (within millimetres) at a corner
+ * position found by the caller (for instance the intersection of
+ * two wall lines, bsf_lc_detect's keypoint point) instead of drifting with
+ * the points around it. vertex_anchor may be NULL (then this is exactly
+ * bsf_pdm_fit). Anchors must be finite with |x|, |y| <= BSF_FIT_MAX_COORD
+ * (else BSF_ERR_ARG); other arguments and results as bsf_pdm_fit.
+ */
+BSF_NODISCARD bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n,
+                                                const uint16_t *vertex_pos,
+                                                const bsf_point_t *vertex_anchor, size_t n_vertex,
+                                                const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                                                bsf_point_t *ctrl_out, uint8_t *is_vertex_out,
+                                                size_t ctrl_cap, size_t *n_ctrl_out,
+                                                float *e_curve_out, bsf_pdm_info_t *info_out);
 
 BSF_END_DECLS
 
