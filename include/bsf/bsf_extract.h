@@ -69,15 +69,20 @@ typedef struct {
 } bsf_params_t;
 
 /** Defaults for a method: what a user gets (segmentation extensions on,
- *  see bsf_sved_params_default, and no-return detection on).
+ *  see bsf_sved_params_default, and no-return detection on). PDM takes
+ *  bsf_pdm_params_default (30 mm target plus the systematic-deviation test)
+ *  except FALKO-SVED-PDM and BID-SVED-PDM, which refine on RMS alone to
+ *  25 mm (bias_window 0): their keypoints miss most corners, which the test
+ *  would round with control points.
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
  *  stored, which bsf_extractor_init then refuses. */
 bsf_params_t bsf_params_default(bsf_method_t method);
 
 /** The paper-faithful configuration of a method: as bsf_params_default but
  *  with the paper's SVED rule (bsf_sved_params_paper), no no-return
- *  detection beyond range_max, and PDM's refinement target at the first
- *  release's 15 mm (the paper states none). `bsf table1 --paper` uses it. */
+ *  detection beyond range_max, and PDM's refinement on RMS alone with the
+ *  first release's 15 mm target (the paper states none; bias_window 0).
+ *  `bsf table1 --paper` uses it. */
 bsf_params_t bsf_params_paper(bsf_method_t method);
 
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
