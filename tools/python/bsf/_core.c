@@ -139,6 +139,8 @@ static const param_desc_t g_params[] = {
     PARAM("pdm_max_ctrl", pdm.max_ctrl, PT_U16),
     PARAM("pdm_footpoint_steps", pdm.footpoint_steps, PT_U8),
     PARAM("pdm_refine", pdm.refine, PT_U8),
+    PARAM("pdm_bias_window", pdm.bias_window, PT_U8),
+    PARAM("pdm_bias_ratio", pdm.bias_ratio, PT_FLOAT),
 };
 #define N_PARAMS (sizeof g_params / sizeof g_params[0])
 
