@@ -100,21 +100,29 @@ typedef struct {
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
     bsf_segment_t segments[BSF_MAX_SEGMENTS];
-    uint16_t seg_label[BSF_MAX_POINTS]; /**< per beam: first beam of its segment, or BSF_SEG_NONE */
-    /** Stage scratch. The corner, segmentation and fitting stages never run
-     *  at the same time, so their working memory overlaps (the segments take
-     *  no more room than one segment's points, so sizeof is unchanged). */
+    /** Stage scratch. The corner stage runs before segmentation, and
+     *  segmentation before fitting, so their working memory overlaps: the
+     *  corner detectors' work, or the per-beam segment labels (written by
+     *  segmentation, read by fitting, valid after bsf_extract until the next
+     *  call) beside either every kept segment before the cap or the fitting
+     *  stage's work. */
     union {
-        bsf_segment_t all_segments[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
         bsf_falko_work_t falko;
         bsf_lc_work_t lc;
         bsf_bid_work_t bid;
         struct {
-            bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
-            uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, positions in seg_points */
-            bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC-SVED-PDM) */
-            bsf_pdm_work_t pdm;
-        } fit;
+            /** per beam: first beam of its segment, or BSF_SEG_NONE */
+            uint16_t label[BSF_MAX_POINTS];
+            union {
+                bsf_segment_t all[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
+                struct {
+                    bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
+                    uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
+                    bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
+                    bsf_pdm_work_t pdm;
+                } fit;
+            } use;
+        } seg;
     } scratch;
     size_t n_keypoints;
     size_t n_segments;
