@@ -17,6 +17,22 @@
 #ifndef BSF_MATH_H
 #define BSF_MATH_H
 
+#include <float.h>
+
+/*
+ * Same bits on every target needs float arithmetic evaluated in float. A
+ * compiler that evaluates float in double or long double (FLT_EVAL_METHOD
+ * 1 or 2: GCC on s390x in ISO C mode, x87 without SSE) rounds intermediate
+ * results differently and the frames would differ from the host's, so the
+ * library refuses to build there rather than give different maps. The
+ * flag: -fexcess-precision=fast or -std=gnu99 (GCC, e.g. s390x), -msse2
+ * -mfpmath=sse (32-bit x86). bsf's CMake adds -fexcess-precision=fast when
+ * that is enough; README, "Portability".
+ */
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#error "bsf needs FLT_EVAL_METHOD == 0: add -fexcess-precision=fast (GCC) or -mfpmath=sse"
+#endif
+
 /** sin(x), radians. Full accuracy for |x| <= 8192; finite in [-1, 1] for any finite x. */
 float bsf_sinf(float x);
 

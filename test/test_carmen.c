@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +27,7 @@
 
 static char path_plain[256];
 static char path_gz[256];
+static char path_tmp[256];
 static char big_line[80000];
 
 void setUp(void)
@@ -119,6 +121,11 @@ static void write_files(void)
     TEST_ASSERT_EQUAL_UINT32((uint32_t)strlen(log_text),
                              (uint32_t)fwrite(log_text, 1, strlen(log_text), f));
     TEST_ASSERT_EQUAL_INT(0, fclose(f));
+
+    snprintf(path_tmp, sizeof path_tmp, "%s/bsf_carmen_tmp_XXXXXX", tmp);
+    fd = mkstemp(path_tmp);
+    TEST_ASSERT_TRUE(fd >= 0);
+    close(fd);
 
     snprintf(path_gz, sizeof path_gz, "%s/bsf_carmen_gz_XXXXXX", tmp);
     fd = mkstemp(path_gz);
@@ -270,6 +277,218 @@ static void test_silent_reader_still_counts_bad_lines(void)
     carmen_close(rd);
 }
 
+/* ---- damaged files ---------------------------------------------------------- */
+
+static void write_bytes(const char *path, const void *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    TEST_ASSERT_NOT_NULL(f);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)fwrite(data, 1, n, f));
+    TEST_ASSERT_EQUAL_INT(0, fclose(f));
+}
+
+static size_t read_all(const char *path, unsigned char *buf, size_t cap)
+{
+    size_t n;
+    FILE *f = fopen(path, "rb");
+    TEST_ASSERT_NOT_NULL(f);
+    n = fread(buf, 1, cap, f);
+    TEST_ASSERT_TRUE(n < cap);
+    fclose(f);
+    return n;
+}
+
+/* gzip-compress src into dst (a .gz file), as the reader's build would. */
+static void gzip_file(const char *src, const char *dst)
+{
+#ifdef BSF_HAVE_ZLIB
+    static unsigned char text[4096];
+    const size_t n = read_all(src, text, sizeof text);
+    gzFile gz = gzopen(dst, "wb9");
+    TEST_ASSERT_NOT_NULL(gz);
+    TEST_ASSERT_EQUAL_INT((int)n, gzwrite(gz, text, (unsigned)n));
+    TEST_ASSERT_EQUAL_INT(Z_OK, gzclose(gz));
+#else
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "gzip -9 -n -c '%s' > '%s'", src, dst);
+    TEST_ASSERT_EQUAL_INT(0, system(cmd));
+#endif
+}
+
+/* Lines 1-9; the damaged ones must be reported, the others read with their
+ * own line numbers (a NUL must not glue line 3 to line 2). */
+static const char damaged_log[] =
+    "FLASER 3 1 2 3 0 0 0 0 0 0 1.0 h 1.0\n"     /* 1 */
+    "FLASER 3 1 2\0 3 0 0 0 0 0 0 2.0 h 2.0\n"   /* 2: NUL at column 13 */
+    "FLASER 3 1 2 3 0 0 0 0 0 0 3.0 h 3.0\n"     /* 3 */
+    "FLASER 3 1 2 3 0 0 0\001 0 0 0 4.0 h 4.0\n" /* 4: SOH at column 21 */
+    "ODOM 0 0 0 0 0 0 5.0 \033[2J 5.0\n"         /* 5: ESC at column 22 */
+    "FLASER 3 1\r2 3 0 0 0 0 0 0 6.0 h 6.0\n"    /* 6: CR at column 11 */
+    "FLASER 3 1 2 3 0 0 0 0 0 0 7.0 h 7.0\r\n"   /* 7: final CR is fine */
+    "FLASER 3 1 2 3 0 0 0 0 0 0 8.0 h 8.0\177\n" /* 8: DEL at column 37 */
+    "\0\0\0\n"                                   /* 9: NULs only */
+    "FLASER 3 1 2 3 0 0 0 0 0 0 10.0 h 10.0\n";  /* 10 */
+
+static void check_damaged(const char *path)
+{
+    static const unsigned long good_lines[] = {1u, 3u, 7u, 10u};
+    static const char *const reports[] = {
+        ":2: control byte 0x00 at column 13", ":4: control byte 0x01 at column 21",
+        ":5: control byte 0x1b at column 22", ":6: control byte 0x0d at column 11",
+        ":8: control byte 0x7f at column 37", ":9: control byte 0x00 at column 1"};
+    FILE *err = tmpfile();
+    carmen_reader_t *rd;
+    carmen_scan_t s;
+    char report[4096];
+    char expect[512];
+    size_t i, n_rep;
+    TEST_ASSERT_NOT_NULL(err);
+    rd = carmen_open(path, err);
+    TEST_ASSERT_NOT_NULL(rd);
+    for (i = 0; i < sizeof good_lines / sizeof good_lines[0]; ++i) {
+        TEST_ASSERT_EQUAL_INT(1, carmen_next(rd, &s));
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)good_lines[i], (uint32_t)s.line);
+        EXPECT_DOUBLE((double)good_lines[i], s.timestamp);
+        TEST_ASSERT_EQUAL_UINT32(3u, (uint32_t)s.count);
+    }
+    TEST_ASSERT_EQUAL_INT(0, carmen_next(rd, &s));
+    TEST_ASSERT_EQUAL_UINT32(6u, (uint32_t)carmen_malformed_count(rd));
+    carmen_close(rd);
+    rewind(err);
+    n_rep = fread(report, 1, sizeof report - 1u, err);
+    report[n_rep] = '\0';
+    fclose(err);
+    for (i = 0; i < sizeof reports / sizeof reports[0]; ++i) {
+        snprintf(expect, sizeof expect, "%s%s\n", path, reports[i]);
+        TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);
+    }
+}
+
+static void test_control_bytes_make_a_reported_malformed_line(void)
+{
+    char gz[300];
+    write_bytes(path_tmp, damaged_log, sizeof damaged_log - 1u);
+    check_damaged(path_tmp);
+    snprintf(gz, sizeof gz, "%s.gz", path_tmp);
+    gzip_file(path_tmp, gz);
+    check_damaged(gz);
+    remove(gz);
+}
+
+/* Newlines in what a gzip decompressor makes of the first n bytes of gz. */
+static unsigned long newlines_in_prefix(const unsigned char *gz, size_t n)
+{
+    unsigned long lines = 0;
+    static unsigned char out[8192];
+#ifdef BSF_HAVE_ZLIB
+    z_stream zs;
+    int rc;
+    size_t i;
+    memset(&zs, 0, sizeof zs);
+    TEST_ASSERT_EQUAL_INT(Z_OK, inflateInit2(&zs, 16 + MAX_WBITS));
+    zs.next_in = (unsigned char *)(uintptr_t)gz;
+    zs.avail_in = (uInt)n;
+    do {
+        zs.next_out = out;
+        zs.avail_out = (uInt)sizeof out;
+        rc = inflate(&zs, Z_NO_FLUSH);
+        for (i = 0; i < sizeof out - zs.avail_out; ++i) {
+            lines += out[i] == '\n';
+        }
+    } while (rc == Z_OK && zs.avail_out == 0u);
+    inflateEnd(&zs);
+#else
+    char cmd[600];
+    FILE *p;
+    size_t got, i;
+    write_bytes(path_tmp, gz, n);
+    snprintf(cmd, sizeof cmd, "gzip -dc < '%s' 2>/dev/null", path_tmp);
+    p = popen(cmd, "r");
+    TEST_ASSERT_NOT_NULL(p);
+    while ((got = fread(out, 1, sizeof out, p)) > 0u) {
+        for (i = 0; i < got; ++i) {
+            lines += out[i] == '\n';
+        }
+    }
+    (void)pclose(p);
+#endif
+    return lines;
+}
+
+/* Every prefix of a gzip log is a read error naming the file and the last
+ * complete line, never a shorter log; the records delivered before the
+ * error all lie before the cut. */
+static void test_every_cut_of_a_gzip_log_is_a_read_error(void)
+{
+    static const char text[] = "# a small log\n"
+                               "FLASER 3 1 2 3 0 0 0 0 0 0 1.0 h 1.0\n"
+                               "ODOM 0 0 0 0 0 0 2.0 h 2.0\n"
+                               "FLASER 3 1.5 2.5 3.5 0 0 0 0 0 0 3.0 h 3.0\n"
+                               "FLASER 3 4 5 6 0 0 0 0 0 0 4.0 h 4.0\n";
+    static unsigned char gz[4096];
+    char gz_path[300];
+    char cut_path[300];
+    char report[2048];
+    char expect[600];
+    size_t size, cut;
+    snprintf(gz_path, sizeof gz_path, "%s_whole.log.gz", path_tmp);
+    snprintf(cut_path, sizeof cut_path, "%s_cut.log.gz", path_tmp);
+    write_bytes(path_tmp, text, sizeof text - 1u);
+    gzip_file(path_tmp, gz_path);
+    size = read_all(gz_path, gz, sizeof gz);
+    TEST_ASSERT_TRUE(size > 20u);
+    for (cut = 0; cut <= size; ++cut) {
+        FILE *err = tmpfile();
+        carmen_reader_t *rd;
+        carmen_scan_t s;
+        unsigned long last_line = 0;
+        const unsigned long complete = newlines_in_prefix(gz, cut);
+        size_t n_rep;
+        int rc;
+        TEST_ASSERT_NOT_NULL(err);
+        write_bytes(cut_path, gz, cut);
+        rd = carmen_open(cut_path, err);
+        TEST_ASSERT_NOT_NULL(rd);
+        while ((rc = carmen_next(rd, &s)) == 1) {
+            last_line = s.line;
+        }
+        carmen_close(rd);
+        rewind(err);
+        n_rep = fread(report, 1, sizeof report - 1u, err);
+        report[n_rep] = '\0';
+        fclose(err);
+        if (cut == size) {
+            TEST_ASSERT_EQUAL_INT_MESSAGE(0, rc, report);
+            TEST_ASSERT_EQUAL_UINT32(5u, (uint32_t)last_line);
+            TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n_rep);
+            continue;
+        }
+        snprintf(expect, sizeof expect, "%s:%lu: read error: ", cut_path, complete + 1u);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(-1, rc, expect);
+        TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);
+        snprintf(expect, sizeof expect, "the last complete line is %lu\n", complete);
+        TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);
+        TEST_ASSERT_TRUE(last_line <= complete);
+    }
+    remove(gz_path);
+    remove(cut_path);
+}
+
+static void test_plain_file_named_gz_is_refused(void)
+{
+    static const char text[] = "FLASER 3 1 2 3 0 0 0 0 0 0 1.0 h 1.0\n";
+    char named[300];
+    carmen_reader_t *rd;
+    carmen_scan_t s;
+    snprintf(named, sizeof named, "%s_plain.log.gz", path_tmp);
+    write_bytes(named, text, sizeof text - 1u);
+    rd = carmen_open(named, NULL);
+    TEST_ASSERT_NOT_NULL(rd);
+    TEST_ASSERT_EQUAL_INT(-1, carmen_next(rd, &s));
+    carmen_close(rd);
+    remove(named);
+}
+
 int main(void)
 {
     int rc;
@@ -279,8 +498,12 @@ int main(void)
     RUN_TEST(test_gzip_log_reads_the_same);
     RUN_TEST(test_missing_file_gives_null);
     RUN_TEST(test_silent_reader_still_counts_bad_lines);
+    RUN_TEST(test_control_bytes_make_a_reported_malformed_line);
+    RUN_TEST(test_every_cut_of_a_gzip_log_is_a_read_error);
+    RUN_TEST(test_plain_file_named_gz_is_refused);
     rc = UNITY_END();
     remove(path_plain);
     remove(path_gz);
+    remove(path_tmp);
     return rc;
 }

@@ -7,8 +7,10 @@
 
 static bsf_extractor_t ex;
 static bsf_result_t res;
+static bsf_decoder_t dec;
+static bsf_frame_t decoded;
 static uint8_t wire[BSF_FRAME_MAX_SIZE];
-static float ranges[DET_BEAMS];
+static float ranges[BSF_MAX_POINTS];
 
 uint32_t det_fnv1a(uint32_t h, const uint8_t *p, size_t n)
 {
@@ -19,6 +21,110 @@ uint32_t det_fnv1a(uint32_t h, const uint8_t *p, size_t n)
     }
     return h;
 }
+
+uint32_t det_hash_u32(uint32_t h, uint32_t v)
+{
+    uint8_t le[4];
+    le[0] = (uint8_t)(v & 0xffu);
+    le[1] = (uint8_t)((v >> 8) & 0xffu);
+    le[2] = (uint8_t)((v >> 16) & 0xffu);
+    le[3] = (uint8_t)(v >> 24);
+    return det_fnv1a(h, le, sizeof le);
+}
+
+uint32_t det_hash_floats(uint32_t h, const float *p, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        uint32_t bits;
+        memcpy(&bits, &p[i], sizeof bits);
+        h = det_hash_u32(h, bits);
+    }
+    return h;
+}
+
+static float float_of_bits(uint32_t bits)
+{
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+/* The decoded values that must not depend on the target: header, pose and
+ * every feature with its control points. */
+static uint32_t hash_frame(uint32_t h, const bsf_frame_t *f)
+{
+    uint16_t i;
+    h = det_hash_u32(h, f->seq);
+    h = det_hash_u32(h, (uint32_t)(f->timestamp_ms & 0xffffffffu));
+    h = det_hash_u32(h, (uint32_t)(f->timestamp_ms >> 32));
+    h = det_hash_u32(h, f->has_pose);
+    h = det_hash_floats(h, &f->pose_x, 1u);
+    h = det_hash_floats(h, &f->pose_y, 1u);
+    h = det_hash_floats(h, &f->pose_theta, 1u);
+    h = det_hash_floats(h, &f->quant_step, 1u);
+    h = det_hash_u32(h, f->result.n_features);
+    h = det_hash_u32(h, f->result.n_ctrl);
+    for (i = 0; i < f->result.n_features; ++i) {
+        const bsf_feature_t *ft = &f->result.features[i];
+        h = det_hash_u32(h, ((uint32_t)ft->first_beam << 16) | ft->last_beam);
+        h = det_hash_u32(h, ((uint32_t)ft->n_ctrl << 8) | ft->kind);
+        h = det_hash_floats(h, &ft->e_curve, 1u);
+    }
+    for (i = 0; i < f->result.n_ctrl; ++i) {
+        h = det_hash_floats(h, &f->result.ctrl[i].x, 1u);
+        h = det_hash_floats(h, &f->result.ctrl[i].y, 1u);
+        h = det_hash_u32(h, f->result.ctrl_is_vertex[i]);
+    }
+    return h;
+}
+
+/* Extract scan with method m, encode it with info, decode the frame again
+ * through the byte-stream decoder, and fold everything into *out. */
+static bsf_status_t det_frame(const bsf_scan_t *scan, const bsf_frame_info_t *info, bsf_method_t m,
+                              det_summary_t *out,
+                              void (*frame_cb)(void *ctx, const uint8_t *frame, size_t len),
+                              void *ctx)
+{
+    const bsf_params_t p = bsf_params_default(m);
+    size_t len = 0u;
+    size_t used = 0u;
+    bsf_status_t st = bsf_extractor_init(&ex, &p);
+    if (st == BSF_OK) {
+        st = bsf_extract(&ex, scan, &res);
+    }
+    if (st < 0) { /* a cut result (BSF_OK_CUT) is output too */
+        return st;
+    }
+    st = bsf_frame_encode(info, &res, wire, sizeof wire, &len);
+    if (st != BSF_OK) {
+        return st;
+    }
+    out->stream_hash = det_fnv1a(out->stream_hash, wire, len);
+    out->stream_bytes += (uint32_t)len;
+    out->n_features += res.n_features;
+    out->n_ctrl += res.n_ctrl;
+    if (frame_cb != NULL) {
+        frame_cb(ctx, wire, len);
+    }
+    bsf_decoder_init(&dec);
+    if (bsf_decoder_feed(&dec, wire, len, &used, &decoded) == 1) {
+        out->decoded_hash = hash_frame(out->decoded_hash, &decoded);
+        ++out->frames_decoded;
+    }
+    return BSF_OK;
+}
+
+static void summary_init(det_summary_t *out)
+{
+    memset(out, 0, sizeof *out);
+    out->ranges_hash = DET_FNV_INIT;
+    out->stream_hash = DET_FNV_INIT;
+    out->decoded_hash = DET_FNV_INIT;
+}
+
+static const bsf_method_t det_methods[DET_METHODS] = {BSF_METHOD_FALKO_SVED_PDM,
+                                                      BSF_METHOD_RPOS_LSBA};
 
 static bsf_lidar_t det_lidar(unsigned k)
 {
@@ -50,13 +156,9 @@ bsf_status_t det_simulate(unsigned k, float *out, bsf_scan_t *scan)
 bsf_status_t det_run(const float *ranges_in, det_summary_t *out,
                      void (*frame_cb)(void *ctx, const uint8_t *frame, size_t len), void *ctx)
 {
-    static const bsf_method_t methods[DET_METHODS] = {BSF_METHOD_FALKO_SVED_PDM,
-                                                      BSF_METHOD_RPOS_LSBA};
     unsigned k;
     unsigned m;
-    memset(out, 0, sizeof *out);
-    out->ranges_hash = DET_FNV_INIT;
-    out->stream_hash = DET_FNV_INIT;
+    summary_init(out);
     for (k = 0; k < DET_SCANS; ++k) {
         bsf_scan_t scan;
         bsf_status_t st = det_simulate(k, ranges, &scan);
@@ -64,33 +166,59 @@ bsf_status_t det_run(const float *ranges_in, det_summary_t *out,
             return st;
         }
         if (ranges_in != NULL) {
-            memcpy(ranges, ranges_in + (size_t)k * DET_BEAMS, sizeof ranges);
+            memcpy(ranges, ranges_in + (size_t)k * DET_BEAMS, DET_BEAMS * sizeof ranges[0]);
         }
-        out->ranges_hash = det_fnv1a(out->ranges_hash, (const uint8_t *)ranges, sizeof ranges);
+        out->ranges_hash = det_hash_floats(out->ranges_hash, ranges, DET_BEAMS);
         for (m = 0; m < DET_METHODS; ++m) {
-            const bsf_params_t p = bsf_params_default(methods[m]);
             bsf_frame_info_t info;
-            size_t len = 0u;
-            st = bsf_extractor_init(&ex, &p);
-            if (st == BSF_OK) {
-                st = bsf_extract(&ex, &scan, &res);
-            }
-            if (st < 0) { /* a cut result (BSF_OK_CUT) is output too */
-                return st;
-            }
             bsf_frame_info_init(&info);
             info.seq = k * DET_METHODS + m;
             info.timestamp_ms = 100u * k;
-            st = bsf_frame_encode(&info, &res, wire, sizeof wire, &len);
+            st = det_frame(&scan, &info, det_methods[m], out, frame_cb, ctx);
             if (st != BSF_OK) {
                 return st;
             }
-            out->stream_hash = det_fnv1a(out->stream_hash, wire, len);
-            out->stream_bytes += (uint32_t)len;
-            out->n_features += res.n_features;
-            out->n_ctrl += res.n_ctrl;
-            if (frame_cb != NULL) {
-                frame_cb(ctx, wire, len);
+        }
+    }
+    return BSF_OK;
+}
+
+bsf_status_t det_run_log(const det_log_scan_t *scans, size_t n, const uint32_t *range_bits,
+                         det_summary_t *out)
+{
+    size_t k, i, at = 0u;
+    unsigned m;
+    summary_init(out);
+    for (k = 0; k < n; ++k) {
+        const det_log_scan_t *s = &scans[k];
+        bsf_scan_t scan;
+        if (s->count > BSF_MAX_POINTS) {
+            return BSF_ERR_CAPACITY;
+        }
+        for (i = 0; i < s->count; ++i) {
+            ranges[i] = float_of_bits(range_bits[at + i]);
+        }
+        at += s->count;
+        out->ranges_hash = det_hash_floats(out->ranges_hash, ranges, s->count);
+        scan.ranges = ranges;
+        scan.count = s->count;
+        scan.angle_min = float_of_bits(s->angle_min);
+        scan.angle_increment = float_of_bits(s->angle_increment);
+        scan.range_min = 0.0f;
+        scan.range_max = float_of_bits(s->range_max);
+        for (m = 0; m < DET_METHODS; ++m) {
+            bsf_frame_info_t info;
+            bsf_status_t st;
+            bsf_frame_info_init(&info);
+            info.seq = (uint32_t)(k * DET_METHODS + m);
+            info.timestamp_ms = s->timestamp_ms;
+            info.has_pose = 1u;
+            info.pose_x = float_of_bits(s->pose_x);
+            info.pose_y = float_of_bits(s->pose_y);
+            info.pose_theta = float_of_bits(s->pose_theta);
+            st = det_frame(&scan, &info, det_methods[m], out, NULL, NULL);
+            if (st != BSF_OK) {
+                return st;
             }
         }
     }

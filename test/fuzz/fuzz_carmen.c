@@ -1,13 +1,24 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * libFuzzer harness: the CARMEN log reader (tools/carmen.c) fed arbitrary
- * text through a temporary file (the reader's real path: zlib reads plain
- * and gzip files alike). Every record it returns must have a beam count in
- * 1..CARMEN_MAX_BEAMS, a finite non-zero increment and a finite start angle,
- * and line numbers that grow; each record then goes through
- * bsf_scan_to_points as the tool does.
+ * libFuzzer harness: the CARMEN log reader (tools/carmen) fed arbitrary
+ * text or gzip data through a temporary file (the reader's real path), and
+ * the tool's range policy (tools/carmen/carmen_bsf.c) on every record.
+ *
+ * Properties: every record has a beam count in 1..CARMEN_MAX_BEAMS, a finite
+ * non-zero increment, a finite start angle and a growing line number; each
+ * malformed line is reported exactly once as "FILE:LINE: ..." with a line
+ * number in order, and a read error once more ("read error", then nothing
+ * is returned); a plain input never yields more records than lines; the
+ * scan the tool would build has a range_max in (0, 81.8] that makes the
+ * no-return codes invalid (or exactly the --range-max given), and
+ * bsf_scan_to_points accepts or cleanly refuses it.
+ *
+ * Input starting with 0x1f (gzip data starts 1f 8b) is written to a file
+ * named *.log.gz, so cut or corrupt gzip streams (and non-gzip data under a
+ * .gz name) reach the reader's read-error paths; other input goes to a
+ * plain *.log file.
  */
-#define _POSIX_C_SOURCE 200809L /* mkstemp, unlink, access */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, unlink, rmdir, access, open_memstream */
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,34 +26,84 @@
 #include <unistd.h>
 
 #include "carmen.h"
+#include "carmen_bsf.h"
 #include "fuzz_check.h"
 
-static char path[256];
+static char path_plain[300];
+static char path_gz[300];
 static bsf_points_t points;
 
+static char dir_path[256];
+
+/* A private directory holding in.log and in.log.gz. */
 static void make_temp(void)
 {
     const char *dir = getenv("TMPDIR");
-    int fd;
     if (access("/dev/shm", W_OK) == 0) {
         dir = "/dev/shm"; /* no disk I/O per input */
     } else if (dir == NULL) {
         dir = "/tmp";
     }
-    snprintf(path, sizeof path, "%s/bsf_fuzz_carmen_XXXXXX", dir);
-    fd = mkstemp(path);
-    FUZZ_CHECK(fd >= 0);
-    close(fd);
+    snprintf(dir_path, sizeof dir_path, "%s/bsf_fuzz_carmen_XXXXXX", dir);
+    FUZZ_CHECK(mkdtemp(dir_path) != NULL);
+    snprintf(path_plain, sizeof path_plain, "%s/in.log", dir_path);
+    snprintf(path_gz, sizeof path_gz, "%s/in.log.gz", dir_path);
 }
 
 static void remove_temp(void)
 {
-    unlink(path);
+    unlink(path_plain);
+    unlink(path_gz);
+    rmdir(dir_path);
+}
+
+/* Checks the report text: one "PATH:N: " line per malformed line (N not
+ * decreasing) plus one read-error line when rc < 0. */
+static void check_reports(const char *text, size_t len, const char *path, unsigned long malformed,
+                          int rc)
+{
+    const size_t plen = strlen(path);
+    unsigned long lines = 0u, read_errors = 0u, last = 0u;
+    const char *p = text;
+    const char *end = text + len;
+    while (p < end) {
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        char *after;
+        unsigned long n;
+        FUZZ_CHECK(nl != NULL);
+        FUZZ_CHECK((size_t)(nl - p) > plen + 2u && memcmp(p, path, plen) == 0 && p[plen] == ':');
+        n = strtoul(p + plen + 1u, &after, 10);
+        FUZZ_CHECK(after[0] == ':' && after[1] == ' ' && n >= 1u);
+        if (strncmp(after + 2, "read error", 10) == 0) {
+            ++read_errors;
+            FUZZ_CHECK(n >= last);
+        } else {
+            ++lines;
+            FUZZ_CHECK(n > last || (lines == 1u && n >= 1u));
+            last = n;
+        }
+        p = nl + 1;
+    }
+    FUZZ_CHECK(lines == malformed);
+    FUZZ_CHECK(read_errors == (rc < 0 ? 1u : 0u));
+}
+
+static void carmen_close_and_check(carmen_reader_t *r, FILE *err, char **report, size_t *report_len,
+                                   const char *path, int rc)
+{
+    const unsigned long malformed = carmen_malformed_count(r);
+    carmen_close(r);
+    FUZZ_CHECK(fclose(err) == 0);
+    check_reports(*report, *report_len, path, malformed, rc);
+    free(*report);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     FILE *f;
+    FILE *err;
+    char *report = NULL;
+    size_t report_len = 0u;
     carmen_reader_t *r;
     carmen_scan_t s;
     unsigned long last_line = 0u;
@@ -50,10 +111,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t newlines = 0u;
     size_t i;
     int rc;
-    if (path[0] == '\0') {
+    const int is_gzip = size >= 2u && data[0] == 0x1Fu && data[1] == 0x8Bu;
+    /* a first byte of 0x1f goes to the .gz name even without the rest of
+     * the magic: "not gzip data" */
+    const int gz_name = size >= 1u && data[0] == 0x1Fu;
+    const char *path;
+    if (path_plain[0] == '\0') {
         make_temp();
         atexit(remove_temp);
     }
+    path = gz_name ? path_gz : path_plain;
     f = fopen(path, "wb");
     FUZZ_CHECK(f != NULL);
     FUZZ_CHECK(fwrite(data, 1, size, f) == size);
@@ -62,11 +129,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         newlines += data[i] == '\n';
     }
 
-    r = carmen_open(path, NULL);
+    err = open_memstream(&report, &report_len);
+    FUZZ_CHECK(err != NULL);
+    r = carmen_open(path, err);
     FUZZ_CHECK(r != NULL);
     while ((rc = carmen_next(r, &s)) == 1) {
         bsf_scan_t scan;
         bsf_status_t st;
+        double opt;
         FUZZ_CHECK(s.type == CARMEN_FLASER || s.type == CARMEN_ROBOTLASER1);
         FUZZ_CHECK(s.ranges != NULL);
         FUZZ_CHECK(s.count >= 1u && s.count <= CARMEN_MAX_BEAMS);
@@ -75,21 +145,31 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_CHECK(s.line > last_line);
         last_line = s.line;
         ++records;
-        scan.ranges = s.ranges;
-        scan.count = s.count;
-        scan.angle_min = s.angle_min;
-        scan.angle_increment = s.angle_increment;
-        scan.range_min = 0.0f;
-        scan.range_max = s.max_range;
+
+        /* the tool's default policy: the log's maximum, below no-return codes */
+        scan = scan_of_record(&s, 0.0);
+        FUZZ_CHECK(scan.ranges == s.ranges && scan.count == s.count);
+        FUZZ_CHECK(scan.range_min == 0.0f);
+        FUZZ_CHECK(scan.range_max > 0.0f && scan.range_max <= CARMEN_NO_RETURN_FLOOR);
+        FUZZ_CHECK(!bsf_range_is_valid(81.83f, scan.range_min, scan.range_max));
+        FUZZ_CHECK(!bsf_range_is_valid(81.91f, scan.range_min, scan.range_max));
+        if (s.max_range > 0.0f && s.max_range < CARMEN_NO_RETURN_FLOOR) {
+            FUZZ_CHECK(scan.range_max == s.max_range);
+        }
         st = bsf_scan_to_points(&scan, &points);
+        fuzz_check_status(st);
         FUZZ_CHECK(st == BSF_OK || st == BSF_ERR_ARG || st == BSF_ERR_CAPACITY);
+        FUZZ_CHECK((st == BSF_ERR_CAPACITY) == (s.count > BSF_MAX_POINTS) || st == BSF_ERR_ARG);
         if (st == BSF_OK) {
             FUZZ_CHECK(points.n_valid <= points.count && points.count == s.count);
         }
+        /* --range-max M (the tool accepts 1e-3..1e4) replaces it exactly */
+        opt = 1e-3 + fmod(fabs(isfinite(s.timestamp) ? s.timestamp : 1.0), 1e4);
+        FUZZ_CHECK(scan_range_max(&s, opt) == (float)opt);
     }
     FUZZ_CHECK(rc == 0 || rc == -1);
     /* a gzip body can hold more lines than the raw input has newlines */
-    FUZZ_CHECK(records <= newlines + 1u || (size >= 2u && data[0] == 0x1Fu && data[1] == 0x8Bu));
-    carmen_close(r);
+    FUZZ_CHECK(records <= newlines + 1u || is_gzip);
+    carmen_close_and_check(r, err, &report, &report_len, path, rc);
     return 0;
 }

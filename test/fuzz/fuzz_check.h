@@ -23,6 +23,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
         }                                                                                          \
     } while (0)
 
+/* Every status the library returns has a non-empty message. */
+static inline void fuzz_check_status(bsf_status_t st)
+{
+    const char *msg = bsf_status_str(st);
+    FUZZ_CHECK(msg != NULL && msg[0] != '\0');
+}
+
 static inline int fuzz_finite(float v)
 {
     return isfinite(v) != 0;

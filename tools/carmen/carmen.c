@@ -24,6 +24,9 @@
 #define CARMEN_PI 3.14159265358979323846
 #define CARMEN_FLASER_MAX_RANGE 80.0f
 
+/* Bytes read from the file (or the decompressor) per refill. */
+#define CARMEN_BLOCK 65536u
+
 struct carmen_reader {
 #ifdef BSF_HAVE_ZLIB
     gzFile gz;
@@ -31,14 +34,29 @@ struct carmen_reader {
     FILE *file;
     int piped; /* file is a gzip -dc pipe */
 #endif
+    int want_gzip;    /* the name ends in .gz: the content must be gzip */
+    int at_end;       /* the source reported end of data (and was checked) */
+    int kind_checked; /* want_gzip was checked against the content */
     FILE *err;
     char *path;
     char *line; /* current line, grown as needed */
     size_t line_cap;
+    size_t line_len; /* bytes in line, without the newline */
+    size_t bad_byte; /* 1 + column of the first control byte, 0: none */
+    unsigned char bad_value;
     unsigned long line_no;
     unsigned long malformed;
+    size_t block_pos;
+    size_t block_len;
+    unsigned char block[CARMEN_BLOCK];
     float ranges[CARMEN_MAX_BEAMS];
 };
+
+static int ends_with_gz(const char *path)
+{
+    const size_t n = strlen(path);
+    return n >= 3u && strcmp(path + n - 3u, ".gz") == 0;
+}
 
 carmen_reader_t *carmen_open(const char *path, FILE *err)
 {
@@ -52,6 +70,7 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
         return NULL;
     }
     r->err = err;
+    r->want_gzip = ends_with_gz(path);
     r->path = malloc(strlen(path) + 1u);
     r->line_cap = 4096;
     r->line = malloc(r->line_cap);
@@ -67,6 +86,7 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
         carmen_close(r);
         return NULL;
     }
+    (void)gzbuffer(r->gz, CARMEN_BLOCK);
 #else
     if (strcmp(path, "-") == 0) {
         /* standard input through gzip -dcf, which passes plain text as is */
@@ -84,9 +104,10 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
         return NULL;
     }
     if (fgetc(r->file) == 0x1f && fgetc(r->file) == 0x8b) {
-        /* gzip magic: decompress through gzip, the path single-quoted */
+        /* gzip magic: decompress through gzip, the path single-quoted;
+         * gzip's own complaints are replaced by the reader's report. */
         size_t i, n = 0;
-        char *cmd = malloc(4u * strlen(path) + 32u);
+        char *cmd = malloc(4u * strlen(path) + 48u);
         if (cmd == NULL) {
             carmen_close(r);
             return NULL;
@@ -102,7 +123,7 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
                 cmd[n++] = path[i];
             }
         }
-        memcpy(cmd + n, "'", 2u);
+        memcpy(cmd + n, "' 2>/dev/null", 14u);
         r->file = popen(cmd, "r");
         free(cmd);
         r->piped = 1;
@@ -145,66 +166,190 @@ unsigned long carmen_malformed_count(const carmen_reader_t *reader)
     return reader->malformed;
 }
 
-/* Read one whole line (without its newline) into reader->line, growing the
- * buffer for long lines. Returns 1, 0 at end of file, -1 on error. */
+/* Reports a read error: where the data stopped and the last line that was
+ * read whole (everything after it is lost). */
+static void report_read_error(carmen_reader_t *r, const char *what)
+{
+    if (r->err != NULL) {
+        fprintf(r->err, "%s:%lu: read error: %s; the last complete line is %lu\n", r->path,
+                r->line_no + 1u, what, r->line_no);
+    }
+}
+
+/* Checks that the data ended where the file says it ends: a gzip stream
+ * complete with its trailer, a gzip -dc that exited 0, no I/O error.
+ * Returns 0 when the end is genuine, -1 (reported) when data was lost. */
+static int check_end(carmen_reader_t *r)
+{
+#ifdef BSF_HAVE_ZLIB
+    int zerr = Z_OK;
+    const char *msg = gzerror(r->gz, &zerr);
+    if (zerr == Z_BUF_ERROR) {
+        /* zlib's "unexpected end of file": the stream was cut */
+        report_read_error(r, "gzip data truncated (unexpected end of file)");
+        return -1;
+    }
+    if (zerr != Z_OK) {
+        report_read_error(r, msg);
+        return -1;
+    }
+#else
+    if (ferror(r->file)) {
+        report_read_error(r, "I/O error");
+        return -1;
+    }
+    if (r->piped) {
+        const int status = pclose(r->file);
+        r->file = NULL;
+        if (status != 0) {
+            report_read_error(r, "gzip -dc failed: the gzip data is truncated or corrupt");
+            return -1;
+        }
+    }
+#endif
+    return 0;
+}
+
+/* Refills the block. Returns the number of bytes now available, 0 at a
+ * checked end of data, -1 on a (reported) read error. */
+static long refill(carmen_reader_t *r)
+{
+    long got;
+    if (r->at_end) {
+        return 0;
+    }
+    if (!r->kind_checked) {
+        /* A .gz name promises gzip: plain text there is a file cut before
+         * (or never given) its gzip header, not a log. */
+        r->kind_checked = 1;
+#ifdef BSF_HAVE_ZLIB
+        if (r->want_gzip && gzdirect(r->gz)) {
+#else
+        if (r->want_gzip && !r->piped) {
+#endif
+            report_read_error(r, "not gzip data (empty or cut before the gzip header)");
+            return -1;
+        }
+    }
+#ifdef BSF_HAVE_ZLIB
+    {
+        const int n = gzread(r->gz, r->block, (unsigned)sizeof r->block);
+        int zerr = Z_OK;
+        (void)gzerror(r->gz, &zerr);
+        if (n < 0 || (zerr != Z_OK && zerr != Z_BUF_ERROR)) {
+            report_read_error(r, gzerror(r->gz, &zerr));
+            return -1;
+        }
+        got = n;
+    }
+#else
+    if (r->file == NULL) {
+        return 0;
+    }
+    got = (long)fread(r->block, 1, sizeof r->block, r->file);
+#endif
+    if (got == 0) {
+        /* Only a genuine end gives 0; a cut or failed source is an error,
+         * never a shorter log. */
+        if (check_end(r) != 0) {
+            return -1;
+        }
+        r->at_end = 1;
+        return 0;
+    }
+    r->block_pos = 0;
+    r->block_len = (size_t)got;
+    return got;
+}
+
+/* Appends n bytes to the line, growing its buffer. Returns 0 or -1. */
+static int append(carmen_reader_t *r, const unsigned char *p, size_t n)
+{
+    size_t i;
+    if (r->line_len + n + 1u > r->line_cap) {
+        size_t cap = r->line_cap;
+        char *bigger;
+        while (r->line_len + n + 1u > cap) {
+            cap *= 2u;
+        }
+        bigger = realloc(r->line, cap);
+        if (bigger == NULL) {
+            if (r->err != NULL) {
+                fprintf(r->err, "%s:%lu: out of memory\n", r->path, r->line_no + 1u);
+            }
+            return -1;
+        }
+        r->line = bigger;
+        r->line_cap = cap;
+    }
+    for (i = 0; i < n; ++i) {
+        /* Control bytes (NUL included) make the line malformed; they are
+         * kept out of the text so that nothing can end a string early. */
+        const unsigned char c = p[i];
+        if ((c < 0x20u && c != '\t' && c != '\r') || c == 0x7fu) {
+            if (r->bad_byte == 0u) {
+                r->bad_byte = r->line_len + i + 1u;
+                r->bad_value = c;
+            }
+            r->line[r->line_len + i] = ' ';
+        } else {
+            r->line[r->line_len + i] = (char)c;
+        }
+    }
+    r->line_len += n;
+    return 0;
+}
+
+/* Read one whole line (without its newline) into reader->line. Every byte
+ * up to the newline belongs to the line, NUL included. Returns 1, 0 at
+ * end of file, -1 on error (the partial last line of a cut file is lost
+ * and reported, never returned). */
 static int read_line(carmen_reader_t *r)
 {
-    size_t len = 0;
+    size_t i;
+    r->line_len = 0;
+    r->bad_byte = 0;
     for (;;) {
-        size_t got;
-#ifdef BSF_HAVE_ZLIB
-        if (gzgets(r->gz, r->line + len, (int)(r->line_cap - len)) == NULL) {
-            int zerr = 0;
-            const char *msg = gzerror(r->gz, &zerr);
-            if (zerr != Z_OK && zerr != Z_BUF_ERROR) {
-#else
-        if (fgets(r->line + len, (int)(r->line_cap - len), r->file) == NULL) {
-            const char *msg = "I/O error";
-            if (ferror(r->file)) {
-#endif
-                if (r->err != NULL) {
-                    fprintf(r->err, "%s:%lu: read error: %s\n", r->path, r->line_no + 1u, msg);
-                }
+        const unsigned char *start;
+        const unsigned char *nl;
+        if (r->block_pos == r->block_len) {
+            const long got = refill(r);
+            if (got < 0) {
                 return -1;
             }
-            if (len == 0) {
-                return 0;
+            if (got == 0) {
+                if (r->line_len == 0 && r->bad_byte == 0u) {
+                    return 0;
+                }
+                break; /* last line without a newline, end checked */
             }
-            break; /* last line without a newline */
         }
-        got = strlen(r->line + len);
-        len += got;
-        if (len > 0 && r->line[len - 1u] == '\n') {
-            r->line[--len] = '\0';
+        start = r->block + r->block_pos;
+        nl = memchr(start, '\n', r->block_len - r->block_pos);
+        if (nl != NULL) {
+            if (append(r, start, (size_t)(nl - start)) != 0) {
+                return -1;
+            }
+            r->block_pos += (size_t)(nl - start) + 1u;
             break;
         }
-        if (len + 1u < r->line_cap) {
-#ifdef BSF_HAVE_ZLIB
-            if (gzeof(r->gz)) {
-                break;
-            }
-#else
-            if (feof(r->file)) {
-                break;
-            }
-#endif
-            continue;
+        if (append(r, start, r->block_len - r->block_pos) != 0) {
+            return -1;
         }
-        {
-            char *bigger = realloc(r->line, r->line_cap * 2u);
-            if (bigger == NULL) {
-                if (r->err != NULL) {
-                    fprintf(r->err, "%s:%lu: out of memory\n", r->path, r->line_no + 1u);
-                }
-                return -1;
-            }
-            r->line = bigger;
-            r->line_cap *= 2u;
+        r->block_pos = r->block_len;
+    }
+    if (r->line_len > 0 && r->line[r->line_len - 1u] == '\r') {
+        --r->line_len;
+    }
+    /* A CR anywhere but at the end is a control byte too. */
+    for (i = 0; r->bad_byte == 0u && i < r->line_len; ++i) {
+        if (r->line[i] == '\r') {
+            r->bad_byte = i + 1u;
+            r->bad_value = '\r';
+            r->line[i] = ' ';
         }
     }
-    if (len > 0 && r->line[len - 1u] == '\r') {
-        r->line[--len] = '\0';
-    }
+    r->line[r->line_len] = '\0';
     ++r->line_no;
     return 1;
 }
@@ -429,6 +574,12 @@ int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan)
         int rc = read_line(reader);
         if (rc <= 0) {
             return rc;
+        }
+        if (reader->bad_byte != 0u) {
+            /* Binary damage: whatever the line says, it cannot be trusted. */
+            report(reader, "control byte 0x%02x at column %lu", (unsigned)reader->bad_value,
+                   (unsigned long)reader->bad_byte);
+            continue;
         }
         f.p = reader->line;
         f.what = NULL;

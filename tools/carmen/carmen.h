@@ -9,6 +9,17 @@
  * and blank lines. A malformed FLASER/ROBOTLASER1 line is reported as
  * "file:line: message" to the error stream given at open, counted, and
  * skipped; reading goes on with the next line.
+ *
+ * Damage is never read as a shorter or different log:
+ *  - A line holding a control byte (NUL, any byte below 0x20 other than tab
+ *    and a final CR, or DEL) is reported as malformed ("file:line: control
+ *    byte 0xNN at column C") whatever its type, and skipped; the bytes up to
+ *    the next newline belong to that line, so later line numbers stay right.
+ *  - A gzip file cut short (or failing its CRC/length check), a `gzip -dc`
+ *    that fails (the fallback without zlib), an I/O error, or a file named
+ *    *.gz that holds no gzip data (e.g. cut before its header) is a read
+ *    error: carmen_next returns -1 after "file:N: read error: WHAT; the last
+ *    complete line is M". The partial line at the cut is never returned.
  */
 #ifndef BSF_TOOLS_CARMEN_H
 #define BSF_TOOLS_CARMEN_H
@@ -72,8 +83,8 @@ carmen_reader_t *carmen_open(const char *path, FILE *err);
 
 /**
  * Read the next laser message into *scan.
- * @return 1 when a scan was read, 0 at end of file, -1 on a read error
- *         (reported to the error stream).
+ * @return 1 when a scan was read, 0 at the (checked) end of the data, -1 on
+ *         a read error or truncated data (reported to the error stream).
  */
 int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan);
 

@@ -1,25 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * log_scan.c - CARMEN records as bsf scans, and the extractor the commands share.
+ * log_scan.c - the extractor the commands share (CARMEN records become scans in
+ * tools/carmen/carmen_bsf.c, where fuzz_carmen reaches them).
  */
 #include "tool.h"
-
-float scan_range_max(const carmen_scan_t *s, double opt)
-{
-    return opt > 0.0 ? (float)opt : carmen_valid_range_max(s);
-}
-
-bsf_scan_t scan_of_record(const carmen_scan_t *s, double range_max_opt)
-{
-    bsf_scan_t sc;
-    sc.ranges = s->ranges;
-    sc.count = s->count;
-    sc.angle_min = s->angle_min;
-    sc.angle_increment = s->angle_increment;
-    sc.range_min = 0.0f;
-    sc.range_max = scan_range_max(s, range_max_opt);
-    return sc;
-}
 
 bsf_extractor_t g_ex;
 bsf_result_t g_res;

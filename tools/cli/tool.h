@@ -25,6 +25,7 @@
 #include "bsf_scene.h"
 #include "bsf_svg.h"
 #include "carmen.h"
+#include "carmen_bsf.h"
 
 #define TOOL_NAME "bsf"
 #define EXIT_USAGE 2
@@ -136,10 +137,7 @@ int metrics_of_stream(FILE *in, const char *name, dataset_metrics_t *out, stream
 
 /* ---- log_scan.c: log records as scans, the shared extractor -------------- */
 
-/** range_max of a record: opt when > 0, else the log's declared maximum below no-return codes. */
-float scan_range_max(const carmen_scan_t *s, double opt);
-/** A CARMEN record as a bsf scan (ranges point into the record). */
-bsf_scan_t scan_of_record(const carmen_scan_t *s, double range_max_opt);
+/* scan_range_max and scan_of_record: tools/carmen/carmen_bsf.h */
 
 extern bsf_extractor_t g_ex;
 extern bsf_result_t g_res;
