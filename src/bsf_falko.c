@@ -258,8 +258,12 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
     if (base < lim) {
         return 0;
     }
-    /* Twice the signed area of (a, f, l), written as the reference does. */
-    area2 = by * a.x - bx * a.y + l.x * f.y - l.y * f.x;
+    /* Twice the signed area of (a, f, l), from coordinates relative to the
+     * apex. The reference's form from absolute coordinates (double there)
+     * cancels terms of the size of |p|^2 in float, losing about 1e-5
+     * relative: enough to flip one test on fr-clinic. Relative to the apex,
+     * float keeps the double result's decision. */
+    area2 = (f.x - a.x) * (l.y - a.y) - (f.y - a.y) * (l.x - a.x);
     return !(fabsf(area2) / base < lim);
 }
 

@@ -28,6 +28,25 @@
 /* Failed footpoint steps longer than this fraction of a span are halved and
  * retried (far from the curve); shorter ones are only rounding noise. */
 #define PDM_HALVE_MIN 0.05f
+/* Weight of a vertex anchor per data point of the segment: the anchor
+ * weighs as much as all the points together, so a vertex stays within a few
+ * millimetres of the two-line intersection (vertex error on the ground-truth
+ * scenes as with a stiff pin, measured 1 to 100) yet the data may still
+ * nudge it (slightly fewer control points on the four logs than a pin). */
+#define PDM_ANCHOR_WEIGHT 1.0f
+/* Shortest chord that sets the local direction of an arc-length step,
+ * metres: well above range noise, well below the radius of a pillar. */
+#define PDM_ARC_BASE 0.1f
+/* Standard errors of a windowed mean that range noise alone rarely exceeds
+ * (bias_window on): on noisy fragments the bias bound grows with the noise,
+ * so refinement does not chase it (measured: without it the bound must stay
+ * near 12 mm to keep curves on the ground-truth walls, and then the four logs
+ * lose 10-20 % of compactness to noise). */
+#define PDM_BIAS_Z 2.0f
+/* With bias_window on, no point may lie further than this multiple of
+ * target_rms from the curve (a curve that swings off the last few points
+ * past an undetected corner keeps a low RMS and a low windowed mean). */
+#define PDM_POINT_RATIO 3.0f
 
 /* Fit state that is not in the caller's work struct: small scalars only. */
 typedef struct {
@@ -40,7 +59,12 @@ typedef struct {
     float lambda;
     float rms;
     uint32_t loaded;
-    float frag_len[BSF_PDM_MAX_FRAGMENTS]; /* polyline length of each fragment */
+    float frag_len[BSF_PDM_MAX_FRAGMENTS];        /* length of each fragment (arc_step) */
+    size_t bias_window;                           /* 0: refinement on RMS alone */
+    float bias_floor;                             /* bias_ratio * target_rms */
+    float target;                                 /* target_rms */
+    const bsf_point_t *anchor;                    /* vertex anchors (absolute), or NULL */
+    uint8_t vertex_unknown[BSF_PDM_MAX_VERTICES]; /* unknown index of each vertex */
 } pdm_state_t;
 
 void bsf_pdm_params_default(bsf_pdm_params_t *p)
@@ -51,12 +75,14 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     p->precision_spacing = 1.0f;
     p->lambda_per_metre = 1e-6f;
     p->rel_tol = 0.01f;
-    p->target_rms = 0.025f;
+    p->target_rms = 0.03f;
     p->max_iterations = 2u;
     p->refine_iterations = 1u;
     p->max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE;
     p->footpoint_steps = 1u;
     p->refine = 1u;
+    p->bias_window = 16u;
+    p->bias_ratio = 0.2f;
 }
 
 bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
@@ -72,10 +98,19 @@ bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
         p->max_iterations > BSF_PDM_MAX_ITERATIONS || p->refine_iterations < 1u ||
         p->refine_iterations > BSF_PDM_MAX_ITERATIONS || p->max_ctrl < 3u ||
         p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
-        p->footpoint_steps > 8u || p->refine > 1u) {
+        p->footpoint_steps > 8u || p->refine > 1u || p->bias_window == 1u ||
+        p->bias_window > BSF_PDM_MAX_BIAS_WINDOW ||
+        !(p->bias_ratio > 0.0f && p->bias_ratio <= 1.0f)) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
+}
+
+static float dist2_pts(bsf_point_t a, bsf_point_t b)
+{
+    const float dx = b.x - a.x;
+    const float dy = b.y - a.y;
+    return dx * dx + dy * dy;
 }
 
 static float dist(bsf_point_t a, bsf_point_t b)
@@ -83,6 +118,51 @@ static float dist(bsf_point_t a, bsf_point_t b)
     const float dx = b.x - a.x;
     const float dy = b.y - a.y;
     return sqrtf(dx * dx + dy * dy);
+}
+
+/* Cumulative arc length of the points, fragment by fragment (w->arc), where
+ * each step from point i - 1 to point i is measured along the local direction
+ * of the points: the chord between the nearest points at least PDM_ARC_BASE
+ * before point i and after point i - 1 (within the fragment). Range noise
+ * across a wall then adds nothing, where the plain polyline length grows by
+ * about the noise at every step and, where points are denser than the noise
+ * (near the sensor, fine beams), puts the start parameters far off the
+ * footpoints. Both window ends only move forward: linear cost. Returns the
+ * fragment's length (<= 0 only for a fragment that folds back on itself,
+ * which the caller then spaces by index). */
+static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
+{
+    const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
+    size_t lo = a;
+    size_t hi = a;
+    size_t i;
+    float acc = 0.0f;
+    arc[a] = 0.0f;
+    for (i = a + 1u; i <= b; ++i) {
+        const float sx = pts[i].x - pts[i - 1u].x;
+        const float sy = pts[i].y - pts[i - 1u].y;
+        float dx;
+        float dy;
+        float len;
+        while (lo + 1u < i && dist2_pts(pts[lo + 1u], pts[i]) >= base2) {
+            ++lo;
+        }
+        if (hi < i) {
+            hi = i;
+        }
+        while (hi < b && dist2_pts(pts[hi], pts[i - 1u]) < base2) {
+            ++hi;
+        }
+        dx = pts[hi].x - pts[lo].x;
+        dy = pts[hi].y - pts[lo].y;
+        len = sqrtf(dx * dx + dy * dy);
+        /* Signed: the noise along the direction then cancels from step to
+         * step instead of piling up (the arc may dip by the noise, which the
+         * start parameters clamp). */
+        acc += len > 0.0f ? (sx * dx + sy * dy) / len : sqrtf(sx * sx + sy * sy);
+        arc[i] = acc;
+    }
+    return acc;
 }
 
 /* Control polygon for the current precision counts: unknown index of every
@@ -110,6 +190,7 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
         if (f + 1u < s->n_frag) {
             t1[f] = (float)stored / n_span;
             t0[f + 1u] = t1[f];
+            s->vertex_unknown[f] = (uint8_t)unknown;
             w->unknown_of[stored++] = (uint8_t)unknown;
             w->unknown_of[stored++] = (uint8_t)unknown++;
         }
@@ -283,7 +364,6 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const float range = t1[f] - t0[f];
         const unsigned straight = w->frag_precision[f] == 0u;
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
-        float arc = 0.0f;
         /* The vertex point closing fragment f opens fragment f + 1: it is
          * accumulated once, by the fragment it closes. */
         for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
@@ -291,12 +371,13 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             float u;
             float t;
             size_t span;
-            if (i > a) {
-                arc += dist(s->pts[i - 1u], s->pts[i]);
-            }
             /* Coincident points: fall back to even spacing by index. */
-            frac = len > 0.0f ? arc * inv_len : (float)(i - a) / (float)(b - a);
-            frac = frac > 1.0f ? 1.0f : frac;
+            if (i == b) {
+                frac = 1.0f; /* its arc slot belongs to the next fragment */
+            } else {
+                frac = len > 0.0f ? w->arc[i] * inv_len : (float)(i - a) / (float)(b - a);
+            }
+            frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
             if (straight) {
                 /* A straight fragment at a vertex is not traversed at
                  * constant speed: boundary-vertex runs as 1 - (1 - u)^2,
@@ -361,6 +442,16 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             sums_flush(w, &r);
         }
     }
+    if (s->anchor != NULL) {
+        /* Each vertex is held near its anchor by a spring. */
+        const float weight = PDM_ANCHOR_WEIGHT * (float)s->n;
+        for (k = 0; k + 1u < s->n_frag; ++k) {
+            const size_t u = s->vertex_unknown[k];
+            w->band[u * 3u] += weight;
+            w->rhs_x[u] += weight * (s->anchor[k].x - s->origin.x);
+            w->rhs_y[u] += weight * (s->anchor[k].y - s->origin.y);
+        }
+    }
     st = bsf_spd_band_solve2(w->band, m, m > 2u ? 2u : m - 1u, w->factor, w->rhs_x, w->rhs_y,
                              &loaded);
     if (st != BSF_OK) {
@@ -372,6 +463,26 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
         w->ctrl[k].y = w->rhs_y[w->unknown_of[k]];
     }
     return BSF_OK;
+}
+
+/* Refinement error of a fragment when bias_window is on: its RMS, raised
+ * so that it exceeds target_rms exactly when (1) the largest mean signed
+ * residual over bias_window consecutive points exceeds the larger of
+ * bias_ratio * target_rms and PDM_BIAS_Z standard errors of such a mean
+ * (rms / sqrt(window): a window of pure noise rarely gets there, a bulge
+ * off a curved wall or a corner cut does), or (2) some point lies more than
+ * PDM_POINT_RATIO * target_rms from the curve. */
+static float systematic_error(const pdm_state_t *s, float rms, float window_max, float point_max2)
+{
+    const float window = (float)s->bias_window;
+    const float noise_bound = PDM_BIAS_Z * rms / sqrtf(window);
+    const float bound = noise_bound > s->bias_floor ? noise_bound : s->bias_floor;
+    const float mean_err = window_max / window / bound * s->target;
+    const float point_err = sqrtf(point_max2) * (1.0f / PDM_POINT_RATIO);
+    float e = rms;
+    e = mean_err > e ? mean_err : e;
+    e = point_err > e ? point_err : e;
+    return e;
 }
 
 /* Step (b): footpoints for fixed control points, by at most `steps` Newton
@@ -400,6 +511,18 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
     size_t frag_end = w->frag_last[0];
     size_t f = 0;
     size_t i;
+    /* Systematic deviation (bias_window > 0): the last bias_window signed
+     * residuals of the fragment (a ring), their sum, the fragment's largest
+     * |sum| and its largest squared distance. */
+    float ring[BSF_PDM_MAX_BIAS_WINDOW] = {0.0f};
+    size_t ring_at = 0;
+    size_t ring_n = 0;
+    float ring_sum = 0.0f;
+    float window_max = 0.0f;
+    float point_max = 0.0f;
+    size_t normal_span = (size_t)-1;
+    float nx = 0.0f;
+    float ny = 0.0f;
 
     if (assemble_next) {
         clear_normal_equations(s, w);
@@ -519,6 +642,48 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
         }
         total += best;
         frag_sum += best;
+        if (s->bias_window > 0u) {
+            /* Signed residual along the normal of the span's chord (one
+             * square root per span), summed over the last bias_window
+             * points of the fragment in a ring. */
+            float r;
+            if (c.span != normal_span) {
+                const float dx = c.bx - c.ax; /* P2 - P0 */
+                const float dy = c.by - c.ay;
+                const float len2 = dx * dx + dy * dy;
+                const float inv = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+                nx = -dy * inv;
+                ny = dx * inv;
+                normal_span = c.span;
+            }
+            r = ex * nx + ey * ny;
+            ring_sum += r - ring[ring_at];
+            ring[ring_at] = r;
+            ring_at = ring_at + 1u == s->bias_window ? 0u : ring_at + 1u;
+            ++ring_n;
+            if (ring_n >= s->bias_window && fabsf(ring_sum) > window_max) {
+                window_max = fabsf(ring_sum);
+            }
+            point_max = best > point_max ? best : point_max;
+            if (i == frag_end) {
+                const size_t count = frag_end - w->frag_first[f] + 1u;
+                const float rms = sqrtf(frag_sum / (float)count);
+                w->frag_rms[f] = systematic_error(s, rms, window_max, point_max);
+                frag_sum = best; /* the vertex point opens the next fragment */
+                point_max = best;
+                memset(ring, 0, sizeof ring);
+                ring[0] = r;
+                ring_sum = r;
+                ring_at = 1u;
+                ring_n = 1u;
+                window_max = 0.0f;
+                if (f + 1u < s->n_frag) {
+                    ++f;
+                    frag_end = w->frag_last[f];
+                }
+            }
+            continue;
+        }
         if (i == frag_end) {
             const size_t count = frag_end - w->frag_first[f] + 1u;
             w->frag_rms[f] = sqrtf(frag_sum / (float)count);
@@ -589,7 +754,7 @@ static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_par
         w->rms_history[w->n_history++] = s->rms;
         if (!(s->rms > 0.0f) || (it > 0u && prev - s->rms < p->rel_tol * prev) ||
             (stop_below > 0.0f &&
-             (worst_fragment(s, w) <= stop_below ||
+             ((worst_fragment(s, w) <= stop_below) ||
               (stop_when_far && worst_fragment(s, w) > PDM_FAR_RATIO * stop_below)))) {
             break;
         }
@@ -725,6 +890,16 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
                          bsf_point_t *ctrl_out, uint8_t *is_vertex_out, size_t ctrl_cap,
                          size_t *n_ctrl_out, float *e_curve_out, bsf_pdm_info_t *info_out)
 {
+    return bsf_pdm_fit_anchored(pts, n, vertex_pos, NULL, n_vertex, p, work, ctrl_out,
+                                is_vertex_out, ctrl_cap, n_ctrl_out, e_curve_out, info_out);
+}
+
+bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16_t *vertex_pos,
+                                  const bsf_point_t *vertex_anchor, size_t n_vertex,
+                                  const bsf_pdm_params_t *p, bsf_pdm_work_t *work,
+                                  bsf_point_t *ctrl_out, uint8_t *is_vertex_out, size_t ctrl_cap,
+                                  size_t *n_ctrl_out, float *e_curve_out, bsf_pdm_info_t *info_out)
+{
     bsf_pdm_params_t defaults;
     pdm_state_t s;
     bsf_pdm_info_t info;
@@ -761,14 +936,29 @@ bsf_status_t bsf_pdm_fit(const bsf_point_t *pts, size_t n, const uint16_t *verte
     if (st != BSF_OK) {
         return st;
     }
-    memset(&s, 0, sizeof s);
-    for (i = 1, f = 0; i < n; ++i) {
-        const float d = dist(pts[i - 1u], pts[i]);
-        s.frag_len[f] += d;
-        length += d;
-        if (f < n_vertex && i == vertex_pos[f]) {
-            ++f; /* the vertex closes fragment f */
+    if (vertex_anchor != NULL) {
+        st = bsf_fit_check_points(vertex_anchor, n_vertex);
+        if (st != BSF_OK) {
+            return st;
         }
+    }
+    memset(&s, 0, sizeof s);
+    s.anchor = n_vertex > 0u ? vertex_anchor : NULL;
+    if (p->refine && p->bias_window > 0u) {
+        s.bias_window = p->bias_window;
+        s.bias_floor = p->bias_ratio * p->target_rms;
+        s.target = p->target_rms;
+    }
+    for (i = 1; i < n; ++i) {
+        length += dist(pts[i - 1u], pts[i]);
+    }
+    for (f = 0; f <= n_vertex; ++f) {
+        const size_t a = f == 0u ? 0u : vertex_pos[f - 1u];
+        const size_t b = f < n_vertex ? vertex_pos[f] : n - 1u;
+        /* Arcs are relative to each fragment's first point, so a vertex
+         * point's slot holds 0 (the fragment it opens); the fragment it
+         * closes ends at its length, frag_len. */
+        s.frag_len[f] = fragment_arc(pts, a, b, work->arc);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;

@@ -872,6 +872,11 @@ static void test_pdm_params_check_refuses_null_and_each_out_of_range_field(void)
     BAD_PDM(footpoint_steps, 0u);
     BAD_PDM(footpoint_steps, 9u);
     BAD_PDM(refine, 2u);
+    BAD_PDM(bias_window, 1u);
+    BAD_PDM(bias_window, BSF_PDM_MAX_BIAS_WINDOW + 1u);
+    BAD_PDM(bias_ratio, 0.0f);
+    BAD_PDM(bias_ratio, 1.5f);
+    BAD_PDM(bias_ratio, NAN);
 #undef BAD_PDM
 }
 

@@ -163,23 +163,69 @@ static void compare_log(const char *log_rel, const char *ref_rel, int force_flas
            ag->ref_total, ag->matched, ag->extra, ag->missing);
 }
 
-static void test_intel_robotlaser_matches_falkolib_on_99_percent_of_scans(void)
+static void test_intel_robotlaser_matches_falkolib_on_every_scan(void)
 {
     agreement_t ag;
     compare_log("data/intel.log.gz", "ref/falko_intel_keypoints.txt", 0, &ag);
     TEST_ASSERT_EQUAL_UINT32(2672u, (uint32_t)ag.scans);
     TEST_ASSERT_EQUAL_UINT32(2124u, (uint32_t)ag.ref_total);
-    TEST_ASSERT_TRUE_MESSAGE(ag.identical * 100u >= ag.scans * 99u, "agreement below 99 %");
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE((uint32_t)ag.scans, (uint32_t)ag.identical,
+                                     "a scan's keypoints differ from FALKOLib's");
 }
 
-static void test_intel_corrected_flaser_matches_falkolib_on_99_percent_of_scans(void)
+static void test_intel_corrected_flaser_matches_falkolib_on_every_scan(void)
 {
     agreement_t ag;
     compare_log("data/alt/intel-corrected.log.gz", "ref/falko_intel_corrected_keypoints.txt", 1,
                 &ag);
     TEST_ASSERT_EQUAL_UINT32(910u, (uint32_t)ag.scans);
     TEST_ASSERT_EQUAL_UINT32(691u, (uint32_t)ag.ref_total);
-    TEST_ASSERT_TRUE_MESSAGE(ag.identical * 100u >= ag.scans * 99u, "agreement below 99 %");
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE((uint32_t)ag.scans, (uint32_t)ag.identical,
+                                     "a scan's keypoints differ from FALKOLib's");
+}
+
+/* fr-clinic scan 5434 (0-based): FALKOLib keeps beam 175 as a keypoint. Its
+ * triangle-height test is within float rounding of the boundary when the
+ * area comes from absolute coordinates (about 1e-5 relative lost to
+ * cancellation): the port dropped it until the area was computed relative to
+ * the apex (issue 14). Skipped without the log. */
+static void test_fr_clinic_scan_5434_keeps_keypoint_175(void)
+{
+    char path[4096];
+    carmen_reader_t *rd;
+    carmen_scan_t rec;
+    const bsf_falko_params_t p = bsf_falko_params_default();
+    unsigned long k = 0;
+    int r;
+    snprintf(path, sizeof path, "%s/data/fr-clinic.log.gz", shared_dir);
+    rd = carmen_open(path, NULL);
+    if (rd == NULL) {
+        TEST_IGNORE_MESSAGE("fr-clinic log not found");
+    }
+    while ((r = carmen_next(rd, &rec)) > 0 && k < 5434u) {
+        ++k;
+    }
+    TEST_ASSERT_TRUE(r > 0);
+    {
+        bsf_scan_t s;
+        size_t n = 0;
+        size_t i;
+        int found = 0;
+        s.ranges = rec.ranges;
+        s.count = rec.count;
+        s.angle_min = rec.angle_min;
+        s.angle_increment = rec.angle_increment;
+        s.range_min = 0.0f;
+        s.range_max = 81.0f; /* below the 81.83 no-return code, as above */
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_falko_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n));
+        for (i = 0; i < n; ++i) {
+            found |= kps[i].index == 175u;
+        }
+        TEST_ASSERT_TRUE_MESSAGE(found, "keypoint 175 of fr-clinic scan 5434 missing");
+    }
+    carmen_close(rd);
 }
 
 int main(void)
@@ -202,7 +248,8 @@ int main(void)
     }
     fclose(f);
     UNITY_BEGIN();
-    RUN_TEST(test_intel_robotlaser_matches_falkolib_on_99_percent_of_scans);
-    RUN_TEST(test_intel_corrected_flaser_matches_falkolib_on_99_percent_of_scans);
+    RUN_TEST(test_intel_robotlaser_matches_falkolib_on_every_scan);
+    RUN_TEST(test_intel_corrected_flaser_matches_falkolib_on_every_scan);
+    RUN_TEST(test_fr_clinic_scan_5434_keeps_keypoint_175);
     return UNITY_END();
 }

@@ -51,7 +51,7 @@ static size_t for_each_point(const bsf_feature_t *f, point_fn visit, void *user)
     size_t b = f->first_beam;
     size_t n = 0;
     for (;;) {
-        if (ex.seg_label[b] == f->first_beam) {
+        if (ex.scratch.seg.label[b] == f->first_beam) {
             visit(ex.points.pt[b], user);
             ++n;
         }
@@ -168,7 +168,7 @@ static double farthest_feature_point(void)
     double far = 0.0;
     size_t i;
     for (i = 0; i < ex.points.count; ++i) {
-        if (ex.seg_label[i] != BSF_SEG_NONE && (double)ex.points.range[i] > far) {
+        if (ex.scratch.seg.label[i] != BSF_SEG_NONE && (double)ex.points.range[i] > far) {
             far = (double)ex.points.range[i];
         }
     }
@@ -295,7 +295,7 @@ static void test_far_sparse_points_are_not_chained_metres_apart(void)
         size_t b = f->first_beam;
         size_t prev = BSF_MAX_POINTS;
         for (;;) {
-            if (ex.seg_label[b] == f->first_beam) {
+            if (ex.scratch.seg.label[b] == f->first_beam) {
                 if (prev != BSF_MAX_POINTS) {
                     const float dx = ex.points.pt[b].x - ex.points.pt[prev].x;
                     const float dy = ex.points.pt[b].y - ex.points.pt[prev].y;
@@ -351,7 +351,7 @@ static void test_a_mixed_pixel_at_a_depth_jump_bends_no_feature(void)
     p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
     extract(&p, &s);
     TEST_ASSERT_EQUAL_UINT16(2u, res.n_features);
-    TEST_ASSERT_EQUAL_UINT16(BSF_SEG_NONE, ex.seg_label[mixed]);
+    TEST_ASSERT_EQUAL_UINT16(BSF_SEG_NONE, ex.scratch.seg.label[mixed]);
     for (i = 0; i < res.n_features; ++i) {
         TEST_ASSERT_TRUE(worst_curve_to_truth(&res.features[i], &l) < 0.005);
     }
@@ -449,7 +449,7 @@ static double outdoor_share(const bsf_params_t *p, size_t *n_features, double *f
             }
         }
         for (i = 0; i < ex.points.count; ++i) {
-            if (ex.seg_label[i] != BSF_SEG_NONE && (double)ex.points.range[i] > *far) {
+            if (ex.scratch.seg.label[i] != BSF_SEG_NONE && (double)ex.points.range[i] > *far) {
                 *far = (double)ex.points.range[i];
             }
         }
@@ -483,6 +483,17 @@ static void test_outdoor_scene_up_to_80_m_keeps_points_near_their_curves(void)
      * (its refinement is capped at one precision point per 4 points). The
      * segmentation no longer chains surfaces (the paper's rule: 84.7 %). */
     TEST_ASSERT_TRUE(share >= 0.975);
+    p = bsf_params_default(BSF_METHOD_DEFAULT);
+    share = outdoor_share(&p, &n, &far);
+    printf("outdoor, default method %s: %lu features, %.1f %% within 0.3 m, farthest point "
+           "%.1f m\n",
+           bsf_method_name(BSF_METHOD_DEFAULT), (unsigned long)n, 100.0 * share, far);
+    /* LC finds the far outline corners FALKO's range limit misses: 98.9 %
+     * (177 of 179; FALKO-SVED-PDM's defaults above: 97.8 %, below this bound).
+     * The two left are outlines seen with two or three points past the
+     * corner, too few for a line on that side. */
+    TEST_ASSERT_TRUE(n >= 100u);
+    TEST_ASSERT_TRUE(share >= 0.985);
 }
 
 /* ---- full-circle scans ------------------------------------------------------- */

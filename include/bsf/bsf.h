@@ -16,6 +16,7 @@
 #include "bsf_metrics.h"
 #include "bsf_segment.h"
 #include "bsf_falko.h"
+#include "bsf_lc.h"
 #include "bsf_bspline.h"
 #include "bsf_fit.h"
 #include "bsf_bid.h"

@@ -68,11 +68,13 @@
 /* Every public function whose arguments include a caps-sized object. */
 #define bsf_scan_to_points BSF_CAPS_NAME(bsf_scan_to_points)
 #define bsf_falko_detect BSF_CAPS_NAME(bsf_falko_detect)
+#define bsf_lc_detect BSF_CAPS_NAME(bsf_lc_detect)
 #define bsf_bid_detect BSF_CAPS_NAME(bsf_bid_detect)
 #define bsf_segment_sved BSF_CAPS_NAME(bsf_segment_sved)
 #define bsf_segment_rpos BSF_CAPS_NAME(bsf_segment_rpos)
 #define bsf_segment_classify BSF_CAPS_NAME(bsf_segment_classify)
 #define bsf_pdm_fit BSF_CAPS_NAME(bsf_pdm_fit)
+#define bsf_pdm_fit_anchored BSF_CAPS_NAME(bsf_pdm_fit_anchored)
 #define bsf_extractor_init BSF_CAPS_NAME(bsf_extractor_init)
 #define bsf_extract BSF_CAPS_NAME(bsf_extract)
 #define bsf_metrics_counts BSF_CAPS_NAME(bsf_metrics_counts)

@@ -19,19 +19,32 @@
 #include "bsf_scan.h"
 #include "bsf_feature.h"
 #include "bsf_falko.h"
+#include "bsf_lc.h"
 #include "bsf_bid.h"
 #include "bsf_segment.h"
 #include "bsf_fit.h"
 
 BSF_BEGIN_DECLS
 
-/** The extraction methods of the paper's Table 1. */
+/**
+ * Extraction methods: the three of the paper's Table 1, and bsf's default.
+ * FALKO-SVED-PDM is the paper's proposal with FALKOLib-identical keypoints
+ * (the paper-faithful configuration). LC-SVED-PDM replaces FALKO by LC, bsf's
+ * line-corner detector (bsf_lc.h), and holds each PDM vertex at LC's two-line
+ * intersection: it finds the corners FALKO misses (FALKO's neighbourhood and
+ * its per-scan relative score hide most corners beyond 3 m and lone corners)
+ * and places them where the walls meet (docs/GROUND_TRUTH.md has the numbers).
+ */
 typedef enum {
-    BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM (default) */
+    BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM */
     BSF_METHOD_BID_SVED_PDM = 1,   /**< baseline: B-spline interest points (slow), SVED, PDM */
-    BSF_METHOD_RPOS_LSBA = 2, /**< baseline: RPOS segments, 4-point least squares, no corners */
-    BSF_METHOD_COUNT = 3
+    BSF_METHOD_RPOS_LSBA = 2,   /**< baseline: RPOS segments, 4-point least squares, no corners */
+    BSF_METHOD_LC_SVED_PDM = 3, /**< default: LC line corners, SVED, PDM with anchored vertices */
+    BSF_METHOD_COUNT = 4
 } bsf_method_t;
+
+/** The method a user gets unless they choose: LC-SVED-PDM. */
+#define BSF_METHOD_DEFAULT BSF_METHOD_LC_SVED_PDM
 
 /**
  * A clock for the time metric: returns a free-running 32-bit tick count
@@ -44,10 +57,11 @@ typedef uint32_t (*bsf_clock_fn)(void *user);
 typedef struct {
     bsf_method_t method;
     bsf_falko_params_t falko;         /**< used by FALKO-SVED-PDM */
+    bsf_lc_params_t lc;               /**< used by LC-SVED-PDM */
     bsf_bid_params_t bid;             /**< used by BID-SVED-PDM */
-    bsf_sved_params_t sved;           /**< used by the two SVED methods */
+    bsf_sved_params_t sved;           /**< used by the three SVED methods */
     bsf_rpos_params_t rpos;           /**< used by RPOS-LSBA */
-    bsf_pdm_params_t pdm;             /**< used by the two PDM methods */
+    bsf_pdm_params_t pdm;             /**< used by the three PDM methods */
     bsf_no_return_params_t no_return; /**< no-return codes, every method (bsf_scan.h) */
     bsf_clock_fn clock;               /**< optional, see bsf_clock_fn */
     void *clock_user;                 /**< passed to clock */
@@ -55,15 +69,20 @@ typedef struct {
 } bsf_params_t;
 
 /** Defaults for a method: what a user gets (segmentation extensions on,
- *  see bsf_sved_params_default, and no-return detection on).
+ *  see bsf_sved_params_default, and no-return detection on). PDM takes
+ *  bsf_pdm_params_default (30 mm target plus the systematic-deviation test)
+ *  except FALKO-SVED-PDM and BID-SVED-PDM, which refine on RMS alone to
+ *  25 mm (bias_window 0): their keypoints miss most corners, which the test
+ *  would round with control points.
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
  *  stored, which bsf_extractor_init then refuses. */
 bsf_params_t bsf_params_default(bsf_method_t method);
 
 /** The paper-faithful configuration of a method: as bsf_params_default but
  *  with the paper's SVED rule (bsf_sved_params_paper), no no-return
- *  detection beyond range_max, and PDM's refinement target at the first
- *  release's 15 mm (the paper states none). `bsf table1 --paper` uses it. */
+ *  detection beyond range_max, and PDM's refinement on RMS alone with the
+ *  first release's 15 mm target (the paper states none; bias_window 0).
+ *  `bsf table1 --paper` uses it. */
 bsf_params_t bsf_params_paper(bsf_method_t method);
 
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
@@ -81,19 +100,29 @@ typedef struct {
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
     bsf_segment_t segments[BSF_MAX_SEGMENTS];
-    uint16_t seg_label[BSF_MAX_POINTS]; /**< per beam: first beam of its segment, or BSF_SEG_NONE */
-    /** Stage scratch. The corner, segmentation and fitting stages never run
-     *  at the same time, so their working memory overlaps (the segments take
-     *  no more room than one segment's points, so sizeof is unchanged). */
+    /** Stage scratch. The corner stage runs before segmentation, and
+     *  segmentation before fitting, so their working memory overlaps: the
+     *  corner detectors' work, or the per-beam segment labels (written by
+     *  segmentation, read by fitting, valid after bsf_extract until the next
+     *  call) beside either every kept segment before the cap or the fitting
+     *  stage's work. */
     union {
-        bsf_segment_t all_segments[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
         bsf_falko_work_t falko;
+        bsf_lc_work_t lc;
         bsf_bid_work_t bid;
         struct {
-            bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
-            uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, positions in seg_points */
-            bsf_pdm_work_t pdm;
-        } fit;
+            /** per beam: first beam of its segment, or BSF_SEG_NONE */
+            uint16_t label[BSF_MAX_POINTS];
+            union {
+                bsf_segment_t all[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
+                struct {
+                    bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
+                    uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
+                    bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
+                    bsf_pdm_work_t pdm;
+                } fit;
+            } use;
+        } seg;
     } scratch;
     size_t n_keypoints;
     size_t n_segments;

@@ -156,7 +156,7 @@ check(r.returncode == 0 and "metadata" in objs[0], "extract writes a metadata fr
 meta = objs[0].get("metadata", {})
 first_time = float([l for l in open(os.path.join(WORK, "synth.log")) if l.startswith("ROBOTLASER1")][0].split()[-3])
 check(meta.get("time_origin_us") == round(first_time * 1e6), "metadata carries the log's absolute time origin (%r)" % meta.get("time_origin_us"))
-check(meta.get("source") == "synth.log" and meta.get("method") == "falko-sved-pdm" and meta.get("n_beams", 0) > 0
+check(meta.get("source") == "synth.log" and meta.get("method") == "lc-sved-pdm" and meta.get("n_beams", 0) > 0
       and meta.get("caps", {}).get("points", 0) > 0 and meta.get("quant_step") == 0.00499999989,
       "metadata: source, method, beams, caps, step")
 scans = [o for o in objs if "seq" in o]
@@ -314,7 +314,7 @@ tool_caps = run(["--version"], text=True).stdout.split("caps: ")[-1].split()
 same_caps = ",".join(tool_caps) == expected["caps"]
 if not same_caps:  # a tool built with larger caps cuts fewer (or none) of these scans
     print("note: the tool's caps (%s) are not the library defaults (%s)" % (" ".join(tool_caps), expected["caps"]))
-r = run(["extract", "clutter.log", "-o", "clutter.bsf"], text=True)
+r = run(["extract", "clutter.log", "--method", "falko-sved-pdm", "-o", "clutter.bsf"], text=True)
 check(r.returncode == 0 and "12 scans extracted" in r.stderr and " 0 failed" in r.stderr,
       "bsf extract keeps cut scans, none failed, and exits 0")
 n_lines = r.stderr.count("cut by a cap:")

@@ -15,7 +15,7 @@ int cmd_demo(int argc, char **argv)
 {
     static float ranges[BSF_MAX_POINTS];
     const char *stream_path = "demo.bsf", *svg_path = "demo.svg";
-    bsf_method_t method = BSF_METHOD_FALKO_SVED_PDM;
+    bsf_method_t method = BSF_METHOD_DEFAULT;
     long n_scans = 60;
     bsf_scene_t scene;
     bsf_scene_rng_t rng;

@@ -9,7 +9,8 @@ static const char extract_help[] =
     "Extract B-spline features from every laser scan of a CARMEN log (plain or .gz;\n"
     "'-' reads standard input) and write them as a bsf stream (docs/FORMAT.md).\n"
     "\n"
-    "  --method M       falko-sved-pdm (default), bid-sved-pdm or rpos-lsba\n"
+    "  --method M       lc-sved-pdm (default), falko-sved-pdm (the paper's, FALKOLib keypoints),\n"
+    "                   bid-sved-pdm or rpos-lsba\n"
     "  --first K        skip the first K scans (default 0)\n"
     "  --count N        process at most N scans (default: all)\n"
     "  --range-max M    readings >= M metres are invalid (default: the log's declared\n"
@@ -323,7 +324,7 @@ int cmd_extract(int argc, char **argv)
     int i;
     int err = 0;
     memset(&o, 0, sizeof o);
-    o.method = BSF_METHOD_FALKO_SVED_PDM;
+    o.method = BSF_METHOD_DEFAULT;
     o.count = -1;
     o.quant = (double)BSF_QUANT_STEP_DEFAULT;
     o.meta_every = 64;
@@ -336,8 +337,9 @@ int cmd_extract(int argc, char **argv)
         } else if ((v = opt_value(argc, argv, &i, "--method", &err)) != NULL) {
             o.method = bsf_method_from_name(v);
             if (o.method == BSF_METHOD_COUNT) {
-                return usage_error("unknown method '%s' (falko-sved-pdm, bid-sved-pdm, rpos-lsba)",
-                                   v);
+                return usage_error(
+                    "unknown method '%s' (lc-sved-pdm, falko-sved-pdm, bid-sved-pdm, rpos-lsba)",
+                    v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--first", &err)) != NULL) {
             if (parse_long(v, 0, 1000000000L, &o.first) != 0) {

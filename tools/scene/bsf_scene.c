@@ -678,3 +678,100 @@ bsf_status_t bsf_scene_add_clutter_room(bsf_scene_t *scene, const bsf_scene_clut
     }
     return BSF_OK;
 }
+
+/* ---- ground-truth benchmark scenes ---------------------------------------- */
+
+void bsf_scene_truth_angles(bsf_scene_t *sc)
+{
+    /* Counter-clockwise outline; (1.5, 4) and (5, 7.5) are reflex notches. */
+    static const double outline[] = {0.0,  0.0, 10.0, 0.0, 10.0, 3.0, 12.0, 4.5,
+                                     12.0, 9.0, 7.0,  9.0, 5.0,  7.5, 2.0,  9.0,
+                                     0.0,  9.0, 0.0,  5.0, 1.5,  4.0, 0.0,  3.0};
+    const double c = cos(SCENE_PI / 6.0);
+    const double s = sin(SCENE_PI / 6.0);
+    double box[8];
+    static const double bx[4] = {-0.4, 0.4, 0.4, -0.4};
+    static const double by[4] = {-0.25, -0.25, 0.25, 0.25};
+    size_t k;
+    bsf_scene_init(sc);
+    (void)bsf_scene_add_polyline(sc, outline, 12u, 1);
+    for (k = 0; k < 4u; ++k) {
+        box[2u * k] = 6.0 + c * bx[k] - s * by[k];
+        box[2u * k + 1u] = 4.3 + s * bx[k] + c * by[k];
+    }
+    (void)bsf_scene_add_polyline(sc, box, 4u, 1);
+    (void)bsf_scene_add_segment(sc, 8.0, 7.6, 10.0, 8.2);
+    (void)bsf_scene_add_circle(sc, 2.5, 7.2, 0.3);
+    (void)bsf_scene_add_circle(sc, 9.0, 1.2, 0.025);
+    (void)bsf_scene_add_circle(sc, 9.4, 1.2, 0.025);
+    (void)bsf_scene_add_circle(sc, 9.0, 1.6, 0.025);
+    (void)bsf_scene_add_circle(sc, 9.4, 1.6, 0.025);
+}
+
+void bsf_scene_truth_curved(bsf_scene_t *sc)
+{
+    bsf_scene_init(sc);
+    (void)bsf_scene_add_circle(sc, 0.0, 0.0, 5.0);
+    (void)bsf_scene_add_segment(sc, -6.0, -2.0, 3.5, -2.0);
+    (void)bsf_scene_add_segment(sc, 3.5, -2.0, 3.5, 6.0);
+    (void)bsf_scene_add_circle(sc, -4.5, 3.5, 1.5);
+    (void)bsf_scene_add_circle(sc, -1.0, 3.0, 0.4);
+    (void)bsf_scene_add_circle(sc, 1.5, 2.5, 0.2);
+    (void)bsf_scene_add_rect_room(sc, -3.0, -1.2, -2.4, -0.6);
+}
+
+void bsf_scene_truth_pose(int which, long k, long n, double *x, double *y, double *theta)
+{
+    const double s = n > 0 ? (double)k / (double)n : 0.0;
+    const double a = 2.0 * SCENE_PI * s;
+    double cx = 6.0;
+    double cy = 4.5;
+    double rx = 3.5;
+    double ry = 2.0;
+    double h;
+    if (which == 0) {
+        bsf_scene_demo_pose(k, n, x, y, theta);
+        return;
+    }
+    if (which == 2) {
+        cx = 0.0;
+        cy = 0.8;
+        rx = 2.0;
+        ry = 1.2;
+    }
+    *x = cx + rx * cos(a);
+    *y = cy + ry * sin(a);
+    h = atan2(ry * cos(a), -rx * sin(a)) + 0.9 * sin(3.0 * a);
+    *theta = atan2(sin(h), cos(h));
+}
+
+size_t bsf_scene_mixed_pixels(float *ranges, size_t n, float no_return, double jump, double prob,
+                              bsf_scene_rng_t *rng)
+{
+    size_t i;
+    size_t changed = 0;
+    if (ranges == NULL || rng == NULL || n < 2u) {
+        return 0u;
+    }
+    for (i = 0; i + 1u < n; ++i) {
+        const double a = (double)ranges[i];
+        const double b = (double)ranges[i + 1u];
+        double w;
+        if (ranges[i] == no_return || ranges[i + 1u] == no_return || fabs(a - b) <= jump) {
+            continue;
+        }
+        if (bsf_scene_rng_uniform(rng) > prob) {
+            continue;
+        }
+        w = bsf_scene_rng_uniform(rng);
+        /* The spot straddles the edge: the far beam of the pair reads between. */
+        if (a > b) {
+            ranges[i] = (float)(b + w * (a - b));
+        } else {
+            ranges[i + 1u] = (float)(a + w * (b - a));
+        }
+        ++changed;
+        ++i; /* the pair is used */
+    }
+    return changed;
+}

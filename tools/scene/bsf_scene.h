@@ -283,6 +283,42 @@ size_t bsf_scene_clutter_shapes(const bsf_scene_clutter_t *c);
 bsf_status_t bsf_scene_add_clutter_room(bsf_scene_t *scene, const bsf_scene_clutter_t *c,
                                         bsf_scene_rng_t *rng);
 
+/* ---- ground-truth benchmark scenes (bench_truth, test_truth) ------------- */
+
+/**
+ * An office with corners of many angles: a 12 m x 11 m outline with 90, 117,
+ * 127, 143 and 153 degree convex corners and two reflex (concave) notches, a
+ * free-standing box turned by 30 degrees, a slanted partition, a round pillar
+ * and four chair legs (2.5 cm circles) as clutter.
+ */
+void bsf_scene_truth_angles(bsf_scene_t *scene);
+
+/**
+ * A room with curved walls: the sensor stands inside a 5 m circle (a concave
+ * curved wall) cut by two straight walls meeting at a 90 degree corner, with a
+ * convex bulge (a 1.5 m circle pushing into the room), two round pillars and
+ * a square box.
+ */
+void bsf_scene_truth_curved(bsf_scene_t *scene);
+
+/**
+ * Sensor pose k of n on a loop through the free space of a benchmark scene:
+ * which = 0 the demo office (as bsf_scene_demo_pose), 1 bsf_scene_truth_angles,
+ * 2 bsf_scene_truth_curved. Heading along the loop, turned by a slow wobble so
+ * that a narrow field of view sees every side. Unknown `which` gives pose 0.
+ */
+void bsf_scene_truth_pose(int which, long k, long n, double *x, double *y, double *theta);
+
+/**
+ * Mixed pixels: where neighbouring beams i, i+1 differ by more than `jump`
+ * metres (both returns), with probability `prob` the nearer-to-the-edge beam
+ * of the pair gets a range blended between the two (uniform weight), as a
+ * real scanner's spot straddling a depth edge does. Returns the number of
+ * beams changed. Beams equal to no_return are left alone.
+ */
+size_t bsf_scene_mixed_pixels(float *ranges, size_t n, float no_return, double jump, double prob,
+                              bsf_scene_rng_t *rng);
+
 #ifdef __cplusplus
 }
 #endif

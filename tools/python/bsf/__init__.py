@@ -63,8 +63,9 @@ __all__ = [
 #: control points) and the wire format version it writes.
 caps: Dict[str, int] = dict(_core.caps)
 
-#: Extraction methods, as the C tool spells them.
-METHODS: Tuple[str, ...] = ("falko-sved-pdm", "bid-sved-pdm", "rpos-lsba")
+#: Extraction methods, as the C tool spells them, in bsf_method_t order (the
+#: stream carries the index); the default is "lc-sved-pdm".
+METHODS: Tuple[str, ...] = ("falko-sved-pdm", "bid-sved-pdm", "rpos-lsba", "lc-sved-pdm")
 
 #: True when this build's wire format has the metadata frame (format version 2).
 HAS_METADATA: bool = hasattr(_core, "encode_metadata")
@@ -77,7 +78,7 @@ Pose = Tuple[float, float, float]
 _KINDS = ("bleak", "auxiliary")
 
 
-def default_params(method: str = "falko-sved-pdm") -> Dict[str, Union[int, float]]:
+def default_params(method: str = "lc-sved-pdm") -> Dict[str, Union[int, float]]:
     """Every runtime parameter of ``method`` with its default value.
 
     The names are ``<stage>_<field>`` of the C ``bsf_params_t`` (for example
@@ -354,7 +355,7 @@ class Extractor:
     byte-reproducible. Parameters: see :func:`default_params`.
     """
 
-    def __init__(self, method: str = "falko-sved-pdm", *, timing: bool = True, **params: Union[int, float]):
+    def __init__(self, method: str = "lc-sved-pdm", *, timing: bool = True, **params: Union[int, float]):
         self.method = method
         self._ex = _core.Extractor(method, params, bool(timing))
 
@@ -410,7 +411,7 @@ def extract(
     angle_increment: float,
     range_min: float,
     range_max: float,
-    method: str = "falko-sved-pdm",
+    method: str = "lc-sved-pdm",
     *,
     timing: bool = True,
     seq: int = 0,
@@ -427,7 +428,8 @@ def extract(
             invalid ones keep their index but are never points.
         angle_min, angle_increment: radians, counter-clockwise.
         range_min, range_max: metres; set range_max below no-return codes.
-        method: "falko-sved-pdm" (default), "bid-sved-pdm" or "rpos-lsba".
+        method: "lc-sved-pdm" (default: LC line corners, the library's default),
+            "falko-sved-pdm" (the paper's, FALKOLib keypoints), "bid-sved-pdm" or "rpos-lsba".
         timing: measure the extraction time (False: 0, reproducible bytes).
         seq, timestamp_ms, pose: carried into the frame for :func:`encode`.
         **params: parameter overrides, see :func:`default_params`.
@@ -735,7 +737,7 @@ def _log_frames(
 
 def extract_log(
     path: Union[str, "os.PathLike[str]"],
-    method: str = "falko-sved-pdm",
+    method: str = "lc-sved-pdm",
     *,
     first: int = 0,
     count: Optional[int] = None,
@@ -770,7 +772,7 @@ class StreamWriter:
     def __init__(
         self,
         out: IO[bytes],
-        method: str = "falko-sved-pdm",
+        method: str = "lc-sved-pdm",
         params: Optional[Dict[str, Union[int, float]]] = None,
         quant_step: float = QUANT_STEP_DEFAULT,
         source: Optional[str] = None,

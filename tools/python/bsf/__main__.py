@@ -135,7 +135,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     e.add_argument("input", metavar="INPUT")
     e.add_argument("--topic", help="LaserScan topic of a bag, e.g. /scan")
     e.add_argument("-o", dest="output", default="-", help="output stream ('-': stdout, the default)")
-    e.add_argument("--method", choices=METHODS, default="falko-sved-pdm")
+    e.add_argument("--method", choices=METHODS, default="lc-sved-pdm")
     e.add_argument("--quant", type=float, default=QUANT_STEP_DEFAULT, help="control point step, metres (0.005)")
     e.add_argument("--range-max", type=float, default=None, help="readings >= M metres are invalid (bags: lowers each message's own limit)")
     e.add_argument("--first", type=int, default=0, help="CARMEN: skip the first K scans")

@@ -99,6 +99,18 @@ static const param_desc_t g_params[] = {
     PARAM("falko_b_ratio", falko.b_ratio, PT_FLOAT),
     PARAM("falko_grid_sectors", falko.grid_sectors, PT_INT),
     PARAM("falko_circular_sector_distance", falko.circular_sector_distance, PT_INT),
+    PARAM("lc_jump_a", lc.jump_a, PT_FLOAT),
+    PARAM("lc_jump_b", lc.jump_b, PT_FLOAT),
+    PARAM("lc_split_min", lc.split_min, PT_FLOAT),
+    PARAM("lc_split_sigmas", lc.split_sigmas, PT_FLOAT),
+    PARAM("lc_min_turn", lc.min_turn, PT_FLOAT),
+    PARAM("lc_curve_ratio", lc.curve_ratio, PT_FLOAT),
+    PARAM("lc_floor", lc.floor, PT_FLOAT),
+    PARAM("lc_max_side", lc.max_side, PT_FLOAT),
+    PARAM("lc_apex_slack", lc.apex_slack, PT_FLOAT),
+    PARAM("lc_min_side_len", lc.min_side_len, PT_FLOAT),
+    PARAM("lc_max_range", lc.max_range, PT_FLOAT),
+    PARAM("lc_min_side_points", lc.min_side_points, PT_U16),
     PARAM("bid_neigh_a", bid.neigh_a, PT_FLOAT),
     PARAM("bid_neigh_b", bid.neigh_b, PT_FLOAT),
     PARAM("bid_t_th", bid.t_th, PT_FLOAT),
@@ -127,6 +139,8 @@ static const param_desc_t g_params[] = {
     PARAM("pdm_max_ctrl", pdm.max_ctrl, PT_U16),
     PARAM("pdm_footpoint_steps", pdm.footpoint_steps, PT_U8),
     PARAM("pdm_refine", pdm.refine, PT_U8),
+    PARAM("pdm_bias_window", pdm.bias_window, PT_U8),
+    PARAM("pdm_bias_ratio", pdm.bias_ratio, PT_FLOAT),
 };
 #define N_PARAMS (sizeof g_params / sizeof g_params[0])
 
@@ -255,7 +269,8 @@ static int method_of(PyObject *name, bsf_method_t *out)
     }
     *out = bsf_method_from_name(s);
     if (*out == BSF_METHOD_COUNT) {
-        PyErr_Format(g_bsf_error, "unknown method %R (falko-sved-pdm, bid-sved-pdm or rpos-lsba)",
+        PyErr_Format(g_bsf_error,
+                     "unknown method %R (lc-sved-pdm, falko-sved-pdm, bid-sved-pdm or rpos-lsba)",
                      name);
         return -1;
     }

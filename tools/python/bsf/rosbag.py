@@ -144,7 +144,7 @@ def extract_bag(
     path: Union[str, Path],
     topic: str,
     out: str,
-    method: str = "falko-sved-pdm",
+    method: str = "lc-sved-pdm",
     *,
     quant_step: Optional[float] = None,
     range_max: Optional[float] = None,

@@ -38,7 +38,7 @@ def _compare(bsf_tool, log, tmp_path, *tool_args):
     assert [f.seq for f in scan_frames(mine)] == [f.seq for f in cli_frames]
     if bsf.HAS_METADATA:
         metas = [m for m in mine if isinstance(m, bsf.Metadata)]
-        assert metas and metas[0].source == log.name and metas[0].method == "falko-sved-pdm"
+        assert metas and metas[0].source == log.name and metas[0].method == "lc-sved-pdm"
         assert mine[0] is metas[0]  # the stream starts with it
         assert all(f.unix_time_ms is not None for f in scan_frames(mine))
     return n

@@ -73,7 +73,10 @@ def test_methods_and_parameters():
     loose = bsf.extract(ranges, amin, inc, 0.05, 30.0, pdm_target_rms=0.1)
     tight = bsf.extract(ranges, amin, inc, 0.05, 30.0, pdm_target_rms=0.004)
     assert loose.stats.n_ctrl < tight.stats.n_ctrl
-    assert bsf.default_params()["pdm_target_rms"] == pytest.approx(0.025)
+    assert bsf.default_params()["pdm_target_rms"] == pytest.approx(0.03)
+    assert bsf.default_params()["pdm_bias_window"] == 16
+    assert bsf.default_params("falko-sved-pdm")["pdm_target_rms"] == pytest.approx(0.025)
+    assert bsf.default_params("falko-sved-pdm")["pdm_bias_window"] == 0
     assert bsf.default_params()["sved_lookback"] == 4 and bsf.default_params()["no_return_min_run"] == 5
     assert bsf.Extractor(sved_min_segment_points=7).params["sved_min_segment_points"] == 7
 

@@ -1,0 +1,92 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * bsf_lc.h - LC, the line-corner detector: bsf's own corner source, used by
+ * the default method "lc-sved-pdm". It is not FALKO and does not try to
+ * reproduce FALKOLib (FALKO stays available, keypoint-identical to FALKOLib,
+ * in "falko-sved-pdm", the paper-faithful method).
+ *
+ * How it works, per run of points that SVED's distance rule keeps together:
+ *  1. split the run where a point lies farther than a tolerance from the chord
+ *     of its piece (Douglas-Peucker without recursion); the tolerance is
+ *     split_sigmas times the run's noise, estimated from how far each point
+ *     lies from the chord of its two neighbours, and at least split_min;
+ *  2. judge every split point with the two pieces beside it (each cut to
+ *     max_side metres from the apex): fit a total-least-squares line to each
+ *     side (the apex left out) and keep the split as a corner only when
+ *     - each side has min_side_points points and reaches min_side_len,
+ *     - the lines turn by at least min_turn,
+ *     - their intersection lies near the apex (within twice the local beam
+ *       spacing plus apex_slack), and
+ *     - two lines explain the points much better than one smooth curve: the
+ *       squared residual of the better of one line and one circle (fitted to
+ *       both sides together) is above curve_ratio times that of the two
+ *       lines, plus (count x floor^2). So round pillars, curved walls and
+ *       noise on straight walls give no corner, whatever the beam spacing;
+ *     a rejected split merges its two pieces and the neighbours are judged
+ *     again;
+ *  3. report each corner at its apex beam, with the intersection of the two
+ *     lines as its position (PDM starts the vertex there and keeps it there).
+ * Thresholds are absolute or relative to the estimated noise; none depends
+ * on the other corners of the scan. Cost is linear in beams per split level.
+ */
+#ifndef BSF_LC_H
+#define BSF_LC_H
+
+#include "bsf_common.h"
+#include "bsf_scan.h"
+
+BSF_BEGIN_DECLS
+
+/** LC parameters; start from bsf_lc_params_default(). */
+typedef struct {
+    float jump_a;       /**< runs break where consecutive points are farther apart than
+                             jump_a * exp(jump_b * range), metres (0.2, SVED's) */
+    float jump_b;       /**< see jump_a, 1/metres (0.07) */
+    float split_min;    /**< smallest split tolerance, metres (0.02) */
+    float split_sigmas; /**< split tolerance in estimated noise sigmas (4) */
+    float min_turn;     /**< smallest change of direction at a corner, radians (0.15) */
+    float curve_ratio;  /**< two lines must beat the best smooth curve by this factor (10) */
+    float floor;        /**< residual floor per point, metres (0.003) */
+    float max_side;     /**< length of each side used for the line fits, metres (1.5) */
+    float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
+    float min_side_len; /**< length each side must reach from the apex, metres (0.15) */
+    float max_range;    /**< no corner at an apex farther than this, metres (30, FALKO's) */
+    uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3); one
+                                   fewer where a side reaches the end of its run */
+} bsf_lc_params_t;
+
+/** The defaults listed beside each field of bsf_lc_params_t. */
+bsf_lc_params_t bsf_lc_params_default(void);
+
+/** @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM when a value is not
+ *  finite or out of range (jump_a, split_min, max_side, curve_ratio, max_range > 0;
+ *  jump_b, floor, apex_slack, min_side_len >= 0; split_sigmas >= 0; min_turn in (0, pi/2);
+ *  min_side_points in 2..64). */
+BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
+
+/** Scratch memory of bsf_lc_detect (about 9 bytes per beam). */
+typedef struct {
+    uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
+    uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
+    uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
+    uint16_t stack_b[BSF_MAX_POINTS];
+    uint8_t is_brk[BSF_MAX_POINTS]; /**< split marks, positions in run */
+} bsf_lc_work_t;
+
+/**
+ * Detect corners. Keypoints come out ascending by beam index, with point =
+ * the two-line intersection (sensor frame), orientation = the direction of
+ * the corner's bisector (radians), radius = the longer side used (metres) and
+ * score = the curve-to-lines residual ratio (higher = sharper evidence).
+ * @return BSF_OK; BSF_ERR_ARG for NULL pointers (out may be NULL when out_cap
+ *         is 0); BSF_ERR_PARAM for bad parameters; BSF_ERR_CAPACITY when
+ *         pts->count > BSF_MAX_POINTS or more than out_cap corners were found
+ *         (out holds the first out_cap, *n_out the total).
+ */
+BSF_NODISCARD bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p,
+                                         bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,
+                                         size_t *n_out);
+
+BSF_END_DECLS
+
+#endif /* BSF_LC_H */

@@ -1,0 +1,567 @@
+/* SPDX-License-Identifier: MIT */
+/* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
+#include "bsf/bsf_lc.h"
+#include "bsf_math.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Split-judge passes per run: each pass after the first only re-judges the
+ * neighbours of merged splits, and a run rarely needs more than three. */
+#define LC_MAX_PASSES 8u
+/* sqrt(1.5) * sqrt(2/pi): mean |distance of a point from its neighbours'
+ * chord| per unit of Gaussian noise normal to a straight wall. */
+#define LC_NOISE_MEAN_ABS 0.9772f
+/* Single distances above this do not count towards the noise estimate
+ * (corners and jumps inside a run), metres. */
+#define LC_NOISE_CLIP 0.05f
+/* A circle is only a candidate shape when its radius is below this multiple
+ * of the window's extent: a larger one is a line in float arithmetic. */
+#define LC_CIRCLE_MAX_RADIUS 10.0f
+
+bsf_lc_params_t bsf_lc_params_default(void)
+{
+    bsf_lc_params_t p;
+    p.jump_a = 0.2f;
+    p.jump_b = 0.07f;
+    p.split_min = 0.02f;
+    p.split_sigmas = 4.0f;
+    p.min_turn = 0.15f;
+    p.curve_ratio = 10.0f;
+    p.floor = 0.003f;
+    p.max_side = 1.5f;
+    p.apex_slack = 0.05f;
+    p.min_side_points = 3u;
+    p.min_side_len = 0.15f;
+    p.max_range = 30.0f;
+    return p;
+}
+
+bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
+{
+    if (p == NULL) {
+        return BSF_ERR_ARG;
+    }
+    /* Written so that NaN fails every test. */
+    if (!(p->jump_a > 0.0f && p->jump_a <= 1e3f) || !(p->jump_b >= 0.0f && p->jump_b <= 10.0f) ||
+        !(p->split_min > 0.0f && p->split_min <= 1e3f) ||
+        !(p->split_sigmas >= 0.0f && p->split_sigmas <= 1e3f) ||
+        !(p->min_turn > 0.0f && p->min_turn < 1.5707963f) ||
+        !(p->curve_ratio > 0.0f && p->curve_ratio <= 1e6f) ||
+        !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
+        !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
+        !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
+        p->min_side_points < 2u || p->min_side_points > 64u) {
+        return BSF_ERR_PARAM;
+    }
+    return BSF_OK;
+}
+
+/* A total-least-squares line: centroid, unit direction, squared residual. */
+typedef struct {
+    float mx, my;
+    float dx, dy;
+    float rss;
+    size_t n;
+} lc_line_t;
+
+typedef struct {
+    const bsf_points_t *pts;
+    const uint16_t *run;
+    const bsf_lc_params_t *p;
+    bsf_point_t o; /* origin of the current judgement (the apex point) */
+} lc_ctx_t;
+
+static bsf_point_t rel(const lc_ctx_t *c, size_t pos)
+{
+    bsf_point_t q = c->pts->pt[c->run[pos]];
+    q.x -= c->o.x;
+    q.y -= c->o.y;
+    return q;
+}
+
+static float dist2(bsf_point_t a, bsf_point_t b)
+{
+    const float dx = a.x - b.x;
+    const float dy = a.y - b.y;
+    return dx * dx + dy * dy;
+}
+
+/* Line through positions a..b of the run, leaving out position skip (pass
+ * b + 1 to keep all). Two passes: centring first keeps float sums exact
+ * enough for centimetre noise on 10 m walls. Returns 0 when fewer than two
+ * points. */
+static int fit_line(const lc_ctx_t *c, size_t a, size_t b, size_t skip, lc_line_t *l)
+{
+    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
+    float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm;
+    size_t i;
+    size_t n = 0;
+    for (i = a; i <= b; ++i) {
+        if (i != skip) {
+            const bsf_point_t q = rel(c, i);
+            sx += q.x;
+            sy += q.y;
+            ++n;
+        }
+    }
+    if (n < 2u) {
+        return 0;
+    }
+    l->n = n;
+    l->mx = sx / (float)n;
+    l->my = sy / (float)n;
+    for (i = a; i <= b; ++i) {
+        if (i != skip) {
+            const bsf_point_t q = rel(c, i);
+            const float x = q.x - l->mx;
+            const float y = q.y - l->my;
+            sxx += x * x;
+            sxy += x * y;
+            syy += y * y;
+        }
+    }
+    half = 0.5f * (sxx + syy);
+    diff = 0.5f * (sxx - syy);
+    root = sqrtf(diff * diff + sxy * sxy);
+    lmax = half + root;
+    lmin = half - root;
+    l->rss = lmin > 0.0f ? lmin : 0.0f;
+    /* Eigenvector of the larger eigenvalue: of the two equivalent forms, the
+     * one with the larger norm is the better conditioned. */
+    v1x = sxy;
+    v1y = lmax - sxx;
+    v2x = lmax - syy;
+    v2y = sxy;
+    if (v1x * v1x + v1y * v1y >= v2x * v2x + v2y * v2y) {
+        nrm = sqrtf(v1x * v1x + v1y * v1y);
+        l->dx = v1x;
+        l->dy = v1y;
+    } else {
+        nrm = sqrtf(v2x * v2x + v2y * v2y);
+        l->dx = v2x;
+        l->dy = v2y;
+    }
+    if (!(nrm > 0.0f)) {
+        return 0; /* all points coincide */
+    }
+    l->dx /= nrm;
+    l->dy /= nrm;
+    return 1;
+}
+
+/* Squared residual of the best circle through positions a..b (algebraic fit,
+ * then geometric distances), or -1 when no sensible circle exists. */
+static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent)
+{
+    float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
+    float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
+    float n = 0.0f;
+    float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
+    size_t i;
+    for (i = a; i <= b; ++i) {
+        const bsf_point_t q = rel(c, i);
+        const float x = q.x - cx0;
+        const float y = q.y - cy0;
+        const float z = x * x + y * y;
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
+        sx += x;
+        sy += y;
+        sxz += x * z;
+        syz += y * z;
+        sz += z;
+        n += 1.0f;
+    }
+    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz) by Cramer. */
+    det = sxx * (syy * n - sy * sy) - sxy * (sxy * n - sy * sx) + sx * (sxy * sy - syy * sx);
+    if (!(fabsf(det) > 0.0f)) {
+        return -1.0f;
+    }
+    d = (-sxz * (syy * n - sy * sy) + sxy * (syz * n - sy * sz) - sx * (syz * sy - syy * sz)) / det;
+    e = (sxx * (-syz * n + sy * sz) + sxz * (sxy * n - sy * sx) + sx * (-sxy * sz + syz * sx)) /
+        det;
+    f = (sxx * (-syy * sz + syz * sy) - sxy * (-sxy * sz + syz * sx) -
+         sxz * (sxy * sy - syy * sx)) /
+        det;
+    cx = -0.5f * d;
+    cy = -0.5f * e;
+    r2 = cx * cx + cy * cy - f;
+    if (!(r2 > 0.0f) || !(r2 < LC_CIRCLE_MAX_RADIUS * LC_CIRCLE_MAX_RADIUS * extent * extent)) {
+        return -1.0f;
+    }
+    r = sqrtf(r2);
+    for (i = a; i <= b; ++i) {
+        const bsf_point_t q = rel(c, i);
+        const float dx = q.x - cx0 - cx;
+        const float dy = q.y - cy0 - cy;
+        const float g = sqrtf(dx * dx + dy * dy) - r;
+        rss += g * g;
+    }
+    return rss;
+}
+
+/* A side is straight unless a circle cuts its squared residual by more than
+ * the factor curve_ratio (beyond the floor). */
+static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
+{
+    const float extent = sqrtf(dist2(rel(c, a), rel(c, b)));
+    const float rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
+    if (rss_circle < 0.0f) {
+        return 1;
+    }
+    return l->rss <=
+           c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
+}
+
+/* Judge the split at position apex between the pieces that start at lo and
+ * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
+ * corner, 0 otherwise. */
+static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_keypoint_t *kp)
+{
+    const bsf_lc_params_t *p = c->p;
+    const float side2 = p->max_side * p->max_side;
+    const float len2 = p->min_side_len * p->min_side_len;
+    const size_t need = p->min_side_points;
+    lc_line_t la;
+    lc_line_t lb;
+    lc_line_t lu;
+    size_t a0 = apex;
+    size_t b1 = apex;
+    size_t best;
+    size_t i;
+    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
+    bsf_point_t x;
+
+    if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
+        return 0;
+    }
+    c->o = c->pts->pt[c->run[apex]];
+    while (a0 > lo && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
+        --a0;
+    }
+    while (b1 < hi && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
+        ++b1;
+    }
+    /* A side cut short by a neighbouring split reaches past it: noise often
+     * splits a corner several times within a few points, and the true apex
+     * must not lose to its own echoes (a side that then crosses another
+     * corner fails the straightness test). */
+    if (apex - a0 < need || dist2(rel(c, a0), rel(c, apex)) < len2) {
+        while (a0 > 0u && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
+            --a0;
+        }
+    }
+    if (b1 - apex < need || dist2(rel(c, b1), rel(c, apex)) < len2) {
+        while (b1 + 1u < m && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
+            ++b1;
+        }
+    }
+    /* A side that runs to the end of the run may be one point shorter: a
+     * far corner at the edge of what is seen has few points beyond it. */
+    if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
+        return 0;
+    }
+    /* Each side must also be long enough to give its line a direction. */
+    if (dist2(rel(c, a0), rel(c, apex)) < len2 || dist2(rel(c, b1), rel(c, apex)) < len2) {
+        return 0;
+    }
+    if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {
+        return 0;
+    }
+    cross = la.dx * lb.dy - la.dy * lb.dx;
+    if (!(fabsf(cross) >= bsf_sinf(p->min_turn))) {
+        return 0;
+    }
+    t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
+    xx = la.mx + t * la.dx;
+    xy = la.my + t * la.dy;
+    x.x = xx;
+    x.y = xy;
+    spacing = sqrtf(dist2(rel(c, apex - 1u), rel(c, apex)));
+    {
+        const float s2 = sqrtf(dist2(rel(c, apex + 1u), rel(c, apex)));
+        spacing = s2 > spacing ? s2 : spacing;
+    }
+    if (!(xx * xx + xy * xy <=
+          (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
+        return 0;
+    }
+    /* One smooth curve over both sides: the better of a line and a circle. */
+    if (!fit_line(c, a0, b1, b1 + 1u, &lu)) {
+        return 0;
+    }
+    extent = sqrtf(dist2(rel(c, a0), rel(c, b1)));
+    rss_curve = lu.rss;
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent);
+    if (rss_circle >= 0.0f && rss_circle < rss_curve) {
+        rss_curve = rss_circle;
+    }
+    rss_lines = la.rss + lb.rss;
+    if (!(rss_curve > p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor)) {
+        return 0;
+    }
+    /* Each side must be straight: a circle may not explain it much better
+     * than its line (a crease between two curved walls is no wall corner,
+     * and its line intersection would lie off the crease). Last, as the
+     * dearest test. */
+    if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
+        return 0;
+    }
+    /* The vertex beam: the point nearest the intersection, near the split. */
+    best = apex;
+    best_d = dist2(rel(c, apex), x);
+    for (i = apex - 2u; i <= apex + 2u; ++i) {
+        if (i > a0 && i < b1) {
+            const float d = dist2(rel(c, i), x);
+            if (d < best_d) {
+                best_d = d;
+                best = i;
+            }
+        }
+    }
+    kp->index = c->run[best];
+    kp->point.x = xx + c->o.x;
+    kp->point.y = xy + c->o.y;
+    kp->orientation = bsf_atan2f(la.my + lb.my - 2.0f * xy, la.mx + lb.mx - 2.0f * xx);
+    {
+        const float ra = sqrtf(dist2(rel(c, a0), rel(c, apex)));
+        const float rb = sqrtf(dist2(rel(c, b1), rel(c, apex)));
+        kp->radius = ra > rb ? ra : rb;
+    }
+    kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
+    return 1;
+}
+
+/* Noise normal to the surface, from each point's distance to the chord of
+ * its two neighbours. */
+static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m)
+{
+    float sum = 0.0f;
+    size_t n = 0;
+    size_t i;
+    for (i = 1; i + 1u < m; ++i) {
+        const bsf_point_t a = pts->pt[run[i - 1u]];
+        const bsf_point_t q = pts->pt[run[i]];
+        const bsf_point_t b = pts->pt[run[i + 1u]];
+        const float ex = b.x - a.x;
+        const float ey = b.y - a.y;
+        const float len = sqrtf(ex * ex + ey * ey);
+        float d;
+        if (!(len > 0.0f)) {
+            continue;
+        }
+        d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
+        if (d <= LC_NOISE_CLIP) {
+            sum += d;
+            ++n;
+        }
+    }
+    return n > 0u ? sum / ((float)n * LC_NOISE_MEAN_ABS) : 0.0f;
+}
+
+/* Douglas-Peucker split of run positions 0..m-1 with an explicit stack;
+ * returns the number of splits, ascending in w->brk. */
+static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, float tol)
+{
+    size_t top = 0;
+    size_t nb = 0;
+    size_t i;
+    memset(w->is_brk, 0, m);
+    w->stack_a[top] = 0u;
+    w->stack_b[top] = (uint16_t)(m - 1u);
+    ++top;
+    while (top > 0u) {
+        const size_t a = w->stack_a[--top];
+        const size_t b = w->stack_b[top];
+        const bsf_point_t pa = pts->pt[w->run[a]];
+        const bsf_point_t pb = pts->pt[w->run[b]];
+        const float ex = pb.x - pa.x;
+        const float ey = pb.y - pa.y;
+        const float len = sqrtf(ex * ex + ey * ey);
+        float dmax = 0.0f;
+        size_t imax = a;
+        if (b < a + 2u) {
+            continue;
+        }
+        for (i = a + 1u; i < b; ++i) {
+            const bsf_point_t q = pts->pt[w->run[i]];
+            const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
+                                       : sqrtf(dist2(q, pa));
+            if (d > dmax) {
+                dmax = d;
+                imax = i;
+            }
+        }
+        if (dmax > tol) {
+            w->is_brk[imax] = 1u;
+            /* Each pushed piece is a strict sub-range with disjoint interior,
+             * so the stack never holds more than m entries. */
+            w->stack_a[top] = (uint16_t)a;
+            w->stack_b[top] = (uint16_t)imax;
+            ++top;
+            w->stack_a[top] = (uint16_t)imax;
+            w->stack_b[top] = (uint16_t)b;
+            ++top;
+        }
+    }
+    for (i = 0; i < m; ++i) {
+        if (w->is_brk[i]) {
+            w->brk[nb++] = (uint16_t)i;
+        }
+    }
+    return nb;
+}
+
+/* Two keypoints of one run on one corner: beams closer than the points a
+ * side needs, or intersections within apex_slack of each other. */
+static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf_lc_params_t *p)
+{
+    return (size_t)a->index + p->min_side_points >= (size_t)b->index ||
+           dist2(a->point, b->point) <= p->apex_slack * p->apex_slack;
+}
+
+/* Append kp, or merge it into the previous keypoint of the same run (from
+ * index first on) when both sit on one corner, keeping the sharper. *last
+ * mirrors the previous keypoint even when out is full, so the count does not
+ * depend on out_cap. */
+static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, bsf_keypoint_t *last,
+                 const bsf_keypoint_t *kp, const bsf_lc_params_t *p)
+{
+    if (*n > first && too_close(last, kp, p)) {
+        if (kp->score > last->score) {
+            *last = *kp;
+            if (*n - 1u < out_cap) {
+                out[*n - 1u] = *kp;
+            }
+        }
+        return;
+    }
+    if (*n < out_cap) {
+        out[*n] = *kp;
+    }
+    *last = *kp;
+    ++*n;
+}
+
+/* Corners of one run: split, then merge the splits that are no corner until
+ * the survivors all pass. */
+static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
+                       size_t *n_found)
+{
+    const float sigma = run_noise(c->pts, w->run, m);
+    float tol = c->p->split_sigmas * sigma;
+    size_t nb;
+    size_t j;
+    unsigned pass;
+    int changed = 1;
+    size_t first;
+    bsf_keypoint_t kp;
+    bsf_keypoint_t last;
+    if (tol < c->p->split_min) {
+        tol = c->p->split_min;
+    }
+    nb = split_run(c->pts, w, m, tol);
+    first = *n_found;
+    memset(&last, 0, sizeof last);
+    for (pass = 0; changed && pass < LC_MAX_PASSES; ++pass) {
+        changed = 0;
+        j = 0;
+        while (j < nb) {
+            const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
+            const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
+            if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                memmove(&w->brk[j], &w->brk[j + 1u], (nb - j - 1u) * sizeof w->brk[0]);
+                --nb;
+                changed = 1;
+            } else {
+                /* Parked where it lands if this pass turns out final. */
+                if (*n_found + j < out_cap) {
+                    out[*n_found + j] = kp;
+                }
+                ++j;
+            }
+        }
+    }
+    if (!changed) {
+        /* The last pass judged every survivor with its final neighbours:
+         * its keypoints stand. */
+        const size_t base = *n_found;
+        for (j = 0; j < nb; ++j) {
+            const size_t parked = base + j; /* never below the next slot written */
+            if (parked < out_cap) {
+                kp = out[parked];
+            } else {
+                const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
+                const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
+                if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                    continue; /* cannot happen: same judgement as in the pass */
+                }
+            }
+            keep(out, out_cap, n_found, first, &last, &kp, c->p);
+        }
+        return;
+    }
+    for (j = 0; j < nb; ++j) {
+        const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
+        const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
+        if (judge(c, lo, w->brk[j], hi, m, &kp)) {
+            keep(out, out_cap, n_found, first, &last, &kp, c->p);
+        }
+    }
+}
+
+bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
+                           bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
+{
+    lc_ctx_t c;
+    bsf_status_t st;
+    size_t n_found = 0;
+    size_t m = 0;
+    size_t i;
+    if (n_out != NULL) {
+        *n_out = 0u;
+    }
+    if (pts == NULL || p == NULL || work == NULL || n_out == NULL ||
+        (out == NULL && out_cap > 0u)) {
+        return BSF_ERR_ARG;
+    }
+    st = bsf_lc_params_check(p);
+    if (st != BSF_OK) {
+        return st;
+    }
+    if (pts->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    c.pts = pts;
+    c.run = work->run;
+    c.p = p;
+    c.o.x = 0.0f;
+    c.o.y = 0.0f;
+    for (i = 0; i <= pts->count; ++i) {
+        int close_run = i == pts->count;
+        if (!close_run && !pts->valid[i]) {
+            continue;
+        }
+        if (!close_run && m > 0u) {
+            /* r >= jump_a: the exponential is only needed past that. */
+            const float d2 = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]);
+            if (d2 > p->jump_a * p->jump_a) {
+                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
+                close_run = d2 > r * r;
+            }
+        }
+        if (close_run) {
+            if (m >= 2u * (size_t)p->min_side_points + 1u) {
+                detect_run(&c, work, m, out, out_cap, &n_found);
+            }
+            m = 0;
+        }
+        if (i < pts->count) {
+            work->run[m++] = (uint16_t)i;
+        }
+    }
+    *n_out = n_found;
+    return n_found > out_cap ? BSF_ERR_CAPACITY : BSF_OK;
+}

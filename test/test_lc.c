@@ -1,0 +1,182 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * LC, the line-corner detector: corners of several angles found where the
+ * walls meet, none on straight walls, pillars or curved walls, lone and far
+ * corners found (what FALKO's relative score and fixed radius miss), and
+ * the refused calls. Runs on the host and on the emulated Cortex-M4F.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "bsf/bsf.h"
+#include "bsf_scene.h"
+#include "unity.h"
+
+#define PI 3.14159265358979323846
+
+static float ranges[BSF_MAX_POINTS];
+static bsf_points_t points;
+static bsf_lc_work_t work;
+static bsf_keypoint_t kps[BSF_MAX_KEYPOINTS];
+static bsf_scene_t scene;
+
+void setUp(void)
+{
+    bsf_scene_init(&scene);
+    memset(kps, 0, sizeof kps);
+}
+
+void tearDown(void)
+{
+}
+
+/* Scan the scene from (x, y, heading) with n beams over fov and noise sigma,
+ * run LC with its defaults; returns the keypoint count. */
+static size_t detect(double x, double y, double heading, size_t n, double fov, double sigma)
+{
+    bsf_lidar_t lid = bsf_lidar_default(x, y, heading, n, fov);
+    bsf_scene_rng_t rng;
+    bsf_scan_t scan;
+    const bsf_lc_params_t p = bsf_lc_params_default();
+    size_t n_out = 0;
+    lid.noise_sigma = sigma;
+    bsf_scene_rng_seed(&rng, 7u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, &rng, ranges, NULL, BSF_MAX_POINTS));
+    scan = bsf_scene_lidar_scan(&lid, ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
+    return n_out;
+}
+
+/* Distance from keypoint k to the world point (wx, wy) seen from the pose. */
+static double dist_to(size_t k, double x, double y, double heading, double wx, double wy)
+{
+    const bsf_scene_pose_t pose = {x, y, heading};
+    double sx;
+    double sy;
+    bsf_scene_world_to_sensor(&pose, wx, wy, &sx, &sy);
+    return hypot((double)kps[k].point.x - sx, (double)kps[k].point.y - sy);
+}
+
+static void test_corners_of_many_angles_are_found_where_the_walls_meet(void)
+{
+    /* 60, 90, 120 and 150 degrees between the walls, 4 m ahead. */
+    static const double angles_deg[4] = {60.0, 90.0, 120.0, 150.0};
+    int a;
+    for (a = 0; a < 4; ++a) {
+        const double half = 0.5 * angles_deg[a] * PI / 180.0;
+        size_t n;
+        bsf_scene_init(&scene);
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_scene_add_corner(&scene, 4.0, 0.0, PI - half, 3.0, PI + half, 3.0));
+        n = detect(0.0, 0.0, 0.0, 361u, 1.5 * PI, 0.0);
+        TEST_ASSERT_EQUAL_size_t_MESSAGE(1u, n, "one corner expected");
+        /* The two-line intersection, not the nearest beam: millimetres. */
+        TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 4.0, 0.0) < 0.005);
+    }
+}
+
+static void test_a_lone_far_corner_is_found_at_one_degree_beams(void)
+{
+    /* FALKO at the same spacing misses it (radius too small for two
+     * points per side, and a lone corner has no rival for its score). */
+    size_t n;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 7.0, 0.5, 0.75 * PI, 3.0, 1.25 * PI, 3.0));
+    n = detect(0.0, 0.0, 0.0, 181u, PI, 0.01);
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+    TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 7.0, 0.5) < 0.03);
+}
+
+static void test_noisy_room_gives_its_four_corners_and_nothing_else(void)
+{
+    size_t n;
+    size_t k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, -3.0, -2.0, 5.0, 4.0));
+    n = detect(0.3, 0.2, 0.4, 721u, 2.0 * PI * 719.0 / 720.0, 0.01);
+    TEST_ASSERT_EQUAL_size_t(4u, n);
+    for (k = 0; k < n; ++k) {
+        const double d =
+            fmin(fmin(dist_to(k, 0.3, 0.2, 0.4, -3.0, -2.0), dist_to(k, 0.3, 0.2, 0.4, 5.0, -2.0)),
+                 fmin(dist_to(k, 0.3, 0.2, 0.4, 5.0, 4.0), dist_to(k, 0.3, 0.2, 0.4, -3.0, 4.0)));
+        TEST_ASSERT_TRUE(d < 0.03);
+        if (k > 0u) {
+            TEST_ASSERT_TRUE(kps[k].index > kps[k - 1u].index);
+        }
+    }
+}
+
+static void test_straight_walls_pillars_and_curved_walls_give_no_corner(void)
+{
+    /* A long wall, a pillar, and the inside of a big circle, with noise. */
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, -6.0, 3.0, 6.0, 3.0) >= 0);
+    TEST_ASSERT_EQUAL_size_t(0u, detect(0.0, 0.0, 0.0, 541u, 1.5 * PI, 0.01));
+    bsf_scene_init(&scene);
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 2.0, 0.0, 0.4) >= 0);
+    TEST_ASSERT_EQUAL_size_t(0u, detect(0.0, 0.0, 0.0, 1081u, 1.5 * PI, 0.01));
+    bsf_scene_init(&scene);
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 0.0, 0.0, 5.0) >= 0);
+    TEST_ASSERT_EQUAL_size_t(0u, detect(1.0, 0.5, 0.0, 541u, 1.5 * PI, 0.01));
+}
+
+static void test_refused_calls(void)
+{
+    bsf_lc_params_t p = bsf_lc_params_default();
+    size_t n = 99;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_lc_params_check(&p));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_lc_params_check(NULL));
+    p.min_turn = 0.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_lc_params_check(&p));
+    p = bsf_lc_params_default();
+    p.curve_ratio = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_lc_params_check(&p));
+    p = bsf_lc_params_default();
+    p.min_side_points = 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_lc_params_check(&p));
+    p = bsf_lc_params_default();
+    p.max_range = -1.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_lc_params_check(&p));
+    p = bsf_lc_params_default();
+    memset(&points, 0, sizeof points);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_lc_detect(NULL, &p, &work, kps, 4u, &n));
+    TEST_ASSERT_EQUAL_size_t(0u, n);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_lc_detect(&points, &p, &work, NULL, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_lc_detect(&points, &p, NULL, kps, 4u, &n));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_lc_detect(&points, &p, &work, kps, 4u, NULL));
+    p.min_turn = 2.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_lc_detect(&points, &p, &work, kps, 4u, &n));
+    p = bsf_lc_params_default();
+    points.count = (size_t)BSF_MAX_POINTS + 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_lc_detect(&points, &p, &work, kps, 4u, &n));
+    /* An empty scan is no error. */
+    points.count = 0u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_lc_detect(&points, &p, &work, kps, 4u, &n));
+    TEST_ASSERT_EQUAL_size_t(0u, n);
+}
+
+static void test_more_corners_than_room_reports_capacity_and_the_total(void)
+{
+    const bsf_lc_params_t p = bsf_lc_params_default();
+    bsf_lidar_t lid = bsf_lidar_default(0.3, 0.2, 0.4, 721u, 2.0 * PI * 719.0 / 720.0);
+    bsf_scan_t scan;
+    size_t n = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, -3.0, -2.0, 5.0, 4.0));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, NULL, ranges, NULL, BSF_MAX_POINTS));
+    scan = bsf_scene_lidar_scan(&lid, ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_lc_detect(&points, &p, &work, kps, 2u, &n));
+    TEST_ASSERT_EQUAL_size_t(4u, n);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_corners_of_many_angles_are_found_where_the_walls_meet);
+    RUN_TEST(test_a_lone_far_corner_is_found_at_one_degree_beams);
+    RUN_TEST(test_noisy_room_gives_its_four_corners_and_nothing_else);
+    RUN_TEST(test_straight_walls_pillars_and_curved_walls_give_no_corner);
+    RUN_TEST(test_refused_calls);
+    RUN_TEST(test_more_corners_than_room_reports_capacity_and_the_total);
+    return UNITY_END();
+}

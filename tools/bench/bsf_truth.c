@@ -1,0 +1,374 @@
+/* SPDX-License-Identifier: MIT */
+#include "bsf_truth.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define TRUTH_MAX_CORNERS 256
+#define TRUTH_MAX_CREASES 256
+
+int bsf_truth_verbose = 0;
+
+void bsf_truth_acc_init(bsf_truth_acc_t *acc)
+{
+    memset(acc, 0, sizeof *acc);
+}
+
+static void hist_add(bsf_truth_hist_t *h, double d)
+{
+    long bin = (long)(d / BSF_TRUTH_BIN);
+    if (bin < 0) {
+        bin = 0;
+    }
+    if (bin > BSF_TRUTH_NBINS) {
+        bin = BSF_TRUTH_NBINS;
+    }
+    h->hist[bin]++;
+    h->sum_sq += d * d;
+    if (d > h->max) {
+        h->max = d;
+    }
+    h->n++;
+}
+
+double bsf_truth_quantile(const bsf_truth_hist_t *h, double q)
+{
+    uint64_t want;
+    uint64_t seen = 0;
+    long b;
+    if (h->n == 0u) {
+        return 0.0;
+    }
+    want = (uint64_t)ceil(q * (double)h->n);
+    if (want < 1u) {
+        want = 1u;
+    }
+    for (b = 0; b <= BSF_TRUTH_NBINS; ++b) {
+        seen += h->hist[b];
+        if (seen >= want) {
+            return b == BSF_TRUTH_NBINS ? h->max : (double)(b + 1) * BSF_TRUTH_BIN;
+        }
+    }
+    return h->max;
+}
+
+/* Where a straight wall meets a circle, or a wall ends on another (world
+ * frame): real creases of the geometry that the corner list does not hold. */
+static size_t creases(const bsf_scene_t *sc, double *xy, size_t cap)
+{
+    size_t n = 0;
+    size_t a;
+    size_t b;
+    /* T-junctions: a wall's end on the inside of another wall. */
+    for (a = 0; a < sc->n_shapes; ++a) {
+        const bsf_shape_t *s = &sc->shape[a];
+        int end;
+        if (s->kind != BSF_SHAPE_SEGMENT) {
+            continue;
+        }
+        for (end = 0; end < 2; ++end) {
+            const double ex = end == 0 ? s->x0 : s->x1;
+            const double ey = end == 0 ? s->y0 : s->y1;
+            for (b = 0; b < sc->n_shapes; ++b) {
+                const bsf_shape_t *o = &sc->shape[b];
+                double dx, dy, t, px, py;
+                if (b == a || o->kind != BSF_SHAPE_SEGMENT) {
+                    continue;
+                }
+                dx = o->x1 - o->x0;
+                dy = o->y1 - o->y0;
+                t = ((ex - o->x0) * dx + (ey - o->y0) * dy) / (dx * dx + dy * dy);
+                px = o->x0 + t * dx - ex;
+                py = o->y0 + t * dy - ey;
+                if (t > 1e-9 && t < 1.0 - 1e-9 && px * px + py * py < 1e-12 && n < cap) {
+                    xy[2u * n] = ex;
+                    xy[2u * n + 1u] = ey;
+                    ++n;
+                }
+            }
+        }
+    }
+    for (a = 0; a < sc->n_shapes; ++a) {
+        const bsf_shape_t *s = &sc->shape[a];
+        if (s->kind != BSF_SHAPE_SEGMENT) {
+            continue;
+        }
+        for (b = 0; b < sc->n_shapes; ++b) {
+            const bsf_shape_t *c = &sc->shape[b];
+            const double dx = s->x1 - s->x0;
+            const double dy = s->y1 - s->y0;
+            const double fx = s->x0 - c->x0;
+            const double fy = s->y0 - c->y0;
+            double qa, qb, qc, disc;
+            int k;
+            if (c->kind != BSF_SHAPE_CIRCLE) {
+                continue;
+            }
+            qa = dx * dx + dy * dy;
+            qb = 2.0 * (fx * dx + fy * dy);
+            qc = fx * fx + fy * fy - c->r * c->r;
+            disc = qb * qb - 4.0 * qa * qc;
+            if (disc < 0.0) {
+                continue;
+            }
+            for (k = -1; k <= 1; k += 2) {
+                const double t = (-qb + (double)k * sqrt(disc)) / (2.0 * qa);
+                if (t >= 0.0 && t <= 1.0 && n < cap) {
+                    xy[2u * n] = s->x0 + t * dx;
+                    xy[2u * n + 1u] = s->y0 + t * dy;
+                    ++n;
+                }
+            }
+        }
+    }
+    return n;
+}
+
+/* Each wall of corner c seen over some length (see bsf_truth.h). */
+static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, const float *ranges,
+                      const int16_t *hit_shape)
+{
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const int wall = side == 0 ? c->shape_a : c->shape_b;
+        int hits = 0;
+        double dmin = 1e300;
+        double dmax = 0.0;
+        double d_sorted[64];
+        size_t i;
+        for (i = 0; i < lidar->n_beams; ++i) {
+            double a;
+            double px;
+            double py;
+            double d;
+            if (hit_shape[i] != wall) {
+                continue;
+            }
+            a = lidar->angle_min + (double)i * lidar->angle_increment;
+            px = (double)ranges[i] * cos(a);
+            py = (double)ranges[i] * sin(a);
+            d = hypot(px - c->x, py - c->y);
+            if (d <= BSF_TRUTH_WALL_LEN) {
+                if (hits < 64) {
+                    d_sorted[hits] = d;
+                }
+                ++hits;
+                dmin = d < dmin ? d : dmin;
+                dmax = d > dmax ? d : dmax;
+            }
+        }
+        if (hits < BSF_TRUTH_MIN_HITS || dmax - dmin < BSF_TRUTH_MIN_SPREAD) {
+            return 0;
+        }
+        {
+            /* The first BSF_TRUTH_MIN_HITS hits from the vertex must sample
+             * the wall as a surface: gaps of at most BSF_TRUTH_MAX_GAP. */
+            const int m = hits < 64 ? hits : 64;
+            int u;
+            int v;
+            double prev = 0.0;
+            for (u = 1; u < m; ++u) {
+                const double key = d_sorted[u];
+                for (v = u - 1; v >= 0 && d_sorted[v] > key; --v) {
+                    d_sorted[v + 1] = d_sorted[v];
+                }
+                d_sorted[v + 1] = key;
+            }
+            for (u = 0; u < BSF_TRUTH_MIN_HITS; ++u) {
+                if (d_sorted[u] - prev > BSF_TRUTH_MAX_GAP) {
+                    return 0;
+                }
+                prev = d_sorted[u];
+            }
+        }
+    }
+    return 1;
+}
+
+int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                  const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
+                  size_t bytes, double time_ns)
+{
+    static bsf_scene_corner_t corners[TRUTH_MAX_CORNERS];
+    double crease_xy[2 * TRUTH_MAX_CREASES];
+    size_t n_corners = 0;
+    size_t n_creases;
+    size_t f;
+    size_t k;
+    size_t j;
+
+    if (bsf_scene_corners(scene, lidar, corners, TRUTH_MAX_CORNERS, &n_corners) != BSF_OK) {
+        return -1;
+    }
+    n_creases = creases(scene, crease_xy, TRUTH_MAX_CREASES);
+    for (k = 0; k < n_creases; ++k) {
+        double sx;
+        double sy;
+        bsf_scene_world_to_sensor(&lidar->pose, crease_xy[2u * k], crease_xy[2u * k + 1u], &sx,
+                                  &sy);
+        crease_xy[2u * k] = sx;
+        crease_xy[2u * k + 1u] = sy;
+    }
+
+    /* Recall and position error. */
+    for (k = 0; k < n_corners; ++k) {
+        const bsf_scene_corner_t *c = &corners[k];
+        int band;
+        double best = 1e300;
+        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX ||
+            !walls_seen(c, lidar, ranges, hit_shape)) {
+            continue;
+        }
+        band = c->range < 3.0 ? 0 : (c->range < 6.0 ? 1 : 2);
+        acc->visible[band]++;
+        for (j = 0; j < res->n_ctrl; ++j) {
+            if (res->ctrl_is_vertex[j]) {
+                const double d =
+                    hypot((double)res->ctrl[j].x - c->x, (double)res->ctrl[j].y - c->y);
+                best = d < best ? d : best;
+            }
+        }
+        if (best <= BSF_TRUTH_MATCH) {
+            acc->found[band]++;
+            hist_add(&acc->vertex_err, best);
+        } else if (bsf_truth_verbose) {
+            printf("missed corner at world (%.3f, %.3f), range %.2f m, beam %d, angle %.0f deg, "
+                   "nearest vertex %.3f m\n",
+                   c->wx, c->wy, c->range, c->beam, c->angle * 57.29577951, best);
+        }
+    }
+
+    /* Precision, and the curves against the true surfaces. */
+    for (f = 0; f < res->n_features; ++f) {
+        const bsf_feature_t *ft = &res->features[f];
+        const bsf_point_t *ctrl = &res->ctrl[ft->ctrl_first];
+        const size_t n_samples = (size_t)BSF_TRUTH_SAMPLES_PER_SPAN * (ft->n_ctrl - 2u);
+        double worst = 0.0;
+        for (j = 0; j < ft->n_ctrl; ++j) {
+            const size_t g = ft->ctrl_first + j;
+            double best = 1e300;
+            int crease = 0;
+            if (!res->ctrl_is_vertex[g] || (j > 0u && res->ctrl_is_vertex[g - 1u])) {
+                continue; /* not a vertex, or its second copy */
+            }
+            for (k = 0; k < n_corners; ++k) {
+                const double d = hypot((double)res->ctrl[g].x - corners[k].x,
+                                       (double)res->ctrl[g].y - corners[k].y);
+                best = d < best ? d : best;
+            }
+            for (k = 0; k < n_creases; ++k) {
+                if (hypot((double)res->ctrl[g].x - crease_xy[2u * k],
+                          (double)res->ctrl[g].y - crease_xy[2u * k + 1u]) <= BSF_TRUTH_MATCH) {
+                    crease = 1;
+                }
+            }
+            if (best > BSF_TRUTH_MATCH && crease) {
+                acc->vertices_creases++;
+                continue;
+            }
+            acc->vertices++;
+            if (best <= BSF_TRUTH_MATCH) {
+                acc->vertices_correct++;
+            } else if (bsf_truth_verbose) {
+                double wx;
+                double wy;
+                int shape = -1;
+                double d;
+                bsf_scene_sensor_to_world(&lidar->pose, (double)res->ctrl[g].x,
+                                          (double)res->ctrl[g].y, &wx, &wy);
+                d = bsf_scene_distance_to_surface(scene, wx, wy, &shape);
+                printf("false vertex at world (%.3f, %.3f), range %.2f m, %.3f m from shape %d, "
+                       "%.3f m from the nearest corner\n",
+                       wx, wy, hypot((double)res->ctrl[g].x, (double)res->ctrl[g].y), d, shape,
+                       best);
+            }
+            ++j; /* skip the second copy */
+        }
+        for (j = 0; j <= n_samples; ++j) {
+            bsf_point_t p;
+            double wx;
+            double wy;
+            double d;
+            if (bsf_bspline_eval(ctrl, ft->n_ctrl, (float)((double)j / (double)n_samples), &p, NULL,
+                                 NULL) != BSF_OK) {
+                continue;
+            }
+            bsf_scene_sensor_to_world(&lidar->pose, (double)p.x, (double)p.y, &wx, &wy);
+            d = bsf_scene_distance_to_surface(scene, wx, wy, NULL);
+            hist_add(&acc->curve, d);
+            worst = d > worst ? d : worst;
+            if (bsf_truth_verbose && d > 0.03) {
+                const size_t span = j / BSF_TRUTH_SAMPLES_PER_SPAN;
+                const size_t ns = ft->n_ctrl - 2u;
+                const int end = span == 0u || span + 1u >= ns;
+                int near_v = 0;
+                size_t q;
+                for (q = span; q < span + 3u && q < ft->n_ctrl; ++q) {
+                    near_v |= res->ctrl_is_vertex[ft->ctrl_first + q];
+                }
+                printf("far sample %.3f m at t %.3f: %s, feature %u ctrl, %u points, beams %u-%u\n",
+                       d, (double)j / (double)n_samples,
+                       end ? "end span" : (near_v ? "vertex span" : "inner span"), ft->n_ctrl,
+                       ft->n_points, ft->first_beam, ft->last_beam);
+            }
+        }
+        acc->features++;
+        if (worst > BSF_TRUTH_STRAY && bsf_truth_verbose) {
+            size_t nv = 0;
+            double wx, wy, wx1, wy1;
+            for (j = 0; j < ft->n_ctrl; ++j) {
+                nv += res->ctrl_is_vertex[ft->ctrl_first + j];
+            }
+            bsf_scene_sensor_to_world(&lidar->pose, (double)ctrl[0].x, (double)ctrl[0].y, &wx, &wy);
+            bsf_scene_sensor_to_world(&lidar->pose, (double)ctrl[ft->n_ctrl - 1u].x,
+                                      (double)ctrl[ft->n_ctrl - 1u].y, &wx1, &wy1);
+            printf("stray feature: max %.3f m, beams %u-%u, %u points, %u ctrl (%lu vertex slots), "
+                   "E %.4f, world (%.2f,%.2f)-(%.2f,%.2f)\n",
+                   worst, ft->first_beam, ft->last_beam, ft->n_points, ft->n_ctrl,
+                   (unsigned long)nv, (double)ft->e_curve, wx, wy, wx1, wy1);
+        }
+        if (worst > BSF_TRUTH_STRAY) {
+            acc->features_stray++;
+        }
+    }
+    acc->scans++;
+    acc->n_valid += res->stats.n_valid;
+    acc->n_in_features += res->stats.n_in_features;
+    acc->n_ctrl += res->stats.n_ctrl;
+    acc->bytes += bytes;
+    acc->time_ns += time_ns;
+    return 0;
+}
+
+static double ratio(uint64_t a, uint64_t b)
+{
+    return b > 0u ? (double)a / (double)b : 0.0;
+}
+
+void bsf_truth_summary(const bsf_truth_acc_t *acc, bsf_truth_summary_t *s)
+{
+    uint64_t vis = 0;
+    uint64_t found = 0;
+    int b;
+    memset(s, 0, sizeof *s);
+    for (b = 0; b < BSF_TRUTH_BANDS; ++b) {
+        vis += acc->visible[b];
+        found += acc->found[b];
+        s->recall_band[b] = ratio(acc->found[b], acc->visible[b]);
+    }
+    s->visible = vis;
+    s->recall = ratio(found, vis);
+    s->precision = acc->vertices > 0u ? ratio(acc->vertices_correct, acc->vertices) : 1.0;
+    s->verr_median = bsf_truth_quantile(&acc->vertex_err, 0.5);
+    s->verr_p90 = bsf_truth_quantile(&acc->vertex_err, 0.9);
+    s->verr_max = acc->vertex_err.max;
+    s->curve_rms = acc->curve.n > 0u ? sqrt(acc->curve.sum_sq / (double)acc->curve.n) : 0.0;
+    s->curve_p99 = bsf_truth_quantile(&acc->curve, 0.99);
+    s->curve_max = acc->curve.max;
+    s->stray_share = ratio(acc->features_stray, acc->features);
+    s->gamma = ratio(acc->n_in_features, acc->n_valid);
+    s->eta = ratio(acc->n_ctrl, acc->n_in_features);
+    s->bytes_per_scan = acc->scans > 0u ? (double)acc->bytes / (double)acc->scans : 0.0;
+    s->us_per_scan = acc->scans > 0u ? acc->time_ns / 1000.0 / (double)acc->scans : 0.0;
+}

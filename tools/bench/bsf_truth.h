@@ -1,0 +1,104 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * bsf_truth.h - judge extraction results against the known geometry of a
+ * synthetic scene (bsf_scene.h): vertex recall, precision and position error,
+ * curve-to-true-surface distance, and the paper's counts. Used by bench_truth
+ * and test_truth. Host-side; not part of the library.
+ *
+ * Definitions (docs/GROUND_TRUTH.md repeats them):
+ *  - A true corner is "visible" when bsf_scene_corners says so (in view, not
+ *    occluded, rays either side hit its two walls), it lies within
+ *    BSF_TRUTH_RANGE_MAX of the sensor, and each of its two walls is seen over
+ *    some length: at least BSF_TRUTH_MIN_HITS beams hit the wall within
+ *    BSF_TRUTH_WALL_LEN of the vertex, spread over at least BSF_TRUTH_MIN_SPREAD,
+ *    and the BSF_TRUTH_MIN_HITS hits nearest the vertex sample the wall as a
+ *    surface: no gap above BSF_TRUTH_MAX_GAP from the vertex to the first or
+ *    between them (a wall seen at grazing incidence, one return every half
+ *    metre, is not seen as a wall by any segmentation).
+ *  - A vertex (a control point stored twice) "finds" a visible corner when it
+ *    lies within BSF_TRUTH_MATCH of it; recall = found / visible.
+ *  - Precision = vertices within BSF_TRUTH_MATCH of any true corner (visible or
+ *    not) / vertices, leaving out the vertices that sit where a straight wall
+ *    meets a curved one or ends on another wall (a T-junction): real creases,
+ *    but not listed corners.
+ *  - Position error: distance from each found corner to its nearest vertex.
+ *  - Curve distance: every feature's curve sampled BSF_TRUTH_SAMPLES_PER_SPAN
+ *    times per span, distance of each sample to the nearest true surface.
+ */
+#ifndef BSF_TRUTH_H
+#define BSF_TRUTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bsf/bsf.h"
+#include "bsf_scene.h"
+
+#define BSF_TRUTH_RANGE_MAX 8.0
+#define BSF_TRUTH_MATCH 0.10
+#define BSF_TRUTH_WALL_LEN 1.0
+#define BSF_TRUTH_MIN_HITS 3
+#define BSF_TRUTH_MIN_SPREAD 0.2
+#define BSF_TRUTH_MAX_GAP 0.25
+#define BSF_TRUTH_SAMPLES_PER_SPAN 8
+#define BSF_TRUTH_STRAY 0.05
+/** Range bands of the recall report: [0,3), [3,6), [6,8] metres. */
+#define BSF_TRUTH_BANDS 3
+/** Histogram resolution and extent of the distance quantiles. */
+#define BSF_TRUTH_BIN 0.0001
+#define BSF_TRUTH_NBINS 5000
+
+typedef struct {
+    uint32_t hist[BSF_TRUTH_NBINS + 1]; /* last bin: beyond the extent */
+    double sum_sq;
+    double max;
+    uint64_t n;
+} bsf_truth_hist_t;
+
+typedef struct {
+    uint64_t visible[BSF_TRUTH_BANDS];
+    uint64_t found[BSF_TRUTH_BANDS];
+    uint64_t vertices;         /* vertices judged */
+    uint64_t vertices_correct; /* within BSF_TRUTH_MATCH of a true corner */
+    uint64_t vertices_creases; /* at a wall-curve crease: not judged */
+    bsf_truth_hist_t vertex_err;
+    bsf_truth_hist_t curve;
+    uint64_t features;
+    uint64_t features_stray; /* features whose curve strays > BSF_TRUTH_STRAY */
+    uint64_t scans;
+    uint64_t n_valid, n_in_features, n_ctrl, bytes;
+    double time_ns;
+} bsf_truth_acc_t;
+
+/** Non-zero: bsf_truth_add prints every false vertex (bench_truth --verbose). */
+extern int bsf_truth_verbose;
+
+void bsf_truth_acc_init(bsf_truth_acc_t *acc);
+
+/**
+ * Judge one result. ranges and hit_shape are the scan as simulated (before
+ * mixed pixels is fine too); lidar holds the pose. bytes is the frame size.
+ * Returns 0, or -1 when the scene has more than 256 corners.
+ */
+int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                  const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
+                  size_t bytes, double time_ns);
+
+/** Quantile q in [0,1] of a histogram (upper bin edge), metres; 0 when empty. */
+double bsf_truth_quantile(const bsf_truth_hist_t *h, double q);
+
+/** Summary numbers of an accumulator. */
+typedef struct {
+    double recall; /* all bands */
+    double recall_band[BSF_TRUTH_BANDS];
+    double precision;
+    double verr_median, verr_p90, verr_max;
+    double curve_rms, curve_p99, curve_max;
+    double stray_share;
+    double gamma, eta, bytes_per_scan, us_per_scan;
+    uint64_t visible;
+} bsf_truth_summary_t;
+
+void bsf_truth_summary(const bsf_truth_acc_t *acc, bsf_truth_summary_t *s);
+
+#endif /* BSF_TRUTH_H */
