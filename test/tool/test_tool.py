@@ -106,7 +106,10 @@ check(r.returncode == 0 and "frames dropped" in r.stdout and not r.stdout.count(
 r = run(["render", "synth.bsf", "-o", "map.svg", "--scans", "0..9", "--points", "synth.log"])
 try:
     root = ET.parse(os.path.join(WORK, "map.svg")).getroot()
-    ok = r.returncode == 0 and len(root.findall(".//{http://www.w3.org/2000/svg}circle")) > 100
+    # raw points are dots in <path class="points"> ("M x yh0" each), curves in <path class="features">
+    paths = root.findall(".//{http://www.w3.org/2000/svg}path")
+    dots = sum(p.get("d", "").count("M") for p in paths if p.get("class") == "points")
+    ok = r.returncode == 0 and dots > 100 and any(p.get("class") == "features" for p in paths)
 except (OSError, ET.ParseError):
     ok = False
 check(ok, "render with --points writes a well-formed SVG with points and curves")

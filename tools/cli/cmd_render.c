@@ -6,13 +6,22 @@
 
 static const char render_help[] =
     "Usage: bsf render IN -o MAP.svg [--scans K..L] [--points LOG] [--width PX]\n"
-    "Draw the stream's B-spline features in the world frame (poses from the\n"
-    "stream), vertices as squares, with a scale bar. --scans keeps the frames with\n"
-    "sequence numbers K..L; --points draws those scans' raw points from LOG\n"
-    "underneath (same sequence numbering: the n-th laser scan of the log).\n"
+    "Draw the stream's B-spline features (exact quadratic curves) in the world\n"
+    "frame (poses from the stream) over a grid labelled in metres, with the robot's\n"
+    "path and last pose, vertices as red squares, a legend and a scale bar.\n"
+    "--scans keeps the frames with sequence numbers K..L (K..K: one scan);\n"
+    "--points draws those scans' raw points from LOG underneath (same numbering:\n"
+    "the n-th laser scan of the log), thinned to one per pixel-sized cell, so a\n"
+    "whole log stays a few megabytes.\n"
     "--width sets the drawing's width in pixels (default 1600). The stream is read\n"
     "several times (a pipe is spooled to a temporary file), so memory does not grow\n"
     "with its length. Exits 1 when a non-empty input holds no valid frame.\n";
+
+#define RENDER_CURVE_COLOUR "#1f5fbf"
+#define RENDER_VERTEX_COLOUR "#d62728"
+#define RENDER_PATH_COLOUR "#2ca02c"
+#define RENDER_POINT_COLOUR "#9a9a9a"
+#define RENDER_WALL_COLOUR "#c8c8c8"
 
 typedef struct {
     double x, y, c, s;
@@ -156,22 +165,24 @@ static void robust_bounds(const bounds_ctx_t *b, bsf_bounds_t *out)
     bsf_bounds_add(out, x1 + mx, y1 + my);
 }
 
-typedef struct {
-    bsf_svg_t *svg;
-    int open;
-} draw_ctx_t;
-
-static void draw_sample(void *vctx, int new_curve, double wx, double wy)
+/* A frame's features as exact curves in the world frame. */
+static void draw_features(bsf_svg_t *svg, const bsf_frame_t *fr)
 {
-    draw_ctx_t *ctx = (draw_ctx_t *)vctx;
-    if (new_curve) {
-        if (ctx->open) {
-            bsf_svg_path_end(ctx->svg, "#1f5fbf", 1.6);
+    const bsf_result_t *r = &fr->result;
+    const pose2_t pose = pose_of(fr);
+    double xy[2 * BSF_MAX_CTRL_PER_FEATURE];
+    size_t i, k;
+    for (i = 0; i < r->n_features; ++i) {
+        const bsf_feature_t *f = &r->features[i];
+        if (f->n_ctrl > BSF_MAX_CTRL_PER_FEATURE || (size_t)f->ctrl_first + f->n_ctrl > r->n_ctrl) {
+            continue; /* the decoder never delivers these */
         }
-        bsf_svg_path_begin(ctx->svg);
-        ctx->open = 1;
+        for (k = 0; k < f->n_ctrl; ++k) {
+            const bsf_point_t *c = &r->ctrl[f->ctrl_first + k];
+            to_world(&pose, (double)c->x, (double)c->y, &xy[2 * k], &xy[2 * k + 1]);
+        }
+        bsf_svg_curve_bspline2(svg, xy, f->n_ctrl);
     }
-    bsf_svg_path_point(ctx->svg, wx, wy);
 }
 
 static int in_range(uint32_t seq, long lo, long hi)
@@ -179,7 +190,15 @@ static int in_range(uint32_t seq, long lo, long hi)
     return (long)seq >= lo && (hi < 0 || (long)seq <= hi);
 }
 
-static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
+/* Raw points are thinned to one per cell of this size (and at least one
+ * pixel): a map stays a few megabytes whatever the number of scans. */
+#define RENDER_POINT_CELL_M 0.01
+/* Diameter of a drawn point, metres (kept between 1.8 and 5 pixels). */
+#define RENDER_POINT_DOT_M 0.03
+
+/* The log's scans in the range, as world points: into the bounds (pts NULL)
+ * or drawn (thinned) into pts. */
+static int draw_log_points(bsf_svg_points_t *pts, const char *log, long lo, long hi,
                            const bounds_ctx_t *frames, bsf_bounds_t *bounds)
 {
     carmen_reader_t *rd = open_log(log);
@@ -214,8 +233,8 @@ static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
                 continue;
             }
             to_world(&p, (double)rg * cos(a), (double)rg * sin(a), &wx, &wy);
-            if (svg != NULL) {
-                bsf_svg_dot(svg, wx, wy, 0.6, "#b0b0b0");
+            if (pts != NULL) {
+                bsf_svg_points_add(pts, wx, wy);
             } else {
                 bsf_bounds_add(bounds, wx, wy);
             }
@@ -224,6 +243,87 @@ static int draw_log_points(bsf_svg_t *svg, const char *log, long lo, long hi,
     }
     carmen_close(rd);
     return r < 0 ? -1 : 0;
+}
+
+/* The robot's path: the poses of the frames drawn, fed in order to
+ * path_add(), one polyline; a jump of more than 5 m (a new log segment, a
+ * relocalisation) starts a new line. path_end() marks the last pose. */
+typedef struct {
+    unsigned long n;
+    double x, y, theta;
+} path_t;
+
+static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
+{
+    const double x = (double)fr->pose_x, y = (double)fr->pose_y;
+    if (!fr->has_pose) {
+        return;
+    }
+    if (p->n == 0 || hypot(x - p->x, y - p->y) > 5.0) {
+        bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
+        bsf_svg_path_begin(svg);
+    }
+    bsf_svg_path_point(svg, x, y);
+    p->x = x;
+    p->y = y;
+    p->theta = (double)fr->pose_theta;
+    ++p->n;
+}
+
+static void path_end(bsf_svg_t *svg, const path_t *p)
+{
+    bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
+    if (p->n > 0) {
+        bsf_svg_robot(svg, p->x, p->y, p->theta, RENDER_PATH_COLOUR);
+    }
+}
+
+/* A frame's vertices (pairs of flagged control points) as markers; returns
+ * how many. */
+static unsigned long draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
+{
+    const pose2_t pose = pose_of(fr);
+    unsigned long n = 0;
+    size_t k;
+    for (k = 0; k + 1u < fr->result.n_ctrl; ++k) {
+        if (fr->result.ctrl_is_vertex[k] && fr->result.ctrl_is_vertex[k + 1u]) {
+            double wx, wy;
+            to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx, &wy);
+            bsf_svg_vertex(svg, wx, wy, 3.5, RENDER_VERTEX_COLOUR);
+            ++n;
+            ++k;
+        }
+    }
+    return n;
+}
+
+/* The legend row: the layers that are in the picture. */
+static void draw_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
+{
+    bsf_svg_legend_item_t key[5];
+    size_t n = 0;
+    key[n].key = BSF_SVG_KEY_LINE;
+    key[n].colour = RENDER_CURVE_COLOUR;
+    key[n++].text = "B-spline features";
+    key[n].key = BSF_SVG_KEY_VERTEX;
+    key[n].colour = RENDER_VERTEX_COLOUR;
+    key[n++].text = "vertices (corners)";
+    if (have_path) {
+        key[n].key = BSF_SVG_KEY_LINE;
+        key[n].colour = RENDER_PATH_COLOUR;
+        key[n++].text = "robot path and last pose";
+    }
+    if (have_points) {
+        key[n].key = BSF_SVG_KEY_DOT;
+        key[n].colour = RENDER_POINT_COLOUR;
+        key[n++].text = "raw LIDAR points (thinned)";
+    }
+    if (have_scene) {
+        key[n].key = BSF_SVG_KEY_LINE;
+        key[n].colour = RENDER_WALL_COLOUR;
+        key[n++].text = "true walls";
+    }
+    bsf_svg_legend(svg, key, n);
 }
 
 static int parse_scan_range(const char *v, long *lo, long *hi)
@@ -279,33 +379,21 @@ static void draw_scene(bsf_svg_t *svg, const bsf_scene_t *scene, bsf_bounds_t *b
             }
         }
         if (svg != NULL) {
-            bsf_svg_path_end(svg, "#c8c8c8", 5.0);
+            bsf_svg_path_end(svg, RENDER_WALL_COLOUR, 5.0);
         }
     }
 }
 
-/* Pass over the stream: bounds (extremes, then histograms), curves, vertices. */
-typedef enum { PASS_EXTREMES, PASS_HISTOGRAM, PASS_CURVES, PASS_VERTICES } render_pass_t;
+/* Pass over the stream: bounds (extremes, then histograms), curves, path, vertices. */
+typedef enum { PASS_EXTREMES, PASS_HISTOGRAM, PASS_CURVES, PASS_PATH, PASS_VERTICES } render_pass_t;
 
 typedef struct {
     render_pass_t pass;
     bounds_ctx_t *b;
-    draw_ctx_t *dc;
+    bsf_svg_t *svg;
+    path_t path;
+    unsigned long vertices;
 } render_ctx_t;
-
-static void draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
-{
-    const pose2_t pose = pose_of(fr);
-    size_t k;
-    for (k = 0; k + 1u < fr->result.n_ctrl; ++k) {
-        if (fr->result.ctrl_is_vertex[k] && fr->result.ctrl_is_vertex[k + 1u]) {
-            double wx, wy;
-            to_world(&pose, (double)fr->result.ctrl[k].x, (double)fr->result.ctrl[k].y, &wx, &wy);
-            bsf_svg_square(svg, wx, wy, 2.5, "#d02020");
-            ++k;
-        }
-    }
-}
 
 static int render_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
 {
@@ -326,9 +414,15 @@ static int render_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
         ++rc->b->frames;
         rc->b->no_pose += fr->has_pose ? 0u : 1u;
         /* fall through */
-    case PASS_HISTOGRAM: for_each_curve_sample(fr, bounds_sample, rc->b); break;
-    case PASS_CURVES: for_each_curve_sample(fr, draw_sample, rc->dc); break;
-    default: draw_vertices(rc->dc->svg, fr); break;
+    case PASS_HISTOGRAM:
+        for_each_curve_sample(fr, bounds_sample, rc->b);
+        if (fr->has_pose) { /* the robot's positions belong in the picture */
+            bounds_sample(rc->b, 0, (double)fr->pose_x, (double)fr->pose_y);
+        }
+        break;
+    case PASS_CURVES: draw_features(rc->svg, fr); break;
+    case PASS_PATH: path_add(rc->svg, &rc->path, fr); break;
+    default: rc->vertices += draw_vertices(rc->svg, fr); break;
     }
     return 0;
 }
@@ -351,17 +445,18 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     static bounds_ctx_t bc;
     bsf_bounds_t b;
     bsf_svg_t svg;
-    draw_ctx_t dc;
+    bsf_svg_points_t pts;
     render_ctx_t rc;
     FILE *out;
-    char legend[160];
+    char caption[200];
     int failed;
 
     memset(&bc, 0, sizeof bc);
     bc.lo = lo;
     bc.hi = hi;
+    memset(&rc, 0, sizeof rc);
     rc.b = &bc;
-    rc.dc = &dc;
+    rc.svg = &svg;
     bsf_bounds_init(&b);
     if (render_pass(in, in_name, &rc, PASS_EXTREMES) != 0) {
         return -1;
@@ -403,28 +498,49 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
         }
         return -1;
     }
-    if (points_log != NULL && draw_log_points(&svg, points_log, lo, hi, &bc, NULL) != 0) {
-        if (out != stdout) {
-            fclose(out);
+    bsf_svg_grid(&svg);
+    memset(&pts, 0, sizeof pts);
+    if (points_log != NULL) {
+        /* dots 3 cm wide, between 1.8 and 5 px: visible on a whole map,
+         * clear on a one-scan close-up */
+        const double dot_px = fmin(5.0, fmax(1.8, RENDER_POINT_DOT_M * svg.px_per_m));
+        int prc =
+            bsf_svg_points_begin(&pts, &svg, RENDER_POINT_CELL_M, dot_px, RENDER_POINT_COLOUR);
+        if (prc != 0) {
+            fail_msg("out of memory");
+        } else {
+            prc = draw_log_points(&pts, points_log, lo, hi, &bc, NULL);
         }
-        return -1;
+        bsf_svg_points_end(&pts);
+        if (prc != 0) {
+            if (out != stdout) {
+                fclose(out);
+            }
+            return -1;
+        }
     }
     if (scene != NULL) {
         draw_scene(&svg, scene, NULL);
     }
-    dc.svg = &svg;
-    dc.open = 0;
+    bsf_svg_curves_begin(&svg, RENDER_CURVE_COLOUR, 1.6);
     failed = render_pass(in, in_name, &rc, PASS_CURVES) != 0;
-    if (dc.open) {
-        bsf_svg_path_end(&svg, "#1f5fbf", 1.6);
+    bsf_svg_curves_end(&svg);
+    if (!failed) {
+        failed = render_pass(in, in_name, &rc, PASS_PATH) != 0;
+        path_end(&svg, &rc.path);
     }
     /* vertices on top */
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_VERTICES) != 0;
     }
-    snprintf(legend, sizeof legend, "%lu scans; blue: B-spline features; red squares: vertices%s",
-             bc.frames, points_log ? "; grey: raw points" : (scene ? "; grey: true walls" : ""));
-    if (bsf_svg_end(&svg, legend) != 0 || close_out(out, out_path) != 0 || failed) {
+    draw_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL);
+    snprintf(caption, sizeof caption, "%lu scans, %lu vertices", bc.frames, rc.vertices);
+    if (points_log != NULL) {
+        size_t len = strlen(caption);
+        snprintf(caption + len, sizeof caption - len, "; %lu raw points, %lu drawn (%.0f cm grid)",
+                 pts.kept + pts.merged + pts.outside, pts.kept, 100.0 * pts.cell_m);
+    }
+    if (bsf_svg_end(&svg, caption) != 0 || close_out(out, out_path) != 0 || failed) {
         return -1;
     }
     if (bc.no_pose) {

@@ -15,6 +15,7 @@ static const char main_help[] =
     "  render IN -o MAP.svg [--scans K..L] [--points LOG] [--width PX]\n"
     "  table1 DATA_DIR             the paper's Table 1 on the four datasets\n"
     "  demo                        built-in synthetic scene, end to end\n"
+    "  listen DEVICE|- [--baud N] [-o FILE]  live stream (serial port, pipe): frames as they come\n"
     "\n"
     "'-' means stdin/stdout:  bsf extract x.log -o - | bsf metrics -\n";
 
@@ -24,7 +25,8 @@ int main(int argc, char **argv)
         const char *name;
         int (*fn)(int, char **);
     } cmds[] = {{"extract", cmd_extract}, {"decode", cmd_decode}, {"metrics", cmd_metrics},
-                {"render", cmd_render},   {"table1", cmd_table1}, {"demo", cmd_demo}};
+                {"render", cmd_render},   {"table1", cmd_table1}, {"demo", cmd_demo},
+                {"listen", cmd_listen}};
     static char cmd_name[64];
     size_t i;
     if (argc < 2) {

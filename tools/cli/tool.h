@@ -166,6 +166,7 @@ int cmd_metrics(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_table1(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
+int cmd_listen(int argc, char **argv);
 
 /** Print the metrics of a stream (cmd_metrics.c; also used by demo). */
 void print_metrics(FILE *f, const char *name, const stream_summary_t *s,
