@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "bsf_math.h"
 #include "bsf_wire.h"
 
 /*
@@ -118,15 +119,11 @@ static void put_bits_wide(writer_t *w, uint64_t v, unsigned n)
 
 /* Exp-Golomb code of order k: for u = (v >> k) + 1 of b bits, b - 1 zeros,
  * u itself, then the k low bits of v; short codes as one field. */
-static void put_eg(writer_t *w, uint64_t v, unsigned k)
+static void put_eg_bits(writer_t *w, uint64_t v, unsigned k)
 {
     const uint64_t u = (v >> k) + 1u;
     const unsigned b = bsf_wire_bitlen(u);
     const uint64_t low = k == 0u ? 0u : v & (~(uint64_t)0 >> (64u - k));
-    if (w->costing) {
-        w->bits += 2u * b - 1u + k;
-        return;
-    }
     if (b + k <= 32u) {
         /* the b - 1 zeros come out as the leading zeros of a wider field */
         put_bits(w, (uint32_t)((u << k) | low), 2u * b - 1u + k);
@@ -135,6 +132,16 @@ static void put_eg(writer_t *w, uint64_t v, unsigned k)
     put_bits_wide(w, 0u, b - 1u);
     put_bits_wide(w, u, b);
     put_bits_wide(w, low, k);
+}
+
+/* Costing runs only add the code's length (inline: most fields pass here). */
+static inline void put_eg(writer_t *w, uint64_t v, unsigned k)
+{
+    if (w->costing) {
+        w->bits += 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
+    } else {
+        put_eg_bits(w, v, k);
+    }
 }
 
 static void put_seg(writer_t *w, int64_t v, unsigned k)
@@ -189,7 +196,7 @@ static int is_finite_f(float v)
 /* Nearest multiple of step, in steps; 0 when v is not finite or too far. */
 static int quantise(float v, float step, int32_t *q)
 {
-    const float r = floorf(v / step + 0.5f);
+    const float r = bsf_floorf(v / step + 0.5f);
     if (!(fabsf(r) <= (float)BSF_QUANT_MAX_STEPS)) {
         *q = 0;
         return 0;
@@ -221,7 +228,7 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f, float step,
-                                 uint32_t *n_unique, uint64_t *mask)
+                                 int check_points, uint32_t *n_unique, uint64_t *mask)
 {
     const size_t n = f->n_ctrl;
     const uint32_t n_beams = res->stats.n_beams;
@@ -240,13 +247,14 @@ static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f
     while (s < n) {
         const size_t slot = (size_t)f->ctrl_first + s;
         int32_t q[2];
-        if (!quantise_point(res->ctrl[slot], step, q)) {
+        if (check_points && !quantise_point(res->ctrl[slot], step, q)) {
             return BSF_ERR_ARG;
         }
         if (res->ctrl_is_vertex[slot] != 0u) {
             int32_t q2[2];
-            if (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
-                !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] || q2[1] != q[1]) {
+            if (check_points && (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
+                                 !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] ||
+                                 q2[1] != q[1])) {
                 return BSF_ERR_ARG;
             }
             *mask |= (uint64_t)1u << j;
@@ -321,7 +329,7 @@ static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code
     if (!is_finite_f(info->quant_step)) {
         return BSF_ERR_ARG;
     }
-    code = floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    code = bsf_floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
     if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
         return BSF_ERR_ARG;
     }
@@ -362,7 +370,7 @@ static bsf_status_t check_stats(const bsf_stats_t *st)
 
 static int32_t round_to_int(float v)
 {
-    return (int32_t)floorf(v + 0.5f);
+    return (int32_t)bsf_floorf(v + 0.5f);
 }
 
 static void put_float(writer_t *w, float v);
@@ -452,7 +460,9 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         uint32_t span;
         uint32_t j;
 
-        st = scan_feature(res, f, step, &n_unique, &mask);
+        /* the points were checked by the costing run that precedes every
+         * other run (a vertex pair's flags alone then give the mask) */
+        st = scan_feature(res, f, step, w->costing, &n_unique, &mask);
         if (st != BSF_OK) {
             return st;
         }
@@ -467,7 +477,8 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         put_seg(w, (int64_t)f->first_beam - prev_last_beam - 1, BSF_WIRE_K_GAP);
         put_eg(w, span, BSF_WIRE_K_SPAN);
         put_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        put_eg(w, (uint64_t)floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f), BSF_WIRE_K_E_CURVE);
+        put_eg(w, (uint64_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
+               BSF_WIRE_K_E_CURVE);
         put_ctrl(w, res, f, step, prev);
         prev_last_beam = f->last_beam;
     }
@@ -540,8 +551,12 @@ static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result
         uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
         unsigned k;
         unsigned best = 0;
-        bsf_wire_eg_tally_costs(&w.tally[cls], BSF_WIRE_K_CTRL_MAX, cost);
-        for (k = 1; k <= BSF_WIRE_K_CTRL_MAX; ++k) {
+        /* above the longest value's bit length L every order costs one bit
+         * per value more than the one before, so none beats order L */
+        const unsigned k_top =
+            w.tally[cls].max_len < BSF_WIRE_K_CTRL_MAX ? w.tally[cls].max_len : BSF_WIRE_K_CTRL_MAX;
+        bsf_wire_eg_tally_costs(&w.tally[cls], k_top, cost);
+        for (k = 1; k <= k_top; ++k) {
             if (cost[k] < cost[best]) {
                 best = k;
             }
@@ -678,7 +693,7 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
     if (!is_finite_f(m->quant_step)) {
         return BSF_ERR_ARG;
     }
-    code = floorf(m->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    code = bsf_floorf(m->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
     if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
         return BSF_ERR_ARG;
     }
