@@ -193,15 +193,20 @@ static int is_finite_f(float v)
     return v == v && fabsf(v) <= 3.402823466e38f;
 }
 
-/* Nearest multiple of step, in steps; 0 when v is not finite or too far. */
+/* Nearest multiple of step, in steps: floor(v / step + 0.5); 0 when v is
+ * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
+ * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
+ * one lower for a negative r with a fraction. */
 static int quantise(float v, float step, int32_t *q)
 {
-    const float r = bsf_floorf(v / step + 0.5f);
-    if (!(fabsf(r) <= (float)BSF_QUANT_MAX_STEPS)) {
+    const float r = v / step + 0.5f;
+    int32_t t;
+    if (!(r >= -(float)BSF_QUANT_MAX_STEPS && r < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
         *q = 0;
-        return 0;
+        return 0; /* NaN included */
     }
-    *q = (int32_t)r;
+    t = (int32_t)r;
+    *q = (float)t > r ? t - 1 : t;
     return 1;
 }
 
