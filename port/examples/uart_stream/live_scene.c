@@ -80,3 +80,37 @@ void live_scene_metadata(bsf_metadata_t *m)
     m->source_len = (uint8_t)(sizeof source - 1u);
     memcpy(m->source, source, sizeof source);
 }
+
+bsf_status_t live_scene_send(bsf_sink_fn sink, void *ctx, uint32_t *failed_scan)
+{
+    static bsf_encoder_t encoder;
+    static const uint8_t delimiter = 0u;
+    bsf_status_t st = live_scene_start();
+    uint32_t k = 0;
+    if (st == BSF_OK && sink(ctx, &delimiter, 1u) != 0) {
+        st = BSF_ERR_BUFFER;
+    }
+    for (; st == BSF_OK && k < LIVE_SCENE_SCANS; ++k) {
+        bsf_frame_info_t info;
+        const bsf_result_t *result = NULL;
+        if (k % LIVE_SCENE_META_EVERY == 0u) {
+            static bsf_metadata_t meta;
+            live_scene_metadata(&meta);
+            st = bsf_metadata_encode_sink(&encoder, &meta, sink, ctx, NULL);
+            if (st != BSF_OK) {
+                break;
+            }
+        }
+        st = live_scene_scan(k, &info, &result);
+        if (st == BSF_OK) {
+            st = bsf_frame_encode_sink(&encoder, &info, result, sink, ctx, NULL);
+        }
+        if (st != BSF_OK) {
+            break;
+        }
+    }
+    if (failed_scan != NULL) {
+        *failed_scan = k;
+    }
+    return st;
+}

@@ -54,6 +54,21 @@ bsf_status_t live_scene_scan(uint32_t k, bsf_frame_info_t *info, const bsf_resul
  */
 void live_scene_metadata(bsf_metadata_t *m);
 
+/**
+ * The whole run through sink, exactly as the firmware sends it: a lone 0x00
+ * (so a receiver that heard line noise drops it rather than the first
+ * frame), then for each scan k a metadata frame when k is a multiple of
+ * LIVE_SCENE_META_EVERY, and the scan's features frame. The firmware and the
+ * host program that writes the expected bytes both call this, so the two
+ * cannot drift apart. Stops at the first error.
+ *
+ * @param failed_scan  receives the scan index at which an error occurred
+ *                     (LIVE_SCENE_SCANS when none); may be NULL.
+ * @return BSF_OK, or the first error of start, extraction or encoding
+ *         (BSF_ERR_BUFFER when sink refused bytes).
+ */
+bsf_status_t live_scene_send(bsf_sink_fn sink, void *ctx, uint32_t *failed_scan);
+
 #ifdef __cplusplus
 }
 #endif

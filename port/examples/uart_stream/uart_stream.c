@@ -59,33 +59,14 @@ static int uart_sink(void *ctx, const uint8_t *data, size_t len)
 
 int main(void)
 {
-    static bsf_encoder_t encoder;
+    uint32_t failed_scan = 0;
     bsf_status_t st;
-    uint32_t k;
 
     uart_init();
-    /* A lone delimiter first: a receiver that picked up line noise before we
-     * started drops it here instead of losing the first frame. */
-    uart_put(0u);
-    st = live_scene_start();
-    for (k = 0; st == BSF_OK && k < LIVE_SCENE_SCANS; ++k) {
-        bsf_frame_info_t info;
-        const bsf_result_t *result = NULL;
-        if (k % LIVE_SCENE_META_EVERY == 0u) {
-            static bsf_metadata_t meta;
-            live_scene_metadata(&meta);
-            st = bsf_metadata_encode_sink(&encoder, &meta, uart_sink, NULL, NULL);
-            if (st != BSF_OK) {
-                break;
-            }
-        }
-        st = live_scene_scan(k, &info, &result);
-        if (st == BSF_OK) {
-            st = bsf_frame_encode_sink(&encoder, &info, result, uart_sink, NULL, NULL);
-        }
-        if (st != BSF_OK) {
-            printf("uart_stream: scan %lu: %s\n", (unsigned long)k, bsf_status_str(st));
-        }
+    st = live_scene_send(uart_sink, NULL, &failed_scan);
+    if (st != BSF_OK) {
+        printf("uart_stream: scan %lu: %s\n", (unsigned long)failed_scan, bsf_status_str(st));
+        return 1;
     }
-    return st == BSF_OK ? 0 : 1;
+    return 0;
 }
