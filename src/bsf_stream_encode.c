@@ -124,8 +124,8 @@ static void put_eg_bits(writer_t *w, uint64_t v, unsigned k)
     const uint64_t u = (v >> k) + 1u;
     const unsigned b = bsf_wire_bitlen(u);
     const uint64_t low = k == 0u ? 0u : v & (~(uint64_t)0 >> (64u - k));
-    if (b + k <= 32u) {
-        /* the b - 1 zeros come out as the leading zeros of a wider field */
+    if (2u * b - 1u + k <= 32u) {
+        /* the b - 1 zeros come out as the leading zeros of the field */
         put_bits(w, (uint32_t)((u << k) | low), 2u * b - 1u + k);
         return;
     }

@@ -85,7 +85,19 @@ static inline int64_t bsf_wire_predict(int64_t a, int64_t b, uint32_t s, uint32_
 {
     const int64_t den = 2 * (int64_t)k;
     const int64_t num = (b - a) * (2 * (int64_t)s - 1) + (int64_t)k;
-    int64_t q = num / den;
+    int64_t q;
+    if (num >= -(int64_t)INT32_MAX && num <= (int64_t)INT32_MAX && den <= (int64_t)INT32_MAX) {
+        /* the usual sizes: one 32-bit division (a library call in 64 bits
+         * on 32-bit targets), the same quotient and remainder */
+        const int32_t num32 = (int32_t)num;
+        const int32_t den32 = (int32_t)den;
+        int32_t q32 = num32 / den32;
+        if (num32 % den32 != 0 && num32 < 0) {
+            --q32;
+        }
+        return a + q32;
+    }
+    q = num / den;
     if (num % den != 0 && num < 0) {
         --q;
     }

@@ -65,6 +65,37 @@ static void test_tally_costs_equal_the_sum_of_code_lengths_at_every_order(void)
     }
 }
 
+/* The prediction's 32-bit fast path gives the 64-bit floor division's
+ * result, on both sides of the switch between them. */
+static int64_t predict_reference(int64_t a, int64_t b, uint32_t s, uint32_t k)
+{
+    const int64_t den = 2 * (int64_t)k;
+    const int64_t num = (b - a) * (2 * (int64_t)s - 1) + (int64_t)k;
+    int64_t q = num / den;
+    if (num % den != 0 && num < 0) {
+        --q;
+    }
+    return a + q;
+}
+
+static void test_prediction_is_the_floor_division_at_every_size(void)
+{
+    unsigned trial;
+    for (trial = 0; trial < 20000u; ++trial) {
+        const unsigned shift = trial % 31u; /* keeps (b - a) * (2s - 1) far from overflow */
+        const int64_t a = (int64_t)(int32_t)next_random() >> (trial % 31u);
+        const int64_t d = (int64_t)(int32_t)next_random() * ((int64_t)1 << shift) / 4096;
+        const uint32_t k = 1u + next_random() % 64u;
+        const uint32_t s = 1u + next_random() % k;
+        const int64_t want = predict_reference(a, a + d, s, k);
+        TEST_ASSERT_TRUE(want == bsf_wire_predict(a, a + d, s, k));
+    }
+    TEST_ASSERT_TRUE(predict_reference(0, -1, 1, 1) == bsf_wire_predict(0, -1, 1, 1));
+    TEST_ASSERT_TRUE(predict_reference(0, INT32_MAX, 1, 1) == bsf_wire_predict(0, INT32_MAX, 1, 1));
+    TEST_ASSERT_TRUE(predict_reference(0, -(int64_t)INT32_MAX - 5, 3, 2) ==
+                     bsf_wire_predict(0, -(int64_t)INT32_MAX - 5, 3, 2));
+}
+
 static void test_bit_length_is_one_plus_floor_log2(void)
 {
     unsigned b;
@@ -80,6 +111,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_tally_costs_equal_the_sum_of_code_lengths_at_every_order);
+    RUN_TEST(test_prediction_is_the_floor_division_at_every_size);
     RUN_TEST(test_bit_length_is_one_plus_floor_log2);
     return UNITY_END();
 }
