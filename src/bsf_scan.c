@@ -67,7 +67,10 @@ static inline size_t fill_points(const bsf_scan_t *scan, bsf_points_t *out, int 
             if (bounded) {
                 bsf_sincosf_bounded(a, &s, &c); /* bits of bsf_sinf(a), bsf_cosf(a) */
             } else {
-                bsf_sincosf(a, &s, &c);
+                /* beyond 16000 rad (caps far above the default): the
+                 * out-of-line functions, to keep one copy of the code */
+                s = bsf_sinf(a);
+                c = bsf_cosf(a);
             }
             out->pt[i].x = r * c;
             out->pt[i].y = r * s;
