@@ -12,13 +12,6 @@
 /* tan(pi/12): above it, atan is reduced by pi/6 */
 #define BSF_M_TAN_PI_12_F 0.267949192431123f
 
-/* pi/2 in three parts (Cody-Waite): k * each part is exact for |k| < 2^12,
- * so the reduced argument loses nothing for |x| up to about 6000. */
-#define PIO2_1 1.5703125f
-#define PIO2_2 4.83751296997070312500e-04f
-#define PIO2_3 7.54978995489188216e-08f
-#define TWO_OVER_PI 0.636619772367581f
-
 /* ln 2 in two parts: k * LN2_HI is exact for |k| <= 256. */
 #define LN2_HI 6.93145751953125e-01f
 #define LN2_LO 1.42860682030941723212e-06f
@@ -33,39 +26,6 @@ static float pow2i(int k)
     return f;
 }
 
-/* sin and cos of r in [-pi/4, pi/4]: Taylor series, truncation below 2e-9. */
-static float sin_kernel(float r)
-{
-    const float r2 = r * r;
-    return r + r * r2 *
-                   (-1.0f / 6.0f +
-                    r2 * (1.0f / 120.0f + r2 * (-1.0f / 5040.0f + r2 * (1.0f / 362880.0f))));
-}
-
-static float cos_kernel(float r)
-{
-    const float r2 = r * r;
-    return 1.0f + r2 * (-0.5f + r2 * (1.0f / 24.0f +
-                                      r2 * (-1.0f / 720.0f +
-                                            r2 * (1.0f / 40320.0f + r2 * (-1.0f / 3628800.0f)))));
-}
-
-/* x = k * pi/2 + r with |r| <= about pi/4; returns r and the quadrant k mod 4. */
-static float reduce(float x, unsigned *quadrant)
-{
-    const float k = floorf(x * TWO_OVER_PI + 0.5f);
-    const float r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
-    /* k is an integer-valued float; its low two bits pick the quadrant */
-    const float k4 = k - 4.0f * floorf(k * 0.25f);
-    *quadrant = (unsigned)k4 & 3u;
-    return r;
-}
-
-static float clamp_unit(float v)
-{
-    return v > 1.0f ? 1.0f : (v < -1.0f ? -1.0f : v);
-}
-
 float bsf_sinf(float x)
 {
     unsigned q;
@@ -74,14 +34,14 @@ float bsf_sinf(float x)
     if (!(fabsf(x) <= 3.402823466e38f)) {
         return x - x; /* NaN for NaN and +-inf */
     }
-    r = reduce(x, &q);
+    r = bsf_trig_reduce(x, &q);
     switch (q) {
-    case 0u: v = sin_kernel(r); break;
-    case 1u: v = cos_kernel(r); break;
-    case 2u: v = -sin_kernel(r); break;
-    default: v = -cos_kernel(r); break;
+    case 0u: v = bsf_sin_kernel(r); break;
+    case 1u: v = bsf_cos_kernel(r); break;
+    case 2u: v = -bsf_sin_kernel(r); break;
+    default: v = -bsf_cos_kernel(r); break;
     }
-    return clamp_unit(v);
+    return bsf_clamp_unit(v);
 }
 
 float bsf_cosf(float x)
@@ -92,14 +52,14 @@ float bsf_cosf(float x)
     if (!(fabsf(x) <= 3.402823466e38f)) {
         return x - x;
     }
-    r = reduce(x, &q);
+    r = bsf_trig_reduce(x, &q);
     switch (q) {
-    case 0u: v = cos_kernel(r); break;
-    case 1u: v = -sin_kernel(r); break;
-    case 2u: v = -cos_kernel(r); break;
-    default: v = sin_kernel(r); break;
+    case 0u: v = bsf_cos_kernel(r); break;
+    case 1u: v = -bsf_sin_kernel(r); break;
+    case 2u: v = -bsf_cos_kernel(r); break;
+    default: v = bsf_sin_kernel(r); break;
     }
-    return clamp_unit(v);
+    return bsf_clamp_unit(v);
 }
 
 float bsf_expf(float x)
@@ -117,7 +77,7 @@ float bsf_expf(float x)
     if (x < -103.98f) {
         return 0.0f;
     }
-    k = floorf(x * LOG2E + 0.5f);
+    k = bsf_floorf(x * LOG2E + 0.5f);
     r = (x - k * LN2_HI) - k * LN2_LO; /* |r| <= about ln2 / 2 */
     /* Taylor series to degree 7: truncation below 5e-9 relative */
     y = 1.0f +

@@ -33,6 +33,165 @@
 #error "bsf needs FLT_EVAL_METHOD == 0: add -fexcess-precision=fast (GCC) or -mfpmath=sse"
 #endif
 
+#include <math.h>
+#include <stdint.h>
+
+/*
+ * floorf(x) with the same result for every float (-0 and the integers kept,
+ * NaN in, NaN out), from one float-to-int conversion: newlib's floorf is a
+ * software routine on the Cortex-M4F, and glibc's a call on x86-64 without
+ * SSE4.1. test_math compares it with floorf on a large sample of floats.
+ */
+static inline float bsf_floorf(float x)
+{
+    if (fabsf(x) < 8388608.0f) {           /* below 2^23 a float may have a fraction */
+        const float t = (float)(int32_t)x; /* x rounded toward zero */
+        if (t == x) {
+            return x; /* integral: keeps -0 */
+        }
+        return t > x ? t - 1.0f : t;
+    }
+    return x; /* integral already, infinite or NaN */
+}
+
+/* Internals of bsf_sinf, bsf_cosf and bsf_sincosf, inline so that a hot loop
+ * (bsf_scan_to_points) pays no call: the same expressions give the same
+ * bits wherever they are compiled (no contraction, FLT_EVAL_METHOD 0). */
+
+/* pi/2 in three parts (Cody-Waite): k * each part is exact for |k| < 2^12,
+ * so the reduced argument loses nothing for |x| up to about 6000. */
+#define BSF_PIO2_1_F 1.5703125f
+#define BSF_PIO2_2_F 4.83751296997070312500e-04f
+#define BSF_PIO2_3_F 7.54978995489188216e-08f
+#define BSF_TWO_OVER_PI_F 0.636619772367581f
+
+/* sin and cos of r in [-pi/4, pi/4]: Taylor series, truncation below 2e-9. */
+static inline float bsf_sin_kernel(float r)
+{
+    const float r2 = r * r;
+    return r + r * r2 *
+                   (-1.0f / 6.0f +
+                    r2 * (1.0f / 120.0f + r2 * (-1.0f / 5040.0f + r2 * (1.0f / 362880.0f))));
+}
+
+static inline float bsf_cos_kernel(float r)
+{
+    const float r2 = r * r;
+    return 1.0f + r2 * (-0.5f + r2 * (1.0f / 24.0f +
+                                      r2 * (-1.0f / 720.0f +
+                                            r2 * (1.0f / 40320.0f + r2 * (-1.0f / 3628800.0f)))));
+}
+
+/* Finite x = k * pi/2 + r with |r| <= about pi/4; returns r and k mod 4.
+ * k = floor(x * 2/pi + 0.5) in integers while that fits (|x| below about
+ * 1.3e7), which is the value floorf gives; beyond, the float is integral. */
+static inline float bsf_trig_reduce(float x, unsigned *quadrant)
+{
+    const float t = x * BSF_TWO_OVER_PI_F + 0.5f;
+    float k;
+    if (fabsf(t) < 8388608.0f) {
+        int32_t ki = (int32_t)t;
+        if ((float)ki > t) {
+            --ki; /* t < 0 with a fraction: toward zero went up */
+        }
+        k = (float)ki;                 /* never -0: t is never -0 */
+        *quadrant = (unsigned)ki & 3u; /* two's complement: k mod 4 */
+    } else {
+        k = t;
+        /* from 2^24 on, floats are even; from 2^25 on, multiples of 4 */
+        *quadrant = fabsf(k) < 2147483648.0f ? (unsigned)(int32_t)k & 3u : 0u;
+    }
+    return ((x - k * BSF_PIO2_1_F) - k * BSF_PIO2_2_F) - k * BSF_PIO2_3_F;
+}
+
+static inline float bsf_clamp_unit(float v)
+{
+    return v > 1.0f ? 1.0f : (v < -1.0f ? -1.0f : v);
+}
+
+/** sin(x) and cos(x) from one range reduction: the same bits as bsf_sinf(x)
+ * and bsf_cosf(x) (test_math checks), about half their combined cost. */
+static inline void bsf_sincosf(float x, float *sin_x, float *cos_x)
+{
+    unsigned q;
+    float r;
+    float s;
+    float c;
+    float vs;
+    float vc;
+    if (!(fabsf(x) <= 3.402823466e38f)) {
+        *sin_x = x - x; /* NaN for NaN and +-inf */
+        *cos_x = x - x;
+        return;
+    }
+    r = bsf_trig_reduce(x, &q);
+    s = bsf_sin_kernel(r);
+    c = bsf_cos_kernel(r);
+    switch (q) {
+    case 0u:
+        vs = s;
+        vc = c;
+        break;
+    case 1u:
+        vs = c;
+        vc = -s;
+        break;
+    case 2u:
+        vs = -s;
+        vc = -c;
+        break;
+    default:
+        vs = -c;
+        vc = s;
+        break;
+    }
+    if (!(fabsf(r) <= 0.8f)) {
+        /* only for |x| far beyond the accurate range: the kernels stay
+         * within [-1, 1] for |r| <= 0.8 */
+        vs = bsf_clamp_unit(vs);
+        vc = bsf_clamp_unit(vc);
+    }
+    *sin_x = vs;
+    *cos_x = vc;
+}
+
+/**
+ * bsf_sincosf for |x| <= 16384 (the beam angles bsf_scan_to_points can form,
+ * |x| <= 4 pi + 4096 pi): the same bits, without the checks that only larger
+ * or non-finite x need. There t stays far below 2^23 and the reduction
+ * leaves |r| < 0.79, so the clamp to [-1, 1] never acts. Larger x: wrong.
+ */
+static inline void bsf_sincosf_bounded(float x, float *sin_x, float *cos_x)
+{
+    const float t = x * BSF_TWO_OVER_PI_F + 0.5f;
+    int32_t ki = (int32_t)t;
+    float k = (float)ki;
+    float r;
+    float s;
+    float c;
+    if (k > t) {
+        k -= 1.0f; /* floorf(t), as bsf_trig_reduce */
+        --ki;
+    }
+    r = ((x - k * BSF_PIO2_1_F) - k * BSF_PIO2_2_F) - k * BSF_PIO2_3_F;
+    s = bsf_sin_kernel(r);
+    c = bsf_cos_kernel(r);
+    /* quadrant k mod 4 in two steps (two tests, where a switch takes up
+     * to three): odd k turns (s, c) by 90 degrees, k & 2 by 180; negating
+     * twice gives the same bits as not negating */
+    if (((unsigned)ki & 1u) != 0u) {
+        const float t90 = c;
+        c = -s;
+        s = t90;
+    }
+    if (((unsigned)ki & 2u) != 0u) {
+        s = -s;
+        c = -c;
+    }
+    *sin_x = s;
+    *cos_x = c;
+}
+
 /** sin(x), radians. Full accuracy for |x| <= 8192; finite in [-1, 1] for any finite x. */
 float bsf_sinf(float x);
 

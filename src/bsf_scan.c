@@ -2,6 +2,8 @@
 #include "bsf/bsf_scan.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "bsf_math.h"
 
@@ -23,10 +25,71 @@ int bsf_range_is_valid(float r, float range_min, float range_max)
     return is_finite_f(r) && r > 0.0f && r >= range_min && r < range_max;
 }
 
+/* For v >= 0 (-0 included): the largest float below v, or 0 for 0, so
+ * that r > float_below(v) exactly when r > 0 and r >= v. */
+static float float_below(float v)
+{
+    uint32_t bits;
+    if (v == 0.0f) {
+        return 0.0f;
+    }
+    memcpy(&bits, &v, sizeof bits);
+    bits -= 1u; /* positive floats order as their bit patterns */
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+/* Points of a checked scan; returns the number of valid beams. Inline with
+ * a constant bounded, so each call site is its own loop. */
+static inline size_t fill_points(const bsf_scan_t *scan, bsf_points_t *out, int bounded)
+{
+    /* Locals: out may alias *scan as far as the compiler knows, so fields
+     * read through scan would be reloaded after every store. */
+    const float *ranges = scan->ranges;
+    const size_t count = scan->count;
+    const float angle_min = scan->angle_min;
+    const float increment = scan->angle_increment;
+    const float range_max = scan->range_max;
+    const float range_above = float_below(scan->range_min);
+    size_t n_valid = 0;
+    size_t i;
+    float beam = 0.0f; /* (float)i, exact: i <= BSF_MAX_POINTS < 2^24 */
+    for (i = 0; i < count; ++i, beam += 1.0f) {
+        const float r = ranges[i];
+        /* bsf_range_is_valid with range_min >= 0 checked: r > range_above
+         * is r > 0 && r >= range_min; NaN fails it, +-inf fails it or
+         * r < range_max (a range_max of +inf included), so no separate
+         * finiteness test. */
+        if (r > range_above && r < range_max) {
+            const float a = angle_min + beam * increment;
+            float s;
+            float c;
+            if (bounded) {
+                bsf_sincosf_bounded(a, &s, &c); /* bits of bsf_sinf(a), bsf_cosf(a) */
+            } else {
+                /* beyond 16000 rad (caps far above the default): the
+                 * out-of-line functions, to keep one copy of the code */
+                s = bsf_sinf(a);
+                c = bsf_cosf(a);
+            }
+            out->pt[i].x = r * c;
+            out->pt[i].y = r * s;
+            out->range[i] = r;
+            out->valid[i] = 1u;
+            ++n_valid;
+        } else {
+            out->pt[i].x = 0.0f;
+            out->pt[i].y = 0.0f;
+            out->range[i] = 0.0f;
+            out->valid[i] = 0u;
+        }
+    }
+    return n_valid;
+}
+
 bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
 {
-    size_t i;
-    size_t n_valid = 0;
+    size_t n_valid;
 
     if (scan == NULL || out == NULL || (scan->count > 0 && scan->ranges == NULL)) {
         return BSF_ERR_ARG;
@@ -42,21 +105,13 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
         return BSF_ERR_ARG;
     }
 
-    for (i = 0; i < scan->count; ++i) {
-        const float r = scan->ranges[i];
-        if (bsf_range_is_valid(r, scan->range_min, scan->range_max)) {
-            const float a = scan->angle_min + (float)i * scan->angle_increment;
-            out->pt[i].x = r * bsf_cosf(a);
-            out->pt[i].y = r * bsf_sinf(a);
-            out->range[i] = r;
-            out->valid[i] = 1u;
-            ++n_valid;
-        } else {
-            out->pt[i].x = 0.0f;
-            out->pt[i].y = 0.0f;
-            out->range[i] = 0.0f;
-            out->valid[i] = 0u;
-        }
+    /* every beam angle within bsf_sincosf_bounded's domain (a margin of
+     * 384 rad covers the rounding of this bound and of the angles): one loop
+     * without the checks only huge angles need, chosen once per scan */
+    if (fabsf(scan->angle_min) + (float)scan->count * fabsf(scan->angle_increment) <= 16000.0f) {
+        n_valid = fill_points(scan, out, 1);
+    } else {
+        n_valid = fill_points(scan, out, 0);
     }
     out->count = scan->count;
     out->n_valid = n_valid;

@@ -4,11 +4,13 @@
 #include <math.h>
 #include <string.h>
 
+#include "bsf_math.h"
 #include "bsf_wire.h"
 
 /*
- * One writer serves four uses: costing the control point values of one
- * class at every Exp-Golomb order (nothing is emitted), counting (buf ==
+ * One writer serves four uses: costing (nothing is emitted: the bits of
+ * everything but the control point values are summed, and those values are
+ * tallied per class to cost every Exp-Golomb order at once), counting (buf ==
  * NULL, sink == NULL), writing to a buffer (COBS code bytes are patched in
  * place once their block ends) and feeding a sink (a block is collected in
  * work->block and handed over whole, because its code byte must go first).
@@ -17,20 +19,21 @@
 typedef struct {
     uint8_t *buf;
     size_t cap;
-    size_t pos;      /* bytes of the frame produced so far */
-    size_t code_pos; /* buffer mode: where the current block's code byte goes */
-    uint8_t code;    /* 1 + data bytes in the current block */
-    uint32_t crc;
+    size_t pos;       /* bytes of the frame produced so far */
+    size_t code_pos;  /* buffer mode: where the current block's code byte goes */
+    uint8_t code;     /* 1 + data bytes in the current block */
+    uint32_t crc_reg; /* CRC-32C register: the CRC is its complement */
     bsf_encoder_t *work;
     bsf_sink_fn sink;
     void *ctx;
     int failed;
-    uint32_t acc;   /* pending bits of the payload's bit stream, MSB first */
+    uint64_t acc;   /* pending bits of the payload's bit stream, MSB first */
     unsigned n_acc; /* number of pending bits (< 8 between calls) */
-    /* Costing runs: when cost_class < BSF_WIRE_N_CLASSES nothing is emitted
-     * and cost[k] sums the bits the values of that class take at order k. */
-    unsigned cost_class;
-    uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
+    /* Costing run (costing != 0): nothing is emitted; bits sums the payload
+     * bits outside the control point values, tally counts those per class. */
+    int costing;
+    uint32_t bits;
+    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
 } writer_t;
 
@@ -65,7 +68,11 @@ static void block_end(writer_t *w)
 
 static void put_u8(writer_t *w, uint8_t b)
 {
-    w->crc = bsf_crc32c(w->crc, &b, 1u);
+    if (w->costing) {
+        w->bits += 8u;
+        return;
+    }
+    w->crc_reg = bsf_wire_crc32c_step(w->crc_reg, b);
     if (b == 0u) {
         block_end(w);
         block_start(w);
@@ -85,39 +92,55 @@ static void put_u8(writer_t *w, uint8_t b)
     }
 }
 
-/* The n (<= 24) low bits of v, most significant first. */
+/* The n (<= 32) low bits of v, most significant first, whole bytes out. */
 static void put_bits(writer_t *w, uint32_t v, unsigned n)
 {
-    if (w->cost_class < BSF_WIRE_N_CLASSES) {
+    if (w->costing) {
+        w->bits += n;
         return;
     }
-    while (n > 0u) {
-        const unsigned take = n > 8u ? 8u : n;
-        n -= take;
-        w->acc = (w->acc << take) | ((v >> n) & ((1u << take) - 1u));
-        w->n_acc += take;
-        if (w->n_acc >= 8u) {
-            w->n_acc -= 8u;
-            put_u8(w, (uint8_t)(w->acc >> w->n_acc));
-        }
+    w->acc = (w->acc << n) | ((uint64_t)v & ((((uint64_t)1) << n) - 1u));
+    w->n_acc += n;
+    while (w->n_acc >= 8u) {
+        w->n_acc -= 8u;
+        put_u8(w, (uint8_t)(w->acc >> w->n_acc));
     }
 }
 
+/* The n (<= 64) low bits of v. */
+static void put_bits_wide(writer_t *w, uint64_t v, unsigned n)
+{
+    if (n > 32u) {
+        put_bits(w, (uint32_t)(v >> 32), n - 32u);
+        n = 32u;
+    }
+    put_bits(w, (uint32_t)v, n);
+}
+
 /* Exp-Golomb code of order k: for u = (v >> k) + 1 of b bits, b - 1 zeros,
- * u itself, then the k low bits of v. */
-static void put_eg(writer_t *w, uint64_t v, unsigned k)
+ * u itself, then the k low bits of v; short codes as one field. */
+static void put_eg_bits(writer_t *w, uint64_t v, unsigned k)
 {
     const uint64_t u = (v >> k) + 1u;
     const unsigned b = bsf_wire_bitlen(u);
-    unsigned i;
-    for (i = 1u; i < b; ++i) {
-        put_bits(w, 0u, 1u);
+    const uint64_t low = k == 0u ? 0u : v & (~(uint64_t)0 >> (64u - k));
+    if (2u * b - 1u + k <= 32u) {
+        /* the b - 1 zeros come out as the leading zeros of the field */
+        put_bits(w, (uint32_t)((u << k) | low), 2u * b - 1u + k);
+        return;
     }
-    for (i = b; i > 0u; --i) {
-        put_bits(w, (uint32_t)(u >> (i - 1u)) & 1u, 1u);
-    }
-    for (i = k; i > 0u; --i) {
-        put_bits(w, (uint32_t)(v >> (i - 1u)) & 1u, 1u);
+    put_bits_wide(w, 0u, b - 1u);
+    put_bits_wide(w, u, b);
+    put_bits_wide(w, low, k);
+}
+
+/* Costing runs only add the code's length (inline: most fields pass here). */
+static inline void put_eg(writer_t *w, uint64_t v, unsigned k)
+{
+    if (w->costing) {
+        w->bits += 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
+    } else {
+        put_eg_bits(w, v, k);
     }
 }
 
@@ -130,12 +153,9 @@ static void put_seg(writer_t *w, int64_t v, unsigned k)
 static void put_ctrl_value(writer_t *w, unsigned cls, int64_t v)
 {
     const uint64_t z = bsf_wire_zigzag(v);
-    if (w->cost_class == cls) {
-        unsigned k;
-        for (k = 0; k <= BSF_WIRE_K_CTRL_MAX; ++k) {
-            w->cost[k] += bsf_wire_eg_bits(z, k);
-        }
-    } else if (w->cost_class >= BSF_WIRE_N_CLASSES) {
+    if (w->costing) {
+        bsf_wire_eg_tally_add(&w->tally[cls], z);
+    } else {
         put_eg(w, z, w->k_ctrl[cls]);
     }
 }
@@ -145,10 +165,13 @@ static void finish(writer_t *w)
 {
     uint32_t crc;
     unsigned i;
+    if (w->costing) {
+        return; /* the caller adds padding and CRC */
+    }
     if (w->n_acc > 0u) {
         put_bits(w, 0u, 8u - w->n_acc); /* pad the last byte with zeros */
     }
-    crc = w->crc;
+    crc = ~w->crc_reg;
     for (i = 0; i < 4u; ++i) {
         put_u8(w, (uint8_t)(crc >> (8u * i)));
     }
@@ -170,15 +193,20 @@ static int is_finite_f(float v)
     return v == v && fabsf(v) <= 3.402823466e38f;
 }
 
-/* Nearest multiple of step, in steps; 0 when v is not finite or too far. */
+/* Nearest multiple of step, in steps: floor(v / step + 0.5); 0 when v is
+ * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
+ * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
+ * one lower for a negative r with a fraction. */
 static int quantise(float v, float step, int32_t *q)
 {
-    const float r = floorf(v / step + 0.5f);
-    if (!(fabsf(r) <= (float)BSF_QUANT_MAX_STEPS)) {
+    const float r = v / step + 0.5f;
+    int32_t t;
+    if (!(r >= -(float)BSF_QUANT_MAX_STEPS && r < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
         *q = 0;
-        return 0;
+        return 0; /* NaN included */
     }
-    *q = (int32_t)r;
+    t = (int32_t)r;
+    *q = (float)t > r ? t - 1 : t;
     return 1;
 }
 
@@ -205,7 +233,7 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f, float step,
-                                 uint32_t *n_unique, uint64_t *mask)
+                                 int check_points, uint32_t *n_unique, uint64_t *mask)
 {
     const size_t n = f->n_ctrl;
     const uint32_t n_beams = res->stats.n_beams;
@@ -224,13 +252,14 @@ static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f
     while (s < n) {
         const size_t slot = (size_t)f->ctrl_first + s;
         int32_t q[2];
-        if (!quantise_point(res->ctrl[slot], step, q)) {
+        if (check_points && !quantise_point(res->ctrl[slot], step, q)) {
             return BSF_ERR_ARG;
         }
         if (res->ctrl_is_vertex[slot] != 0u) {
             int32_t q2[2];
-            if (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
-                !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] || q2[1] != q[1]) {
+            if (check_points && (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
+                                 !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] ||
+                                 q2[1] != q[1])) {
                 return BSF_ERR_ARG;
             }
             *mask |= (uint64_t)1u << j;
@@ -305,7 +334,7 @@ static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code
     if (!is_finite_f(info->quant_step)) {
         return BSF_ERR_ARG;
     }
-    code = floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    code = bsf_floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
     if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
         return BSF_ERR_ARG;
     }
@@ -346,7 +375,7 @@ static bsf_status_t check_stats(const bsf_stats_t *st)
 
 static int32_t round_to_int(float v)
 {
-    return (int32_t)floorf(v + 0.5f);
+    return (int32_t)bsf_floorf(v + 0.5f);
 }
 
 static void put_float(writer_t *w, float v);
@@ -436,7 +465,9 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         uint32_t span;
         uint32_t j;
 
-        st = scan_feature(res, f, step, &n_unique, &mask);
+        /* the points were checked by the costing run that precedes every
+         * other run (a vertex pair's flags alone then give the mask) */
+        st = scan_feature(res, f, step, w->costing, &n_unique, &mask);
         if (st != BSF_OK) {
             return st;
         }
@@ -451,7 +482,8 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
         put_seg(w, (int64_t)f->first_beam - prev_last_beam - 1, BSF_WIRE_K_GAP);
         put_eg(w, span, BSF_WIRE_K_SPAN);
         put_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        put_eg(w, (uint64_t)floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f), BSF_WIRE_K_E_CURVE);
+        put_eg(w, (uint64_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
+               BSF_WIRE_K_E_CURVE);
         put_ctrl(w, res, f, step, prev);
         prev_last_beam = f->last_beam;
     }
@@ -486,46 +518,61 @@ static void writer_init(writer_t *w)
     w->pos = 0u;
     w->code_pos = 0u;
     w->code = 1u;
-    w->crc = 0u;
+    w->crc_reg = 0xFFFFFFFFu;
     w->work = NULL;
     w->sink = NULL;
     w->ctx = NULL;
     w->failed = 0;
     w->acc = 0u;
     w->n_acc = 0u;
-    w->cost_class = BSF_WIRE_N_CLASSES;
-    memset(w->cost, 0, sizeof w->cost);
+    w->costing = 0;
+    w->bits = 0u;
     memset(w->k_ctrl, 0, sizeof w->k_ctrl);
 }
 
 /*
  * The Exp-Golomb order of each control point class that makes the frame
- * shortest (one costing run per class; ties go to the smaller order). The
- * chosen total never exceeds the total at order 25, which bounds every
- * value by 26 bits (BSF_FRAME_CTRL_MAX_BITS).
+ * shortest (one costing run; ties go to the smaller order), and an upper
+ * bound on the frame's size. The chosen total never exceeds the total at
+ * order 25, which bounds every value by 26 bits (BSF_FRAME_CTRL_MAX_BITS).
  */
 static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result_t *res,
-                                  uint8_t k_ctrl[BSF_WIRE_N_CLASSES])
+                                  uint8_t k_ctrl[BSF_WIRE_N_CLASSES], size_t *size_bound)
 {
     writer_t w;
     unsigned cls;
+    uint32_t bits;
+    size_t body;
+    bsf_status_t st;
+    writer_init(&w);
+    w.costing = 1;
+    memset(w.tally, 0, sizeof w.tally);
+    st = write_frame(&w, info, res);
+    if (st != BSF_OK) {
+        return st;
+    }
+    bits = w.bits;
     for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
+        uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
         unsigned k;
         unsigned best = 0;
-        bsf_status_t st;
-        writer_init(&w);
-        w.cost_class = cls;
-        st = write_frame(&w, info, res);
-        if (st != BSF_OK) {
-            return st;
-        }
-        for (k = 1; k <= BSF_WIRE_K_CTRL_MAX; ++k) {
-            if (w.cost[k] < w.cost[best]) {
+        /* above the longest value's bit length L every order costs one bit
+         * per value more than the one before, so none beats order L */
+        const unsigned k_top =
+            w.tally[cls].max_len < BSF_WIRE_K_CTRL_MAX ? w.tally[cls].max_len : BSF_WIRE_K_CTRL_MAX;
+        bsf_wire_eg_tally_costs(&w.tally[cls], k_top, cost);
+        for (k = 1; k <= k_top; ++k) {
+            if (cost[k] < cost[best]) {
                 best = k;
             }
         }
         k_ctrl[cls] = (uint8_t)best;
+        bits += cost[best];
     }
+    /* payload bytes and CRC, one COBS code byte first and one per 254
+     * bytes at most (a zero byte is replaced by one), the 0x00 delimiter */
+    body = ((size_t)bits + 7u) / 8u + 4u;
+    *size_bound = body + body / 254u + 2u;
     return BSF_OK;
 }
 
@@ -534,12 +581,23 @@ bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *
 {
     writer_t w;
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    size_t bound = 0;
     bsf_status_t st;
 
     if (info == NULL || result == NULL || out_len == NULL) {
         return BSF_ERR_ARG;
     }
-    st = choose_orders(info, result, k_ctrl);
+    st = choose_orders(info, result, k_ctrl, &bound);
+    if (st == BSF_OK && buf != NULL && cap >= bound) {
+        /* validated, and fits whatever its COBS blocks: write at once */
+        writer_init(&w);
+        memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
+        w.buf = buf;
+        w.cap = cap;
+        st = write_frame(&w, info, result);
+        *out_len = st == BSF_OK ? w.pos : 0u;
+        return st;
+    }
     if (st == BSF_OK) {
         writer_init(&w);
         memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
@@ -569,6 +627,7 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
 {
     writer_t w;
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    size_t bound;
     bsf_status_t st;
 
     if (written != NULL) {
@@ -577,7 +636,7 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
     if (work == NULL || info == NULL || result == NULL || sink == NULL) {
         return BSF_ERR_ARG;
     }
-    st = choose_orders(info, result, k_ctrl);
+    st = choose_orders(info, result, k_ctrl, &bound);
     if (st != BSF_OK) {
         return st;
     }
@@ -639,7 +698,7 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
     if (!is_finite_f(m->quant_step)) {
         return BSF_ERR_ARG;
     }
-    code = floorf(m->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    code = bsf_floorf(m->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
     if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
         return BSF_ERR_ARG;
     }

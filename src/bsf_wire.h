@@ -85,32 +85,127 @@ static inline int64_t bsf_wire_predict(int64_t a, int64_t b, uint32_t s, uint32_
 {
     const int64_t den = 2 * (int64_t)k;
     const int64_t num = (b - a) * (2 * (int64_t)s - 1) + (int64_t)k;
-    int64_t q = num / den;
+    int64_t q;
+    if (num >= -(int64_t)INT32_MAX && num <= (int64_t)INT32_MAX && den <= (int64_t)INT32_MAX) {
+        /* the usual sizes: one 32-bit division (a library call in 64 bits
+         * on 32-bit targets), the same quotient and remainder */
+        const int32_t num32 = (int32_t)num;
+        const int32_t den32 = (int32_t)den;
+        int32_t q32 = num32 / den32;
+        if (num32 % den32 != 0 && num32 < 0) {
+            --q32;
+        }
+        return a + q32;
+    }
+    q = num / den;
     if (num % den != 0 && num < 0) {
         --q;
     }
     return a + q;
 }
 
-/* Bits of v: 0 for 0, else 1 + floor(log2 v) (binary search: the encoder
- * evaluates it 26 times per control point value when it picks the orders). */
-static inline unsigned bsf_wire_bitlen(uint64_t v)
+/* Bits of v: 0 for 0, else 1 + floor(log2 v): the count-leading-zeros
+ * instruction where the compiler has one (x86 BSR/LZCNT, Arm CLZ), else a
+ * binary search; the encoder evaluates it for every value it writes. */
+static inline unsigned bsf_wire_bitlen32(uint32_t v)
 {
+#if defined(__GNUC__) || defined(__clang__)
+    return v == 0u ? 0u : 32u - (unsigned)__builtin_clz(v);
+#else
     unsigned n = 0;
     unsigned half;
-    for (half = 32u; half > 0u; half >>= 1) {
+    for (half = 16u; half > 0u; half >>= 1) {
         if ((v >> half) != 0u) {
             v >>= half;
             n += half;
         }
     }
     return n + (unsigned)v;
+#endif
+}
+
+static inline unsigned bsf_wire_bitlen(uint64_t v)
+{
+    const uint32_t hi = (uint32_t)(v >> 32);
+    return hi != 0u ? 32u + bsf_wire_bitlen32(hi) : bsf_wire_bitlen32((uint32_t)v);
+}
+
+/* CRC-32C register (not inverted) after one more byte: two steps of a
+ * 16-entry table (64 bytes of ROM where 256 entries would take 1 KiB). */
+static inline uint32_t bsf_wire_crc32c_step(uint32_t reg, uint8_t b)
+{
+    static const uint32_t nibble[16] = {0x00000000u, 0x105EC76Fu, 0x20BD8EDEu, 0x30E349B1u,
+                                        0x417B1DBCu, 0x5125DAD3u, 0x61C69362u, 0x7198540Du,
+                                        0x82F63B78u, 0x92A8FC17u, 0xA24BB5A6u, 0xB21572C9u,
+                                        0xC38D26C4u, 0xD3D3E1ABu, 0xE330A81Au, 0xF36E6F75u};
+    reg ^= b;
+    reg = (reg >> 4) ^ nibble[reg & 0x0Fu];
+    return (reg >> 4) ^ nibble[reg & 0x0Fu];
 }
 
 /* Length in bits of the Exp-Golomb code of order k of v (v >> k < 2^63). */
 static inline unsigned bsf_wire_eg_bits(uint64_t v, unsigned k)
 {
     return 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
+}
+
+/*
+ * Costs of one control point class at every order from one pass over its
+ * values. The code of v at order k is v + 2^k written in 2 * bitlen(v + 2^k)
+ * - 1 - k bits. With L = bitlen(v) and m = bitlen(v ^ (2^L - 1)) (the bits
+ * below v's leading run of ones), bitlen(v + 2^k) is k + 1 for k >= L, L + 1
+ * for m <= k < L (the carry runs through the ones) and L for k < m. So the
+ * counts of L and of m give every order's total exactly.
+ */
+/* Bit lengths 0..26: the encoder's control point values stay below 2^26
+ * (quantised coordinates within BSF_QUANT_MAX_STEPS = 2^23 - 1, so deltas
+ * and residuals within 2^24, zigzag within 2^25). */
+#define BSF_WIRE_EG_HIST 27u
+
+typedef struct {
+    uint32_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
+    uint32_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
+    unsigned max_len;                   /* largest L counted */
+} bsf_wire_eg_tally_t;
+
+static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
+{
+    const unsigned len = bsf_wire_bitlen(v);
+    const uint64_t ones = len == 0u ? 0u : (~(uint64_t)0 >> (64u - len));
+    t->n_len[len] += 1u;
+    t->n_below[bsf_wire_bitlen(v ^ ones)] += 1u;
+    if (len > t->max_len) {
+        t->max_len = len;
+    }
+}
+
+/* cost[k] for k = 0..k_max: total bits of the tallied values at order k. */
+static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigned k_max,
+                                           uint32_t *cost)
+{
+    uint32_t n = 0;
+    uint32_t above = 0;      /* sum of (2L - 1) over the values with L > k */
+    uint32_t n_len_le = 0;   /* values with L <= k */
+    uint32_t n_below_le = 0; /* values with m <= k */
+    unsigned len;
+    unsigned k;
+    for (len = 0; len <= t->max_len; ++len) {
+        n += t->n_len[len];
+        if (len > 0u) {
+            above += t->n_len[len] * (2u * len - 1u);
+        }
+    }
+    for (k = 0; k <= k_max; ++k) {
+        if (k <= t->max_len) {
+            n_len_le += t->n_len[k];
+            n_below_le += t->n_below[k];
+            if (k > 0u) {
+                above -= t->n_len[k] * (2u * k - 1u);
+            }
+        }
+        /* unsigned arithmetic: intermediate wrap-around cancels */
+        cost[k] = (k + 1u) * n_len_le + above - k * (n - n_len_le) + 2u * (n_below_le - n_len_le);
+    }
 }
 
 /*

@@ -49,6 +49,8 @@ static float g_synth_ranges[N_SYNTH_SCENES * N_SYNTH_POSES * 2][361];
 static uint32_t g_whole[MAX_SCANS];
 static uint32_t g_stage[BSF_STAGE_COUNT][MAX_SCANS];
 static uint32_t g_sorted[MAX_SCANS];
+static uint32_t g_encode[MAX_SCANS];
+static uint8_t g_frame[BSF_FRAME_MAX_SIZE];
 
 static double g_ticks_per_instr;
 static uint32_t g_stack_bytes;
@@ -239,9 +241,21 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
     for (i = 0; i < src->n; ++i) {
         bsf_scan_t tmp;
         const bsf_scan_t *scan = src->get(i, &tmp);
+        bsf_frame_info_t info;
+        size_t len;
+        uint32_t t0;
         if (bsf_extract(&g_ex, scan, &g_res) < 0) {
             return 1;
         }
+        /* The scan's frame, as firmware sends it after extracting. */
+        bsf_frame_info_init(&info);
+        info.seq = (uint32_t)i;
+        t0 = ticks_now();
+        if (bsf_frame_encode(&info, &g_res, g_frame, sizeof g_frame, &len) != BSF_OK) {
+            printf("  %s: scan %u: frame not encoded\n", bsf_method_name(method), (unsigned)i);
+            return 1;
+        }
+        g_encode[i] = to_instr(ticks_now() - t0);
         for (s = 0; s < BSF_STAGE_COUNT; ++s) {
             g_stage[s][i] = to_instr(g_res.stats.stage_ns[s]);
         }
@@ -252,6 +266,7 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
     for (s = 0; s < BSF_STAGE_COUNT; ++s) {
         printf(" %8lu", (unsigned long)median_of(g_stage[s], src->n, NULL));
     }
+    printf(" | %8lu", (unsigned long)median_of(g_encode, src->n, NULL));
     printf(" | %5.2f | %5lu\n", (double)feats / (double)src->n, (unsigned long)g_stack_bytes);
     return 0;
 }
@@ -260,10 +275,10 @@ static int run_source(const scan_source_t *src)
 {
     int m, rc = 0;
     printf("\n%s: %u scans\n", src->name, (unsigned)src->n);
-    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %5s | %5s\n", "instructions", "median", "mean",
-           "max", "points", "corners", "segment", "fit", "feat", "stack");
-    printf("  %-15s %29s | %35s |\n", "", "whole bsf_extract per scan",
-           "median per stage (with clock hook)");
+    printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %8s | %5s | %5s\n", "instructions", "median",
+           "mean", "max", "points", "corners", "segment", "fit", "encode", "feat", "stack");
+    printf("  %-15s %29s | %35s | %8s |\n", "", "whole bsf_extract per scan",
+           "median per stage (with clock hook)", "frame");
     for (m = 0; m < BSF_METHOD_COUNT; ++m) {
         rc |= run_method(src, (bsf_method_t)m);
     }

@@ -2,6 +2,8 @@
 /* The library's own sin, cos, exp, atan2 and asin (src/bsf_math.c): close to
  * the C library's, and the special values callers can meet. White-box. */
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "bsf_math.h"
 #include "unity.h"
@@ -40,6 +42,145 @@ static void test_sin_and_cos_of_nan_and_inf_are_nan_and_huge_arguments_stay_in_r
     TEST_ASSERT_TRUE(isnan(bsf_sinf(-INFINITY)));
     TEST_ASSERT_TRUE(fabsf(bsf_sinf(1.0e30f)) <= 1.0f);
     TEST_ASSERT_TRUE(fabsf(bsf_cosf(-3.0e38f)) <= 1.0f);
+}
+
+static uint32_t bits_of(float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+static float float_of(uint32_t u)
+{
+    float v;
+    memcpy(&v, &u, sizeof v);
+    return v;
+}
+
+/* The same value as floorf, bit for bit (NaN: both NaN). */
+static int floor_matches(float x)
+{
+    const float want = floorf(x);
+    const float got = bsf_floorf(x);
+    if (want != want) {
+        return got != got;
+    }
+    return bits_of(want) == bits_of(got);
+}
+
+static void test_floor_is_floorf_bit_for_bit(void)
+{
+    uint32_t u;
+    int i;
+    unsigned long bad = 0;
+    /* every float pattern at a prime stride: all exponents, both signs */
+    for (u = 0u; u < 0xFFFFF000u; u += 4093u) {
+        bad += floor_matches(float_of(u)) ? 0u : 1u;
+    }
+    /* around every quarter in [-2^14, 2^14], and the edges of the fast path */
+    for (i = -65536; i <= 65536; ++i) {
+        const float x = (float)i * 0.25f;
+        bad += floor_matches(x) ? 0u : 1u;
+        bad += floor_matches(nextafterf(x, -INFINITY)) ? 0u : 1u;
+        bad += floor_matches(nextafterf(x, INFINITY)) ? 0u : 1u;
+    }
+    for (i = -3; i <= 3; ++i) {
+        bad += floor_matches(8388608.0f + (float)i) ? 0u : 1u;
+        bad += floor_matches(-8388608.0f + (float)i) ? 0u : 1u;
+        bad += floor_matches(8388607.5f + (float)i) ? 0u : 1u;
+        bad += floor_matches(-8388607.5f + (float)i) ? 0u : 1u;
+    }
+    bad += floor_matches(-0.0f) ? 0u : 1u;
+    bad += floor_matches(INFINITY) && floor_matches(-INFINITY) && floor_matches(NAN) ? 0u : 1u;
+    TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)bad);
+    TEST_ASSERT_EQUAL_HEX32(bits_of(-0.0f), bits_of(bsf_floorf(-0.0f)));
+    TEST_ASSERT_EQUAL_FLOAT(-1.0f, bsf_floorf(-0.25f));
+}
+
+/* The sin and cos the library computed before bsf_sincosf (libm floorf for
+ * the range reduction): the points of every scan, and so every stream byte,
+ * depend on keeping exactly these bits. */
+static float ref_reduce(float x, unsigned *quadrant)
+{
+    const float k = floorf(x * BSF_TWO_OVER_PI_F + 0.5f);
+    const float r = ((x - k * BSF_PIO2_1_F) - k * BSF_PIO2_2_F) - k * BSF_PIO2_3_F;
+    const float k4 = k - 4.0f * floorf(k * 0.25f);
+    *quadrant = (unsigned)k4 & 3u;
+    return r;
+}
+
+static float ref_sin_cos(float x, int want_cos)
+{
+    unsigned q;
+    float r;
+    float v;
+    if (!(fabsf(x) <= 3.402823466e38f)) {
+        return x - x;
+    }
+    r = ref_reduce(x, &q);
+    q = (q + (want_cos ? 1u : 0u)) & 3u; /* cos x = sin(x + pi/2) */
+    switch (q) {
+    case 0u: v = bsf_sin_kernel(r); break;
+    case 1u: v = bsf_cos_kernel(r); break;
+    case 2u: v = -bsf_sin_kernel(r); break;
+    default: v = -bsf_cos_kernel(r); break;
+    }
+    return v > 1.0f ? 1.0f : (v < -1.0f ? -1.0f : v);
+}
+
+/* 1 when sincos, sin and cos of x all give the reference's bits. */
+static int trig_matches(float x)
+{
+    float s;
+    float c;
+    const uint32_t want_s = bits_of(ref_sin_cos(x, 0));
+    const uint32_t want_c = bits_of(ref_sin_cos(x, 1));
+    bsf_sincosf(x, &s, &c);
+    if (fabsf(x) <= 16384.0f) {
+        float sb;
+        float cb;
+        bsf_sincosf_bounded(x, &sb, &cb);
+        if (bits_of(sb) != want_s || bits_of(cb) != want_c) {
+            return 0;
+        }
+    }
+    if (x != x || !(fabsf(x) <= 3.402823466e38f)) {
+        return s != s && c != c && bsf_sinf(x) != bsf_sinf(x) && bsf_cosf(x) != bsf_cosf(x);
+    }
+    return bits_of(s) == want_s && bits_of(c) == want_c && bits_of(bsf_sinf(x)) == want_s &&
+           bits_of(bsf_cosf(x)) == want_c;
+}
+
+static void test_sincos_sin_and_cos_keep_the_reference_bits(void)
+{
+    static const float angle_min[] = {-3.14159265f, -2.35619449f, -1.57079633f, 0.0f, -12.5f};
+    static const float increment[] = {0.0174532925f,  0.00436332313f, 0.00872664626f,
+                                      0.00196349541f, -0.0174532925f, 3.0f};
+    unsigned long bad = 0;
+    uint32_t u;
+    size_t a;
+    size_t b;
+    int i;
+    /* beam angles exactly as bsf_scan_to_points forms them */
+    for (a = 0; a < sizeof angle_min / sizeof angle_min[0]; ++a) {
+        for (b = 0; b < sizeof increment / sizeof increment[0]; ++b) {
+            for (i = 0; i < 4096; ++i) {
+                bad += trig_matches(angle_min[a] + (float)i * increment[b]) ? 0u : 1u;
+            }
+        }
+    }
+    /* every float pattern at a prime stride: tiny, huge, NaN, both signs */
+    for (u = 0u; u < 0xFFFFF000u; u += 40009u) {
+        bad += trig_matches(float_of(u)) ? 0u : 1u;
+    }
+    /* densely where the quadrant changes, to the bounded variant's limit */
+    for (i = -20861; i <= 20861; ++i) {
+        const float x = (float)i * 0.785398163f;
+        bad += trig_matches(x) ? 0u : 1u;
+        bad += trig_matches(nextafterf(x, 0.0f)) ? 0u : 1u;
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)bad);
 }
 
 static void test_exp_agrees_with_libm_within_three_ulp(void)
@@ -125,6 +266,8 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_sin_and_cos_agree_with_libm_within_two_ulp_of_one);
     RUN_TEST(test_sin_and_cos_of_nan_and_inf_are_nan_and_huge_arguments_stay_in_range);
+    RUN_TEST(test_floor_is_floorf_bit_for_bit);
+    RUN_TEST(test_sincos_sin_and_cos_keep_the_reference_bits);
     RUN_TEST(test_exp_agrees_with_libm_within_three_ulp);
     RUN_TEST(test_exp_overflows_to_inf_underflows_to_zero_and_keeps_nan);
     RUN_TEST(test_atan2_agrees_with_libm_in_every_quadrant);

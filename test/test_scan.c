@@ -1,9 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /* Scan model: which readings become points, and which calls are refused. */
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "bsf/bsf.h"
+#include "bsf_math.h"
 #include "unity.h"
 
 static bsf_points_t points;
@@ -180,6 +182,64 @@ static void test_empty_and_all_invalid_scans_give_no_points(void)
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)points.n_valid);
 }
 
+static uint32_t bits_of(float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+/* The loop's shortcuts (one bound test, fused sin/cos) agree with
+ * bsf_range_is_valid and with r * bsf_cosf, r * bsf_sinf, bit for bit, at
+ * the edges of every range bound. */
+static void test_points_and_validity_match_the_reference_at_every_bound(void)
+{
+    static const float mins[] = {0.0f, -0.0f, 1.4e-45f, 1.17549435e-38f, 0.1f, 1.0f};
+    static const float maxs[] = {30.0f, INFINITY};
+    size_t a;
+    size_t b;
+    for (a = 0; a < sizeof mins / sizeof mins[0]; ++a) {
+        for (b = 0; b < sizeof maxs / sizeof maxs[0]; ++b) {
+            const float lo = mins[a];
+            const float hi = maxs[b];
+            const float probe[] = {0.0f,
+                                   -0.0f,
+                                   1.4e-45f,
+                                   2.8e-45f,
+                                   lo,
+                                   nextafterf(lo, -INFINITY),
+                                   nextafterf(lo, INFINITY),
+                                   hi,
+                                   nextafterf(hi, 0.0f),
+                                   INFINITY,
+                                   -INFINITY,
+                                   NAN,
+                                   -1.0f,
+                                   5.0f};
+            const size_t n = sizeof probe / sizeof probe[0];
+            bsf_scan_t s = make_scan(n);
+            size_t i;
+            s.angle_min = -2.3561945f;
+            s.angle_increment = 0.4f;
+            s.range_min = lo;
+            s.range_max = hi;
+            memcpy(ranges, probe, sizeof probe);
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &points));
+            for (i = 0; i < n; ++i) {
+                const float ang = s.angle_min + (float)i * s.angle_increment;
+                const int want = bsf_range_is_valid(probe[i], lo, hi);
+                TEST_ASSERT_EQUAL_INT(want, points.valid[i] != 0u);
+                if (want) {
+                    TEST_ASSERT_EQUAL_HEX32(bits_of(probe[i] * bsf_cosf(ang)),
+                                            bits_of(points.pt[i].x));
+                    TEST_ASSERT_EQUAL_HEX32(bits_of(probe[i] * bsf_sinf(ang)),
+                                            bits_of(points.pt[i].y));
+                }
+            }
+        }
+    }
+}
+
 static void test_status_strings_name_every_code(void)
 {
     TEST_ASSERT_EQUAL_STRING("ok", bsf_status_str(BSF_OK));
@@ -200,6 +260,7 @@ int main(void)
     RUN_TEST(test_bad_geometry_is_refused);
     RUN_TEST(test_negative_increment_scans_clockwise);
     RUN_TEST(test_empty_and_all_invalid_scans_give_no_points);
+    RUN_TEST(test_points_and_validity_match_the_reference_at_every_bound);
     RUN_TEST(test_status_strings_name_every_code);
     return UNITY_END();
 }
