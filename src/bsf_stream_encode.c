@@ -33,7 +33,8 @@ typedef struct {
      * bits outside the control point values, tally counts those per class. */
     int costing;
     uint32_t bits;
-    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
+    bsf_wire_eg_tally_t *tally; /* costing run only: BSF_WIRE_N_CLASSES entries (the
+                                 * writing runs do not carry them on the stack) */
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
 } writer_t;
 
@@ -526,6 +527,7 @@ static void writer_init(writer_t *w)
     w->acc = 0u;
     w->n_acc = 0u;
     w->costing = 0;
+    w->tally = NULL;
     w->bits = 0u;
     memset(w->k_ctrl, 0, sizeof w->k_ctrl);
 }
@@ -540,13 +542,15 @@ static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result
                                   uint8_t k_ctrl[BSF_WIRE_N_CLASSES], size_t *size_bound)
 {
     writer_t w;
+    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     unsigned cls;
     uint32_t bits;
     size_t body;
     bsf_status_t st;
     writer_init(&w);
     w.costing = 1;
-    memset(w.tally, 0, sizeof w.tally);
+    memset(tally, 0, sizeof tally);
+    w.tally = tally;
     st = write_frame(&w, info, res);
     if (st != BSF_OK) {
         return st;
@@ -559,8 +563,8 @@ static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result
         /* above the longest value's bit length L every order costs one bit
          * per value more than the one before, so none beats order L */
         const unsigned k_top =
-            w.tally[cls].max_len < BSF_WIRE_K_CTRL_MAX ? w.tally[cls].max_len : BSF_WIRE_K_CTRL_MAX;
-        bsf_wire_eg_tally_costs(&w.tally[cls], k_top, cost);
+            tally[cls].max_len < BSF_WIRE_K_CTRL_MAX ? tally[cls].max_len : BSF_WIRE_K_CTRL_MAX;
+        bsf_wire_eg_tally_costs(&tally[cls], k_top, cost);
         for (k = 1; k <= k_top; ++k) {
             if (cost[k] < cost[best]) {
                 best = k;
