@@ -580,6 +580,19 @@ static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result
     return BSF_OK;
 }
 
+/* Write a validated frame with the chosen orders into buf (cap bytes). */
+static bsf_status_t write_frame_into(uint8_t *buf, size_t cap,
+                                     const uint8_t k_ctrl[BSF_WIRE_N_CLASSES],
+                                     const bsf_frame_info_t *info, const bsf_result_t *res,
+                                     writer_t *w)
+{
+    writer_init(w);
+    memcpy(w->k_ctrl, k_ctrl, BSF_WIRE_N_CLASSES);
+    w->buf = buf;
+    w->cap = cap;
+    return write_frame(w, info, res);
+}
+
 bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
                               uint8_t *buf, size_t cap, size_t *out_len)
 {
@@ -594,11 +607,7 @@ bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *
     st = choose_orders(info, result, k_ctrl, &bound);
     if (st == BSF_OK && buf != NULL && cap >= bound) {
         /* validated, and fits whatever its COBS blocks: write at once */
-        writer_init(&w);
-        memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
-        w.buf = buf;
-        w.cap = cap;
-        st = write_frame(&w, info, result);
+        st = write_frame_into(buf, cap, k_ctrl, info, result, &w);
         *out_len = st == BSF_OK ? w.pos : 0u;
         return st;
     }
@@ -618,11 +627,7 @@ bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *
     if (w.pos > cap) {
         return BSF_ERR_BUFFER;
     }
-    writer_init(&w);
-    memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
-    w.buf = buf;
-    w.cap = cap;
-    return write_frame(&w, info, result);
+    return write_frame_into(buf, cap, k_ctrl, info, result, &w);
 }
 
 bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,

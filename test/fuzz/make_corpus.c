@@ -262,8 +262,8 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
         }
         n = sizeof gz - zs.avail_out;
         deflateEnd(&zs);
-        err |= write_file(dir, "carmen", "two_scans.log.gz", gz, n);
-        err |= write_file(dir, "carmen", "two_scans_cut.log.gz", gz, n / 2u);
+        err |= write_file(dir, "carmen", "two_scans_gzip.seed", gz, n);
+        err |= write_file(dir, "carmen", "two_scans_gzip_cut.seed", gz, n / 2u);
     }
 #endif
     return err;
