@@ -3,6 +3,7 @@
 #include "bsf/bsf_lc.h"
 #include "bsf_math.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -33,7 +34,10 @@ bsf_lc_params_t bsf_lc_params_default(void)
     p.apex_slack = 0.05f;
     p.min_side_points = 3u;
     p.min_side_len = 0.15f;
-    p.max_range = 30.0f;
+    /* No range limit of its own: a corner needs min_side_points points per
+     * side within max_side of the apex, so the beam spacing, not the range,
+     * decides how far corners are found (about 57 m at 0.5 deg beams). */
+    p.max_range = FLT_MAX;
     return p;
 }
 
@@ -202,17 +206,27 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     return rss;
 }
 
-/* A side is straight unless a circle cuts its squared residual by more than
- * the factor curve_ratio (beyond the floor). */
+/* A side is straight unless a circle cuts its squared residual per degree of
+ * freedom (n - 2 for a line, n - 3 for a circle) by more than the factor
+ * curve_ratio (beyond the floor). A circle passes through any three points,
+ * so a side of three points or fewer shows no curvature: straight. Without
+ * the degrees of freedom a short leg past a corner (three or four points)
+ * was judged curved by its noise alone and the corner was lost. */
 static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
 {
-    const float extent = sqrtf(dist2(rel(c, a), rel(c, b)));
-    const float rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
+    const size_t n = b - a + 1u;
+    float extent;
+    float rss_circle;
+    if (n <= 3u) {
+        return 1;
+    }
+    extent = sqrtf(dist2(rel(c, a), rel(c, b)));
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
     if (rss_circle < 0.0f) {
         return 1;
     }
-    return l->rss <=
-           c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
+    return l->rss * (float)(n - 3u) <= (float)(n - 2u) * (c->p->curve_ratio * rss_circle +
+                                                          (float)n * c->p->floor * c->p->floor);
 }
 
 /* Judge the split at position apex between the pieces that start at lo and

@@ -488,12 +488,14 @@ static void test_outdoor_scene_up_to_80_m_keeps_points_near_their_curves(void)
     printf("outdoor, default method %s: %lu features, %.1f %% within 0.3 m, farthest point "
            "%.1f m\n",
            bsf_method_name(BSF_METHOD_DEFAULT), (unsigned long)n, 100.0 * share, far);
-    /* LC finds the far outline corners FALKO's range limit misses: 98.9 %
-     * (177 of 179; FALKO-SVED-PDM's defaults above: 97.8 %, below this bound).
-     * The two left are outlines seen with two or three points past the
-     * corner, too few for a line on that side. */
+    /* LC finds the outline corners FALKO misses, also beyond 30 m (LC has
+     * no range limit of its own) and with a side of three points: 99.4 %
+     * (178 of 179; with LC's former 30 m limit and its straightness test
+     * blind to degrees of freedom 98.9 %, FALKO-SVED-PDM's defaults above
+     * 97.8 %, both below this bound). The one left is a corner hidden
+     * behind a post, 0.32 m from its curve. */
     TEST_ASSERT_TRUE(n >= 100u);
-    TEST_ASSERT_TRUE(share >= 0.985);
+    TEST_ASSERT_TRUE(share >= 0.99);
 }
 
 /* ---- full-circle scans ------------------------------------------------------- */
