@@ -526,6 +526,39 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
 }
 
+/* Point b continues the run that ends at point a: within the jump radius
+ * at b's range. */
+static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+{
+    /* r >= jump_a: the exponential is only needed past that. */
+    const float d2 = dist2(pts->pt[a], pts->pt[b]);
+    float r;
+    if (d2 <= p->jump_a * p->jump_a) {
+        return 1;
+    }
+    r = p->jump_a * bsf_expf(p->jump_b * pts->range[b]);
+    return d2 <= r * r;
+}
+
+/* The run ending at point a jumps at point i. When the surface resumes
+ * within the next 2 * min_side_points beams (a valid point within the jump
+ * radius of a), the beams between are an occluder (a post, a chair leg)
+ * too narrow to hold a corner of its own (LC judges no run shorter than
+ * 2 * min_side_points + 1): returns the beam where the run resumes, so a
+ * corner hidden behind it is still judged from both walls (SVED's look-back
+ * keeps such a wall one segment too). Else returns i. */
+static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
+{
+    const size_t span = 2u * (size_t)p->min_side_points;
+    size_t j;
+    for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
+        if (pts->valid[j] && within_jump(pts, p, a, j)) {
+            return j;
+        }
+    }
+    return i;
+}
+
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
 {
@@ -559,11 +592,13 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            /* r >= jump_a: the exponential is only needed past that. */
-            const float d2 = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]);
-            if (d2 > p->jump_a * p->jump_a) {
-                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
-                close_run = d2 > r * r;
+            close_run = !within_jump(pts, p, work->run[m - 1u], i);
+            if (close_run) {
+                const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
+                if (j > i) {
+                    i = j - 1u; /* the run resumes at j */
+                    continue;
+                }
             }
         }
         if (close_run) {

@@ -106,6 +106,20 @@ static void test_a_corner_beyond_30_m_is_found(void)
     TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 45.0, 2.0) < 0.1);
 }
 
+/* A post in front of a corner hides its apex (and breaks the run of
+ * consecutive points there): the two walls still meet in a corner, found
+ * through the gap the post leaves (SVED's look-back joins the walls too). */
+static void test_a_corner_behind_a_thin_post_is_found(void)
+{
+    size_t n;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 6.0, 0.0, 0.75 * PI, 3.0, 1.25 * PI, 3.0));
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 3.0, 0.0, 0.05) >= 0);
+    n = detect(0.0, 0.0, 0.0, 541u, 1.5 * PI, 0.01);
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+    TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
+}
+
 static void test_noisy_room_gives_its_four_corners_and_nothing_else(void)
 {
     size_t n;
@@ -192,6 +206,7 @@ int main(void)
     RUN_TEST(test_corners_of_many_angles_are_found_where_the_walls_meet);
     RUN_TEST(test_a_lone_far_corner_is_found_at_one_degree_beams);
     RUN_TEST(test_a_corner_beyond_30_m_is_found);
+    RUN_TEST(test_a_corner_behind_a_thin_post_is_found);
     RUN_TEST(test_noisy_room_gives_its_four_corners_and_nothing_else);
     RUN_TEST(test_straight_walls_pillars_and_curved_walls_give_no_corner);
     RUN_TEST(test_refused_calls);

@@ -488,12 +488,10 @@ static void test_outdoor_scene_up_to_80_m_keeps_points_near_their_curves(void)
     printf("outdoor, default method %s: %lu features, %.1f %% within 0.3 m, farthest point "
            "%.1f m\n",
            bsf_method_name(BSF_METHOD_DEFAULT), (unsigned long)n, 100.0 * share, far);
-    /* LC finds the outline corners FALKO misses, also beyond 30 m (LC has
-     * no range limit of its own) and with a side of three points: 99.4 %
-     * (178 of 179; with LC's former 30 m limit and its straightness test
-     * blind to degrees of freedom 98.9 %, FALKO-SVED-PDM's defaults above
-     * 97.8 %, both below this bound). The one left is a corner hidden
-     * behind a post, 0.32 m from its curve. */
+    /* LC finds the outline corners FALKO misses: 100 % (179 of 179). Before
+     * 98.9 %: LC stopped at 30 m (FALKO's range limit), judged a side of three
+     * points curved (a circle fits any three points), and lost a corner
+     * hidden behind a post; FALKO-SVED-PDM's defaults above: 97.8 %. */
     TEST_ASSERT_TRUE(n >= 100u);
     TEST_ASSERT_TRUE(share >= 0.99);
 }
