@@ -542,18 +542,27 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
 
 /* The run ending at point a jumps at point i. When the surface resumes
  * within the next 2 * min_side_points beams (a valid point within the jump
- * radius of a), the beams between are an occluder (a post, a chair leg)
- * too narrow to hold a corner of its own (LC judges no run shorter than
- * 2 * min_side_points + 1): returns the beam where the run resumes, so a
- * corner hidden behind it is still judged from both walls (SVED's look-back
- * keeps such a wall one segment too). Else returns i. */
+ * radius at a's range), the beams between are an occluder (a post, a chair
+ * leg) too narrow to hold a corner of its own (LC judges no run shorter
+ * than 2 * min_side_points + 1): returns the beam where the run resumes, so
+ * a corner hidden behind it is still judged from both walls (SVED's
+ * look-back keeps such a wall one segment too). Else returns i. One
+ * exponential per jump: the radius is taken at a's range. */
 static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
 {
     const size_t span = 2u * (size_t)p->min_side_points;
+    float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
     size_t j;
     for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
-        if (pts->valid[j] && within_jump(pts, p, a, j)) {
-            return j;
+        if (pts->valid[j]) {
+            const float d2 = dist2(pts->pt[a], pts->pt[j]);
+            if (d2 > p->jump_a * p->jump_a && r2 < 0.0f) {
+                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[a]);
+                r2 = r * r;
+            }
+            if (d2 <= p->jump_a * p->jump_a || d2 <= r2) {
+                return j;
+            }
         }
     }
     return i;
