@@ -4,6 +4,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 #include "carmen.h"
+#include "carmen_number.h"
 
 #include <errno.h>
 #include <float.h>
@@ -377,14 +378,28 @@ static const char *next_token(fields_t *f, size_t *len)
     return s;
 }
 
+/* Moves the cursor to the next field's first byte (or the end). */
+static const char *skip_blanks(fields_t *f)
+{
+    while (*f->p == ' ' || *f->p == '\t') {
+        ++f->p;
+    }
+    return f->p;
+}
+
 static double get_double(fields_t *f, const char *name)
 {
     size_t len;
     char *end;
     const char *t;
+    const char *fast_end;
     double v;
     if (f->what != NULL) {
         return 0.0;
+    }
+    if (carmen_parse_double(skip_blanks(f), &fast_end, &v)) {
+        f->p = fast_end;
+        return v;
     }
     t = next_token(f, &len);
     if (t == NULL) {
@@ -404,9 +419,14 @@ static float get_float(fields_t *f, const char *name)
     size_t len;
     char *end;
     const char *t;
+    const char *fast_end;
     float v;
     if (f->what != NULL) {
         return 0.0f;
+    }
+    if (carmen_parse_float(skip_blanks(f), &fast_end, &v)) {
+        f->p = fast_end;
+        return v;
     }
     t = next_token(f, &len);
     if (t == NULL) {
@@ -427,9 +447,14 @@ static long get_count(fields_t *f, const char *name)
     size_t len;
     char *end;
     const char *t;
+    const char *fast_end;
     long v;
     if (f->what != NULL) {
         return 0;
+    }
+    if (carmen_parse_count(skip_blanks(f), &fast_end, &v)) {
+        f->p = fast_end;
+        return v;
     }
     t = next_token(f, &len);
     if (t == NULL) {
