@@ -40,56 +40,52 @@ static inline int carmen_is_token_end(char c)
 }
 
 /* The decimal m * 10^k (sign apart) of s when s has the handled form:
- * returns 1 with *end at the token's end, else 0. */
+ * returns 1 with *end at the token's end, else 0. Digit counts come from
+ * pointer differences: the loops do nothing but accumulate. */
 static inline int carmen_scan_decimal(const char *s, const char **end, int *negative,
                                       uint64_t *mantissa, int *exp10)
 {
     const char *p = s;
+    const char *digits_start;
     uint64_t m = 0u;
-    int digits = 0, frac = 0, e = 0;
-    *negative = 0;
-    if (*p == '-') {
-        *negative = 1;
-        ++p;
-    } else if (*p == '+') {
-        ++p;
-    }
-    while ((unsigned)(*p - '0') <= 9u) {
-        m = m * 10u + (uint64_t)(unsigned)(*p - '0');
-        ++digits;
+    unsigned d;
+    int digits, frac = 0, e = 0;
+    *negative = *p == '-';
+    p += *p == '-' || *p == '+';
+    digits_start = p;
+    while ((d = (unsigned)(unsigned char)*p - '0') <= 9u) {
+        m = m * 10u + d;
         ++p;
     }
+    digits = (int)(p - digits_start);
     if (*p == '.') {
-        ++p;
-        while ((unsigned)(*p - '0') <= 9u) {
-            m = m * 10u + (uint64_t)(unsigned)(*p - '0');
-            ++digits;
-            ++frac;
+        const char *frac_start = ++p;
+        while ((d = (unsigned)(unsigned char)*p - '0') <= 9u) {
+            m = m * 10u + d;
             ++p;
         }
+        frac = (int)(p - frac_start);
+        digits += frac;
     }
     /* 19 digits always fit 64 bits; more may have wrapped. */
     if (digits == 0 || digits > 19) {
         return 0;
     }
-    if (*p == 'e' || *p == 'E') {
-        int eneg = 0, edigits = 0;
+    if ((*p | 0x20) == 'e') {
+        const char *exp_start;
+        int eneg;
         ++p;
-        if (*p == '-') {
-            eneg = 1;
-            ++p;
-        } else if (*p == '+') {
-            ++p;
-        }
-        while ((unsigned)(*p - '0') <= 9u) {
-            e = e * 10 + (*p - '0');
-            ++edigits;
-            ++p;
-            if (edigits > 4) {
-                return 0;
+        eneg = *p == '-';
+        p += *p == '-' || *p == '+';
+        exp_start = p;
+        while ((d = (unsigned)(unsigned char)*p - '0') <= 9u) {
+            if (p - exp_start == 4) {
+                return 0; /* 4 digits are plenty; more go to the library */
             }
+            e = e * 10 + (int)d;
+            ++p;
         }
-        if (edigits == 0) {
+        if (p == exp_start) {
             return 0;
         }
         if (eneg) {
@@ -119,14 +115,12 @@ static inline int carmen_parse_float(const char *s, const char **end, float *val
     if (!CARMEN_NUMBER_FAST || !carmen_scan_decimal(s, end, &negative, &m, &k)) {
         return 0;
     }
-    if (m == 0u) {
+    if (m <= ((uint64_t)1 << 24) && (unsigned)(k + 10) <= 20u) {
+        v = k < 0 ? (float)m / pow10f[-k] : (float)m * pow10f[k];
+    } else if (m == 0u) {
         v = 0.0f; /* any exponent: zero, with its sign */
-    } else if (m > ((uint64_t)1 << 24) || k < -10 || k > 10) {
-        return 0;
-    } else if (k < 0) {
-        v = (float)m / pow10f[-k];
     } else {
-        v = (float)m * pow10f[k];
+        return 0;
     }
     *value = negative ? -v : v;
     return 1;
@@ -147,14 +141,12 @@ static inline int carmen_parse_double(const char *s, const char **end, double *v
     if (!CARMEN_NUMBER_FAST || !carmen_scan_decimal(s, end, &negative, &m, &k)) {
         return 0;
     }
-    if (m == 0u) {
+    if (m <= ((uint64_t)1 << 53) && (unsigned)(k + 22) <= 44u) {
+        v = k < 0 ? (double)m / pow10d[-k] : (double)m * pow10d[k];
+    } else if (m == 0u) {
         v = 0.0;
-    } else if (m > ((uint64_t)1 << 53) || k < -22 || k > 22) {
-        return 0;
-    } else if (k < 0) {
-        v = (double)m / pow10d[-k];
     } else {
-        v = (double)m * pow10d[k];
+        return 0;
     }
     *value = negative ? -v : v;
     return 1;
