@@ -82,8 +82,9 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
     r->err = err;
     r->want_gzip = ends_with_gz(path);
     r->path = malloc(strlen(path) + 1u);
-    /* room for a cut line's start plus a whole block, and the final NUL */
-    r->buf_cap = 2u * CARMEN_BLOCK + 1u;
+    /* room for a whole block after a cut line's first 4 KiB, and the final
+     * NUL; longer lines grow the buffer */
+    r->buf_cap = CARMEN_BLOCK + 4096u + 1u;
     r->buf = malloc(r->buf_cap);
     if (r->path == NULL || r->buf == NULL) {
         carmen_close(r);
