@@ -29,24 +29,35 @@ void tearDown(void)
 
 static unsigned long g_checked, g_fast;
 
-/* Compares the float fast path with strtof on s; the token is all of s. */
+static void expect_strtof(const char *s, const char *end, float fast, const char *path)
+{
+    char *lib_end;
+    const float lib = strtof(s, &lib_end);
+    if (lib_end != end || memcmp(&lib, &fast, sizeof lib) != 0) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "float '%s': %s %a (end +%ld), strtof %a (end +%ld)", s, path,
+                 (double)fast, (long)(end - s), (double)lib, (long)(lib_end - s));
+        TEST_FAIL_MESSAGE(msg);
+    }
+}
+
+/* Compares both float fast paths with strtof on s; the token is all of s.
+ * g_fast counts the strings the general path answers, g_short those the
+ * short path (readings of at most 7 digits) answers. */
+static unsigned long g_short;
+
 static void check_float(const char *s)
 {
     const char *end = NULL;
     float fast = 0.0f;
-    char *lib_end;
-    float lib;
     ++g_checked;
-    if (!carmen_parse_float(s, &end, &fast)) {
-        return;
+    if (carmen_parse_float(s, &end, &fast)) {
+        ++g_fast;
+        expect_strtof(s, end, fast, "general path");
     }
-    ++g_fast;
-    lib = strtof(s, &lib_end);
-    if (lib_end != end || memcmp(&lib, &fast, sizeof lib) != 0) {
-        char msg[160];
-        snprintf(msg, sizeof msg, "float '%s': fast %a (end +%ld), strtof %a (end +%ld)", s,
-                 (double)fast, (long)(end - s), (double)lib, (long)(lib_end - s));
-        TEST_FAIL_MESSAGE(msg);
+    if (carmen_parse_short_float(s, &end, &fast)) {
+        ++g_short;
+        expect_strtof(s, end, fast, "short path");
     }
 }
 
@@ -108,7 +119,7 @@ static void test_float_fast_path_equals_strtof_on_every_short_decimal(void)
     char buf[64];
     unsigned long m;
     int frac, neg;
-    g_checked = g_fast = 0u;
+    g_checked = g_fast = g_short = 0u;
     for (neg = 0; neg < 2; ++neg) {
         for (frac = 0; frac <= 6; ++frac) {
             for (m = 0; m < (1ul << 17); ++m) {
@@ -120,6 +131,7 @@ static void test_float_fast_path_equals_strtof_on_every_short_decimal(void)
     }
     if (CARMEN_NUMBER_FAST) {
         TEST_ASSERT_EQUAL_UINT32(g_checked, g_fast);
+        TEST_ASSERT_EQUAL_UINT32(g_checked, g_short);
     }
 }
 
@@ -133,7 +145,7 @@ static void test_float_fast_path_at_its_limits(void)
     char buf[64];
     size_t b;
     int k, d;
-    g_checked = g_fast = 0u;
+    g_checked = g_fast = g_short = 0u;
     for (k = -11; k <= 11; ++k) {
         for (b = 0; b < sizeof bases / sizeof bases[0]; ++b) {
             for (d = -3; d <= 3; ++d) {
@@ -192,7 +204,7 @@ static void test_random_strings_agree_with_the_library(void)
     char buf[48];
     uint64_t x = 0x9E3779B97F4A7C15u;
     unsigned long i, fast_before;
-    g_checked = g_fast = 0u;
+    g_checked = g_fast = g_short = 0u;
     for (i = 0; i < 1500000u; ++i) {
         size_t n, j;
         x ^= x << 13;
@@ -212,9 +224,9 @@ static void test_random_strings_agree_with_the_library(void)
         check_double(buf);
         check_count(buf);
     }
-    /* The test must reach the fast path, not only its refusals. */
+    /* The test must reach the fast paths, not only their refusals. */
     fast_before = g_fast;
-    TEST_ASSERT_TRUE(!CARMEN_NUMBER_FAST || fast_before > 100000u);
+    TEST_ASSERT_TRUE(!CARMEN_NUMBER_FAST || (fast_before > 100000u && g_short > 50000u));
 }
 
 /* What must be left to the library (its judgement, its messages). */
@@ -234,6 +246,17 @@ static void test_unusual_forms_are_left_to_the_library(void)
         TEST_ASSERT_EQUAL_INT_MESSAGE(0, carmen_parse_float(refused[i], &end, &f), refused[i]);
         TEST_ASSERT_EQUAL_INT_MESSAGE(0, carmen_parse_double(refused[i], &end, &d), refused[i]);
     }
+    /* The short path: at most 7 digits, one point, a '-' at most. */
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float("12345678", &end, &f));
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float("0.1234567", &end, &f));
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float("+5", &end, &f));
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float("1e5", &end, &f));
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float("-", &end, &f));
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float(".", &end, &f));
+    TEST_ASSERT_EQUAL_INT(0, carmen_parse_short_float("1.2.3", &end, &f));
+    TEST_ASSERT_EQUAL_INT(CARMEN_NUMBER_FAST, carmen_parse_short_float("1234567", &end, &f));
+    TEST_ASSERT_EQUAL_INT(CARMEN_NUMBER_FAST, carmen_parse_short_float("-.5", &end, &f));
+    TEST_ASSERT_EQUAL_INT(CARMEN_NUMBER_FAST, carmen_parse_short_float("5.", &end, &f));
     TEST_ASSERT_EQUAL_INT(0, carmen_parse_count("-0", &end, &c));
     TEST_ASSERT_EQUAL_INT(0, carmen_parse_count("+5", &end, &c));
     TEST_ASSERT_EQUAL_INT(0, carmen_parse_count("1234567890123456789", &end, &c));
@@ -259,7 +282,7 @@ static void test_float_fast_path_exhaustive_when_asked(void)
     if (env == NULL || strcmp(env, "1") != 0) {
         TEST_IGNORE_MESSAGE("set BSF_NUMBER_EXHAUSTIVE=1 for the exhaustive float check");
     }
-    g_checked = g_fast = 0u;
+    g_checked = g_fast = g_short = 0u;
     for (k = -10; k <= 10; ++k) {
         for (m = 0; m <= (1ul << 24); ++m) {
             snprintf(buf, sizeof buf, "%lue%d", m, k);
@@ -269,6 +292,16 @@ static void test_float_fast_path_exhaustive_when_asked(void)
     printf("exhaustive: %lu strings, %lu on the fast path, all equal to strtof\n", g_checked,
            g_fast);
     TEST_ASSERT_EQUAL_UINT32(g_checked, g_fast);
+    /* every reading of at most 7 digits, point anywhere, both signs */
+    g_checked = g_fast = g_short = 0u;
+    for (k = 0; k <= 7; ++k) {
+        for (m = 0; m < 10000000ul; ++m) {
+            format_fixed(buf, sizeof buf, (int)(m & 1u), m, k);
+            check_float(buf);
+        }
+    }
+    printf("exhaustive short forms: %lu strings, %lu on the short path, all equal to strtof\n",
+           g_checked, g_short);
 }
 
 int main(void)

@@ -569,7 +569,8 @@ static int get_ranges(carmen_reader_t *r, fields_t *f, long n, const char *type)
             while (*p == ' ' || *p == '\t') {
                 ++p;
             }
-            if (carmen_parse_float(p, &end, &out[i])) {
+            if (carmen_parse_short_float(p, &end, &out[i]) ||
+                carmen_parse_float(p, &end, &out[i])) {
                 p = end;
                 continue;
             }

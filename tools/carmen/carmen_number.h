@@ -25,6 +25,7 @@
 #define BSF_TOOLS_CARMEN_NUMBER_H
 
 #include <float.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0
@@ -175,6 +176,44 @@ static inline int carmen_parse_count(const char *s, const char **end, long *valu
     *end = p;
     *value = v;
     return 1;
+}
+
+/**
+ * carmen_parse_float for the short tokens most readings are: an optional
+ * '-', at most 7 digits with at most one point among them ("81.83",
+ * "-1.570796"), so m < 10^7 < 2^24 over 10^f with f <= 7; fewer checks than
+ * the general form.
+ * @return 1 with *value and *end (the token's end) set, 0: not this form.
+ */
+static inline int carmen_parse_short_float(const char *s, const char **end, float *value)
+{
+    static const float pow10f[8] = {1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f, 1e6f, 1e7f};
+    const char *p = s + (*s == '-');
+    const char *const start = p;
+    uint32_t m = 0u;
+    unsigned d, frac = 0u;
+    size_t point = 0u;
+    while ((d = (unsigned)(unsigned char)*p - '0') <= 9u) {
+        m = m * 10u + d;
+        ++p;
+    }
+    if (*p == '.') {
+        const char *const frac_start = ++p;
+        point = 1u;
+        while ((d = (unsigned)(unsigned char)*p - '0') <= 9u) {
+            m = m * 10u + d;
+            ++p;
+        }
+        frac = (unsigned)(p - frac_start);
+    }
+    /* 1..7 digits (m has not wrapped), then the token's end */
+    if (CARMEN_NUMBER_FAST && (size_t)(p - start) - point - 1u < 7u && carmen_is_token_end(*p)) {
+        const float v = (float)m / pow10f[frac];
+        *value = *s == '-' ? -v : v;
+        *end = p;
+        return 1;
+    }
+    return 0;
 }
 
 #endif /* BSF_TOOLS_CARMEN_NUMBER_H */
