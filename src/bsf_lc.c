@@ -69,14 +69,18 @@ typedef struct {
     const bsf_points_t *pts;
     const uint16_t *run;
     const bsf_lc_params_t *p;
-    bsf_point_t o; /* origin of the current judgement (the apex point) */
+    bsf_point_t o;    /* origin of the current judgement (the apex point) */
+    bsf_point_t *rel; /* run points minus o, filled by judge for its window */
 } lc_ctx_t;
 
-static bsf_point_t rel(const lc_ctx_t *c, size_t pos)
+/* Run point pos relative to the origin, also stored for the fits: judge's
+ * side walks visit every point of the window a0..b1 this way first. */
+static bsf_point_t rel_store(const lc_ctx_t *c, size_t pos)
 {
     bsf_point_t q = c->pts->pt[c->run[pos]];
     q.x -= c->o.x;
     q.y -= c->o.y;
+    c->rel[pos] = q;
     return q;
 }
 
@@ -87,39 +91,34 @@ static float dist2(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
-/* Line through positions a..b of the run, leaving out position skip (pass
- * b + 1 to keep all). Two passes: centring first keeps float sums exact
- * enough for centimetre noise on 10 m walls. Returns 0 when fewer than two
- * points. */
-static int fit_line(const lc_ctx_t *c, size_t a, size_t b, size_t skip, lc_line_t *l)
+/* Line through positions a..b of the run (from c->rel). Two passes:
+ * centring first keeps float sums exact enough for centimetre noise on 10 m
+ * walls. Returns 0 when fewer than two points. */
+static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
 {
+    const bsf_point_t *rp = c->rel;
     float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
-    float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm;
+    float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm, mx, my;
     size_t i;
-    size_t n = 0;
-    for (i = a; i <= b; ++i) {
-        if (i != skip) {
-            const bsf_point_t q = rel(c, i);
-            sx += q.x;
-            sy += q.y;
-            ++n;
-        }
-    }
-    if (n < 2u) {
+    const size_t n = b + 1u - a;
+    if (b < a + 1u) {
         return 0;
     }
-    l->n = n;
-    l->mx = sx / (float)n;
-    l->my = sy / (float)n;
     for (i = a; i <= b; ++i) {
-        if (i != skip) {
-            const bsf_point_t q = rel(c, i);
-            const float x = q.x - l->mx;
-            const float y = q.y - l->my;
-            sxx += x * x;
-            sxy += x * y;
-            syy += y * y;
-        }
+        sx += rp[i].x;
+        sy += rp[i].y;
+    }
+    mx = sx / (float)n;
+    my = sy / (float)n;
+    l->n = n;
+    l->mx = mx;
+    l->my = my;
+    for (i = a; i <= b; ++i) {
+        const float x = rp[i].x - mx;
+        const float y = rp[i].y - my;
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
     }
     half = 0.5f * (sxx + syy);
     diff = 0.5f * (sxx - syy);
@@ -154,15 +153,15 @@ static int fit_line(const lc_ctx_t *c, size_t a, size_t b, size_t skip, lc_line_
  * then geometric distances), or -1 when no sensible circle exists. */
 static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent)
 {
+    const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
     float n = 0.0f;
     float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
     size_t i;
     for (i = a; i <= b; ++i) {
-        const bsf_point_t q = rel(c, i);
-        const float x = q.x - cx0;
-        const float y = q.y - cy0;
+        const float x = rp[i].x - cx0;
+        const float y = rp[i].y - cy0;
         const float z = x * x + y * y;
         sxx += x * x;
         sxy += x * y;
@@ -193,9 +192,8 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     }
     r = sqrtf(r2);
     for (i = a; i <= b; ++i) {
-        const bsf_point_t q = rel(c, i);
-        const float dx = q.x - cx0 - cx;
-        const float dy = q.y - cy0 - cy;
+        const float dx = rp[i].x - cx0 - cx;
+        const float dy = rp[i].y - cy0 - cy;
         const float g = sqrtf(dx * dx + dy * dy) - r;
         rss += g * g;
     }
@@ -206,13 +204,20 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
  * the factor curve_ratio (beyond the floor). */
 static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
 {
-    const float extent = sqrtf(dist2(rel(c, a), rel(c, b)));
-    const float rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
+    const float floor_rss = (float)(b - a + 1u) * c->p->floor * c->p->floor;
+    float extent;
+    float rss_circle;
+    /* The circle's term is >= 0: a residual within the floor is straight
+     * whatever the circle gives, so it is not fitted. */
+    if (l->rss <= floor_rss) {
+        return 1;
+    }
+    extent = sqrtf(dist2(c->rel[a], c->rel[b]));
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
     if (rss_circle < 0.0f) {
         return 1;
     }
-    return l->rss <=
-           c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
+    return l->rss <= c->p->curve_ratio * rss_circle + floor_rss;
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -231,30 +236,33 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     size_t b1 = apex;
     size_t best;
     size_t i;
-    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
+    const bsf_point_t *rp = c->rel;
+    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, lines_bound, best_d;
     bsf_point_t x;
+    bsf_point_t ap;
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
         return 0;
     }
     c->o = c->pts->pt[c->run[apex]];
-    while (a0 > lo && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
+    ap = rel_store(c, apex);
+    while (a0 > lo && dist2(rel_store(c, a0 - 1u), ap) <= side2) {
         --a0;
     }
-    while (b1 < hi && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
+    while (b1 < hi && dist2(rel_store(c, b1 + 1u), ap) <= side2) {
         ++b1;
     }
     /* A side cut short by a neighbouring split reaches past it: noise often
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2(rel(c, a0), rel(c, apex)) < len2) {
-        while (a0 > 0u && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
+    if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
+        while (a0 > 0u && dist2(rel_store(c, a0 - 1u), ap) <= side2) {
             --a0;
         }
     }
-    if (b1 - apex < need || dist2(rel(c, b1), rel(c, apex)) < len2) {
-        while (b1 + 1u < m && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
+    if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
+        while (b1 + 1u < m && dist2(rel_store(c, b1 + 1u), ap) <= side2) {
             ++b1;
         }
     }
@@ -264,10 +272,10 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2(rel(c, a0), rel(c, apex)) < len2 || dist2(rel(c, b1), rel(c, apex)) < len2) {
+    if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
         return 0;
     }
-    if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {
+    if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
         return 0;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
@@ -279,9 +287,9 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     xy = la.my + t * la.dy;
     x.x = xx;
     x.y = xy;
-    spacing = sqrtf(dist2(rel(c, apex - 1u), rel(c, apex)));
+    spacing = sqrtf(dist2(rp[apex - 1u], ap));
     {
-        const float s2 = sqrtf(dist2(rel(c, apex + 1u), rel(c, apex)));
+        const float s2 = sqrtf(dist2(rp[apex + 1u], ap));
         spacing = s2 > spacing ? s2 : spacing;
     }
     if (!(xx * xx + xy * xy <=
@@ -289,17 +297,23 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     /* One smooth curve over both sides: the better of a line and a circle. */
-    if (!fit_line(c, a0, b1, b1 + 1u, &lu)) {
+    if (!fit_line(c, a0, b1, &lu)) {
         return 0;
     }
-    extent = sqrtf(dist2(rel(c, a0), rel(c, b1)));
+    rss_lines = la.rss + lb.rss;
+    lines_bound = p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor;
+    /* The curve's residual is at most the line's: when the line already
+     * fails the test, so does the curve, and no circle is fitted. */
+    if (!(lu.rss > lines_bound)) {
+        return 0;
+    }
+    extent = sqrtf(dist2(rp[a0], rp[b1]));
     rss_curve = lu.rss;
     rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent);
     if (rss_circle >= 0.0f && rss_circle < rss_curve) {
         rss_curve = rss_circle;
     }
-    rss_lines = la.rss + lb.rss;
-    if (!(rss_curve > p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor)) {
+    if (!(rss_curve > lines_bound)) {
         return 0;
     }
     /* Each side must be straight: a circle may not explain it much better
@@ -311,10 +325,10 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
     best = apex;
-    best_d = dist2(rel(c, apex), x);
+    best_d = dist2(ap, x);
     for (i = apex - 2u; i <= apex + 2u; ++i) {
         if (i > a0 && i < b1) {
-            const float d = dist2(rel(c, i), x);
+            const float d = dist2(rp[i], x);
             if (d < best_d) {
                 best_d = d;
                 best = i;
@@ -326,8 +340,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     kp->point.y = xy + c->o.y;
     kp->orientation = bsf_atan2f(la.my + lb.my - 2.0f * xy, la.mx + lb.mx - 2.0f * xx);
     {
-        const float ra = sqrtf(dist2(rel(c, a0), rel(c, apex)));
-        const float rb = sqrtf(dist2(rel(c, b1), rel(c, apex)));
+        const float ra = sqrtf(dist2(rp[a0], ap));
+        const float rb = sqrtf(dist2(rp[b1], ap));
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
@@ -465,20 +479,39 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
     memset(&last, 0, sizeof last);
+    for (j = 0; j < nb; ++j) {
+        w->judged_lo[j] = UINT16_MAX; /* no verdict yet */
+    }
     for (pass = 0; changed && pass < LC_MAX_PASSES; ++pass) {
         changed = 0;
         j = 0;
         while (j < nb) {
             const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
             const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-            if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
-                memmove(&w->brk[j], &w->brk[j + 1u], (nb - j - 1u) * sizeof w->brk[0]);
+            /* A verdict depends only on the split and its two neighbours:
+             * a corner whose neighbours have not moved since it was judged
+             * stays one, with its keypoint still parked. */
+            if (w->judged_lo[j] == lo && w->judged_hi[j] == hi) {
+                ++j;
+            } else if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                const size_t tail = nb - j - 1u;
+                const size_t slot = *n_found + j;
+                memmove(&w->brk[j], &w->brk[j + 1u], tail * sizeof w->brk[0]);
+                memmove(&w->judged_lo[j], &w->judged_lo[j + 1u], tail * sizeof w->judged_lo[0]);
+                memmove(&w->judged_hi[j], &w->judged_hi[j + 1u], tail * sizeof w->judged_hi[0]);
+                if (slot + 1u < out_cap) {
+                    const size_t fit = out_cap - slot - 1u;
+                    memmove(&out[slot], &out[slot + 1u], (tail < fit ? tail : fit) * sizeof out[0]);
+                }
                 --nb;
                 changed = 1;
             } else {
-                /* Parked where it lands if this pass turns out final. */
+                /* Parked where it lands if this pass turns out final; only
+                 * a parked verdict is remembered (slots only move down). */
                 if (*n_found + j < out_cap) {
                     out[*n_found + j] = kp;
+                    w->judged_lo[j] = (uint16_t)lo;
+                    w->judged_hi[j] = (uint16_t)hi;
                 }
                 ++j;
             }
@@ -539,6 +572,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.p = p;
     c.o.x = 0.0f;
     c.o.y = 0.0f;
+    c.rel = work->rel;
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
         if (!close_run && !pts->valid[i]) {
