@@ -167,6 +167,44 @@ static int within_radius(float d2, float rho, float a2, float two_b, float cap2)
     return d2 <= a2 * exp_lower_bound(two_b * rho) || d2 <= a2 * bsf_expf(two_b * rho);
 }
 
+/* within_radius for the tests of one beam (one rho), with the beam's
+ * threshold worked out once, when a test first needs it. */
+typedef struct {
+    float a2;
+    float two_b;
+    float cap2;
+    float rho;
+    float limit; /* valid when have_limit */
+    int have_limit;
+} beam_radius_t;
+
+static void beam_radius_start(beam_radius_t *r, float rho)
+{
+    r->rho = rho;
+    r->have_limit = 0;
+}
+
+/* Same answer as within_radius(d2, r->rho, ...): past a2 and inside the cap,
+ * d2 <= A || d2 <= B is d2 <= max(A, B), and d2 <= cap2 && d2 <= M is
+ * d2 <= min(cap2, M) (a NaN bound fails both forms). */
+static int beam_within(beam_radius_t *r, float d2)
+{
+    if (d2 <= r->a2) {
+        return 1;
+    }
+    if (r->cap2 > 0.0f && !(d2 <= r->cap2)) {
+        return 0;
+    }
+    if (!r->have_limit) {
+        const float x = r->two_b * r->rho;
+        const float lower = r->a2 * exp_lower_bound(x);
+        const float exact = r->a2 * bsf_expf(x);
+        r->limit = lower > exact ? lower : exact;
+        r->have_limit = 1;
+    }
+    return d2 <= r->limit;
+}
+
 /* Range of beam i + k (k in -2..2) into *r, wrapping on a ring; 0 when that
  * beam is outside the scan or invalid. */
 static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, float *r)
@@ -198,24 +236,46 @@ static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, f
     return 1;
 }
 
-/* The mixed-pixel rule documented on bsf_segment_sved_labelled. */
-static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, float a2, float two_b,
-                          float cap2)
+/* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
+ * beam i's range. */
+static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
 {
     float r[5];
     float lo;
     float hi;
     float jump;
     int k;
-    for (k = -2; k <= 2; ++k) {
-        if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
+    if (i >= 2u && i + 2u < pts->count) {
+        /* Inside the scan (most beams): the cheap tests first. */
+        const uint8_t *v = &pts->valid[i - 2u];
+        const float *rg = &pts->range[i - 2u];
+        if (!((v[1] != 0u) & (v[2] != 0u) & (v[3] != 0u))) {
+            return 0;
+        }
+        r[1] = rg[1];
+        r[2] = rg[2];
+        r[3] = rg[3];
+        lo = r[1] < r[3] ? r[1] : r[3];
+        hi = r[1] < r[3] ? r[3] : r[1];
+        if (!(r[2] > lo && r[2] < hi) || !((v[0] != 0u) & (v[4] != 0u))) {
+            return 0;
+        }
+        r[0] = rg[0];
+        r[4] = rg[4];
+    } else {
+        for (k = -2; k <= 2; ++k) {
+            if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
+                return 0;
+            }
+        }
+        lo = r[1] < r[3] ? r[1] : r[3];
+        hi = r[1] < r[3] ? r[3] : r[1];
+        if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
     }
-    lo = r[1] < r[3] ? r[1] : r[3];
-    hi = r[1] < r[3] ? r[3] : r[1];
     jump = hi - lo;
-    if (!(r[2] > lo && r[2] < hi) || within_radius(jump * jump, r[2], a2, two_b, cap2)) {
+    if (beam_within(rad, jump * jump)) {
         return 0;
     }
     return fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
@@ -303,6 +363,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     float a2;
     float two_b;
     float cap2;
+    beam_radius_t rad;
     int reject_mixed;
     int ring;
 
@@ -321,6 +382,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     slots = extensions ? 1u + (size_t)p->lookback : 1u;
     reject_mixed = extensions && p->reject_mixed;
     ring = extensions && bsf_points_full_circle(pts);
+    rad.a2 = a2;
+    rad.two_b = two_b;
+    rad.cap2 = cap2;
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
@@ -342,12 +406,13 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         if (!pts->valid[b]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
-        if (reject_mixed && is_mixed_pixel(pts, b, ring, a2, two_b, cap2)) {
+        rho = pts->range[b];
+        beam_radius_start(&rad, rho);
+        if (reject_mixed && is_mixed_pixel(pts, b, ring, &rad)) {
             sink.n_wasted++;
             continue;
         }
         q = pts->pt[b];
-        rho = pts->range[b];
         /* open[0] is the current segment (the paper's only candidate); older
          * ones expire once their last point is more than max_gap_beams back. */
         for (k = 0; k < n_open; ++k) {
@@ -369,12 +434,17 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             dx = q.x - open[k].end.x;
             dy = q.y - open[k].end.y;
             d2 = dx * dx + dy * dy;
-            if (within_radius(d2, rho, a2, two_b, cap2) && (best == slots || d2 < best_d2)) {
+            if ((best == slots || d2 < best_d2) && beam_within(&rad, d2)) {
                 best = k;
                 best_d2 = d2;
             }
         }
-        if (best < slots) {
+        if (best == 0u) {
+            open[0].last = b; /* the current segment goes on (most beams) */
+            open[0].last_pos = j;
+            open[0].n++;
+            open[0].end = q;
+        } else if (best < slots) {
             open_seg_t s = open[best];
             s.last = b;
             s.last_pos = j;
