@@ -145,13 +145,13 @@ static float exp_lower_bound(float x)
 
 /* ---- SVED with look-back, radius cap, mixed pixels and full-circle scans ---- */
 
-/* One open segment of the labelled pass. */
+/* One open segment of the labelled pass (24 bytes: moved often). */
 typedef struct {
-    size_t first;    /* beam of its first point (its label) */
-    size_t last;     /* beam of its last point */
-    size_t last_pos; /* pass position of its last point */
-    size_t n;        /* points */
-    bsf_point_t end; /* its last point */
+    uint32_t first;    /* beam of its first point (its label) */
+    uint32_t last;     /* beam of its last point */
+    uint32_t last_pos; /* pass position of its last point */
+    uint32_t n;        /* points */
+    bsf_point_t end;   /* its last point */
 } open_seg_t;
 
 /* Radius test d^2 <= r(rho)^2, r = a*exp(b*rho) capped at sqrt(cap2) when
@@ -414,23 +414,25 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         }
         q = pts->pt[b];
         /* open[0] is the current segment (the paper's only candidate); older
-         * ones expire once their last point is more than max_gap_beams back. */
+         * ones expire once their last point is more than max_gap_beams back.
+         * The list is most recently extended first, so last_pos falls along
+         * it and the expired ones are a tail, closed first to last. */
+        if (n_open > 1u && j - open[n_open - 1u].last_pos > (size_t)p->max_gap_beams) {
+            size_t keep_n = n_open - 1u;
+            while (keep_n > 1u && j - open[keep_n - 1u].last_pos > (size_t)p->max_gap_beams) {
+                --keep_n;
+            }
+            for (k = keep_n; k < n_open; ++k) {
+                if (!close_open(&sink, &open[k], label, pts->count)) {
+                    return BSF_ERR_CAPACITY;
+                }
+            }
+            n_open = keep_n;
+        }
         for (k = 0; k < n_open; ++k) {
             float dx;
             float dy;
             float d2;
-            if (k > 0u && j - open[k].last_pos > (size_t)p->max_gap_beams) {
-                size_t m;
-                if (!close_open(&sink, &open[k], label, pts->count)) {
-                    return BSF_ERR_CAPACITY;
-                }
-                for (m = k + 1u; m < n_open; ++m) {
-                    open[m - 1u] = open[m];
-                }
-                --n_open;
-                --k;
-                continue;
-            }
             dx = q.x - open[k].end.x;
             dy = q.y - open[k].end.y;
             d2 = dx * dx + dy * dy;
@@ -440,14 +442,14 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             }
         }
         if (best == 0u) {
-            open[0].last = b; /* the current segment goes on (most beams) */
-            open[0].last_pos = j;
+            open[0].last = (uint32_t)b; /* the current segment goes on (most beams) */
+            open[0].last_pos = (uint32_t)j;
             open[0].n++;
             open[0].end = q;
         } else if (best < slots) {
             open_seg_t s = open[best];
-            s.last = b;
-            s.last_pos = j;
+            s.last = (uint32_t)b;
+            s.last_pos = (uint32_t)j;
             s.n++;
             s.end = q;
             for (k = best; k > 0u; --k) {
@@ -464,9 +466,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             for (k = n_open; k > 0u; --k) {
                 open[k] = open[k - 1u];
             }
-            open[0].first = b;
-            open[0].last = b;
-            open[0].last_pos = j;
+            open[0].first = (uint32_t)b;
+            open[0].last = (uint32_t)b;
+            open[0].last_pos = (uint32_t)j;
             open[0].n = 1u;
             open[0].end = q;
             ++n_open;
