@@ -620,13 +620,6 @@ static size_t upper_bound(const uint16_t *interest, size_t n, size_t key)
     return lo;
 }
 
-/* Is beam b one of the (strictly ascending) interest beams? */
-static int is_interest(const uint16_t *interest, size_t n, size_t b)
-{
-    const size_t j = upper_bound(interest, n, b);
-    return j > 0u && (size_t)interest[j - 1u] == b;
-}
-
 /* Is beam b a point of the segment whose first beam is first? */
 static int is_member(const bsf_points_t *pts, const uint16_t *label, size_t b, size_t first)
 {
@@ -656,30 +649,39 @@ bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const 
     }
     for (k = 0; k < n; ++k) {
         bsf_segment_t *s = &segs[k];
-        size_t total = 0;
         size_t pos = 0;
         size_t count = 0;
+        unsigned last1 = 0u; /* the last member so far was counted */
+        unsigned last2 = 0u; /* the one before it was */
         size_t b = s->first;
-        /* Two walks over the run: count the members, then test the inner ones
-         * (not among the first two or the last two). */
+        /* Next interest beam at or after b (interest is ascending; a walk
+         * through the seam starts again from beam 0). */
+        size_t next_int = b > 0u ? upper_bound(interest_beams, n_interest, b - 1u) : 0u;
+        /* One walk: count the interest members from the third on, then
+         * take back the last two members (inner means not among the first
+         * two or the last two). */
         for (;;) {
-            total += (size_t)is_member(pts, label, b, s->first);
-            if (b == s->last) {
-                break;
-            }
-            b = next_beam(b, pts->count);
-        }
-        for (b = s->first;; b = next_beam(b, pts->count)) {
             if (is_member(pts, label, b, s->first)) {
-                if (pos >= 2u && pos + 3u <= total && is_interest(interest_beams, n_interest, b)) {
-                    ++count;
+                unsigned hit;
+                while (next_int < n_interest && (size_t)interest_beams[next_int] < b) {
+                    ++next_int;
                 }
+                hit = (unsigned)(pos >= 2u && next_int < n_interest &&
+                                 (size_t)interest_beams[next_int] == b);
+                count += hit;
+                last2 = last1;
+                last1 = hit;
                 ++pos;
             }
             if (b == s->last) {
                 break;
             }
+            b = next_beam(b, pts->count);
+            if (b == 0u) {
+                next_int = 0u;
+            }
         }
+        count -= (size_t)last1 + (size_t)last2;
         s->n_interest = (uint8_t)(count > 255u ? 255u : count);
         s->kind = (uint8_t)(count > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK);
     }
