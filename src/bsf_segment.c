@@ -626,6 +626,65 @@ static int is_member(const bsf_points_t *pts, const uint16_t *label, size_t b, s
     return label != NULL ? label[b] == (uint16_t)first : pts->valid[b] != 0u;
 }
 
+/* Interest beams among beams from..to (ascending, no seam) that are members. */
+static size_t interest_members_in(const bsf_points_t *pts, const uint16_t *label, size_t first,
+                                  const uint16_t *interest, size_t n_interest, size_t from,
+                                  size_t to)
+{
+    size_t c = 0;
+    size_t j = from > 0u ? upper_bound(interest, n_interest, from - 1u) : 0u;
+    for (; j < n_interest && (size_t)interest[j] <= to; ++j) {
+        c += (size_t)is_member(pts, label, interest[j], first);
+    }
+    return c;
+}
+
+/* Inner interest points of the segment first..last (walking on through beam
+ * 0 when first > last): interest beams among its members, not among the
+ * first two members or the last two. Those lie strictly between the second
+ * member from either end, so only the ends are walked. */
+static size_t inner_interest(const bsf_points_t *pts, const uint16_t *label, size_t first,
+                             size_t last, const uint16_t *interest, size_t n_interest)
+{
+    const size_t count = pts->count;
+    size_t seen = 0;
+    size_t lo = first; /* the second member from the start */
+    size_t hi = last;  /* the second member from the end */
+    size_t off_lo;
+    size_t off_hi;
+    for (;;) {
+        if (is_member(pts, label, lo, first) && ++seen == 2u) {
+            break;
+        }
+        if (lo == last) {
+            return 0u;
+        }
+        lo = next_beam(lo, count);
+    }
+    seen = 0;
+    for (;;) {
+        if (is_member(pts, label, hi, first) && ++seen == 2u) {
+            break;
+        }
+        if (hi == first) {
+            return 0u;
+        }
+        hi = hi > 0u ? hi - 1u : count - 1u;
+    }
+    off_lo = lo >= first ? lo - first : lo + count - first;
+    off_hi = hi >= first ? hi - first : hi + count - first;
+    if (off_lo + 1u >= off_hi) {
+        return 0u;
+    }
+    if (lo < hi) {
+        return interest_members_in(pts, label, first, interest, n_interest, lo + 1u, hi - 1u);
+    }
+    /* through the seam */
+    return interest_members_in(pts, label, first, interest, n_interest, lo + 1u, count - 1u) +
+           (hi > 0u ? interest_members_in(pts, label, first, interest, n_interest, 0u, hi - 1u)
+                    : 0u);
+}
+
 bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
                                            const uint16_t *label, const uint16_t *interest_beams,
                                            size_t n_interest)
@@ -649,39 +708,8 @@ bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const 
     }
     for (k = 0; k < n; ++k) {
         bsf_segment_t *s = &segs[k];
-        size_t pos = 0;
-        size_t count = 0;
-        unsigned last1 = 0u; /* the last member so far was counted */
-        unsigned last2 = 0u; /* the one before it was */
-        size_t b = s->first;
-        /* Next interest beam at or after b (interest is ascending; a walk
-         * through the seam starts again from beam 0). */
-        size_t next_int = b > 0u ? upper_bound(interest_beams, n_interest, b - 1u) : 0u;
-        /* One walk: count the interest members from the third on, then
-         * take back the last two members (inner means not among the first
-         * two or the last two). */
-        for (;;) {
-            if (is_member(pts, label, b, s->first)) {
-                unsigned hit;
-                while (next_int < n_interest && (size_t)interest_beams[next_int] < b) {
-                    ++next_int;
-                }
-                hit = (unsigned)(pos >= 2u && next_int < n_interest &&
-                                 (size_t)interest_beams[next_int] == b);
-                count += hit;
-                last2 = last1;
-                last1 = hit;
-                ++pos;
-            }
-            if (b == s->last) {
-                break;
-            }
-            b = next_beam(b, pts->count);
-            if (b == 0u) {
-                next_int = 0u;
-            }
-        }
-        count -= (size_t)last1 + (size_t)last2;
+        const size_t count =
+            inner_interest(pts, label, s->first, s->last, interest_beams, n_interest);
         s->n_interest = (uint8_t)(count > 255u ? 255u : count);
         s->kind = (uint8_t)(count > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK);
     }
