@@ -385,6 +385,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     rad.a2 = a2;
     rad.two_b = two_b;
     rad.cap2 = cap2;
+    rad.rho = 0.0f;
+    rad.limit = 0.0f;
+    rad.have_limit = 0;
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
@@ -436,10 +439,16 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             dx = q.x - open[k].end.x;
             dy = q.y - open[k].end.y;
             d2 = dx * dx + dy * dy;
-            if ((best == slots || d2 < best_d2) && beam_within(&rad, d2)) {
+            if (d2 == d2 && (best == slots || d2 < best_d2)) {
                 best = k;
                 best_d2 = d2;
             }
+        }
+        /* The radius test is a bound on d2 (a smaller d2 passes whenever a
+         * larger one does), so the nearest end, first of equals, is the one
+         * the nearest passing end would be, or none passes. NaN never does. */
+        if (best < slots && !beam_within(&rad, best_d2)) {
+            best = slots;
         }
         if (best == 0u) {
             open[0].last = (uint32_t)b; /* the current segment goes on (most beams) */
