@@ -582,8 +582,30 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             /* r >= jump_a: the exponential is only needed past that. */
             const float d2 = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]);
             if (d2 > p->jump_a * p->jump_a) {
-                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
-                close_run = d2 > r * r;
+                const float x = p->jump_b * pts->range[i];
+                int known = 0;
+                if (x >= 0.0f && x <= 1.0f) {
+                    /* lo <= bsf_expf(x) <= hi, and rounding is monotonic:
+                     * r * r lies between the squares of jump_a * lo and
+                     * jump_a * hi, so expf only for d2 between them. */
+                    float lo;
+                    float hi;
+                    float r_lo;
+                    float r_hi;
+                    bsf_exp_bounds01(x, &lo, &hi);
+                    r_lo = p->jump_a * lo;
+                    r_hi = p->jump_a * hi;
+                    if (d2 <= r_lo * r_lo) {
+                        known = 1; /* close_run stays 0 */
+                    } else if (d2 > r_hi * r_hi) {
+                        close_run = 1;
+                        known = 1;
+                    }
+                }
+                if (!known) {
+                    const float r = p->jump_a * bsf_expf(x);
+                    close_run = d2 > r * r;
+                }
             }
         }
         if (close_run) {

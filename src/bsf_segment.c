@@ -137,12 +137,6 @@ static bsf_status_t finish(const seg_sink_t *sink, size_t *n_out, size_t *n_wast
     return BSF_OK;
 }
 
-/* 1 + x + x^2/2 + x^3/6 + x^4/24: a lower bound of exp(x) for x >= 0. */
-static float exp_lower_bound(float x)
-{
-    return 1.0f + x * (1.0f + x * (0.5f + x * (0.16666667f + x * 0.041666668f)));
-}
-
 /* ---- SVED with look-back, radius cap, mixed pixels and full-circle scans ---- */
 
 /* One open segment of the labelled pass (24 bytes: moved often). */
@@ -164,7 +158,7 @@ static int within_radius(float d2, float rho, float a2, float two_b, float cap2)
     if (cap2 > 0.0f && !(d2 <= cap2)) {
         return 0;
     }
-    return d2 <= a2 * exp_lower_bound(two_b * rho) || d2 <= a2 * bsf_expf(two_b * rho);
+    return d2 <= a2 * bsf_exp_taylor4(two_b * rho) || d2 <= a2 * bsf_expf(two_b * rho);
 }
 
 /* within_radius for the tests of one beam (one rho), with the beam's
@@ -174,20 +168,55 @@ typedef struct {
     float two_b;
     float cap2;
     float rho;
-    float limit; /* valid when have_limit */
+    float lower; /* the threshold is >= lower ... */
+    float upper; /* ... and <= upper; both valid when have_bounds */
+    float limit; /* the threshold itself, valid when have_limit */
+    int have_bounds;
     int have_limit;
 } beam_radius_t;
 
 static void beam_radius_start(beam_radius_t *r, float rho)
 {
     r->rho = rho;
+    r->have_bounds = 0;
     r->have_limit = 0;
+}
+
+/* The threshold max(a2 * taylor4(x), a2 * expf(x)), x = 2 b rho, or its
+ * bounds: at least the first term and, for x in [0, 1], at most a2 * hi
+ * (bsf_exp_bounds01), so expf is needed only for d2 between the two. */
+static int beam_within_slow(beam_radius_t *r, float d2)
+{
+    const float x = r->two_b * r->rho;
+    if (!r->have_bounds) {
+        r->lower = r->a2 * bsf_exp_taylor4(x);
+        r->upper = HUGE_VALF; /* no upper bound */
+        if (x >= 0.0f && x <= 1.0f) {
+            float lo;
+            float hi;
+            bsf_exp_bounds01(x, &lo, &hi);
+            r->upper = r->a2 * hi;
+        }
+        r->have_bounds = 1;
+    }
+    if (d2 <= r->lower) {
+        return 1;
+    }
+    if (!(d2 <= r->upper)) {
+        return 0;
+    }
+    {
+        const float exact = r->a2 * bsf_expf(x);
+        r->limit = r->lower > exact ? r->lower : exact;
+        r->have_limit = 1;
+    }
+    return d2 <= r->limit;
 }
 
 /* Same answer as within_radius(d2, r->rho, ...): past a2 and inside the cap,
  * d2 <= A || d2 <= B is d2 <= max(A, B), and d2 <= cap2 && d2 <= M is
  * d2 <= min(cap2, M) (a NaN bound fails both forms). */
-static int beam_within(beam_radius_t *r, float d2)
+static inline int beam_within(beam_radius_t *r, float d2)
 {
     if (d2 <= r->a2) {
         return 1;
@@ -195,14 +224,10 @@ static int beam_within(beam_radius_t *r, float d2)
     if (r->cap2 > 0.0f && !(d2 <= r->cap2)) {
         return 0;
     }
-    if (!r->have_limit) {
-        const float x = r->two_b * r->rho;
-        const float lower = r->a2 * exp_lower_bound(x);
-        const float exact = r->a2 * bsf_expf(x);
-        r->limit = lower > exact ? lower : exact;
-        r->have_limit = 1;
+    if (r->have_limit) {
+        return d2 <= r->limit;
     }
-    return d2 <= r->limit;
+    return beam_within_slow(r, d2);
 }
 
 /* Range of beam i + k (k in -2..2) into *r, wrapping on a ring; 0 when that
@@ -386,7 +411,10 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     rad.two_b = two_b;
     rad.cap2 = cap2;
     rad.rho = 0.0f;
+    rad.lower = 0.0f;
+    rad.upper = 0.0f;
     rad.limit = 0.0f;
+    rad.have_bounds = 0;
     rad.have_limit = 0;
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
