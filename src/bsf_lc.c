@@ -62,6 +62,7 @@ typedef struct {
     float mx, my;
     float dx, dy;
     float rss;
+    float sx, sy; /* the coordinate sums, in order from the first point */
     size_t n;
 } lc_line_t;
 
@@ -71,6 +72,7 @@ typedef struct {
     const bsf_lc_params_t *p;
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
+    float sin_min_turn;
 } lc_ctx_t;
 
 /* Run point pos relative to the origin, also stored for the fits: judge's
@@ -91,25 +93,29 @@ static float dist2(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
-/* Line through positions a..b of the run (from c->rel). Two passes:
- * centring first keeps float sums exact enough for centimetre noise on 10 m
- * walls. Returns 0 when fewer than two points. */
-static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
+/* Line through positions a..b of the run (from c->rel), whose coordinate
+ * sums over a..from-1, added in order from 0, are sx, sy (from = a, sums 0:
+ * all of them). Two passes: centring first keeps float sums exact enough
+ * for centimetre noise on 10 m walls. Returns 0 when fewer than two points. */
+static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, float sx, float sy,
+                         lc_line_t *l)
 {
     const bsf_point_t *rp = c->rel;
-    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
+    float sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
     float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm, mx, my;
     size_t i;
     const size_t n = b + 1u - a;
     if (b < a + 1u) {
         return 0;
     }
-    for (i = a; i <= b; ++i) {
+    for (i = from; i <= b; ++i) {
         sx += rp[i].x;
         sy += rp[i].y;
     }
     mx = sx / (float)n;
     my = sy / (float)n;
+    l->sx = sx;
+    l->sy = sy;
     l->n = n;
     l->mx = mx;
     l->my = my;
@@ -147,6 +153,11 @@ static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
     l->dx /= nrm;
     l->dy /= nrm;
     return 1;
+}
+
+static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
+{
+    return fit_line_from(c, a, b, a, 0.0f, 0.0f, l);
 }
 
 /* Squared residual of the best circle through positions a..b (algebraic fit,
@@ -279,7 +290,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
-    if (!(fabsf(cross) >= bsf_sinf(p->min_turn))) {
+    if (!(fabsf(cross) >= c->sin_min_turn)) {
         return 0;
     }
     t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
@@ -297,7 +308,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     /* One smooth curve over both sides: the better of a line and a circle. */
-    if (!fit_line(c, a0, b1, &lu)) {
+    /* (the left side's sums are the first part of the whole's) */
+    if (!fit_line_from(c, a0, b1, apex, la.sx, la.sy, &lu)) {
         return 0;
     }
     rss_lines = la.rss + lb.rss;
@@ -399,13 +411,22 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        for (i = a + 1u; i < b; ++i) {
-            const bsf_point_t q = pts->pt[w->run[i]];
-            const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
-                                       : sqrtf(dist2(q, pa));
-            if (d > dmax) {
-                dmax = d;
-                imax = i;
+        if (len > 0.0f) {
+            for (i = a + 1u; i < b; ++i) {
+                const bsf_point_t q = pts->pt[w->run[i]];
+                const float d = fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len;
+                if (d > dmax) {
+                    dmax = d;
+                    imax = i;
+                }
+            }
+        } else {
+            for (i = a + 1u; i < b; ++i) {
+                const float d = sqrtf(dist2(pts->pt[w->run[i]], pa));
+                if (d > dmax) {
+                    dmax = d;
+                    imax = i;
+                }
             }
         }
         if (dmax > tol) {
@@ -573,6 +594,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.x = 0.0f;
     c.o.y = 0.0f;
     c.rel = work->rel;
+    c.sin_min_turn = bsf_sinf(p->min_turn);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
         if (!close_run && !pts->valid[i]) {
