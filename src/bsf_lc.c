@@ -160,9 +160,18 @@ static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
     return fit_line_from(c, a, b, a, 0.0f, 0.0f, l);
 }
 
+/* When a partial circle residual is enough for the caller:
+ * ratio * rss + floor_rss >= target. */
+typedef struct {
+    float ratio;
+    float floor_rss;
+    float target;
+} lc_enough_t;
+
 /* Squared residual of the best circle through positions a..b (algebraic fit,
  * then geometric distances), or -1 when no sensible circle exists. */
-static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent)
+static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent,
+                        const lc_enough_t *enough)
 {
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
@@ -207,6 +216,12 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         const float dy = rp[i].y - cy0 - cy;
         const float g = sqrtf(dx * dx + dy * dy) - r;
         rss += g * g;
+        /* The sum only grows (terms >= 0, rounding is monotonic): once the
+         * caller's test is settled by the partial sum, the rest cannot
+         * change its answer. */
+        if (enough->ratio * rss + enough->floor_rss >= enough->target) {
+            break;
+        }
     }
     return rss;
 }
@@ -218,13 +233,17 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     const float floor_rss = (float)(b - a + 1u) * c->p->floor * c->p->floor;
     float extent;
     float rss_circle;
+    lc_enough_t enough;
     /* The circle's term is >= 0: a residual within the floor is straight
      * whatever the circle gives, so it is not fitted. */
     if (l->rss <= floor_rss) {
         return 1;
     }
     extent = sqrtf(dist2(c->rel[a], c->rel[b]));
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
+    enough.ratio = c->p->curve_ratio;
+    enough.floor_rss = floor_rss;
+    enough.target = l->rss; /* straight from there on */
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough);
     if (rss_circle < 0.0f) {
         return 1;
     }
@@ -249,6 +268,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     size_t i;
     const bsf_point_t *rp = c->rel;
     float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, lines_bound, best_d;
+    lc_enough_t enough;
     bsf_point_t x;
     bsf_point_t ap;
 
@@ -321,7 +341,10 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     extent = sqrtf(dist2(rp[a0], rp[b1]));
     rss_curve = lu.rss;
-    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent);
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = lu.rss; /* from there on, the line is the better curve */
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough);
     if (rss_circle >= 0.0f && rss_circle < rss_curve) {
         rss_curve = rss_circle;
     }
