@@ -250,6 +250,37 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     return l->rss <= c->p->curve_ratio * rss_circle + floor_rss;
 }
 
+/* From position pos, step (-1 or +1) towards stop while the next point is
+ * within sqrt(side2) of the apex ap, storing the points relative to the
+ * apex; returns the last position reached. */
+static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2,
+                        bsf_point_t ap)
+{
+    /* Locals: the stores into rel[] could alias *c as far as the compiler
+     * knows. */
+    const bsf_point_t *pt = c->pts->pt;
+    const uint16_t *run = c->run;
+    bsf_point_t *rel = c->rel;
+    const float ox = c->o.x;
+    const float oy = c->o.y;
+    const int ap_zero = ap.x == 0.0f && ap.y == 0.0f; /* always, for finite points */
+    while (pos != stop) {
+        const size_t next = step > 0 ? pos + 1u : pos - 1u;
+        bsf_point_t q = pt[run[next]];
+        float d2;
+        q.x -= ox;
+        q.y -= oy;
+        rel[next] = q;
+        /* x - 0 is x: dist2(q, ap) without the subtractions */
+        d2 = ap_zero ? q.x * q.x + q.y * q.y : dist2(q, ap);
+        if (!(d2 <= side2)) {
+            break;
+        }
+        pos = next;
+    }
+    return pos;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
  * corner, 0 otherwise. */
@@ -277,25 +308,17 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
-    while (a0 > lo && dist2(rel_store(c, a0 - 1u), ap) <= side2) {
-        --a0;
-    }
-    while (b1 < hi && dist2(rel_store(c, b1 + 1u), ap) <= side2) {
-        ++b1;
-    }
+    a0 = walk_side(c, apex, lo, -1, side2, ap);
+    b1 = walk_side(c, apex, hi, 1, side2, ap);
     /* A side cut short by a neighbouring split reaches past it: noise often
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
     if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
-        while (a0 > 0u && dist2(rel_store(c, a0 - 1u), ap) <= side2) {
-            --a0;
-        }
+        a0 = walk_side(c, a0, 0u, -1, side2, ap);
     }
     if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
-        while (b1 + 1u < m && dist2(rel_store(c, b1 + 1u), ap) <= side2) {
-            ++b1;
-        }
+        b1 = walk_side(c, b1, m - 1u, 1, side2, ap);
     }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
@@ -390,22 +413,27 @@ static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m)
     float sum = 0.0f;
     size_t n = 0;
     size_t i;
+    bsf_point_t a;
+    bsf_point_t q;
+    if (m < 3u) {
+        return 0.0f;
+    }
+    a = pts->pt[run[0]];
+    q = pts->pt[run[1]];
     for (i = 1; i + 1u < m; ++i) {
-        const bsf_point_t a = pts->pt[run[i - 1u]];
-        const bsf_point_t q = pts->pt[run[i]];
         const bsf_point_t b = pts->pt[run[i + 1u]];
         const float ex = b.x - a.x;
         const float ey = b.y - a.y;
         const float len = sqrtf(ex * ex + ey * ey);
-        float d;
-        if (!(len > 0.0f)) {
-            continue;
+        if (len > 0.0f) {
+            const float d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
+            if (d <= LC_NOISE_CLIP) {
+                sum += d;
+                ++n;
+            }
         }
-        d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
-        if (d <= LC_NOISE_CLIP) {
-            sum += d;
-            ++n;
-        }
+        a = q; /* the window moves by one point */
+        q = b;
     }
     return n > 0u ? sum / ((float)n * LC_NOISE_MEAN_ABS) : 0.0f;
 }
