@@ -429,7 +429,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         size_t b = start + j;
         bsf_point_t q;
         float rho;
-        float best_d2 = 0.0f;
+        float best_d2 = HUGE_VALF;
         size_t best = slots; /* none */
         if (b >= pts->count) {
             b -= pts->count;
@@ -467,9 +467,21 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             dx = q.x - open[k].end.x;
             dy = q.y - open[k].end.y;
             d2 = dx * dx + dy * dy;
-            if (d2 == d2 && (best == slots || d2 < best_d2)) {
+            if (d2 < best_d2) { /* NaN and +inf never are */
                 best = k;
                 best_d2 = d2;
+            }
+        }
+        if (best == slots) {
+            /* Only +inf or NaN distances (points at infinity): an infinite
+             * one may still pass an infinite radius. */
+            for (k = 0; k < n_open; ++k) {
+                const float dx = q.x - open[k].end.x;
+                const float dy = q.y - open[k].end.y;
+                if (dx * dx + dy * dy == HUGE_VALF) {
+                    best = k;
+                    break;
+                }
             }
         }
         /* The radius test is a bound on d2 (a smaller d2 passes whenever a
