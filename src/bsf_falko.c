@@ -38,6 +38,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "bsf_math.h"
 #include "bsf_nms.h"
@@ -323,18 +324,51 @@ static int sector_distance(int a, int b, int sectors, int circular)
     }
 }
 
+/* Sector values lie in -S/2 - 1 .. 3S/2 (S <= 64): the clamped angle is
+ * within (-pi, pi), theta within [-pi, pi], so (ang + pi - theta) / width
+ * lies within (-S/2 - 1, 3S/2 + 1). Offset into sector_count[]. */
+#define FALKO_SECTOR_OFFSET 33
+
+/* Step 8 for one side: the sum of sector distances over pairs of its
+ * neighbours, the first of each pair the one nearer the apex. Neighbours are
+ * visited from the apex outwards (sec[0], sec[step], ...); each adds its
+ * distances to all nearer ones, taken per sector value with its count, so the
+ * cost is n times the number of distinct values (a side along a wall covers
+ * one to three sectors), not n^2 / 2. Integer sums: the same total. */
+static long side_score(const int8_t *sec, int n, int step, const bsf_falko_params_t *p,
+                       bsf_falko_work_t *work)
+{
+    long score = 0;
+    int n_seen = 0;
+    int k, m;
+    for (k = 0; k < n; ++k) {
+        const int s = sec[k * step];
+        uint16_t *count = &work->sector_count[s + FALKO_SECTOR_OFFSET];
+        for (m = 0; m < n_seen; ++m) {
+            const int t = work->sector_seen[m];
+            score += (long)work->sector_count[t + FALKO_SECTOR_OFFSET] *
+                     sector_distance(t, s, p->grid_sectors, p->circular_sector_distance);
+        }
+        if (*count == 0u) {
+            work->sector_seen[n_seen++] = (int8_t)s;
+        }
+        ++*count;
+    }
+    for (m = 0; m < n_seen; ++m) {
+        work->sector_count[work->sector_seen[m] + FALKO_SECTOR_OFFSET] = 0u;
+    }
+    return score;
+}
+
 /* Steps 7-9 for an apex that passed steps 1-6: the raw integer score. */
 static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float theta,
-                         const bsf_falko_params_t *p, int8_t *sector)
+                         const bsf_falko_params_t *p, bsf_falko_work_t *work)
 {
     const ball_t ball = make_ball(pts->pt[i], r);
     const bsf_point_t c = ball.c;
     const float width = 2.0f * FALKO_PI / (float)p->grid_sectors;
-    const int nl = nb->n_left;
-    const int nr = nb->n_right;
+    int8_t *sector = work->sector;
     int k = 0;
-    int a, b;
-    long score = 0;
     ptrdiff_t j;
 
     /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
@@ -343,20 +377,9 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
             sector[k++] = (int8_t)sector_of(pts->pt[beam_at(pts, j)], c, theta, width);
         }
     }
-    /* Ordered pairs: the first of each pair is the one nearer the apex. */
-    for (a = nl - 1; a >= 0; --a) {
-        for (b = a - 1; b >= 0; --b) {
-            score +=
-                sector_distance(sector[a], sector[b], p->grid_sectors, p->circular_sector_distance);
-        }
-    }
-    for (a = 0; a < nr; ++a) {
-        for (b = a + 1; b < nr; ++b) {
-            score += sector_distance(sector[nl + a], sector[nl + b], p->grid_sectors,
-                                     p->circular_sector_distance);
-        }
-    }
-    return score;
+    /* Left: nearest is sector[nl - 1], walking down; right: sector[nl] up. */
+    return side_score(&sector[nb->n_left - 1], nb->n_left, -1, p, work) +
+           side_score(&sector[nb->n_left], nb->n_right, 1, p, work);
 }
 
 /* Total-least-squares line through beams [from, to] that are neighbours of
@@ -426,7 +449,7 @@ static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falk
 /* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
  * FALKO_REJECTED. */
 static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
-                        const bsf_falko_params_t *p, int8_t *sector)
+                        const bsf_falko_params_t *p, bsf_falko_work_t *work)
 {
     float theta;
     neigh_t nb;
@@ -434,7 +457,7 @@ static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
-    return (float)corner_score(pts, i, &nb, r, theta, p, sector);
+    return (float)corner_score(pts, i, &nb, r, theta, p, work);
 }
 
 bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
@@ -467,6 +490,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         return BSF_ERR_ARG;
     }
     ring = bsf_points_full_circle(pts);
+    memset(work->sector_count, 0, sizeof work->sector_count);
 
     /* Radius and window of every apex first, in a loop without hard branches
      * (the exp, division and conversion latencies of successive beams
@@ -483,8 +507,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     }
     for (i = 0; i < pts->count; ++i) {
         const float r = work->score[i];
-        const float s = (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], ring, p, work->sector)
-                                   : FALKO_REJECTED;
+        const float s =
+            (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], ring, p, work) : FALKO_REJECTED;
         work->score[i] = s;
         if (s > (float)score_max) {
             if (s > (float)FALKO_SCORE_LIMIT) {

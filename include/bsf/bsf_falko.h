@@ -73,6 +73,11 @@ typedef struct {
     float score[BSF_MAX_POINTS];   /**< per-beam raw score, then NMS strength */
     uint16_t peak[BSF_MAX_POINTS]; /**< NMS candidates, then keypoint beams */
     int8_t sector[BSF_MAX_POINTS]; /**< angular sectors of one neighbourhood */
+    /** How often each sector value occurs among the neighbours seen so far
+     *  (sector values lie in -33..96, stored offset by 33), and the values that
+     *  occur: the score sums sector distances per value, not per pair. */
+    uint16_t sector_count[130];
+    int8_t sector_seen[130];
 } bsf_falko_work_t;
 
 /**
