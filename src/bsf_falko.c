@@ -172,12 +172,20 @@ typedef struct {
  * clamped to the scan, with A >= alpha from a bound that costs one division,
  * asin(s) <= s / sqrt(1 - s^2) <= s / (1 - s^2) = r rho / (rho^2 - r^2)
  * (r <= 0.8 rho keeps the denominator positive), with a rounding margin. */
-static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
+static float window_alpha_f(float rho, float r, float inv_inc)
 {
-    const float rho = pts->range[i];
-    const float a = r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
+    return r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
+}
+
+static size_t window_clamp(float a)
+{
     /* a >= 0; BSF_MAX_POINTS fits int, and int conversion is one instruction */
     return (a < (float)BSF_MAX_POINTS) ? (size_t)(int)a : (size_t)BSF_MAX_POINTS;
+}
+
+static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
+{
+    return window_clamp(window_alpha_f(pts->range[i], r, inv_inc));
 }
 
 static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, int ring, neigh_t *nb)
@@ -446,6 +454,141 @@ static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falk
     return pts->valid[i] && rho >= p->min_range && rho <= p->max_range;
 }
 
+/* Certain rejection without the exact radius. Nearly every apex of a scan
+ * is rejected by steps 3-5 (an apex on a wall fails the triangle test), and
+ * each of those would need bsf_expf for its radius. Here the radius is only
+ * bracketed, lo <= r <= hi, from a short exp: every test that decides a
+ * rejection is monotone in r, so a rejection that holds for the bracket holds
+ * for r, and one that does not (a neighbour too near the ball's edge, a
+ * triangle that might pass) goes to the exact path. Results are therefore
+ * those of the exact path alone. */
+typedef struct {
+    float lo, hi; /* lo <= neigh_radius(p, rho) <= hi */
+} radius_bracket_t;
+
+/* 0 when no cheap bracket exists (then the exact path decides). */
+static int radius_bracket(const bsf_falko_params_t *p, float rho, radius_bracket_t *rb)
+{
+    /* The same float product neigh_radius passes to bsf_expf. */
+    const float x = p->neigh_b * rho;
+    float f, e, two_k, m;
+    uint32_t bits;
+    int k;
+    if (!(x < 80.0f)) {
+        return 0; /* x >= 0: neigh_b >= 0, rho >= 0 */
+    }
+    /* exp(x) = 2^k exp(f), |f| <= ln2 / 2 + 1e-5: degree-5 Taylor series,
+     * truncation below 5e-6 relative; the rounding of k ln2 (k <= 116) adds
+     * below 4e-6, the other roundings and bsf_expf's own error below 1e-6.
+     * The bracket's margin, 1e-4, is ten times their sum. */
+    k = (int)(x * 1.44269504f + 0.5f);
+    f = x - (float)k * 0.693147182f;
+    e = 1.0f +
+        f * (1.0f + f * (0.5f + f * (1.0f / 6.0f + f * (1.0f / 24.0f + f * (1.0f / 120.0f)))));
+    bits = (uint32_t)(k + 127) << 23;
+    memcpy(&two_k, &bits, sizeof two_k);
+    m = p->neigh_a * (e * two_k);
+    rb->lo = m * (1.0f - 1e-4f);
+    rb->hi = m * (1.0f + 1e-4f);
+    if (rb->hi < rho) {
+        return 1; /* r is a exp(b rho) itself */
+    }
+    if (rb->lo >= rho) {
+        rb->lo = 0.8f * rho; /* r is neigh_radius's cap, exactly */
+        rb->hi = rb->lo;
+        return 1;
+    }
+    return 0;
+}
+
+enum { FALKO_REJECT = 0, FALKO_MAYBE = 1 };
+
+/* The outermost neighbour on one side, walking from window position `from`
+ * towards the apex by `step`: FALKO_REJECT when no beam can be a neighbour
+ * for any r in the bracket, else *end = the outermost certain neighbour, or
+ * FALKO_MAYBE (*end = apex) when a beam on the way is undecided. */
+static int bracket_end(const bsf_points_t *pts, ptrdiff_t from, ptrdiff_t i, ptrdiff_t step,
+                       bsf_point_t c, float in2, float out2, ptrdiff_t *end)
+{
+    ptrdiff_t v;
+    for (v = from; v != i; v += step) {
+        const size_t j = beam_at(pts, v);
+        float dx, dy, d2;
+        if (!pts->valid[j]) {
+            continue;
+        }
+        dx = c.x - pts->pt[j].x;
+        dy = c.y - pts->pt[j].y;
+        d2 = dx * dx + dy * dy;
+        if (d2 > out2) {
+            continue;
+        }
+        *end = (d2 <= in2) ? v : i;
+        return FALKO_MAYBE;
+    }
+    return FALKO_REJECT;
+}
+
+/* FALKO_REJECT when steps 3-5 certainly reject apex i (see radius_bracket);
+ * FALKO_MAYBE when only the exact path can tell. */
+static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
+                              const bsf_falko_params_t *p, float inv_inc)
+{
+    const bsf_point_t c = pts->pt[i];
+    const float rho = pts->range[i];
+    radius_bracket_t rb;
+    neigh_t win;
+    ptrdiff_t first, last;
+    float a_hi, in2, out2, lim;
+    size_t inner;
+    if (!radius_bracket(p, rho, &rb)) {
+        return FALKO_MAYBE;
+    }
+    /* Windows grow with r (every operation of window_alpha is monotone), so
+     * the exact window lies between those of lo and hi. */
+    a_hi = window_alpha_f(rho, rb.hi, inv_inc);
+    neigh_window(pts, i, window_clamp(a_hi), ring, &win);
+    /* Certainly inside / outside the exact ball (see make_ball). */
+    in2 = rb.lo * rb.lo * (1.0f - 1e-6f);
+    out2 = rb.hi * rb.hi * (1.0f + 1e-6f);
+    if (bracket_end(pts, win.beg, (ptrdiff_t)i, 1, c, in2, out2, &first) == FALKO_REJECT ||
+        bracket_end(pts, win.end, (ptrdiff_t)i, -1, c, in2, out2, &last) == FALKO_REJECT) {
+        return FALKO_REJECT;
+    }
+    if (first == (ptrdiff_t)i || last == (ptrdiff_t)i) {
+        return FALKO_MAYBE;
+    }
+    /* Certain neighbours inside the smallest window are the exact ends: the
+     * exact search meets only certain outsiders before them. lo's window is
+     * at least 0.999 hi's when lo = hi (1 - 2e-4) and hi <= 0.8 rho (then
+     * rho^2 - r^2 changes by under 7.2e-4 relative between them): the ends
+     * nearer than that need no second window. */
+    inner = (rb.lo == rb.hi) ? window_clamp(a_hi)
+                             : (rb.hi <= 0.8f * rho ? window_clamp(a_hi * 0.999f) : 0u);
+    if ((size_t)((ptrdiff_t)i - first) > inner || (size_t)(last - (ptrdiff_t)i) > inner) {
+        neigh_t lo_win;
+        neigh_window(pts, i, window_alpha(pts, i, rb.lo, inv_inc), ring, &lo_win);
+        if (first < lo_win.beg || last > lo_win.end) {
+            return FALKO_MAYBE;
+        }
+    }
+    /* Step 5 with the smallest limit: r / b_ratio >= lo / b_ratio. */
+    lim = rb.lo / p->b_ratio;
+    {
+        const bsf_point_t f = pts->pt[beam_at(pts, first)];
+        const bsf_point_t l = pts->pt[beam_at(pts, last)];
+        const float bx = l.x - f.x;
+        const float by = l.y - f.y;
+        const float base = sqrtf(bx * bx + by * by);
+        float area2;
+        if (base < lim) {
+            return FALKO_REJECT;
+        }
+        area2 = (f.x - c.x) * (l.y - c.y) - (f.y - c.y) * (l.x - c.x);
+        return (fabsf(area2) / base < lim) ? FALKO_REJECT : FALKO_MAYBE;
+    }
+}
+
 /* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
  * FALKO_REJECTED. */
 static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
@@ -465,7 +608,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
                               size_t *n_out)
 {
     size_t i, k, n_peak;
-    float inc;
+    float inc, inv_inc;
     long score_max = 0;
     long min_val;
     bsf_status_t st;
@@ -489,32 +632,23 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     if (!finite_f(inc) || inc == 0.0f) {
         return BSF_ERR_ARG;
     }
+    inv_inc = 1.0f / inc;
     ring = bsf_points_full_circle(pts);
     memset(work->sector_count, 0, sizeof work->sector_count);
 
-    /* Radius and window of every apex first, in a loop without hard branches
-     * (the exp, division and conversion latencies of successive beams
-     * overlap): r in score[], alpha in peak[]; 0 marks a beam that is no apex. */
     for (i = 0; i < pts->count; ++i) {
-        float r = 0.0f;
-        size_t alpha = 0;
-        if (in_extraction_range(pts, i, p)) {
-            r = neigh_radius(p, pts->range[i]);
-            alpha = window_alpha(pts, i, r, 1.0f / inc);
+        float sc = FALKO_REJECTED;
+        if (in_extraction_range(pts, i, p) &&
+            certainly_rejected(pts, i, ring, p, inv_inc) == FALKO_MAYBE) {
+            const float r = neigh_radius(p, pts->range[i]);
+            sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
         }
-        work->score[i] = r;
-        work->peak[i] = (uint16_t)alpha;
-    }
-    for (i = 0; i < pts->count; ++i) {
-        const float r = work->score[i];
-        const float s =
-            (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], ring, p, work) : FALKO_REJECTED;
-        work->score[i] = s;
-        if (s > (float)score_max) {
-            if (s > (float)FALKO_SCORE_LIMIT) {
+        work->score[i] = sc;
+        if (sc > (float)score_max) {
+            if (sc > (float)FALKO_SCORE_LIMIT) {
                 return BSF_ERR_CAPACITY;
             }
-            score_max = (long)s;
+            score_max = (long)sc;
         }
     }
     if (score_max == 0) {
@@ -556,7 +690,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, 1.0f / inc), ring, p,
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, inv_inc), ring, p,
                             &nb); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);
