@@ -466,28 +466,59 @@ typedef struct {
     float lo, hi; /* lo <= neigh_radius(p, rho) <= hi */
 } radius_bracket_t;
 
-/* 0 when no cheap bracket exists (then the exact path decides). */
-static int radius_bracket(const bsf_falko_params_t *p, float rho, radius_bracket_t *rb)
+/* The middle of the bracket, about a exp(b rho), for every beam (valid or
+ * not: the values of the others go unused) in one loop without branches, so
+ * that compilers can run several beams per instruction; and the window of
+ * the bracket's top (see window_alpha; garbage, never used, when the top
+ * reaches rho). */
+static void radius_middles(const bsf_points_t *pts, const bsf_falko_params_t *p, float inv_inc,
+                           bsf_falko_work_t *work)
 {
-    /* The same float product neigh_radius passes to bsf_expf. */
-    const float x = p->neigh_b * rho;
-    float f, e, two_k, m;
-    uint32_t bits;
-    int k;
-    if (!(x < 80.0f)) {
+    const float a = p->neigh_a;
+    const float b = p->neigh_b;
+    const size_t n = pts->count;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        const float rho = pts->range[i];
+        /* The same float product neigh_radius passes to bsf_expf, capped at
+         * 80 so that the conversion below stays defined (x >= 80 takes the
+         * exact path). x >= 0 (b >= 0, rho >= 0), so its bits order as
+         * integers do, and an integer minimum keeps the loop free of branches. */
+        const float x0 = b * rho;
+        int32_t x_bits;
+        float x;
+        memcpy(&x_bits, &x0, sizeof x_bits);
+        x_bits = (x_bits < 0x42a00000) ? x_bits : 0x42a00000; /* 80.0f */
+        memcpy(&x, &x_bits, sizeof x);
+        {
+            /* exp(x) = 2^k exp(f), |f| <= ln2 / 2 + 1e-5: degree-5 Taylor
+             * series, truncation below 5e-6 relative; the rounding of k ln2
+             * (k <= 116) adds below 4e-6, the other roundings and bsf_expf's own
+             * error below 1e-6. The bracket's margin, 1e-4, is ten times their
+             * sum. */
+            const int k = (int)(x * 1.44269504f + 0.5f);
+            const float f = x - (float)k * 0.693147182f;
+            const float e =
+                1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6.0f +
+                                                    f * (1.0f / 24.0f + f * (1.0f / 120.0f)))));
+            const uint32_t bits = (uint32_t)(k + 127) << 23;
+            float two_k, m, hi;
+            memcpy(&two_k, &bits, sizeof two_k);
+            m = a * (e * two_k);
+            hi = m * (1.0f + 1e-4f);
+            work->mid[i] = m;
+            work->window_hi[i] = window_alpha_f(rho, hi, inv_inc);
+        }
+    }
+}
+
+/* The bracket of beam i from its middle m; 0 when no cheap bracket exists
+ * (then the exact path decides). */
+static int radius_bracket(const bsf_falko_params_t *p, float rho, float m, radius_bracket_t *rb)
+{
+    if (!(p->neigh_b * rho < 80.0f)) {
         return 0; /* x >= 0: neigh_b >= 0, rho >= 0 */
     }
-    /* exp(x) = 2^k exp(f), |f| <= ln2 / 2 + 1e-5: degree-5 Taylor series,
-     * truncation below 5e-6 relative; the rounding of k ln2 (k <= 116) adds
-     * below 4e-6, the other roundings and bsf_expf's own error below 1e-6.
-     * The bracket's margin, 1e-4, is ten times their sum. */
-    k = (int)(x * 1.44269504f + 0.5f);
-    f = x - (float)k * 0.693147182f;
-    e = 1.0f +
-        f * (1.0f + f * (0.5f + f * (1.0f / 6.0f + f * (1.0f / 24.0f + f * (1.0f / 120.0f)))));
-    bits = (uint32_t)(k + 127) << 23;
-    memcpy(&two_k, &bits, sizeof two_k);
-    m = p->neigh_a * (e * two_k);
     rb->lo = m * (1.0f - 1e-4f);
     rb->hi = m * (1.0f + 1e-4f);
     if (rb->hi < rho) {
@@ -532,7 +563,8 @@ static int bracket_end(const bsf_points_t *pts, ptrdiff_t from, ptrdiff_t i, ptr
 /* FALKO_REJECT when steps 3-5 certainly reject apex i (see radius_bracket);
  * FALKO_MAYBE when only the exact path can tell. */
 static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
-                              const bsf_falko_params_t *p, float inv_inc)
+                              const bsf_falko_params_t *p, float inv_inc,
+                              const bsf_falko_work_t *work)
 {
     const bsf_point_t c = pts->pt[i];
     const float rho = pts->range[i];
@@ -541,12 +573,12 @@ static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
     ptrdiff_t first, last;
     float a_hi, in2, out2, lim;
     size_t inner;
-    if (!radius_bracket(p, rho, &rb)) {
+    if (!radius_bracket(p, rho, work->mid[i], &rb)) {
         return FALKO_MAYBE;
     }
     /* Windows grow with r (every operation of window_alpha is monotone), so
      * the exact window lies between those of lo and hi. */
-    a_hi = window_alpha_f(rho, rb.hi, inv_inc);
+    a_hi = (rb.lo == rb.hi) ? window_alpha_f(rho, rb.hi, inv_inc) : work->window_hi[i];
     neigh_window(pts, i, window_clamp(a_hi), ring, &win);
     /* Certainly inside / outside the exact ball (see make_ball). */
     in2 = rb.lo * rb.lo * (1.0f - 1e-6f);
@@ -560,7 +592,7 @@ static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
     }
     /* Certain neighbours inside the smallest window are the exact ends: the
      * exact search meets only certain outsiders before them. lo's window is
-     * at least 0.999 hi's when lo = hi (1 - 2e-4) and hi <= 0.8 rho (then
+     * at least 0.999 hi's when lo >= hi (1 - 2e-4) and hi <= 0.8 rho (then
      * rho^2 - r^2 changes by under 7.2e-4 relative between them): the ends
      * nearer than that need no second window. */
     inner = (rb.lo == rb.hi) ? window_clamp(a_hi)
@@ -635,11 +667,12 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     inv_inc = 1.0f / inc;
     ring = bsf_points_full_circle(pts);
     memset(work->sector_count, 0, sizeof work->sector_count);
+    radius_middles(pts, p, inv_inc, work);
 
     for (i = 0; i < pts->count; ++i) {
         float sc = FALKO_REJECTED;
         if (in_extraction_range(pts, i, p) &&
-            certainly_rejected(pts, i, ring, p, inv_inc) == FALKO_MAYBE) {
+            certainly_rejected(pts, i, ring, p, inv_inc, work) == FALKO_MAYBE) {
             const float r = neigh_radius(p, pts->range[i]);
             sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
         }

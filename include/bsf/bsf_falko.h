@@ -70,9 +70,11 @@ BSF_NODISCARD bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p);
  * BSF_MAX_POINTS = 1081.
  */
 typedef struct {
-    float score[BSF_MAX_POINTS];   /**< per-beam raw score, then NMS strength */
-    uint16_t peak[BSF_MAX_POINTS]; /**< NMS candidates, then keypoint beams */
-    int8_t sector[BSF_MAX_POINTS]; /**< angular sectors of one neighbourhood */
+    float score[BSF_MAX_POINTS];     /**< per-beam raw score, then NMS strength */
+    uint16_t peak[BSF_MAX_POINTS];   /**< NMS candidates, then keypoint beams */
+    int8_t sector[BSF_MAX_POINTS];   /**< angular sectors of one neighbourhood */
+    float mid[BSF_MAX_POINTS];       /**< per beam: about its neighbourhood radius */
+    float window_hi[BSF_MAX_POINTS]; /**< per beam: a window for the radius's upper bound */
     /** How often each sector value occurs among the neighbours seen so far
      *  (sector values lie in -33..96, stored offset by 33), and the values that
      *  occur: the score sums sector distances per value, not per pair. */
