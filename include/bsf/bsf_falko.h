@@ -66,7 +66,7 @@ BSF_NODISCARD bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p);
 
 /**
  * Scratch memory of bsf_falko_detect, owned by the caller (static or on a
- * task's stack); its content between calls is irrelevant. About 7.4 KiB at
+ * task's stack); its content between calls is irrelevant. About 16 KiB at
  * BSF_MAX_POINTS = 1081.
  */
 typedef struct {
