@@ -541,9 +541,12 @@ enum { FALKO_REJECT = 0, FALKO_MAYBE = 1 };
 static int bracket_end(const bsf_points_t *pts, ptrdiff_t from, ptrdiff_t i, ptrdiff_t step,
                        bsf_point_t c, float in2, float out2, ptrdiff_t *end)
 {
+    /* Windows that stay inside the scan (all but a few on a full circle)
+     * need no wrapping. */
+    const int wraps = from < 0 || from >= (ptrdiff_t)pts->count;
     ptrdiff_t v;
     for (v = from; v != i; v += step) {
-        const size_t j = beam_at(pts, v);
+        const size_t j = wraps ? beam_at(pts, v) : (size_t)v;
         float dx, dy, d2;
         if (!pts->valid[j]) {
             continue;
