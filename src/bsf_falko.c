@@ -462,74 +462,87 @@ static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falk
  * for r, and one that does not (a neighbour too near the ball's edge, a
  * triangle that might pass) goes to the exact path. Results are therefore
  * those of the exact path alone. */
-typedef struct {
-    float lo, hi; /* lo <= neigh_radius(p, rho) <= hi */
-} radius_bracket_t;
 
-/* The middle of the bracket, about a exp(b rho), for every beam (valid or
- * not: the values of the others go unused) in one loop without branches, so
- * that compilers can run several beams per instruction; and the window of
- * the bracket's top (see window_alpha; garbage, never used, when the top
- * reaches rho). */
-static void radius_middles(const bsf_points_t *pts, const bsf_falko_params_t *p, float inv_inc,
-                           bsf_falko_work_t *work)
+/* work->win_hi of a beam whose bracket is not cheap: the exact path decides. */
+#define FALKO_WIN_EXACT 0xFFFFu
+
+/* Float bits of a non-negative float: they order as the values do, so the
+ * loop below compares and clamps them as integers (no branches). */
+static int32_t float_bits(float v)
+{
+    int32_t b;
+    memcpy(&b, &v, sizeof b);
+    return b;
+}
+
+static float bits_float(int32_t b)
+{
+    float v;
+    memcpy(&v, &b, sizeof v);
+    return v;
+}
+
+/* window_clamp for any value (negative, NaN and garbage give 0 or the cap). */
+static int32_t window_clamp_any(float a)
+{
+    int32_t b = float_bits(a);
+    b = (b > 0) ? b : 0;
+    b = (b < float_bits((float)BSF_MAX_POINTS)) ? b : float_bits((float)BSF_MAX_POINTS);
+    return (int32_t)bits_float(b);
+}
+
+/* The bracket of every beam (valid or not: the others go unused) in one loop
+ * without branches, so that compilers run several beams per instruction:
+ * the squared distances certainly inside / outside the exact ball (see
+ * make_ball), the smallest triangle limit lo / b_ratio, the window of hi (or
+ * FALKO_WIN_EXACT) and a window the ends may reach without a second look. */
+static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p, float inv_inc,
+                            bsf_falko_work_t *work)
 {
     const float a = p->neigh_a;
     const float b = p->neigh_b;
+    const float b_ratio = p->b_ratio;
     const size_t n = pts->count;
     size_t i;
     for (i = 0; i < n; ++i) {
         const float rho = pts->range[i];
         /* The same float product neigh_radius passes to bsf_expf, capped at
          * 80 so that the conversion below stays defined (x >= 80 takes the
-         * exact path). x >= 0 (b >= 0, rho >= 0), so its bits order as
-         * integers do, and an integer minimum keeps the loop free of branches. */
-        const float x0 = b * rho;
-        int32_t x_bits;
-        float x;
-        memcpy(&x_bits, &x0, sizeof x_bits);
-        x_bits = (x_bits < 0x42a00000) ? x_bits : 0x42a00000; /* 80.0f */
-        memcpy(&x, &x_bits, sizeof x);
-        {
-            /* exp(x) = 2^k exp(f), |f| <= ln2 / 2 + 1e-5: degree-5 Taylor
-             * series, truncation below 5e-6 relative; the rounding of k ln2
-             * (k <= 116) adds below 4e-6, the other roundings and bsf_expf's own
-             * error below 1e-6. The bracket's margin, 1e-4, is ten times their
-             * sum. */
-            const int k = (int)(x * 1.44269504f + 0.5f);
-            const float f = x - (float)k * 0.693147182f;
-            const float e =
-                1.0f + f * (1.0f + f * (0.5f + f * (1.0f / 6.0f +
-                                                    f * (1.0f / 24.0f + f * (1.0f / 120.0f)))));
-            const uint32_t bits = (uint32_t)(k + 127) << 23;
-            float two_k, m, hi;
-            memcpy(&two_k, &bits, sizeof two_k);
-            m = a * (e * two_k);
-            hi = m * (1.0f + 1e-4f);
-            work->mid[i] = m;
-            work->window_hi[i] = window_alpha_f(rho, hi, inv_inc);
-        }
+         * exact path). x >= 0 (b >= 0, rho >= 0). */
+        const int32_t x_bits = float_bits(b * rho);
+        const float x = bits_float((x_bits < 0x42a00000) ? x_bits : 0x42a00000); /* 80.0f */
+        /* exp(x) = 2^k exp(f), |f| <= ln2 / 2 + 1e-5: degree-5 Taylor
+         * series, truncation below 5e-6 relative; the rounding of k ln2
+         * (k <= 116) adds below 4e-6, the other roundings and bsf_expf's own
+         * error below 1e-6. The bracket's margin, 1e-4, is ten times their
+         * sum. */
+        const int32_t k = (int32_t)(x * 1.44269504f + 0.5f);
+        const float f = x - (float)k * 0.693147182f;
+        const float e =
+            1.0f +
+            f * (1.0f + f * (0.5f + f * (1.0f / 6.0f + f * (1.0f / 24.0f + f * (1.0f / 120.0f)))));
+        const float m = a * (e * bits_float((k + 127) << 23));
+        const float lo = m * (1.0f - 1e-4f);
+        const float hi = m * (1.0f + 1e-4f);
+        /* Windows grow with r (every operation of window_alpha is
+         * monotone), so the exact window lies between those of lo and hi.
+         * lo's window is at least 0.999 hi's when lo >= hi (1 - 2e-4) and
+         * hi <= 0.8 rho (rho^2 - r^2 then changes by under 7.2e-4 relative
+         * between them). */
+        const float a_hi = window_alpha_f(rho, hi, inv_inc);
+        /* r = a exp(b rho) itself when hi < rho; otherwise (r may be
+         * neigh_radius's cap) and for x >= 80 the exact path decides. */
+        const int32_t cheap = -((x_bits < 0x42a00000) & (float_bits(hi) < float_bits(rho)));
+        const int32_t near = -(float_bits(hi) <= float_bits(0.8f * rho));
+        /* Selections by masks: conversions inside a branch would not run
+         * four at a time. */
+        work->win_hi[i] =
+            (uint16_t)((window_clamp_any(a_hi) & cheap) | ((int32_t)FALKO_WIN_EXACT & ~cheap));
+        work->win_inner[i] = (uint16_t)(window_clamp_any(a_hi * 0.999f) & near);
+        work->in2[i] = lo * lo * (1.0f - 1e-6f);
+        work->out2[i] = hi * hi * (1.0f + 1e-6f);
+        work->lim[i] = lo / b_ratio;
     }
-}
-
-/* The bracket of beam i from its middle m; 0 when no cheap bracket exists
- * (then the exact path decides). */
-static int radius_bracket(const bsf_falko_params_t *p, float rho, float m, radius_bracket_t *rb)
-{
-    if (!(p->neigh_b * rho < 80.0f)) {
-        return 0; /* x >= 0: neigh_b >= 0, rho >= 0 */
-    }
-    rb->lo = m * (1.0f - 1e-4f);
-    rb->hi = m * (1.0f + 1e-4f);
-    if (rb->hi < rho) {
-        return 1; /* r is a exp(b rho) itself */
-    }
-    if (rb->lo >= rho) {
-        rb->lo = 0.8f * rho; /* r is neigh_radius's cap, exactly */
-        rb->hi = rb->lo;
-        return 1;
-    }
-    return 0;
 }
 
 enum { FALKO_REJECT = 0, FALKO_MAYBE = 1 };
@@ -563,55 +576,39 @@ static int bracket_end(const bsf_points_t *pts, ptrdiff_t from, ptrdiff_t i, ptr
     return FALKO_REJECT;
 }
 
-/* FALKO_REJECT when steps 3-5 certainly reject apex i (see radius_bracket);
+/* FALKO_REJECT when steps 3-5 certainly reject apex i (see radius_brackets);
  * FALKO_MAYBE when only the exact path can tell. */
 static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
-                              const bsf_falko_params_t *p, float inv_inc,
                               const bsf_falko_work_t *work)
 {
     const bsf_point_t c = pts->pt[i];
-    const float rho = pts->range[i];
-    radius_bracket_t rb;
+    const size_t w = work->win_hi[i];
+    const size_t inner = work->win_inner[i];
+    const float in2 = work->in2[i];
+    const float out2 = work->out2[i];
+    const float lim = work->lim[i];
     neigh_t win;
     ptrdiff_t first, last;
-    float a_hi, in2, out2, lim;
-    size_t inner;
-    if (!radius_bracket(p, rho, work->mid[i], &rb)) {
+    if (w == FALKO_WIN_EXACT) {
         return FALKO_MAYBE;
     }
-    /* Windows grow with r (every operation of window_alpha is monotone), so
-     * the exact window lies between those of lo and hi. */
-    a_hi = (rb.lo == rb.hi) ? window_alpha_f(rho, rb.hi, inv_inc) : work->window_hi[i];
-    neigh_window(pts, i, window_clamp(a_hi), ring, &win);
-    /* Certainly inside / outside the exact ball (see make_ball). */
-    in2 = rb.lo * rb.lo * (1.0f - 1e-6f);
-    out2 = rb.hi * rb.hi * (1.0f + 1e-6f);
+    neigh_window(pts, i, w, ring, &win);
     if (bracket_end(pts, win.beg, (ptrdiff_t)i, 1, c, in2, out2, &first) == FALKO_REJECT ||
         bracket_end(pts, win.end, (ptrdiff_t)i, -1, c, in2, out2, &last) == FALKO_REJECT) {
         return FALKO_REJECT;
     }
-    if (first == (ptrdiff_t)i || last == (ptrdiff_t)i) {
+    /* Certain neighbours inside lo's window are the exact ends: the exact
+     * search meets only certain outsiders before them. Ends beyond `inner`
+     * (rare) are left to the exact path. */
+    if (first == (ptrdiff_t)i || last == (ptrdiff_t)i || (size_t)((ptrdiff_t)i - first) > inner ||
+        (size_t)(last - (ptrdiff_t)i) > inner) {
         return FALKO_MAYBE;
     }
-    /* Certain neighbours inside the smallest window are the exact ends: the
-     * exact search meets only certain outsiders before them. lo's window is
-     * at least 0.999 hi's when lo >= hi (1 - 2e-4) and hi <= 0.8 rho (then
-     * rho^2 - r^2 changes by under 7.2e-4 relative between them): the ends
-     * nearer than that need no second window. */
-    inner = (rb.lo == rb.hi) ? window_clamp(a_hi)
-                             : (rb.hi <= 0.8f * rho ? window_clamp(a_hi * 0.999f) : 0u);
-    if ((size_t)((ptrdiff_t)i - first) > inner || (size_t)(last - (ptrdiff_t)i) > inner) {
-        neigh_t lo_win;
-        neigh_window(pts, i, window_alpha(pts, i, rb.lo, inv_inc), ring, &lo_win);
-        if (first < lo_win.beg || last > lo_win.end) {
-            return FALKO_MAYBE;
-        }
-    }
     /* Step 5 with the smallest limit: r / b_ratio >= lo / b_ratio. */
-    lim = rb.lo / p->b_ratio;
     {
-        const bsf_point_t f = pts->pt[beam_at(pts, first)];
-        const bsf_point_t l = pts->pt[beam_at(pts, last)];
+        const int wraps = first < 0 || last >= (ptrdiff_t)pts->count;
+        const bsf_point_t f = pts->pt[wraps ? beam_at(pts, first) : (size_t)first];
+        const bsf_point_t l = pts->pt[wraps ? beam_at(pts, last) : (size_t)last];
         const float bx = l.x - f.x;
         const float by = l.y - f.y;
         const float base = sqrtf(bx * bx + by * by);
@@ -670,12 +667,12 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     inv_inc = 1.0f / inc;
     ring = bsf_points_full_circle(pts);
     memset(work->sector_count, 0, sizeof work->sector_count);
-    radius_middles(pts, p, inv_inc, work);
+    radius_brackets(pts, p, inv_inc, work);
 
     for (i = 0; i < pts->count; ++i) {
         float sc = FALKO_REJECTED;
         if (in_extraction_range(pts, i, p) &&
-            certainly_rejected(pts, i, ring, p, inv_inc, work) == FALKO_MAYBE) {
+            certainly_rejected(pts, i, ring, work) == FALKO_MAYBE) {
             const float r = neigh_radius(p, pts->range[i]);
             sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
         }
