@@ -2,12 +2,29 @@
 #include "bsf_nms.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "bsf_math.h"
 
 /* asin(0.8): the reference's window angle when the radius reaches the range. */
 #define BSF_ASIN_0_8 0.927295218f
+
+/* An integer whose order is the order of the float v (not NaN), and back. */
+static int32_t float_key(float v)
+{
+    int32_t b;
+    memcpy(&b, &v, sizeof b);
+    return b ^ ((b >> 31) & INT32_MAX);
+}
+
+static float key_float(int32_t key)
+{
+    const int32_t b = key ^ ((key >> 31) & INT32_MAX);
+    float v;
+    memcpy(&v, &b, sizeof v);
+    return v;
+}
 
 /* What every window of one scan shares. */
 typedef struct {
@@ -98,19 +115,28 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
     if (n == 0u) {
         return 0u;
     }
-    bottom = sign * score[0];
-    min_range = -1.0f;
-    close = 0;
-    for (k = 0; k < n; ++k) {
-        const float v = sign * score[k];
-        bottom = (v < bottom) ? v : bottom;
-        if (pts->valid[k]) {
-            if (pts->range[k] <= radius) {
-                close = 1;
-            } else if (min_range < 0.0f || pts->range[k] < min_range) {
-                min_range = pts->range[k];
-            }
+    {
+        /* One loop without branches (compilers run several beams per
+         * instruction): float comparisons as integer ones on keys that
+         * order as the floats do (sign-magnitude to two's complement; ranges
+         * are non-negative, so their bits already do). */
+        const int32_t radius_bits = float_key(radius);
+        int32_t bottom_key = INT32_MAX;
+        int32_t range_key = INT32_MAX; /* smallest valid range above the radius */
+        int32_t close_any = 0;         /* a valid range at or below the radius */
+        for (k = 0; k < n; ++k) {
+            const int32_t v = float_key(sign * score[k]);
+            const int32_t r = float_key(pts->range[k]);
+            const int32_t valid = -(int32_t)(pts->valid[k] != 0u);
+            const int32_t above = -(int32_t)(r > radius_bits) & valid;
+            const int32_t r_above = (r & above) | (INT32_MAX & ~above);
+            bottom_key = (v < bottom_key) ? v : bottom_key;
+            range_key = (r_above < range_key) ? r_above : range_key;
+            close_any |= valid & ~above;
         }
+        bottom = key_float(bottom_key);
+        min_range = (range_key == INT32_MAX) ? -1.0f : key_float(range_key);
+        close = close_any != 0;
     }
     if (bottom > min_val) {
         w_max = n; /* every bottom beam could be a candidate: no jumps */
