@@ -447,13 +447,6 @@ static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh
     return q;
 }
 
-/* Is beam i an apex candidate at all (step 1)? */
-static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p)
-{
-    const float rho = pts->range[i];
-    return pts->valid[i] && rho >= p->min_range && rho <= p->max_range;
-}
-
 /* Certain rejection without the exact radius. Nearly every apex of a scan
  * is rejected by steps 3-5 (an apex on a wall fails the triangle test), and
  * each of those would need bsf_expf for its radius. Here the radius is only
@@ -463,8 +456,11 @@ static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falk
  * triangle that might pass) goes to the exact path. Results are therefore
  * those of the exact path alone. */
 
-/* work->win_hi of a beam whose bracket is not cheap: the exact path decides. */
+/* work->win_hi of a beam whose bracket is not cheap: the exact path decides;
+ * and of a beam that is no apex (step 1: invalid or out of the extraction
+ * range). Windows are at most BSF_MAX_POINTS. */
 #define FALKO_WIN_EXACT 0xFFFFu
+#define FALKO_WIN_NONE 0xFFFEu
 
 /* Float bits of a non-negative float: they order as the values do, so the
  * loop below compares and clamps them as integers (no branches). */
@@ -502,6 +498,10 @@ static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p
     const float a = p->neigh_a;
     const float b = p->neigh_b;
     const float b_ratio = p->b_ratio;
+    /* Step 1, is beam i an apex at all: valid, min_range <= rho <= max_range
+     * (both >= 0, as ranges are; -0.0 min_range compares as below all). */
+    const int32_t min_range_bits = float_bits(p->min_range);
+    const int32_t max_range_bits = float_bits(p->max_range);
     const size_t n = pts->count;
     size_t i;
     for (i = 0; i < n; ++i) {
@@ -532,12 +532,14 @@ static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p
         const float a_hi = window_alpha_f(rho, hi, inv_inc);
         /* r = a exp(b rho) itself when hi < rho; otherwise (r may be
          * neigh_radius's cap) and for x >= 80 the exact path decides. */
+        const int32_t apex = -((pts->valid[i] != 0u) & (float_bits(rho) >= min_range_bits) &
+                               (float_bits(rho) <= max_range_bits));
         const int32_t cheap = -((x_bits < 0x42a00000) & (float_bits(hi) < float_bits(rho)));
         const int32_t near = -(float_bits(hi) <= float_bits(0.8f * rho));
         /* Selections by masks: conversions inside a branch would not run
          * four at a time. */
-        work->win_hi[i] =
-            (uint16_t)((window_clamp_any(a_hi) & cheap) | ((int32_t)FALKO_WIN_EXACT & ~cheap));
+        const int32_t win = (window_clamp_any(a_hi) & cheap) | ((int32_t)FALKO_WIN_EXACT & ~cheap);
+        work->win_hi[i] = (uint16_t)((win & apex) | ((int32_t)FALKO_WIN_NONE & ~apex));
         work->win_inner[i] = (uint16_t)(window_clamp_any(a_hi * 0.999f) & near);
         work->in2[i] = lo * lo * (1.0f - 1e-6f);
         work->out2[i] = hi * hi * (1.0f + 1e-6f);
@@ -670,18 +672,19 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     radius_brackets(pts, p, inv_inc, work);
 
     for (i = 0; i < pts->count; ++i) {
-        float sc = FALKO_REJECTED;
-        if (in_extraction_range(pts, i, p) &&
-            certainly_rejected(pts, i, ring, work) == FALKO_MAYBE) {
+        const size_t w = work->win_hi[i];
+        work->score[i] = FALKO_REJECTED;
+        if (w != FALKO_WIN_NONE &&
+            (w == FALKO_WIN_EXACT || certainly_rejected(pts, i, ring, work) == FALKO_MAYBE)) {
             const float r = neigh_radius(p, pts->range[i]);
-            sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
-        }
-        work->score[i] = sc;
-        if (sc > (float)score_max) {
-            if (sc > (float)FALKO_SCORE_LIMIT) {
-                return BSF_ERR_CAPACITY;
+            const float sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
+            work->score[i] = sc;
+            if (sc > (float)score_max) {
+                if (sc > (float)FALKO_SCORE_LIMIT) {
+                    return BSF_ERR_CAPACITY;
+                }
+                score_max = (long)sc;
             }
-            score_max = (long)sc;
         }
     }
     if (score_max == 0) {
