@@ -336,6 +336,9 @@ static int sector_distance(int a, int b, int sectors, int circular)
  * within (-pi, pi), theta within [-pi, pi], so (ang + pi - theta) / width
  * lies within (-S/2 - 1, 3S/2 + 1). Offset into sector_count[]. */
 #define FALKO_SECTOR_OFFSET 33
+/* Differences of two sector values lie in -129 .. 129: offset into
+ * sector_dist[]. */
+#define FALKO_SECTOR_SPAN 129
 
 /* Step 8 for one side: the sum of sector distances over pairs of its
  * neighbours, the first of each pair the one nearer the apex. Neighbours are
@@ -354,8 +357,12 @@ static long side_score(const int8_t *sec, int n, int step, const bsf_falko_param
         uint16_t *count = &work->sector_count[s + FALKO_SECTOR_OFFSET];
         for (m = 0; m < n_seen; ++m) {
             const int t = work->sector_seen[m];
-            score += (long)work->sector_count[t + FALKO_SECTOR_OFFSET] *
-                     sector_distance(t, s, p->grid_sectors, p->circular_sector_distance);
+            /* sector_distance depends on t - s only: remembered per call. */
+            int8_t *d = &work->sector_dist[t - s + FALKO_SECTOR_SPAN];
+            if (*d < 0) {
+                *d = (int8_t)sector_distance(t, s, p->grid_sectors, p->circular_sector_distance);
+            }
+            score += (long)work->sector_count[t + FALKO_SECTOR_OFFSET] * *d;
         }
         if (*count == 0u) {
             work->sector_seen[n_seen++] = (int8_t)s;
@@ -669,6 +676,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     inv_inc = 1.0f / inc;
     ring = bsf_points_full_circle(pts);
     memset(work->sector_count, 0, sizeof work->sector_count);
+    memset(work->sector_dist, -1, sizeof work->sector_dist);
     radius_brackets(pts, p, inv_inc, work);
 
     for (i = 0; i < pts->count; ++i) {

@@ -84,6 +84,7 @@ typedef struct {
      *  occur: the score sums sector distances per value, not per pair. */
     uint16_t sector_count[130];
     int8_t sector_seen[130];
+    int8_t sector_dist[259]; /**< sector distance per difference of sector values, or -1 */
 } bsf_falko_work_t;
 
 /**
