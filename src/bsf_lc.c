@@ -3,6 +3,7 @@
 #include "bsf/bsf_lc.h"
 #include "bsf_math.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -33,7 +34,10 @@ bsf_lc_params_t bsf_lc_params_default(void)
     p.apex_slack = 0.05f;
     p.min_side_points = 3u;
     p.min_side_len = 0.15f;
-    p.max_range = 30.0f;
+    /* No range limit of its own: a corner needs min_side_points points per
+     * side within max_side of the apex, so the beam spacing, not the range,
+     * decides how far corners are found (about 57 m at 0.5 deg beams). */
+    p.max_range = FLT_MAX;
     return p;
 }
 
@@ -202,17 +206,27 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     return rss;
 }
 
-/* A side is straight unless a circle cuts its squared residual by more than
- * the factor curve_ratio (beyond the floor). */
+/* A side is straight unless a circle cuts its squared residual per degree of
+ * freedom (n - 2 for a line, n - 3 for a circle) by more than the factor
+ * curve_ratio (beyond the floor). A circle passes through any three points,
+ * so a side of three points or fewer shows no curvature: straight. Without
+ * the degrees of freedom a short leg past a corner (three or four points)
+ * was judged curved by its noise alone and the corner was lost. */
 static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
 {
-    const float extent = sqrtf(dist2(rel(c, a), rel(c, b)));
-    const float rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
+    const size_t n = b - a + 1u;
+    float extent;
+    float rss_circle;
+    if (n <= 3u) {
+        return 1;
+    }
+    extent = sqrtf(dist2(rel(c, a), rel(c, b)));
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
     if (rss_circle < 0.0f) {
         return 1;
     }
-    return l->rss <=
-           c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
+    return l->rss * (float)(n - 3u) <= (float)(n - 2u) * (c->p->curve_ratio * rss_circle +
+                                                          (float)n * c->p->floor * c->p->floor);
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -512,6 +526,48 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
 }
 
+/* Point b continues the run that ends at point a: within the jump radius
+ * at b's range. */
+static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+{
+    /* r >= jump_a: the exponential is only needed past that. */
+    const float d2 = dist2(pts->pt[a], pts->pt[b]);
+    float r;
+    if (d2 <= p->jump_a * p->jump_a) {
+        return 1;
+    }
+    r = p->jump_a * bsf_expf(p->jump_b * pts->range[b]);
+    return d2 <= r * r;
+}
+
+/* The run ending at point a jumps at point i. When the surface resumes
+ * within the next 2 * min_side_points beams (a valid point within the jump
+ * radius at a's range), the beams between are an occluder (a post, a chair
+ * leg) too narrow to hold a corner of its own (LC judges no run shorter
+ * than 2 * min_side_points + 1): returns the beam where the run resumes, so
+ * a corner hidden behind it is still judged from both walls (SVED's
+ * look-back keeps such a wall one segment too). Else returns i. One
+ * exponential per jump: the radius is taken at a's range. */
+static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
+{
+    const size_t span = 2u * (size_t)p->min_side_points;
+    float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
+    size_t j;
+    for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
+        if (pts->valid[j]) {
+            const float d2 = dist2(pts->pt[a], pts->pt[j]);
+            if (d2 > p->jump_a * p->jump_a && r2 < 0.0f) {
+                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[a]);
+                r2 = r * r;
+            }
+            if (d2 <= p->jump_a * p->jump_a || d2 <= r2) {
+                return j;
+            }
+        }
+    }
+    return i;
+}
+
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
 {
@@ -545,11 +601,13 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            /* r >= jump_a: the exponential is only needed past that. */
-            const float d2 = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]);
-            if (d2 > p->jump_a * p->jump_a) {
-                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
-                close_run = d2 > r * r;
+            close_run = !within_jump(pts, p, work->run[m - 1u], i);
+            if (close_run) {
+                const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
+                if (j > i) {
+                    i = j - 1u; /* the run resumes at j */
+                    continue;
+                }
             }
         }
         if (close_run) {

@@ -22,6 +22,9 @@
  *       both sides together) is above curve_ratio times that of the two
  *       lines, plus (count x floor^2). So round pillars, curved walls and
  *       noise on straight walls give no corner, whatever the beam spacing;
+ *     - each side is straight: a circle does not explain it curve_ratio times
+ *       better per degree of freedom (n - 2 for a line, n - 3 for a circle;
+ *       a side of three points passes, since any circle fits three points);
  *     a rejected split merges its two pieces and the neighbours are judged
  *     again;
  *  3. report each corner at its apex beam, with the intersection of the two
@@ -50,7 +53,9 @@ typedef struct {
     float max_side;     /**< length of each side used for the line fits, metres (1.5) */
     float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
     float min_side_len; /**< length each side must reach from the apex, metres (0.15) */
-    float max_range;    /**< no corner at an apex farther than this, metres (30, FALKO's) */
+    float max_range;    /**< no corner at an apex farther than this, metres (FLT_MAX: no
+                             limit; the side tests already need min_side_points points
+                             within max_side of the apex, which the beam spacing decides) */
     uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3); one
                                    fewer where a side reaches the end of its run */
 } bsf_lc_params_t;
