@@ -538,10 +538,13 @@ static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p
          * between them). */
         const float a_hi = window_alpha_f(rho, hi, inv_inc);
         /* r = a exp(b rho) itself when hi < rho; otherwise (r may be
-         * neigh_radius's cap) and for x >= 80 the exact path decides. */
+         * neigh_radius's cap), for x >= 80 and for radii so small that their
+         * squares leave float's normal range (lo < 1e-15) the exact path
+         * decides. */
         const int32_t apex = -((pts->valid[i] != 0u) & (float_bits(rho) >= min_range_bits) &
                                (float_bits(rho) <= max_range_bits));
-        const int32_t cheap = -((x_bits < 0x42a00000) & (float_bits(hi) < float_bits(rho)));
+        const int32_t cheap = -((x_bits < 0x42a00000) & (float_bits(hi) < float_bits(rho)) &
+                                (float_bits(lo) >= float_bits(1e-15f)));
         const int32_t near = -(float_bits(hi) <= float_bits(0.8f * rho));
         /* Selections by masks: conversions inside a branch would not run
          * four at a time. */
