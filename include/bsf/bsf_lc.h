@@ -69,13 +69,17 @@ bsf_lc_params_t bsf_lc_params_default(void);
  *  min_side_points in 2..64). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
-/** Scratch memory of bsf_lc_detect (about 9 bytes per beam). */
+/** Scratch memory of bsf_lc_detect (about 21 bytes per beam; in the
+ *  extractor it shares its space with the larger BID scratch). */
 typedef struct {
     uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
     uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
     uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
     uint16_t stack_b[BSF_MAX_POINTS];
-    uint8_t is_brk[BSF_MAX_POINTS]; /**< split marks, positions in run */
+    uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner verdict */
+    uint16_t judged_hi[BSF_MAX_POINTS];
+    bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
+    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run */
 } bsf_lc_work_t;
 
 /**
