@@ -8,185 +8,348 @@
 #include "bsf_wire.h"
 
 /*
- * One writer serves four uses: costing (nothing is emitted: the bits of
- * everything but the control point values are summed, and those values are
- * tallied per class to cost every Exp-Golomb order at once), counting (buf ==
- * NULL, sink == NULL), writing to a buffer (COBS code bytes are patched in
- * place once their block ends) and feeding a sink (a block is collected in
- * work->block and handed over whole, because its code byte must go first).
- * The payload's bit stream goes through put_bits, whole bytes through put_u8.
+ * How a features frame is made (two runs over the result, docs/PERFORMANCE.md):
+ *
+ * 1. Planning: validates the whole input, sums the bits of every field but
+ *    the control point values, quantises each control point once into a
+ *    per-frame table of wire values (zigzag value and class) and tallies
+ *    those per class, from which each class's shortest Exp-Golomb order and
+ *    the payload's exact size follow.
+ * 2. Writing: when the caller's buffer holds the size bound, a bit writer
+ *    that stores whole 32-bit words writes the payload straight into it,
+ *    behind room for COBS's extra bytes, taking the values from the table
+ *    (a feature beyond the table is quantised again); then CRC-32C over the
+ *    payload and COBS in place.
+ *
+ * Sinks, metadata frames and buffers smaller than the bound take the
+ * streaming path: the same bit writer fills a small chunk whose bytes go
+ * through CRC and COBS to a counter, the buffer or the sink.
+ */
+
+/* ---- Streaming output: COBS blocks to a counter, a buffer or a sink ---- */
+
+typedef struct {
+    uint8_t *buf;    /* buffer mode, else NULL */
+    size_t cap;      /* size of buf */
+    size_t pos;      /* bytes of the frame produced so far */
+    size_t code_pos; /* buffer mode: where the current block's code byte goes */
+    uint8_t code;    /* 1 + data bytes in the current block */
+    uint32_t crc;    /* CRC-32C of the payload so far */
+    bsf_encoder_t *work;
+    bsf_sink_fn sink; /* sink mode: a block is collected in work->block, its code byte first */
+    void *ctx;
+    int failed; /* the sink refused bytes */
+} stream_t;
+
+static void emit(stream_t *s, const uint8_t *data, size_t len)
+{
+    if (!s->failed) {
+        if (s->sink(s->ctx, data, len) != 0) {
+            s->failed = 1;
+        } else {
+            s->pos += len;
+        }
+    }
+}
+
+static void block_start(stream_t *s)
+{
+    s->code = 1u;
+    if (s->sink == NULL) {
+        s->code_pos = s->pos++;
+    }
+}
+
+static void block_end(stream_t *s)
+{
+    if (s->sink != NULL) {
+        s->work->block[0] = s->code;
+        emit(s, s->work->block, s->code);
+    } else if (s->buf != NULL && s->code_pos < s->cap) {
+        s->buf[s->code_pos] = s->code;
+    }
+}
+
+static void stream_init(stream_t *s)
+{
+    memset(s, 0, sizeof *s);
+    block_start(s);
+}
+
+/* One body byte (payload or CRC) through COBS. */
+static void stream_byte(stream_t *s, uint8_t b)
+{
+    if (b == 0u) {
+        block_end(s);
+        block_start(s);
+        return;
+    }
+    if (s->sink != NULL) {
+        s->work->block[s->code] = b;
+    } else {
+        if (s->buf != NULL && s->pos < s->cap) {
+            s->buf[s->pos] = b;
+        }
+        ++s->pos;
+    }
+    if (++s->code == 0xFFu) {
+        block_end(s);
+        block_start(s);
+    }
+}
+
+static void stream_payload(stream_t *s, const uint8_t *data, size_t len)
+{
+    size_t i;
+    s->crc = bsf_crc32c(s->crc, data, len);
+    for (i = 0; i < len; ++i) {
+        stream_byte(s, data[i]);
+    }
+}
+
+/* The CRC (not itself checksummed), the last block and the 0x00. */
+static void stream_finish(stream_t *s)
+{
+    unsigned i;
+    const uint32_t crc = s->crc;
+    for (i = 0; i < 4u; ++i) {
+        stream_byte(s, (uint8_t)(crc >> (8u * i)));
+    }
+    if (s->sink != NULL) {
+        s->work->block[0] = s->code;
+        s->work->block[s->code] = 0u;
+        emit(s, s->work->block, (size_t)s->code + 1u);
+    } else {
+        block_end(s);
+        if (s->buf != NULL && s->pos < s->cap) {
+            s->buf[s->pos] = 0u;
+        }
+        ++s->pos;
+    }
+}
+
+/* ---- Bit writer ---------------------------------------------------------- */
+
+#define CHUNK_BYTES 32u /* streaming path: payload bytes handed on at a time */
+
+/*
+ * The payload's bits, most significant first, gather in acc and leave as
+ * whole big-endian 32-bit words. In the planning run (costing) nothing is
+ * written: bits sums the fields' lengths.
  */
 typedef struct {
-    uint8_t *buf;
-    size_t cap;
-    size_t pos;       /* bytes of the frame produced so far */
-    size_t code_pos;  /* buffer mode: where the current block's code byte goes */
-    uint8_t code;     /* 1 + data bytes in the current block */
-    uint32_t crc_reg; /* CRC-32C register: the CRC is its complement */
-    bsf_encoder_t *work;
-    bsf_sink_fn sink;
-    void *ctx;
-    int failed;
-    uint64_t acc;   /* pending bits of the payload's bit stream, MSB first */
-    unsigned n_acc; /* number of pending bits (< 8 between calls) */
-    /* Costing run (costing != 0): nothing is emitted; bits sums the payload
-     * bits outside the control point values, tally counts those per class. */
-    int costing;
-    uint32_t bits;
-    bsf_wire_eg_tally_t *tally; /* costing run only: BSF_WIRE_N_CLASSES entries (the
-                                 * writing runs do not carry them on the stack) */
+    uint8_t *p;    /* the next word goes here */
+    uint8_t *end;  /* words must end at or before this */
+    uint32_t acc;  /* pending bits in the low 32 - room bits (higher bits: leftovers) */
+    unsigned room; /* free bits in acc, 1..32 */
+    stream_t *out; /* streaming path; NULL when writing straight into a buffer */
+    int overflow;  /* direct writing ran past end (a planning bug: never written) */
+    int costing;   /* planning run */
+    uint32_t bits; /* planning run: payload bits outside the control point values */
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    uint8_t chunk[CHUNK_BYTES];
 } writer_t;
 
-static void emit(writer_t *w, const uint8_t *data, size_t len)
+static void writer_init(writer_t *w, stream_t *out)
 {
-    if (!w->failed) {
-        if (w->sink(w->ctx, data, len) != 0) {
-            w->failed = 1;
-        } else {
-            w->pos += len;
-        }
-    }
+    w->acc = 0u;
+    w->room = 32u;
+    w->out = out;
+    w->overflow = 0;
+    w->costing = 0;
+    w->bits = 0u;
+    memset(w->k_ctrl, 0, sizeof w->k_ctrl);
+    w->p = w->chunk;
+    w->end = w->chunk + CHUNK_BYTES;
 }
 
-static void block_start(writer_t *w)
+static void store_be32(uint8_t *p, uint32_t v)
 {
-    w->code = 1u;
-    if (w->sink == NULL) {
-        w->code_pos = w->pos++;
-    }
+#if defined(__BYTE_ORDER__) && defined(__ORDER_BIG_ENDIAN__) &&                                    \
+    __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+    memcpy(p, &v, 4u);
+#elif defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                               \
+    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__ && (defined(__GNUC__) || defined(__clang__))
+    v = __builtin_bswap32(v);
+    memcpy(p, &v, 4u);
+#else
+    p[0] = (uint8_t)(v >> 24);
+    p[1] = (uint8_t)(v >> 16);
+    p[2] = (uint8_t)(v >> 8);
+    p[3] = (uint8_t)v;
+#endif
 }
 
-static void block_end(writer_t *w)
+/* The chunk is full: hand it on (streaming), or stop writing (direct). */
+static void writer_spill(writer_t *w)
 {
-    if (w->sink != NULL) {
-        w->work->block[0] = w->code;
-        emit(w, w->work->block, w->code);
-    } else if (w->buf != NULL && w->code_pos < w->cap) {
-        w->buf[w->code_pos] = w->code;
-    }
-}
-
-static void put_u8(writer_t *w, uint8_t b)
-{
-    if (w->costing) {
-        w->bits += 8u;
-        return;
-    }
-    w->crc_reg = bsf_wire_crc32c_step(w->crc_reg, b);
-    if (b == 0u) {
-        block_end(w);
-        block_start(w);
-        return;
-    }
-    if (w->sink != NULL) {
-        w->work->block[w->code] = b;
+    if (w->out != NULL) {
+        stream_payload(w->out, w->chunk, (size_t)(w->p - w->chunk));
     } else {
-        if (w->buf != NULL && w->pos < w->cap) {
-            w->buf[w->pos] = b;
-        }
-        ++w->pos;
+        w->overflow = 1;
+        w->end = w->chunk + CHUNK_BYTES;
     }
-    if (++w->code == 0xFFu) {
-        block_end(w);
-        block_start(w);
+    w->p = w->chunk;
+}
+
+static inline void put_word(writer_t *w, uint32_t word)
+{
+    if ((size_t)(w->end - w->p) < 4u) {
+        writer_spill(w);
+    }
+    store_be32(w->p, word);
+    w->p += 4;
+}
+
+/* The n (0..31) bits of v (v < 2^n) into the accumulator *acc with *room free bits. */
+static inline void put_acc(writer_t *w, uint32_t *acc, unsigned *room, uint32_t v, unsigned n)
+{
+    if (n < *room) {
+        *acc = (*acc << n) | v;
+        *room -= n;
+    } else {
+        const unsigned rest = n - *room; /* bits of v for the next word; *room <= n <= 31 */
+        put_word(w, (*acc << *room) | (v >> rest));
+        *acc = v; /* the bits of v above rest leave with the next word's shifts */
+        *room = 32u - rest;
     }
 }
 
-/* The n (<= 32) low bits of v, most significant first, whole bytes out. */
-static void put_bits(writer_t *w, uint32_t v, unsigned n)
+/* Exp-Golomb code of order k (<= 25) of v < 2^30: v + 2^k in 2 b - 1 - k
+ * bits, b its bit length (the b - 1 - k leading zeros, then v + 2^k). */
+static inline void put_eg_acc(writer_t *w, uint32_t *acc, unsigned *room, uint32_t v, unsigned k)
+{
+    const uint32_t c = v + ((uint32_t)1 << k);
+    const unsigned b = bsf_wire_bitlen32(c);
+    const unsigned len = 2u * b - 1u - k;
+    if (len < 32u) {
+        put_acc(w, acc, room, c, len);
+    } else {
+        put_acc(w, acc, room, 0u, len - b);
+        put_acc(w, acc, room, c, b);
+    }
+}
+
+static inline unsigned eg_len32(uint32_t v, unsigned k)
+{
+    return 2u * bsf_wire_bitlen32(v + ((uint32_t)1 << k)) - 1u - k;
+}
+
+/* Fields: u(n), n <= 31. */
+static void field_u(writer_t *w, uint32_t v, unsigned n)
 {
     if (w->costing) {
         w->bits += n;
+    } else {
+        put_acc(w, &w->acc, &w->room, v, n);
+    }
+}
+
+/* EGk of v < 2^30, k <= 25. */
+static void field_eg(writer_t *w, uint32_t v, unsigned k)
+{
+    if (w->costing) {
+        w->bits += eg_len32(v, k);
+    } else {
+        put_eg_acc(w, &w->acc, &w->room, v, k);
+    }
+}
+
+/* The n (<= 64) low bits of v, 16 at a time. */
+static void put_wide(writer_t *w, uint64_t v, unsigned n)
+{
+    while (n > 16u) {
+        n -= 16u;
+        put_acc(w, &w->acc, &w->room, (uint32_t)(v >> n) & 0xFFFFu, 16u);
+    }
+    put_acc(w, &w->acc, &w->room, (uint32_t)v & ((1u << n) - 1u), n);
+}
+
+/* EGk of any v with v >> k < 2^63, k <= 63. */
+static void field_eg64(writer_t *w, uint64_t v, unsigned k)
+{
+    uint64_t u;
+    unsigned b;
+    if (v < ((uint64_t)1 << 30) && k <= 25u) {
+        field_eg(w, (uint32_t)v, k);
         return;
     }
-    w->acc = (w->acc << n) | ((uint64_t)v & ((((uint64_t)1) << n) - 1u));
-    w->n_acc += n;
-    while (w->n_acc >= 8u) {
-        w->n_acc -= 8u;
-        put_u8(w, (uint8_t)(w->acc >> w->n_acc));
-    }
-}
-
-/* The n (<= 64) low bits of v. */
-static void put_bits_wide(writer_t *w, uint64_t v, unsigned n)
-{
-    if (n > 32u) {
-        put_bits(w, (uint32_t)(v >> 32), n - 32u);
-        n = 32u;
-    }
-    put_bits(w, (uint32_t)v, n);
-}
-
-/* Exp-Golomb code of order k: for u = (v >> k) + 1 of b bits, b - 1 zeros,
- * u itself, then the k low bits of v; short codes as one field. */
-static void put_eg_bits(writer_t *w, uint64_t v, unsigned k)
-{
-    const uint64_t u = (v >> k) + 1u;
-    const unsigned b = bsf_wire_bitlen(u);
-    const uint64_t low = k == 0u ? 0u : v & (~(uint64_t)0 >> (64u - k));
-    if (2u * b - 1u + k <= 32u) {
-        /* the b - 1 zeros come out as the leading zeros of the field */
-        put_bits(w, (uint32_t)((u << k) | low), 2u * b - 1u + k);
+    u = (v >> k) + 1u;
+    b = bsf_wire_bitlen(u);
+    if (w->costing) {
+        w->bits += 2u * b - 1u + k;
         return;
     }
-    put_bits_wide(w, 0u, b - 1u);
-    put_bits_wide(w, u, b);
-    put_bits_wide(w, low, k);
+    put_wide(w, 0u, b - 1u);
+    put_wide(w, u, b);
+    put_wide(w, v, k);
 }
 
-/* Costing runs only add the code's length (inline: most fields pass here). */
-static inline void put_eg(writer_t *w, uint64_t v, unsigned k)
+static void field_seg(writer_t *w, int64_t v, unsigned k)
 {
-    if (w->costing) {
-        w->bits += 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
-    } else {
-        put_eg_bits(w, v, k);
+    field_eg64(w, bsf_wire_zigzag(v), k);
+}
+
+static uint32_t float_bits(float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+static void field_float(writer_t *w, float v)
+{
+    const uint32_t u = float_bits(v);
+    field_u(w, u >> 16, 16u);
+    field_u(w, u & 0xFFFFu, 16u);
+}
+
+/* Pads the payload to whole bytes and pushes out its last, partial word
+ * (its unused bytes are overwritten by what follows). */
+static void writer_flush(writer_t *w)
+{
+    if (w->room < 32u) {
+        put_word(w, w->acc << w->room);
     }
 }
 
-static void put_seg(writer_t *w, int64_t v, unsigned k)
+/* ---- Control point values ------------------------------------------------ */
+
+/* A value in the per-frame table: zigzag code (below 2^26) | class << 30. */
+#define VALUE_CLASS_SHIFT 30u
+#define VALUE_MASK 0x3FFFFFFFu
+
+/* Table size: two whole features at least (a feature beyond the table is
+ * quantised again into it), and the values of a typical frame (about 55 on
+ * Intel, 100 on MIT and Freiburg) at 4 bytes each. */
+#define VALUE_TABLE 128u
+#if VALUE_TABLE < 2u * BSF_MAX_CTRL_PER_FEATURE
+#error "VALUE_TABLE must hold the values of one feature"
+#endif
+
+static inline uint32_t zigzag32(int32_t v)
 {
-    put_eg(w, bsf_wire_zigzag(v), k);
+    return ((uint32_t)v << 1) ^ (0u - ((uint32_t)v >> 31));
 }
 
-/* A control point value of class cls: costed or written at the frame's order. */
-static void put_ctrl_value(writer_t *w, unsigned cls, int64_t v)
-{
-    const uint64_t z = bsf_wire_zigzag(v);
-    if (w->costing) {
-        bsf_wire_eg_tally_add(&w->tally[cls], z);
-    } else {
-        put_eg(w, z, w->k_ctrl[cls]);
-    }
-}
+/* The control point values of one feature, in wire order, into the table. */
+typedef struct {
+    uint32_t *out;              /* the table */
+    uint32_t n;                 /* values produced (stored while below cap) */
+    uint32_t cap;               /* table entries left */
+    bsf_wire_eg_tally_t *tally; /* planning: per class */
+} values_t;
 
-/* Ends the frame: the CRC (not itself checksummed), the last block, 0x00. */
-static void finish(writer_t *w)
+static inline void add_value(values_t *vs, unsigned cls, int32_t v)
 {
-    uint32_t crc;
-    unsigned i;
-    if (w->costing) {
-        return; /* the caller adds padding and CRC */
+    const uint32_t z = zigzag32(v);
+    if (vs->tally != NULL) {
+        bsf_wire_eg_tally_add32(&vs->tally[cls], z);
     }
-    if (w->n_acc > 0u) {
-        put_bits(w, 0u, 8u - w->n_acc); /* pad the last byte with zeros */
+    if (vs->n < vs->cap) {
+        vs->out[vs->n] = z | ((uint32_t)cls << VALUE_CLASS_SHIFT);
     }
-    crc = ~w->crc_reg;
-    for (i = 0; i < 4u; ++i) {
-        put_u8(w, (uint8_t)(crc >> (8u * i)));
-    }
-    if (w->sink != NULL) {
-        w->work->block[0] = w->code;
-        w->work->block[w->code] = 0u;
-        emit(w, w->work->block, (size_t)w->code + 1u);
-    } else {
-        block_end(w);
-        if (w->buf != NULL && w->pos < w->cap) {
-            w->buf[w->pos] = 0u;
-        }
-        ++w->pos;
-    }
+    ++vs->n;
 }
 
 static int is_finite_f(float v)
@@ -198,7 +361,7 @@ static int is_finite_f(float v)
  * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
  * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
  * one lower for a negative r with a fraction. */
-static int quantise(float v, float step, int32_t *q)
+static inline int quantise(float v, float step, int32_t *q)
 {
     const float r = v / step + 0.5f;
     int32_t t;
@@ -211,18 +374,133 @@ static int quantise(float v, float step, int32_t *q)
     return 1;
 }
 
-static int quantise_point(bsf_point_t p, float step, int32_t q[2])
+static inline int quantise_point(bsf_point_t p, float step, int32_t q[2])
 {
     const int ok_x = quantise(p.x, step, &q[0]);
     const int ok_y = quantise(p.y, step, &q[1]);
     return ok_x && ok_y;
 }
 
+/* A flagged slot s needs a flagged partner s + 1 that quantises to q. */
+static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s, size_t n,
+                             float step, const int32_t q[2])
+{
+    int32_t q2[2];
+    return s + 1u < n && vtx[s + 1u] != 0u && quantise_point(p[s + 1u], step, q2) &&
+           q2[0] == q[0] && q2[1] == q[1];
+}
+
 /*
- * Checks one feature and finds its unique control points: a flagged slot
- * must be followed by a flagged partner with the same quantised value;
- * the pair is one vertex, bit j of *mask for unique point j.
+ * The values of one feature's n control points: the first distinct point
+ * as a delta from prev (the last anchor of the previous feature), then per
+ * fragment the next anchor (vertex or last point) as a delta from the
+ * previous anchor, then the fragment's precision points as residuals from
+ * their predicted places on the chord (FORMAT.md section 3.3). Returns 0
+ * when a point cannot be represented or a flagged slot has no equal
+ * partner, else 1; *mask gets bit j for distinct point j that is a vertex.
  */
+static int feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
+                          int32_t prev[2], values_t *vs, uint64_t *mask)
+{
+    size_t s_a = 0;
+    size_t c_a;
+    unsigned j_a = 0; /* distinct index of anchor a */
+    int32_t q_a[2];
+
+    *mask = 0u;
+    if (!quantise_point(p[0], step, q_a)) {
+        return 0;
+    }
+    if (vtx[0] != 0u) {
+        if (!vertex_partner_ok(p, vtx, 0u, n, step, q_a)) {
+            return 0;
+        }
+        *mask = 1u;
+        c_a = 2u;
+    } else {
+        c_a = 1u;
+    }
+    add_value(vs, BSF_WIRE_CLASS_FIRST, q_a[0] - prev[0]);
+    add_value(vs, BSF_WIRE_CLASS_FIRST, q_a[1] - prev[1]);
+    while (s_a + c_a < n) {
+        const size_t t = s_a + c_a;
+        size_t s_b = t;
+        size_t i;
+        int32_t q_b[2];
+        uint32_t k;
+        while (s_b < n - 1u && vtx[s_b] == 0u) {
+            ++s_b;
+        }
+        k = (uint32_t)(s_b - t);
+        if (!quantise_point(p[s_b], step, q_b)) {
+            return 0;
+        }
+        j_a += k + 1u;
+        if (vtx[s_b] != 0u) {
+            if (!vertex_partner_ok(p, vtx, s_b, n, step, q_b)) {
+                return 0;
+            }
+            *mask |= (uint64_t)1u << j_a;
+            c_a = 2u;
+        } else {
+            c_a = 1u;
+        }
+        add_value(vs, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
+        add_value(vs, BSF_WIRE_CLASS_ANCHOR, q_b[1] - q_a[1]);
+        for (i = t; i < s_b; ++i) {
+            const uint32_t s = (uint32_t)(i - t) + 1u;
+            int32_t q[2];
+            if (!quantise_point(p[i], step, q)) {
+                return 0;
+            }
+            add_value(vs, BSF_WIRE_CLASS_PREC,
+                      q[0] - (int32_t)bsf_wire_predict(q_a[0], q_b[0], s, k));
+            add_value(vs, BSF_WIRE_CLASS_PREC,
+                      q[1] - (int32_t)bsf_wire_predict(q_a[1], q_b[1], s, k));
+        }
+        s_a = s_b;
+        q_a[0] = q_b[0];
+        q_a[1] = q_b[1];
+    }
+    prev[0] = q_a[0];
+    prev[1] = q_a[1];
+    return 1;
+}
+
+/* Distinct points of a checked feature and its vertex mask, from the flags. */
+static uint32_t feature_mask(const uint8_t *vtx, size_t n, uint64_t *mask)
+{
+    size_t s = 0;
+    uint32_t j = 0;
+    *mask = 0u;
+    while (s < n) {
+        if (vtx[s] != 0u) {
+            *mask |= (uint64_t)1u << j;
+            s += 2u;
+        } else {
+            s += 1u;
+        }
+        ++j;
+    }
+    return j;
+}
+
+/* The values' codes at the frame's orders: the hot loop of the writing run. */
+static void put_values(writer_t *w, const uint32_t *values, uint32_t n)
+{
+    uint32_t acc = w->acc;
+    unsigned room = w->room;
+    uint32_t i;
+    for (i = 0; i < n; ++i) {
+        const uint32_t v = values[i];
+        put_eg_acc(w, &acc, &room, v & VALUE_MASK, w->k_ctrl[v >> VALUE_CLASS_SHIFT]);
+    }
+    w->acc = acc;
+    w->room = room;
+}
+
+/* ---- Features frame ------------------------------------------------------ */
+
 /* Beams minus one of a feature's run: last - first, or through the seam of
  * a full-circle scan of n_beams beams when first > last. */
 static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
@@ -233,100 +511,17 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
     return (uint32_t)(f->last_beam - f->first_beam);
 }
 
-static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f, float step,
-                                 int check_points, uint32_t *n_unique, uint64_t *mask)
+/* A feature's own fields (not its points) within the result and the caps. */
+static int feature_ok(const bsf_result_t *res, const bsf_feature_t *f)
 {
     const size_t n = f->n_ctrl;
     const uint32_t n_beams = res->stats.n_beams;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
-    size_t s = 0;
-    uint32_t j = 0;
-
-    if (f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
-        (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
-        f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
-        f->n_points > feature_span(f, n_beams) + 1u ||
-        !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX)) {
-        return BSF_ERR_ARG;
-    }
-    *mask = 0u;
-    while (s < n) {
-        const size_t slot = (size_t)f->ctrl_first + s;
-        int32_t q[2];
-        if (check_points && !quantise_point(res->ctrl[slot], step, q)) {
-            return BSF_ERR_ARG;
-        }
-        if (res->ctrl_is_vertex[slot] != 0u) {
-            int32_t q2[2];
-            if (check_points && (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
-                                 !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] ||
-                                 q2[1] != q[1])) {
-                return BSF_ERR_ARG;
-            }
-            *mask |= (uint64_t)1u << j;
-            s += 2u;
-        } else {
-            s += 1u;
-        }
-        ++j;
-    }
-    *n_unique = j;
-    return BSF_OK;
-}
-
-static void put_delta(writer_t *w, unsigned cls, const int32_t q[2], const int64_t ref[2])
-{
-    put_ctrl_value(w, cls, (int64_t)q[0] - ref[0]);
-    put_ctrl_value(w, cls, (int64_t)q[1] - ref[1]);
-}
-
-/*
- * Control points of one (already checked) feature: the first unique point
- * as a delta from *prev, then per fragment the next anchor (vertex or last
- * point) as a delta from the previous anchor, then the fragment's precision
- * points as residuals from their predicted places on the chord.
- */
-static void put_ctrl(writer_t *w, const bsf_result_t *res, const bsf_feature_t *f, float step,
-                     int64_t prev[2])
-{
-    const bsf_point_t *p = &res->ctrl[f->ctrl_first];
-    const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
-    const size_t n = f->n_ctrl;
-    size_t s_a = 0;
-    size_t c_a = vtx[0] != 0u ? 2u : 1u;
-    int32_t q_a[2];
-    int64_t ref[2];
-
-    (void)quantise_point(p[0], step, q_a);
-    put_delta(w, BSF_WIRE_CLASS_FIRST, q_a, prev);
-    while (s_a + c_a < n) {
-        const size_t t = s_a + c_a;
-        size_t s_b = t;
-        size_t i;
-        int32_t q_b[2];
-        while (s_b < n - 1u && vtx[s_b] == 0u) {
-            ++s_b;
-        }
-        (void)quantise_point(p[s_b], step, q_b);
-        ref[0] = q_a[0];
-        ref[1] = q_a[1];
-        put_delta(w, BSF_WIRE_CLASS_ANCHOR, q_b, ref);
-        for (i = t; i < s_b; ++i) {
-            const uint32_t k = (uint32_t)(s_b - t);
-            const uint32_t s = (uint32_t)(i - t) + 1u;
-            int32_t q[2];
-            (void)quantise_point(p[i], step, q);
-            ref[0] = bsf_wire_predict(q_a[0], q_b[0], s, k);
-            ref[1] = bsf_wire_predict(q_a[1], q_b[1], s, k);
-            put_delta(w, BSF_WIRE_CLASS_PREC, q, ref);
-        }
-        s_a = s_b;
-        c_a = vtx[s_b] != 0u ? 2u : 1u;
-        q_a[0] = q_b[0];
-        q_a[1] = q_b[1];
-    }
-    prev[0] = q_a[0];
-    prev[1] = q_a[1];
+    return !(f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
+             (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
+             f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
+             f->n_points > feature_span(f, n_beams) + 1u ||
+             !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX));
 }
 
 static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code)
@@ -379,29 +574,27 @@ static int32_t round_to_int(float v)
     return (int32_t)bsf_floorf(v + 0.5f);
 }
 
-static void put_float(writer_t *w, float v);
-
-/* The whole frame through w. It may fail half-way, so every caller runs it
- * in costing and counting mode first and writes only when those passes
- * succeeded. */
-static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const bsf_result_t *res)
-{
+/* What the planning run learns for the writing run. */
+typedef struct {
     uint32_t step_code;
     float step;
-    uint32_t i;
-    uint32_t sum_points = 0;
-    int64_t prev_last_beam = -1;
-    int64_t prev[2] = {0, 0};
-    uint32_t wraps = 0u;
     int has_beams;
     int has_ext;
-    bsf_status_t st;
+    uint32_t n_cached;      /* leading features whose values are all in the table */
+    int32_t prev_resume[2]; /* the last anchor before feature n_cached */
+    uint32_t bits;          /* payload bits, byte 0 included */
+} plan_t;
 
+/* The checks that come before any field. */
+static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t *res, plan_t *pl)
+{
+    uint32_t i;
+    bsf_status_t st;
     if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS ||
         res->n_ctrl > (uint32_t)BSF_MAX_CTRL_POINTS) {
         return BSF_ERR_CAPACITY;
     }
-    st = check_info(info, &step_code);
+    st = check_info(info, &pl->step_code);
     if (st != BSF_OK) {
         return st;
     }
@@ -412,256 +605,201 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     if (info->has_geometry != 0u && res->stats.n_beams == 0u) {
         return BSF_ERR_ARG;
     }
-    step = (float)step_code * BSF_QUANT_STEP_UNIT;
+    pl->step = (float)pl->step_code * BSF_QUANT_STEP_UNIT;
+    pl->has_beams = info->has_geometry != 0u;
     for (i = 0; i < res->n_features; ++i) {
         if (res->features[i].first_beam > res->features[i].last_beam) {
-            wraps = 1u;
+            pl->has_beams = 1;
         }
     }
-    has_beams = wraps != 0u || info->has_geometry != 0u;
-    has_ext = has_beams || res->stats.cut != 0u;
+    pl->has_ext = pl->has_beams || res->stats.cut != 0u;
+    return BSF_OK;
+}
 
-    block_start(w);
-    put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES));
-    put_bits(w, info->has_pose != 0u ? 1u : 0u, 1u);
-    put_bits(w, has_ext ? 1u : 0u, 1u);
-    put_eg(w, info->seq, BSF_WIRE_K_SEQ);
-    put_eg(w, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
+/*
+ * The payload through w. Planning run (w->costing, tally given): checks
+ * every feature, fills the value table and the tallies, sums the other
+ * fields' bits. Writing run: the input was checked, the values come from
+ * the table or are made again.
+ */
+static bsf_status_t frame_payload(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
+                                  const bsf_result_t *res, uint32_t *table,
+                                  bsf_wire_eg_tally_t *tally)
+{
+    const float step = pl->step;
+    uint32_t i;
+    uint32_t sum_points = 0;
+    uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
+    uint32_t used = 0;                 /* table entries of the leading features */
+    int32_t prev[2] = {0, 0};
+
+    field_u(w, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
+    field_u(w, info->has_pose != 0u ? 1u : 0u, 1u);
+    field_u(w, pl->has_ext ? 1u : 0u, 1u);
+    field_eg64(w, info->seq, BSF_WIRE_K_SEQ);
+    field_eg64(w, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
         const uint32_t theta =
             (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
-        put_seg(w, round_to_int(info->pose_x * 1000.0f), BSF_WIRE_K_POSE);
-        put_seg(w, round_to_int(info->pose_y * 1000.0f), BSF_WIRE_K_POSE);
-        put_bits(w, theta, 16u);
+        field_seg(w, round_to_int(info->pose_x * 1000.0f), BSF_WIRE_K_POSE);
+        field_seg(w, round_to_int(info->pose_y * 1000.0f), BSF_WIRE_K_POSE);
+        field_u(w, theta, 16u);
     }
-    put_eg(w, step_code, BSF_WIRE_K_STEP);
-    put_eg(w, res->stats.n_valid, BSF_WIRE_K_N);
-    put_eg(w, ((uint64_t)res->stats.time_ns + 500u) / 1000u, BSF_WIRE_K_TIME_US);
-    put_eg(w, res->n_features, BSF_WIRE_K_FEATURES);
+    field_eg(w, pl->step_code, BSF_WIRE_K_STEP);
+    field_eg(w, res->stats.n_valid, BSF_WIRE_K_N);
+    field_eg(w, (uint32_t)(((uint64_t)res->stats.time_ns + 500u) / 1000u), BSF_WIRE_K_TIME_US);
+    field_eg(w, res->n_features, BSF_WIRE_K_FEATURES);
     for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
-        put_bits(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
+        field_u(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
     }
-    if (has_ext) {
-        put_bits(w, has_beams ? 1u : 0u, 1u);
-        put_bits(w, info->has_geometry != 0u ? 1u : 0u, 1u);
-        put_bits(w, res->stats.cut, BSF_WIRE_CUT_BITS);
-        if (has_beams) {
-            put_eg(w, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
+    if (pl->has_ext) {
+        field_u(w, pl->has_beams ? 1u : 0u, 1u);
+        field_u(w, info->has_geometry != 0u ? 1u : 0u, 1u);
+        field_u(w, res->stats.cut, BSF_WIRE_CUT_BITS);
+        if (pl->has_beams) {
+            field_eg(w, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
         }
         if (info->has_geometry != 0u) {
-            put_float(w, info->angle_min);
-            put_float(w, info->angle_increment);
+            field_float(w, info->angle_min);
+            field_float(w, info->angle_increment);
         }
         if (res->stats.cut != 0u) {
-            put_eg(w, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
-            put_eg(w, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
-            put_eg(w, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
+            field_eg(w, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
+            field_eg(w, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
+            field_eg(w, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
         }
     }
 
     for (i = 0; i < res->n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
-        uint32_t n_unique = 0;
+        const bsf_point_t *p = &res->ctrl[f->ctrl_first];
+        const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
+        const uint32_t span = feature_span(f, res->stats.n_beams);
+        const int32_t gap = (int32_t)f->first_beam - (int32_t)prev_last_beam_plus1;
         uint64_t mask = 0;
-        uint32_t span;
+        uint32_t n_unique;
         uint32_t j;
+        const uint32_t *values;
+        values_t vs;
 
-        /* the points were checked by the costing run that precedes every
-         * other run (a vertex pair's flags alone then give the mask) */
-        st = scan_feature(res, f, step, w->costing, &n_unique, &mask);
-        if (st != BSF_OK) {
-            return st;
+        if (w->costing) {
+            if (!feature_ok(res, f)) {
+                return BSF_ERR_ARG;
+            }
+            /* into the table while it has room, else only tallied */
+            if (pl->n_cached == i) {
+                pl->prev_resume[0] = prev[0];
+                pl->prev_resume[1] = prev[1];
+            }
+            vs.out = table + used;
+            vs.cap = pl->n_cached == i ? VALUE_TABLE - used : 0u;
+            vs.n = 0u;
+            vs.tally = tally;
+            if (!feature_values(p, vtx, f->n_ctrl, step, prev, &vs, &mask)) {
+                return BSF_ERR_ARG;
+            }
+            if (vs.n <= vs.cap) {
+                used += vs.n;
+                pl->n_cached = i + 1u;
+            }
+            n_unique = vs.n / 2u;
+            values = NULL;
+        } else if (i < pl->n_cached) {
+            n_unique = feature_mask(vtx, f->n_ctrl, &mask);
+            values = table + used;
+            used += 2u * n_unique;
+        } else {
+            /* beyond the table: the same values again, into it */
+            if (i == pl->n_cached) {
+                prev[0] = pl->prev_resume[0];
+                prev[1] = pl->prev_resume[1];
+            }
+            vs.out = table;
+            vs.cap = VALUE_TABLE;
+            vs.n = 0u;
+            vs.tally = NULL;
+            (void)feature_values(p, vtx, f->n_ctrl, step, prev, &vs, &mask);
+            n_unique = vs.n / 2u;
+            values = table;
         }
-        span = feature_span(f, res->stats.n_beams);
         sum_points += f->n_points;
-        put_bits(w, f->kind, 1u);
-        put_eg(w, n_unique - 2u, BSF_WIRE_K_M);
-        put_bits(w, mask != 0u ? 1u : 0u, 1u);
+        field_u(w, f->kind, 1u);
+        field_eg(w, n_unique - 2u, BSF_WIRE_K_M);
+        field_u(w, mask != 0u ? 1u : 0u, 1u);
         for (j = 0; mask != 0u && j < n_unique; ++j) {
-            put_bits(w, (uint32_t)(mask >> j) & 1u, 1u);
+            field_u(w, (uint32_t)(mask >> j) & 1u, 1u);
         }
-        put_seg(w, (int64_t)f->first_beam - prev_last_beam - 1, BSF_WIRE_K_GAP);
-        put_eg(w, span, BSF_WIRE_K_SPAN);
-        put_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        put_eg(w, (uint64_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
-               BSF_WIRE_K_E_CURVE);
-        put_ctrl(w, res, f, step, prev);
-        prev_last_beam = f->last_beam;
+        field_eg(w, zigzag32(gap), BSF_WIRE_K_GAP);
+        field_eg(w, span, BSF_WIRE_K_SPAN);
+        field_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
+        field_eg(w, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
+                 BSF_WIRE_K_E_CURVE);
+        if (values != NULL) {
+            put_values(w, values, 2u * n_unique);
+        }
+        prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
     }
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
-    finish(w);
+    if (!w->costing && pl->n_cached < res->n_features) {
+        /* values made again overwrote the table: a further run makes all again */
+        pl->n_cached = 0u;
+        pl->prev_resume[0] = 0;
+        pl->prev_resume[1] = 0;
+    }
     return BSF_OK;
 }
 
-void bsf_frame_info_init(bsf_frame_info_t *info)
-{
-    if (info != NULL) {
-        info->seq = 0u;
-        info->timestamp_ms = 0u;
-        info->has_pose = 0u;
-        info->pose_x = 0.0f;
-        info->pose_y = 0.0f;
-        info->pose_theta = 0.0f;
-        info->quant_step = BSF_QUANT_STEP_DEFAULT;
-        info->has_geometry = 0u;
-        info->angle_min = 0.0f;
-        info->angle_increment = 0.0f;
-    }
-}
-
-static void writer_init(writer_t *w)
-{
-    w->buf = NULL;
-    w->cap = 0u;
-    w->pos = 0u;
-    w->code_pos = 0u;
-    w->code = 1u;
-    w->crc_reg = 0xFFFFFFFFu;
-    w->work = NULL;
-    w->sink = NULL;
-    w->ctx = NULL;
-    w->failed = 0;
-    w->acc = 0u;
-    w->n_acc = 0u;
-    w->costing = 0;
-    w->tally = NULL;
-    w->bits = 0u;
-    memset(w->k_ctrl, 0, sizeof w->k_ctrl);
-}
-
 /*
- * The Exp-Golomb order of each control point class that makes the frame
- * shortest (one costing run; ties go to the smaller order), and an upper
- * bound on the frame's size. The chosen total never exceeds the total at
- * order 25, which bounds every value by 26 bits (BSF_FRAME_CTRL_MAX_BITS).
+ * Planning run: checks, the value table, each class's order (the shortest;
+ * ties to the smaller) and the payload's exact size in bits. The chosen
+ * total never exceeds the total at order 25, which bounds every value by 26
+ * bits (BSF_FRAME_CTRL_MAX_BITS).
  */
-static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result_t *res,
-                                  uint8_t k_ctrl[BSF_WIRE_N_CLASSES], size_t *size_bound)
+static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t *res,
+                               uint32_t *table, plan_t *pl, uint8_t k_ctrl[BSF_WIRE_N_CLASSES])
 {
     writer_t w;
     bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     unsigned cls;
-    uint32_t bits;
-    size_t body;
     bsf_status_t st;
-    writer_init(&w);
-    w.costing = 1;
-    memset(tally, 0, sizeof tally);
-    w.tally = tally;
-    st = write_frame(&w, info, res);
+
+    memset(pl, 0, sizeof *pl);
+    st = check_frame(info, res, pl);
     if (st != BSF_OK) {
         return st;
     }
-    bits = w.bits;
-    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
-        uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
-        unsigned k;
-        unsigned best = 0;
-        /* above the longest value's bit length L every order costs one bit
-         * per value more than the one before, so none beats order L */
-        const unsigned k_top =
-            tally[cls].max_len < BSF_WIRE_K_CTRL_MAX ? tally[cls].max_len : BSF_WIRE_K_CTRL_MAX;
-        bsf_wire_eg_tally_costs(&tally[cls], k_top, cost);
-        for (k = 1; k <= k_top; ++k) {
-            if (cost[k] < cost[best]) {
-                best = k;
-            }
-        }
-        k_ctrl[cls] = (uint8_t)best;
-        bits += cost[best];
+    writer_init(&w, NULL);
+    w.costing = 1;
+    memset(tally, 0, sizeof tally);
+    st = frame_payload(&w, pl, info, res, table, tally);
+    if (st != BSF_OK) {
+        return st;
     }
-    /* payload bytes and CRC, one COBS code byte first and one per 254
-     * bytes at most (a zero byte is replaced by one), the 0x00 delimiter */
-    body = ((size_t)bits + 7u) / 8u + 4u;
-    *size_bound = body + body / 254u + 2u;
+    pl->bits = w.bits;
+    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
+        uint32_t bits;
+        k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);
+        pl->bits += bits;
+    }
     return BSF_OK;
 }
 
-/* Write a validated frame with the chosen orders into buf (cap bytes). */
-static bsf_status_t write_frame_into(uint8_t *buf, size_t cap,
-                                     const uint8_t k_ctrl[BSF_WIRE_N_CLASSES],
-                                     const bsf_frame_info_t *info, const bsf_result_t *res,
-                                     writer_t *w)
+/* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
+static void writer_end_stream(writer_t *w)
 {
-    writer_init(w);
-    memcpy(w->k_ctrl, k_ctrl, BSF_WIRE_N_CLASSES);
-    w->buf = buf;
-    w->cap = cap;
-    return write_frame(w, info, res);
-}
-
-bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
-                              uint8_t *buf, size_t cap, size_t *out_len)
-{
-    writer_t w;
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
-    size_t bound = 0;
-    bsf_status_t st;
-
-    if (info == NULL || result == NULL || out_len == NULL) {
-        return BSF_ERR_ARG;
+    size_t n;
+    if (w->room < 32u) {
+        const unsigned tail = (32u - w->room + 7u) / 8u; /* bytes of the partial word */
+        put_word(w, w->acc << w->room);
+        n = (size_t)(w->p - w->chunk) - (4u - tail);
+    } else {
+        n = (size_t)(w->p - w->chunk);
     }
-    st = choose_orders(info, result, k_ctrl, &bound);
-    if (st == BSF_OK && buf != NULL && cap >= bound) {
-        /* validated, and fits whatever its COBS blocks: write at once */
-        st = write_frame_into(buf, cap, k_ctrl, info, result, &w);
-        *out_len = st == BSF_OK ? w.pos : 0u;
-        return st;
-    }
-    if (st == BSF_OK) {
-        writer_init(&w);
-        memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
-        st = write_frame(&w, info, result);
-    }
-    if (st != BSF_OK) {
-        *out_len = 0u;
-        return st;
-    }
-    *out_len = w.pos;
-    if (buf == NULL) {
-        return BSF_OK;
-    }
-    if (w.pos > cap) {
-        return BSF_ERR_BUFFER;
-    }
-    return write_frame_into(buf, cap, k_ctrl, info, result, &w);
-}
-
-bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,
-                                   const bsf_result_t *result, bsf_sink_fn sink, void *ctx,
-                                   size_t *written)
-{
-    writer_t w;
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
-    size_t bound;
-    bsf_status_t st;
-
-    if (written != NULL) {
-        *written = 0u;
-    }
-    if (work == NULL || info == NULL || result == NULL || sink == NULL) {
-        return BSF_ERR_ARG;
-    }
-    st = choose_orders(info, result, k_ctrl, &bound);
-    if (st != BSF_OK) {
-        return st;
-    }
-    writer_init(&w);
-    memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
-    w.work = work;
-    w.sink = sink;
-    w.ctx = ctx;
-    st = write_frame(&w, info, result);
-    if (written != NULL) {
-        *written = w.pos;
-    }
-    if (st == BSF_OK && w.failed) {
-        st = BSF_ERR_BUFFER;
-    }
-    return st;
+    stream_payload(w->out, w->chunk, n);
+    stream_finish(w->out);
 }
 
 /* ---- Metadata frame ------------------------------------------------------ */
@@ -680,20 +818,6 @@ void bsf_metadata_init(bsf_metadata_t *m)
         m->max_ctrl_per_feature = (uint32_t)BSF_MAX_CTRL_PER_FEATURE;
         m->max_ctrl_points = (uint32_t)BSF_MAX_CTRL_POINTS;
     }
-}
-
-static uint32_t float_bits(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
-static void put_float(writer_t *w, float v)
-{
-    const uint32_t u = float_bits(v);
-    put_bits(w, u >> 16, 16u);
-    put_bits(w, u & 0xFFFFu, 16u);
 }
 
 static int cap_ok(uint32_t v)
@@ -727,99 +851,261 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
     return BSF_OK;
 }
 
-/* The whole metadata frame through w (FORMAT.md section 3.6). */
-static bsf_status_t write_metadata(writer_t *w, const bsf_metadata_t *m)
+/* The metadata payload through w (FORMAT.md section 3.6); m was checked. */
+static void metadata_payload(writer_t *w, const bsf_metadata_t *m, uint32_t step_code)
 {
-    uint32_t step_code;
     unsigned i;
-    const bsf_status_t st = check_metadata(m, &step_code);
-    if (st != BSF_OK) {
-        return st;
-    }
-    block_start(w);
-    put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA));
-    put_eg(w, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
-    put_eg(w, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
-    put_eg(w, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
-    put_eg(w, m->method, BSF_WIRE_K_METHOD);
-    put_float(w, m->target_rms);
-    put_eg(w, step_code, BSF_WIRE_K_STEP);
-    put_eg(w, m->max_points, BSF_WIRE_K_CAP_POINTS);
-    put_eg(w, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
-    put_eg(w, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
-    put_eg(w, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
-    put_eg(w, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
-    put_eg(w, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
-    put_float(w, m->angle_min);
-    put_float(w, m->angle_increment);
-    put_float(w, m->range_min);
-    put_float(w, m->range_max);
-    put_bits(w, m->has_time_origin != 0u ? 1u : 0u, 1u);
+    field_u(w, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA, 8u);
+    field_eg(w, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, m->method, BSF_WIRE_K_METHOD);
+    field_float(w, m->target_rms);
+    field_eg(w, step_code, BSF_WIRE_K_STEP);
+    field_eg(w, m->max_points, BSF_WIRE_K_CAP_POINTS);
+    field_eg(w, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
+    field_eg(w, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
+    field_eg(w, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
+    field_eg(w, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
+    field_eg(w, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
+    field_float(w, m->angle_min);
+    field_float(w, m->angle_increment);
+    field_float(w, m->range_min);
+    field_float(w, m->range_max);
+    field_u(w, m->has_time_origin != 0u ? 1u : 0u, 1u);
     if (m->has_time_origin != 0u) {
-        put_seg(w, m->time_origin_us, BSF_WIRE_K_TIME_ORIGIN);
+        field_seg(w, m->time_origin_us, BSF_WIRE_K_TIME_ORIGIN);
     }
-    put_eg(w, m->source_len, BSF_WIRE_K_SOURCE_LEN);
+    field_eg(w, m->source_len, BSF_WIRE_K_SOURCE_LEN);
     for (i = 0; i < m->source_len; ++i) {
-        put_bits(w, (uint8_t)m->source[i], 8u);
+        field_u(w, (uint8_t)m->source[i], 8u);
     }
-    finish(w);
-    return BSF_OK;
 }
 
-bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap, size_t *out_len)
+/* ---- Both frame types: plan, then write to a buffer or a sink ------------ */
+
+typedef struct {
+    const bsf_frame_info_t *info; /* features frame: info and res */
+    const bsf_result_t *res;
+    const bsf_metadata_t *meta; /* or a metadata frame */
+    uint32_t *table;            /* features frame: VALUE_TABLE entries */
+    plan_t plan;
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+} job_t;
+
+/* Checks the input and finds the payload's size (and the orders). */
+static bsf_status_t job_plan(job_t *job)
 {
     writer_t w;
     bsf_status_t st;
-
-    if (m == NULL || out_len == NULL) {
-        return BSF_ERR_ARG;
+    if (job->meta == NULL) {
+        return plan_frame(job->info, job->res, job->table, &job->plan, job->k_ctrl);
     }
-    writer_init(&w);
-    st = write_metadata(&w, m);
+    memset(&job->plan, 0, sizeof job->plan);
+    st = check_metadata(job->meta, &job->plan.step_code);
+    if (st != BSF_OK) {
+        return st;
+    }
+    writer_init(&w, NULL);
+    w.costing = 1;
+    metadata_payload(&w, job->meta, job->plan.step_code);
+    job->plan.bits = w.bits;
+    return BSF_OK;
+}
+
+/* The planned payload through w (cannot fail: the plan checked it all). */
+static void job_payload(writer_t *w, job_t *job)
+{
+    memcpy(w->k_ctrl, job->k_ctrl, BSF_WIRE_N_CLASSES);
+    if (job->meta != NULL) {
+        metadata_payload(w, job->meta, job->plan.step_code);
+    } else {
+        (void)frame_payload(w, &job->plan, job->info, job->res, job->table, NULL);
+    }
+}
+
+static void job_stream(job_t *job, stream_t *s)
+{
+    writer_t w;
+    writer_init(&w, s);
+    job_payload(&w, job);
+    writer_end_stream(&w);
+}
+
+/* Body bytes of the planned frame: payload and CRC. */
+static size_t job_body(const job_t *job)
+{
+    return ((size_t)job->plan.bits + 7u) / 8u + BSF_FRAME_CRC_SIZE;
+}
+
+/*
+ * The frame straight into buf, which holds the bound job_body +
+ * job_body / 254 + 2: the payload goes to buf + 1 (behind the first code
+ * byte) and gets its CRC; a body with full COBS blocks moves up by their
+ * number (a code byte each), and COBS turns it into its code in place.
+ * Nothing is written beyond the frame.
+ */
+static bsf_status_t job_direct(job_t *job, uint8_t *buf, size_t *out_len)
+{
+    const size_t body = job_body(job);
+    const size_t payload = body - BSF_FRAME_CRC_SIZE;
+    uint8_t *const start = buf + 1;
+    writer_t w;
+    uint32_t crc;
+    size_t full = 0;
+    size_t len;
+    unsigned i;
+    writer_init(&w, NULL);
+    w.p = start;
+    w.end = start + body; /* the last word may reach into the CRC's place */
+    job_payload(&w, job);
+    writer_flush(&w);
+    if (w.overflow || (size_t)(w.p - start) != ((size_t)job->plan.bits + 31u) / 32u * 4u) {
+        *out_len = 0u;
+        return BSF_ERR_BUFFER; /* not the planned size: never happens */
+    }
+    crc = bsf_crc32c(0u, start, payload);
+    for (i = 0; i < 4u; ++i) {
+        start[payload + i] = (uint8_t)(crc >> (8u * i));
+    }
+    if (body >= 254u) {
+        full = bsf_cobs_full_blocks(start, body);
+        if (full > 0u) {
+            memmove(start + full, start, body);
+        }
+    }
+    len = bsf_cobs_encode_in_place(buf, 1u + full, body);
+    buf[len] = 0u;
+    *out_len = len + 1u;
+    return BSF_OK;
+}
+
+static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out_len)
+{
+    const bsf_status_t st = job_plan(job);
+    size_t body;
+    stream_t s;
     if (st != BSF_OK) {
         *out_len = 0u;
         return st;
     }
-    *out_len = w.pos;
+    body = job_body(job);
+    if (buf != NULL && cap >= body + body / 254u + 2u) {
+        return job_direct(job, buf, out_len);
+    }
+    if (body < 254u) {
+        *out_len = body + 2u; /* exact: no block reaches 254 bytes */
+    } else {
+        stream_init(&s); /* count */
+        job_stream(job, &s);
+        *out_len = s.pos;
+    }
     if (buf == NULL) {
         return BSF_OK;
     }
-    if (w.pos > cap) {
+    if (*out_len > cap) {
         return BSF_ERR_BUFFER;
     }
-    writer_init(&w);
-    w.buf = buf;
-    w.cap = cap;
-    return write_metadata(&w, m);
+    stream_init(&s);
+    s.buf = buf;
+    s.cap = cap;
+    job_stream(job, &s);
+    *out_len = s.pos;
+    return BSF_OK;
+}
+
+static bsf_status_t job_encode_sink(job_t *job, bsf_encoder_t *work, bsf_sink_fn sink, void *ctx,
+                                    size_t *written)
+{
+    stream_t s;
+    bsf_status_t st = job_plan(job);
+    if (st != BSF_OK) {
+        return st;
+    }
+    memset(&s, 0, sizeof s);
+    s.work = work;
+    s.sink = sink;
+    s.ctx = ctx;
+    block_start(&s);
+    job_stream(job, &s);
+    if (written != NULL) {
+        *written = s.pos;
+    }
+    return s.failed ? BSF_ERR_BUFFER : BSF_OK;
+}
+
+void bsf_frame_info_init(bsf_frame_info_t *info)
+{
+    if (info != NULL) {
+        info->seq = 0u;
+        info->timestamp_ms = 0u;
+        info->has_pose = 0u;
+        info->pose_x = 0.0f;
+        info->pose_y = 0.0f;
+        info->pose_theta = 0.0f;
+        info->quant_step = BSF_QUANT_STEP_DEFAULT;
+        info->has_geometry = 0u;
+        info->angle_min = 0.0f;
+        info->angle_increment = 0.0f;
+    }
+}
+
+bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
+                              uint8_t *buf, size_t cap, size_t *out_len)
+{
+    uint32_t table[VALUE_TABLE];
+    job_t job;
+    if (info == NULL || result == NULL || out_len == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&job, 0, sizeof job);
+    job.info = info;
+    job.res = result;
+    job.table = table;
+    return job_encode(&job, buf, cap, out_len);
+}
+
+bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,
+                                   const bsf_result_t *result, bsf_sink_fn sink, void *ctx,
+                                   size_t *written)
+{
+    uint32_t table[VALUE_TABLE];
+    job_t job;
+    if (written != NULL) {
+        *written = 0u;
+    }
+    if (work == NULL || info == NULL || result == NULL || sink == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&job, 0, sizeof job);
+    job.info = info;
+    job.res = result;
+    job.table = table;
+    return job_encode_sink(&job, work, sink, ctx, written);
+}
+
+bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap, size_t *out_len)
+{
+    job_t job;
+    if (m == NULL || out_len == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&job, 0, sizeof job);
+    job.meta = m;
+    return job_encode(&job, buf, cap, out_len);
 }
 
 bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const bsf_metadata_t *m,
                                       bsf_sink_fn sink, void *ctx, size_t *written)
 {
-    writer_t w;
-    uint32_t step_code;
-    bsf_status_t st;
-
+    job_t job;
     if (written != NULL) {
         *written = 0u;
     }
     if (work == NULL || m == NULL || sink == NULL) {
         return BSF_ERR_ARG;
     }
-    st = check_metadata(m, &step_code);
-    if (st != BSF_OK) {
-        return st;
-    }
-    writer_init(&w);
-    w.work = work;
-    w.sink = sink;
-    w.ctx = ctx;
-    st = write_metadata(&w, m);
-    if (written != NULL) {
-        *written = w.pos;
-    }
-    if (st == BSF_OK && w.failed) {
-        st = BSF_ERR_BUFFER;
-    }
-    return st;
+    memset(&job, 0, sizeof job);
+    job.meta = m;
+    return job_encode_sink(&job, work, sink, ctx, written);
 }

@@ -9,6 +9,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bsf/bsf_config.h"
+
 /* Exp-Golomb orders of the fixed-parameter fields (FORMAT.md section 3). */
 #define BSF_WIRE_K_SEQ 8u
 #define BSF_WIRE_K_TIMESTAMP 20u
@@ -130,19 +132,6 @@ static inline unsigned bsf_wire_bitlen(uint64_t v)
     return hi != 0u ? 32u + bsf_wire_bitlen32(hi) : bsf_wire_bitlen32((uint32_t)v);
 }
 
-/* CRC-32C register (not inverted) after one more byte: two steps of a
- * 16-entry table (64 bytes of ROM where 256 entries would take 1 KiB). */
-static inline uint32_t bsf_wire_crc32c_step(uint32_t reg, uint8_t b)
-{
-    static const uint32_t nibble[16] = {0x00000000u, 0x105EC76Fu, 0x20BD8EDEu, 0x30E349B1u,
-                                        0x417B1DBCu, 0x5125DAD3u, 0x61C69362u, 0x7198540Du,
-                                        0x82F63B78u, 0x92A8FC17u, 0xA24BB5A6u, 0xB21572C9u,
-                                        0xC38D26C4u, 0xD3D3E1ABu, 0xE330A81Au, 0xF36E6F75u};
-    reg ^= b;
-    reg = (reg >> 4) ^ nibble[reg & 0x0Fu];
-    return (reg >> 4) ^ nibble[reg & 0x0Fu];
-}
-
 /* Length in bits of the Exp-Golomb code of order k of v (v >> k < 2^63). */
 static inline unsigned bsf_wire_eg_bits(uint64_t v, unsigned k)
 {
@@ -162,41 +151,54 @@ static inline unsigned bsf_wire_eg_bits(uint64_t v, unsigned k)
  * and residuals within 2^24, zigzag within 2^25). */
 #define BSF_WIRE_EG_HIST 27u
 
+/* Counts per class: a frame has at most 2 * BSF_MAX_CTRL_POINTS values. */
+#if BSF_MAX_CTRL_POINTS <= 32767
+typedef uint16_t bsf_wire_eg_count_t;
+#else
+typedef uint32_t bsf_wire_eg_count_t;
+#endif
+
 typedef struct {
-    uint32_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
-    uint32_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    unsigned max_len;                   /* largest L counted */
+    bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
+    bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
+    uint32_t or_all;                               /* OR of the values: its bit length is max L */
 } bsf_wire_eg_tally_t;
+
+/* One value v < 2^26. */
+static inline void bsf_wire_eg_tally_add32(bsf_wire_eg_tally_t *t, uint32_t v)
+{
+    const unsigned len = bsf_wire_bitlen32(v);
+    /* the len low bits set (0 for v = 0) without a shift by 32 */
+    const uint32_t ones = (uint32_t)((((uint64_t)1) << len) - 1u);
+    t->n_len[len] += 1u;
+    t->n_below[bsf_wire_bitlen32(v ^ ones)] += 1u;
+    t->or_all |= v;
+}
 
 static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
 {
-    const unsigned len = bsf_wire_bitlen(v);
-    const uint64_t ones = len == 0u ? 0u : (~(uint64_t)0 >> (64u - len));
-    t->n_len[len] += 1u;
-    t->n_below[bsf_wire_bitlen(v ^ ones)] += 1u;
-    if (len > t->max_len) {
-        t->max_len = len;
-    }
+    bsf_wire_eg_tally_add32(t, (uint32_t)v);
 }
 
 /* cost[k] for k = 0..k_max: total bits of the tallied values at order k. */
 static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigned k_max,
                                            uint32_t *cost)
 {
+    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
     uint32_t n = 0;
     uint32_t above = 0;      /* sum of (2L - 1) over the values with L > k */
     uint32_t n_len_le = 0;   /* values with L <= k */
     uint32_t n_below_le = 0; /* values with m <= k */
     unsigned len;
     unsigned k;
-    for (len = 0; len <= t->max_len; ++len) {
+    for (len = 0; len <= max_len; ++len) {
         n += t->n_len[len];
         if (len > 0u) {
             above += t->n_len[len] * (2u * len - 1u);
         }
     }
     for (k = 0; k <= k_max; ++k) {
-        if (k <= t->max_len) {
+        if (k <= max_len) {
             n_len_le += t->n_len[k];
             n_below_le += t->n_below[k];
             if (k > 0u) {
@@ -207,6 +209,57 @@ static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigne
         cost[k] = (k + 1u) * n_len_le + above - k * (n - n_len_le) + 2u * (n_below_le - n_len_le);
     }
 }
+
+/*
+ * The order 0..BSF_WIRE_K_CTRL_MAX with the fewest bits for the tallied
+ * values (ties to the smaller order), and those bits in *bits. Above the
+ * longest value's bit length L every order costs one bit per value more than
+ * the one before, so none beats order L and the search stops there.
+ */
+static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint32_t *bits)
+{
+    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
+    const unsigned k_top = max_len < BSF_WIRE_K_CTRL_MAX ? max_len : BSF_WIRE_K_CTRL_MAX;
+    uint32_t n = 0;
+    uint32_t above = 0;
+    uint32_t n_len_le = 0;
+    uint32_t n_below_le = 0;
+    uint32_t best_cost = 0;
+    unsigned best = 0;
+    unsigned k;
+    for (k = 1; k <= max_len; ++k) {
+        n += t->n_len[k];
+        above += t->n_len[k] * (2u * k - 1u);
+    }
+    n += t->n_len[0];
+    for (k = 0; k <= k_top; ++k) {
+        uint32_t cost;
+        n_len_le += t->n_len[k];
+        n_below_le += t->n_below[k];
+        if (k > 0u) {
+            above -= t->n_len[k] * (2u * k - 1u);
+        }
+        cost = (k + 1u) * n_len_le + above - k * (n - n_len_le) + 2u * (n_below_le - n_len_le);
+        if (k == 0u || cost < best_cost) {
+            best_cost = cost;
+            best = k;
+        }
+    }
+    *bits = best_cost;
+    return best;
+}
+
+/*
+ * COBS of a body of n bytes takes 1 + n + F bytes (without the 0x00
+ * delimiter), F the number of full blocks (254 data bytes, code 0xFF):
+ * bsf_cobs_full_blocks counts them (bsf_cobs.c). bsf_cobs_encode_in_place
+ * turns the body buf[offset .. offset + n - 1], offset >= 1 + F, into its
+ * code in buf[0 ..] and returns the code's length; with offset = 1 + F the
+ * code ends where the body ended. The output never overtakes the input it
+ * still has to read.
+ */
+size_t bsf_cobs_full_blocks(const uint8_t *body, size_t n);
+size_t bsf_cobs_encode_in_place(uint8_t *buf, size_t offset, size_t n);
 
 /*
  * A metadata source name: well-formed UTF-8 (RFC 3629: shortest form, no
