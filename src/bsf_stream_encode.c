@@ -130,40 +130,56 @@ static void stream_finish(stream_t *s)
 
 /* ---- Bit writer ---------------------------------------------------------- */
 
+/* The hot paths inline their helpers so that the writer's state lives in
+ * registers; a size-optimised build (-Os) leaves that to the compiler. */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
+#define ENC_INLINE static inline __attribute__((always_inline))
+#else
+#define ENC_INLINE static inline
+#endif
+
 #define CHUNK_BYTES 32u /* streaming path: payload bytes handed on at a time */
 
 /*
  * The payload's bits, most significant first, gather in acc and leave as
- * whole big-endian 32-bit words. In the planning run (costing) nothing is
- * written: bits sums the fields' lengths.
+ * whole big-endian 32-bit words. A run copies this into a local, so that it
+ * stays in registers. In a costing run nothing is written: bits sums the
+ * fields' lengths.
  */
 typedef struct {
     uint8_t *p;    /* the next word goes here */
     uint8_t *end;  /* words must end at or before this */
     uint32_t acc;  /* pending bits in the low 32 - room bits (higher bits: leftovers) */
     unsigned room; /* free bits in acc, 1..32 */
+    uint32_t bits; /* costing run: payload bits so far */
+} bits_t;
+
+/* Where the words go. */
+typedef struct {
+    bits_t b;
     stream_t *out; /* streaming path; NULL when writing straight into a buffer */
-    int overflow;  /* direct writing ran past end (a planning bug: never written) */
-    int costing;   /* planning run */
-    uint32_t bits; /* planning run: payload bits outside the control point values */
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    uint8_t *end;  /* the end after a spill */
+    int overflow;  /* direct writing reached its end (a planning bug: never written) */
     uint8_t chunk[CHUNK_BYTES];
 } writer_t;
 
-static void writer_init(writer_t *w, stream_t *out)
+static void writer_init(writer_t *w, stream_t *out, uint8_t *start, uint8_t *end)
 {
-    w->acc = 0u;
-    w->room = 32u;
     w->out = out;
     w->overflow = 0;
-    w->costing = 0;
-    w->bits = 0u;
-    memset(w->k_ctrl, 0, sizeof w->k_ctrl);
-    w->p = w->chunk;
-    w->end = w->chunk + CHUNK_BYTES;
+    w->b.acc = 0u;
+    w->b.room = 32u;
+    w->b.bits = 0u;
+    if (start != NULL) {
+        w->b.p = start;
+        w->b.end = end;
+    } else {
+        w->b.p = w->chunk;
+        w->b.end = w->chunk + CHUNK_BYTES;
+    }
 }
 
-static void store_be32(uint8_t *p, uint32_t v)
+ENC_INLINE void store_be32(uint8_t *p, uint32_t v)
 {
 #if defined(__BYTE_ORDER__) && defined(__ORDER_BIG_ENDIAN__) &&                                    \
     __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
@@ -180,114 +196,128 @@ static void store_be32(uint8_t *p, uint32_t v)
 #endif
 }
 
-/* The chunk is full: hand it on (streaming), or stop writing (direct). */
-static void writer_spill(writer_t *w)
+/* No room for a word at p: hand the chunk on (streaming), or stop writing
+ * (direct). Returns where the next word goes; w->end is its end. */
+static uint8_t *writer_spill(writer_t *w, uint8_t *p)
 {
     if (w->out != NULL) {
-        stream_payload(w->out, w->chunk, (size_t)(w->p - w->chunk));
+        stream_payload(w->out, w->chunk, (size_t)(p - w->chunk));
     } else {
         w->overflow = 1;
-        w->end = w->chunk + CHUNK_BYTES;
     }
-    w->p = w->chunk;
+    w->end = w->chunk + CHUNK_BYTES;
+    return w->chunk;
 }
 
-static inline void put_word(writer_t *w, uint32_t word)
+ENC_INLINE void put_word(writer_t *w, bits_t *b, uint32_t word)
 {
-    if ((size_t)(w->end - w->p) < 4u) {
-        writer_spill(w);
+    if ((size_t)(b->end - b->p) < 4u) {
+        b->p = writer_spill(w, b->p);
+        b->end = w->end;
     }
-    store_be32(w->p, word);
-    w->p += 4;
+    store_be32(b->p, word);
+    b->p += 4;
 }
 
-/* The n (0..31) bits of v (v < 2^n) into the accumulator *acc with *room free bits. */
-static inline void put_acc(writer_t *w, uint32_t *acc, unsigned *room, uint32_t v, unsigned n)
+/* The n (0..31) bits of v (v < 2^n). */
+ENC_INLINE void put_bits(writer_t *w, bits_t *b, uint32_t v, unsigned n)
 {
-    if (n < *room) {
-        *acc = (*acc << n) | v;
-        *room -= n;
+    if (n < b->room) {
+        b->acc = (b->acc << n) | v;
+        b->room -= n;
     } else {
-        const unsigned rest = n - *room; /* bits of v for the next word; *room <= n <= 31 */
-        put_word(w, (*acc << *room) | (v >> rest));
-        *acc = v; /* the bits of v above rest leave with the next word's shifts */
-        *room = 32u - rest;
+        const unsigned rest = n - b->room; /* bits of v for the next word; room <= n <= 31 */
+        put_word(w, b, (b->acc << b->room) | (v >> rest));
+        b->acc = v; /* the bits of v above rest leave with the next word's shifts */
+        b->room = 32u - rest;
     }
+}
+
+/* floor(log2(c)) for 1 <= c < 2^31 (x86 BSR). */
+ENC_INLINE unsigned log2_nz(uint32_t c)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return 31u ^ (unsigned)__builtin_clz(c);
+#else
+    return bsf_wire_bitlen31(c) - 1u;
+#endif
 }
 
 /* Exp-Golomb code of order k (<= 25) of v < 2^30: v + 2^k in 2 b - 1 - k
- * bits, b its bit length (the b - 1 - k leading zeros, then v + 2^k). */
-static inline void put_eg_acc(writer_t *w, uint32_t *acc, unsigned *room, uint32_t v, unsigned k)
+ * bits, b its bit length (b - 1 - k leading zeros, then v + 2^k). */
+ENC_INLINE void put_eg(writer_t *w, bits_t *b, uint32_t v, unsigned k)
 {
     const uint32_t c = v + ((uint32_t)1 << k);
-    const unsigned b = bsf_wire_bitlen32(c);
-    const unsigned len = 2u * b - 1u - k;
+    const unsigned lg = log2_nz(c);
+    const unsigned len = 2u * lg + 1u - k;
     if (len < 32u) {
-        put_acc(w, acc, room, c, len);
+        put_bits(w, b, c, len);
     } else {
-        put_acc(w, acc, room, 0u, len - b);
-        put_acc(w, acc, room, c, b);
+        put_bits(w, b, 0u, lg - k);
+        put_bits(w, b, c, lg + 1u);
     }
 }
 
-static inline unsigned eg_len32(uint32_t v, unsigned k)
+ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
 {
-    return 2u * bsf_wire_bitlen32(v + ((uint32_t)1 << k)) - 1u - k;
+    return 2u * log2_nz(v + ((uint32_t)1 << k)) + 1u - k;
 }
 
-/* Fields: u(n), n <= 31. */
-static void field_u(writer_t *w, uint32_t v, unsigned n)
+/* Fields, written or (costing) counted: u(n) with n <= 31. */
+ENC_INLINE void field_u(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned n)
 {
-    if (w->costing) {
-        w->bits += n;
+    if (costing) {
+        b->bits += n;
     } else {
-        put_acc(w, &w->acc, &w->room, v, n);
+        put_bits(w, b, v, n);
     }
 }
 
 /* EGk of v < 2^30, k <= 25. */
-static void field_eg(writer_t *w, uint32_t v, unsigned k)
+ENC_INLINE void field_eg(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned k)
 {
-    if (w->costing) {
-        w->bits += eg_len32(v, k);
+    if (costing) {
+        b->bits += eg_len(v, k);
     } else {
-        put_eg_acc(w, &w->acc, &w->room, v, k);
+        put_eg(w, b, v, k);
     }
 }
 
-/* The n (<= 64) low bits of v, 16 at a time. */
-static void put_wide(writer_t *w, uint64_t v, unsigned n)
+/* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
+ * wide fields. State in and out by value, so that the caller's stays in
+ * registers. */
+static bits_t put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k)
 {
-    while (n > 16u) {
-        n -= 16u;
-        put_acc(w, &w->acc, &w->room, (uint32_t)(v >> n) & 0xFFFFu, 16u);
+    const uint64_t u = (v >> k) + 1u;
+    const unsigned n = bsf_wire_bitlen(u);
+    unsigned i;
+    if (costing) {
+        b.bits += 2u * n - 1u + k;
+        return b;
     }
-    put_acc(w, &w->acc, &w->room, (uint32_t)v & ((1u << n) - 1u), n);
+    for (i = 1u; i < n; ++i) {
+        put_bits(w, &b, 0u, 1u); /* the n - 1 zeros */
+    }
+    for (i = n; i > 0u;) { /* u, then the k low bits of v: 16 bits at a time */
+        const unsigned take = i > 16u ? 16u : i;
+        i -= take;
+        put_bits(w, &b, (uint32_t)(u >> i) & ((1u << take) - 1u), take);
+    }
+    for (i = k; i > 0u;) {
+        const unsigned take = i > 16u ? 16u : i;
+        i -= take;
+        put_bits(w, &b, (uint32_t)(v >> i) & ((1u << take) - 1u), take);
+    }
+    return b;
 }
 
-/* EGk of any v with v >> k < 2^63, k <= 63. */
-static void field_eg64(writer_t *w, uint64_t v, unsigned k)
+ENC_INLINE void field_eg64(writer_t *w, bits_t *b, int costing, uint64_t v, unsigned k)
 {
-    uint64_t u;
-    unsigned b;
     if (v < ((uint64_t)1 << 30) && k <= 25u) {
-        field_eg(w, (uint32_t)v, k);
-        return;
+        field_eg(w, b, costing, (uint32_t)v, k);
+    } else {
+        *b = put_eg_wide(w, *b, costing, v, k);
     }
-    u = (v >> k) + 1u;
-    b = bsf_wire_bitlen(u);
-    if (w->costing) {
-        w->bits += 2u * b - 1u + k;
-        return;
-    }
-    put_wide(w, 0u, b - 1u);
-    put_wide(w, u, b);
-    put_wide(w, v, k);
-}
-
-static void field_seg(writer_t *w, int64_t v, unsigned k)
-{
-    field_eg64(w, bsf_wire_zigzag(v), k);
 }
 
 static uint32_t float_bits(float v)
@@ -297,60 +327,44 @@ static uint32_t float_bits(float v)
     return u;
 }
 
-static void field_float(writer_t *w, float v)
+ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
 {
     const uint32_t u = float_bits(v);
-    field_u(w, u >> 16, 16u);
-    field_u(w, u & 0xFFFFu, 16u);
+    field_u(w, b, costing, u >> 16, 16u);
+    field_u(w, b, costing, u & 0xFFFFu, 16u);
+}
+
+/* Bits written so far. */
+static size_t writer_bits(const writer_t *w, const uint8_t *start)
+{
+    return (size_t)(w->b.p - start) * 8u + (32u - w->b.room);
 }
 
 /* Pads the payload to whole bytes and pushes out its last, partial word
  * (its unused bytes are overwritten by what follows). */
 static void writer_flush(writer_t *w)
 {
-    if (w->room < 32u) {
-        put_word(w, w->acc << w->room);
+    if (w->b.room < 32u) {
+        put_word(w, &w->b, w->b.acc << w->b.room);
     }
 }
 
-/* ---- Control point values ------------------------------------------------ */
-
-/* A value in the per-frame table: zigzag code (below 2^26) | class << 30. */
-#define VALUE_CLASS_SHIFT 30u
-#define VALUE_MASK 0x3FFFFFFFu
-
-/* Table size: two whole features at least (a feature beyond the table is
- * quantised again into it), and the values of a typical frame (about 55 on
- * Intel, 100 on MIT and Freiburg) at 4 bytes each. */
-#define VALUE_TABLE 128u
-#if VALUE_TABLE < 2u * BSF_MAX_CTRL_PER_FEATURE
-#error "VALUE_TABLE must hold the values of one feature"
-#endif
-
-static inline uint32_t zigzag32(int32_t v)
+/* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
+static void writer_end_stream(writer_t *w)
 {
-    return ((uint32_t)v << 1) ^ (0u - ((uint32_t)v >> 31));
+    size_t n;
+    if (w->b.room < 32u) {
+        const unsigned tail = (32u - w->b.room + 7u) / 8u; /* bytes of the partial word */
+        put_word(w, &w->b, w->b.acc << w->b.room);
+        n = (size_t)(w->b.p - w->chunk) - (4u - tail);
+    } else {
+        n = (size_t)(w->b.p - w->chunk);
+    }
+    stream_payload(w->out, w->chunk, n);
+    stream_finish(w->out);
 }
 
-/* The control point values of one feature, in wire order, into the table. */
-typedef struct {
-    uint32_t *out;              /* the table */
-    uint32_t n;                 /* values produced (stored while below cap) */
-    uint32_t cap;               /* table entries left */
-    bsf_wire_eg_tally_t *tally; /* planning: per class */
-} values_t;
-
-static inline void add_value(values_t *vs, unsigned cls, int32_t v)
-{
-    const uint32_t z = zigzag32(v);
-    if (vs->tally != NULL) {
-        bsf_wire_eg_tally_add32(&vs->tally[cls], z);
-    }
-    if (vs->n < vs->cap) {
-        vs->out[vs->n] = z | ((uint32_t)cls << VALUE_CLASS_SHIFT);
-    }
-    ++vs->n;
-}
+/* ---- Quantisation and checks ------------------------------------------- */
 
 static int is_finite_f(float v)
 {
@@ -361,7 +375,7 @@ static int is_finite_f(float v)
  * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
  * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
  * one lower for a negative r with a fraction. */
-static inline int quantise(float v, float step, int32_t *q)
+ENC_INLINE int quantise(float v, float step, int32_t *q)
 {
     const float r = v / step + 0.5f;
     int32_t t;
@@ -374,11 +388,59 @@ static inline int quantise(float v, float step, int32_t *q)
     return 1;
 }
 
-static inline int quantise_point(bsf_point_t p, float step, int32_t q[2])
+ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
 {
     const int ok_x = quantise(p.x, step, &q[0]);
     const int ok_y = quantise(p.y, step, &q[1]);
     return ok_x && ok_y;
+}
+
+/* ---- Control point values ------------------------------------------------ */
+
+/* A value in the per-frame table: zigzag code (below 2^26) | class << 30. */
+#define VALUE_CLASS_SHIFT 30u
+#define VALUE_MASK 0x3FFFFFFFu
+
+/* Table entries: the values of a typical frame (about 55 on Intel, 100 on
+ * MIT and Freiburg) at 4 bytes each, and room for the values of one more
+ * feature (at most 2 per stored control point) behind them, where the
+ * planning run puts those of features beyond the table and the writing runs
+ * make them again. */
+#define VALUE_KEEP 128u
+#define VALUE_TABLE (VALUE_KEEP + 2u * BSF_MAX_CTRL_PER_FEATURE)
+
+ENC_INLINE uint32_t zigzag32(int32_t v)
+{
+    const uint32_t twice = (uint32_t)v << 1;
+    return v < 0 ? ~twice : twice; /* -2v - 1 for v < 0 */
+}
+
+/* One value of class cls: stored, and tallied in the planning run. */
+ENC_INLINE uint32_t add_value(uint32_t *out, uint32_t cnt, bsf_wire_eg_tally_t *tally, unsigned cls,
+                              int32_t v)
+{
+    const uint32_t z = zigzag32(v);
+    if (tally != NULL) {
+        bsf_wire_eg_tally_add32(&tally[cls], z);
+    }
+    out[cnt] = z | ((uint32_t)cls << VALUE_CLASS_SHIFT);
+    return cnt + 1u;
+}
+
+/* bsf_wire_predict in 32 bits: quantised coordinates within 2^23 - 1 make
+ * |b - a| <= 2^24 - 2, and k <= BSF_MAX_CTRL_PER_FEATURE - 2 <= 62 (bsf_stream.h
+ * caps it at 64), so (b - a)(2s - 1) + k stays below 2^24 * 123 + 62 < 2^31. */
+ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
+{
+    const int32_t den = 2 * (int32_t)k;
+    const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;
+    int32_t q;
+    if (k == 1u) {
+        q = num / 2; /* the usual case, a fragment with one precision point: a shift */
+        return a + (num - 2 * q < 0 ? q - 1 : q);
+    }
+    q = num / den;
+    return a + (num - q * den < 0 ? q - 1 : q); /* floor */
 }
 
 /* A flagged slot s needs a flagged partner s + 1 that quantises to q. */
@@ -391,37 +453,36 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
 }
 
 /*
- * The values of one feature's n control points: the first distinct point
- * as a delta from prev (the last anchor of the previous feature), then per
- * fragment the next anchor (vertex or last point) as a delta from the
- * previous anchor, then the fragment's precision points as residuals from
- * their predicted places on the chord (FORMAT.md section 3.3). Returns 0
- * when a point cannot be represented or a flagged slot has no equal
- * partner, else 1; *mask gets bit j for distinct point j that is a vertex.
+ * The values of one feature's n control points in wire order (FORMAT.md
+ * section 3.3): the first distinct point as a delta from prev (the last
+ * anchor of the previous feature, updated here), then per fragment the next
+ * anchor (vertex or last point) as a delta from the previous anchor, then
+ * the fragment's precision points as residuals from their predicted places
+ * on the chord. Stores them in out (room for 2 n), tallies them when tally
+ * is given (the planning run), and returns their number (2 per distinct
+ * point), or 0 when a point cannot be represented or a flagged slot has no
+ * equal partner.
  */
-static int feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
-                          int32_t prev[2], values_t *vs, uint64_t *mask)
+ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
+                                   int32_t prev[2], uint32_t *out, bsf_wire_eg_tally_t *tally)
 {
     size_t s_a = 0;
     size_t c_a;
-    unsigned j_a = 0; /* distinct index of anchor a */
+    uint32_t cnt = 0;
     int32_t q_a[2];
 
-    *mask = 0u;
     if (!quantise_point(p[0], step, q_a)) {
-        return 0;
+        return 0u;
     }
+    c_a = 1u;
     if (vtx[0] != 0u) {
         if (!vertex_partner_ok(p, vtx, 0u, n, step, q_a)) {
-            return 0;
+            return 0u;
         }
-        *mask = 1u;
         c_a = 2u;
-    } else {
-        c_a = 1u;
     }
-    add_value(vs, BSF_WIRE_CLASS_FIRST, q_a[0] - prev[0]);
-    add_value(vs, BSF_WIRE_CLASS_FIRST, q_a[1] - prev[1]);
+    cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_FIRST, q_a[0] - prev[0]);
+    cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_FIRST, q_a[1] - prev[1]);
     while (s_a + c_a < n) {
         const size_t t = s_a + c_a;
         size_t s_b = t;
@@ -433,30 +494,27 @@ static int feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, fl
         }
         k = (uint32_t)(s_b - t);
         if (!quantise_point(p[s_b], step, q_b)) {
-            return 0;
+            return 0u;
         }
-        j_a += k + 1u;
+        c_a = 1u;
         if (vtx[s_b] != 0u) {
             if (!vertex_partner_ok(p, vtx, s_b, n, step, q_b)) {
-                return 0;
+                return 0u;
             }
-            *mask |= (uint64_t)1u << j_a;
             c_a = 2u;
-        } else {
-            c_a = 1u;
         }
-        add_value(vs, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
-        add_value(vs, BSF_WIRE_CLASS_ANCHOR, q_b[1] - q_a[1]);
+        cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
+        cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[1] - q_a[1]);
         for (i = t; i < s_b; ++i) {
             const uint32_t s = (uint32_t)(i - t) + 1u;
             int32_t q[2];
             if (!quantise_point(p[i], step, q)) {
-                return 0;
+                return 0u;
             }
-            add_value(vs, BSF_WIRE_CLASS_PREC,
-                      q[0] - (int32_t)bsf_wire_predict(q_a[0], q_b[0], s, k));
-            add_value(vs, BSF_WIRE_CLASS_PREC,
-                      q[1] - (int32_t)bsf_wire_predict(q_a[1], q_b[1], s, k));
+            cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_PREC,
+                            q[0] - predict32(q_a[0], q_b[0], s, k));
+            cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_PREC,
+                            q[1] - predict32(q_a[1], q_b[1], s, k));
         }
         s_a = s_b;
         q_a[0] = q_b[0];
@@ -464,11 +522,12 @@ static int feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, fl
     }
     prev[0] = q_a[0];
     prev[1] = q_a[1];
-    return 1;
+    return cnt;
 }
 
-/* Distinct points of a checked feature and its vertex mask, from the flags. */
-static uint32_t feature_mask(const uint8_t *vtx, size_t n, uint64_t *mask)
+/* Distinct points of a checked feature and its vertex mask (bit j for
+ * distinct point j), from the flags: a flagged slot and its partner are one. */
+ENC_INLINE uint32_t feature_mask(const uint8_t *vtx, size_t n, uint64_t *mask)
 {
     size_t s = 0;
     uint32_t j = 0;
@@ -486,17 +545,14 @@ static uint32_t feature_mask(const uint8_t *vtx, size_t n, uint64_t *mask)
 }
 
 /* The values' codes at the frame's orders: the hot loop of the writing run. */
-static void put_values(writer_t *w, const uint32_t *values, uint32_t n)
+ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
+                           const uint8_t k_ctrl[BSF_WIRE_N_CLASSES])
 {
-    uint32_t acc = w->acc;
-    unsigned room = w->room;
     uint32_t i;
     for (i = 0; i < n; ++i) {
         const uint32_t v = values[i];
-        put_eg_acc(w, &acc, &room, v & VALUE_MASK, w->k_ctrl[v >> VALUE_CLASS_SHIFT]);
+        field_eg(w, b, costing, v & VALUE_MASK, k_ctrl[v >> VALUE_CLASS_SHIFT]);
     }
-    w->acc = acc;
-    w->room = room;
 }
 
 /* ---- Features frame ------------------------------------------------------ */
@@ -574,7 +630,12 @@ static int32_t round_to_int(float v)
     return (int32_t)bsf_floorf(v + 0.5f);
 }
 
-/* What the planning run learns for the writing run. */
+/* Header bits at most, and per feature bits at most outside the control
+ * point values (FORMAT.md section 7). */
+#define HEADER_MAX_BITS 619u
+#define FEATURE_MAX_BITS 211u
+
+/* What the planning run learns for the writing runs. */
 typedef struct {
     uint32_t step_code;
     float step;
@@ -582,10 +643,11 @@ typedef struct {
     int has_ext;
     uint32_t n_cached;      /* leading features whose values are all in the table */
     int32_t prev_resume[2]; /* the last anchor before feature n_cached */
-    uint32_t bits;          /* payload bits, byte 0 included */
+    uint32_t max_bits;      /* payload bits at most (exact for a metadata frame) */
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
 } plan_t;
 
-/* The checks that come before any field. */
+/* The checks that come before any feature. */
 static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t *res, plan_t *pl)
 {
     uint32_t i;
@@ -617,189 +679,162 @@ static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t
 }
 
 /*
- * The payload through w. Planning run (w->costing, tally given): checks
- * every feature, fills the value table and the tallies, sums the other
- * fields' bits. Writing run: the input was checked, the values come from
- * the table or are made again.
+ * Planning run: checks everything, quantises the control points into the
+ * value table (while it has room) and tallies them per class, takes each
+ * class's shortest order (ties to the smaller one; never longer than order
+ * 25, which bounds every value by 26 bits, BSF_FRAME_CTRL_MAX_BITS), and
+ * bounds the payload's size: the values' exact bits plus the most the
+ * header and feature fields can take.
  */
-static bsf_status_t frame_payload(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
-                                  const bsf_result_t *res, uint32_t *table,
-                                  bsf_wire_eg_tally_t *tally)
+static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t *res,
+                               uint32_t *table, plan_t *pl)
 {
+    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     const float step = pl->step;
-    uint32_t i;
-    uint32_t sum_points = 0;
-    uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
-    uint32_t used = 0;                 /* table entries of the leading features */
     int32_t prev[2] = {0, 0};
+    uint32_t used = 0; /* table entries of the leading features */
+    uint32_t sum_points = 0;
+    uint32_t i;
+    unsigned cls;
 
-    field_u(w, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
-    field_u(w, info->has_pose != 0u ? 1u : 0u, 1u);
-    field_u(w, pl->has_ext ? 1u : 0u, 1u);
-    field_eg64(w, info->seq, BSF_WIRE_K_SEQ);
-    field_eg64(w, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
-    if (info->has_pose != 0u) {
-        const uint32_t theta =
-            (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
-        field_seg(w, round_to_int(info->pose_x * 1000.0f), BSF_WIRE_K_POSE);
-        field_seg(w, round_to_int(info->pose_y * 1000.0f), BSF_WIRE_K_POSE);
-        field_u(w, theta, 16u);
-    }
-    field_eg(w, pl->step_code, BSF_WIRE_K_STEP);
-    field_eg(w, res->stats.n_valid, BSF_WIRE_K_N);
-    field_eg(w, (uint32_t)(((uint64_t)res->stats.time_ns + 500u) / 1000u), BSF_WIRE_K_TIME_US);
-    field_eg(w, res->n_features, BSF_WIRE_K_FEATURES);
-    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
-        field_u(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
-    }
-    if (pl->has_ext) {
-        field_u(w, pl->has_beams ? 1u : 0u, 1u);
-        field_u(w, info->has_geometry != 0u ? 1u : 0u, 1u);
-        field_u(w, res->stats.cut, BSF_WIRE_CUT_BITS);
-        if (pl->has_beams) {
-            field_eg(w, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
-        }
-        if (info->has_geometry != 0u) {
-            field_float(w, info->angle_min);
-            field_float(w, info->angle_increment);
-        }
-        if (res->stats.cut != 0u) {
-            field_eg(w, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
-            field_eg(w, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
-            field_eg(w, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
-        }
-    }
-
+    memset(tally, 0, sizeof tally);
     for (i = 0; i < res->n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
-        const bsf_point_t *p = &res->ctrl[f->ctrl_first];
-        const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
-        const uint32_t span = feature_span(f, res->stats.n_beams);
-        const int32_t gap = (int32_t)f->first_beam - (int32_t)prev_last_beam_plus1;
-        uint64_t mask = 0;
-        uint32_t n_unique;
-        uint32_t j;
-        const uint32_t *values;
-        values_t vs;
-
-        if (w->costing) {
-            if (!feature_ok(res, f)) {
-                return BSF_ERR_ARG;
-            }
-            /* into the table while it has room, else only tallied */
-            if (pl->n_cached == i) {
-                pl->prev_resume[0] = prev[0];
-                pl->prev_resume[1] = prev[1];
-            }
-            vs.out = table + used;
-            vs.cap = pl->n_cached == i ? VALUE_TABLE - used : 0u;
-            vs.n = 0u;
-            vs.tally = tally;
-            if (!feature_values(p, vtx, f->n_ctrl, step, prev, &vs, &mask)) {
-                return BSF_ERR_ARG;
-            }
-            if (vs.n <= vs.cap) {
-                used += vs.n;
-                pl->n_cached = i + 1u;
-            }
-            n_unique = vs.n / 2u;
-            values = NULL;
-        } else if (i < pl->n_cached) {
-            n_unique = feature_mask(vtx, f->n_ctrl, &mask);
-            values = table + used;
-            used += 2u * n_unique;
-        } else {
-            /* beyond the table: the same values again, into it */
-            if (i == pl->n_cached) {
-                prev[0] = pl->prev_resume[0];
-                prev[1] = pl->prev_resume[1];
-            }
-            vs.out = table;
-            vs.cap = VALUE_TABLE;
-            vs.n = 0u;
-            vs.tally = NULL;
-            (void)feature_values(p, vtx, f->n_ctrl, step, prev, &vs, &mask);
-            n_unique = vs.n / 2u;
-            values = table;
+        uint32_t n_values;
+        if (!feature_ok(res, f)) {
+            return BSF_ERR_ARG;
+        }
+        if (pl->n_cached == i) {
+            pl->prev_resume[0] = prev[0];
+            pl->prev_resume[1] = prev[1];
+        }
+        /* behind the kept values: at most 2 n_ctrl values, VALUE_TABLE has room */
+        n_values = feature_values(&res->ctrl[f->ctrl_first], &res->ctrl_is_vertex[f->ctrl_first],
+                                  f->n_ctrl, step, prev, table + used, tally);
+        if (n_values == 0u) {
+            return BSF_ERR_ARG;
+        }
+        if (pl->n_cached == i && used + n_values <= VALUE_KEEP) {
+            used += n_values;
+            pl->n_cached = i + 1u;
         }
         sum_points += f->n_points;
-        field_u(w, f->kind, 1u);
-        field_eg(w, n_unique - 2u, BSF_WIRE_K_M);
-        field_u(w, mask != 0u ? 1u : 0u, 1u);
-        for (j = 0; mask != 0u && j < n_unique; ++j) {
-            field_u(w, (uint32_t)(mask >> j) & 1u, 1u);
-        }
-        field_eg(w, zigzag32(gap), BSF_WIRE_K_GAP);
-        field_eg(w, span, BSF_WIRE_K_SPAN);
-        field_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        field_eg(w, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
-                 BSF_WIRE_K_E_CURVE);
-        if (values != NULL) {
-            put_values(w, values, 2u * n_unique);
-        }
-        prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
     }
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
-    if (!w->costing && pl->n_cached < res->n_features) {
+    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * (uint32_t)res->n_features;
+    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
+        uint32_t bits;
+        pl->k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);
+        pl->max_bits += bits;
+    }
+    (void)info;
+    return BSF_OK;
+}
+
+/*
+ * The features payload through w, written or (costing) counted, after the
+ * planning run: the values of the leading features come from the table,
+ * the others are made again into it.
+ */
+ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
+                                  const bsf_frame_info_t *info, const bsf_result_t *res,
+                                  uint32_t *table)
+{
+    bits_t b = w->b;
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
+    uint32_t used = 0;
+    int32_t prev[2];
+    uint32_t i;
+
+    memcpy(k_ctrl, pl->k_ctrl, sizeof k_ctrl);
+    prev[0] = pl->prev_resume[0];
+    prev[1] = pl->prev_resume[1];
+    field_u(w, &b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
+    field_u(w, &b, costing, info->has_pose != 0u ? 1u : 0u, 1u);
+    field_u(w, &b, costing, pl->has_ext ? 1u : 0u, 1u);
+    field_eg64(w, &b, costing, info->seq, BSF_WIRE_K_SEQ);
+    field_eg64(w, &b, costing, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
+    if (info->has_pose != 0u) {
+        const uint32_t theta =
+            (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
+        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose_x * 1000.0f)),
+                   BSF_WIRE_K_POSE);
+        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose_y * 1000.0f)),
+                   BSF_WIRE_K_POSE);
+        field_u(w, &b, costing, theta, 16u);
+    }
+    field_eg(w, &b, costing, pl->step_code, BSF_WIRE_K_STEP);
+    field_eg(w, &b, costing, res->stats.n_valid, BSF_WIRE_K_N);
+    field_eg(w, &b, costing, (uint32_t)(((uint64_t)res->stats.time_ns + 500u) / 1000u),
+             BSF_WIRE_K_TIME_US);
+    field_eg(w, &b, costing, res->n_features, BSF_WIRE_K_FEATURES);
+    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
+        field_u(w, &b, costing, k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
+    }
+    if (pl->has_ext) {
+        field_u(w, &b, costing, pl->has_beams ? 1u : 0u, 1u);
+        field_u(w, &b, costing, info->has_geometry != 0u ? 1u : 0u, 1u);
+        field_u(w, &b, costing, res->stats.cut, BSF_WIRE_CUT_BITS);
+        if (pl->has_beams) {
+            field_eg(w, &b, costing, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
+        }
+        if (info->has_geometry != 0u) {
+            field_float(w, &b, costing, info->angle_min);
+            field_float(w, &b, costing, info->angle_increment);
+        }
+        if (res->stats.cut != 0u) {
+            field_eg(w, &b, costing, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
+            field_eg(w, &b, costing, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
+            field_eg(w, &b, costing, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
+        }
+    }
+
+    for (i = 0; i < res->n_features; ++i) {
+        const bsf_feature_t *f = &res->features[i];
+        const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
+        const uint32_t span = feature_span(f, res->stats.n_beams);
+        uint64_t mask;
+        const uint32_t n_unique = feature_mask(vtx, f->n_ctrl, &mask);
+        const uint32_t *values = table;
+        if (i < pl->n_cached) {
+            values = table + used;
+            used += 2u * n_unique;
+        } else {
+            /* beyond the table: the same values again, into it */
+            (void)feature_values(&res->ctrl[f->ctrl_first], vtx, f->n_ctrl, pl->step, prev, table,
+                                 NULL);
+        }
+        field_u(w, &b, costing, f->kind, 1u);
+        field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
+        if (mask == 0u) {
+            field_u(w, &b, costing, 0u, 1u);
+        } else {
+            uint32_t j;
+            field_u(w, &b, costing, 1u, 1u);
+            for (j = 0; j < n_unique; ++j) {
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & 1u, 1u);
+            }
+        }
+        field_eg(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
+                 BSF_WIRE_K_GAP);
+        field_eg(w, &b, costing, span, BSF_WIRE_K_SPAN);
+        field_eg(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
+        field_eg(w, &b, costing, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
+                 BSF_WIRE_K_E_CURVE);
+        put_values(w, &b, costing, values, 2u * n_unique, k_ctrl);
+        prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
+    }
+    if (pl->n_cached < res->n_features) {
         /* values made again overwrote the table: a further run makes all again */
         pl->n_cached = 0u;
         pl->prev_resume[0] = 0;
         pl->prev_resume[1] = 0;
     }
-    return BSF_OK;
-}
-
-/*
- * Planning run: checks, the value table, each class's order (the shortest;
- * ties to the smaller) and the payload's exact size in bits. The chosen
- * total never exceeds the total at order 25, which bounds every value by 26
- * bits (BSF_FRAME_CTRL_MAX_BITS).
- */
-static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t *res,
-                               uint32_t *table, plan_t *pl, uint8_t k_ctrl[BSF_WIRE_N_CLASSES])
-{
-    writer_t w;
-    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
-    unsigned cls;
-    bsf_status_t st;
-
-    memset(pl, 0, sizeof *pl);
-    st = check_frame(info, res, pl);
-    if (st != BSF_OK) {
-        return st;
-    }
-    writer_init(&w, NULL);
-    w.costing = 1;
-    memset(tally, 0, sizeof tally);
-    st = frame_payload(&w, pl, info, res, table, tally);
-    if (st != BSF_OK) {
-        return st;
-    }
-    pl->bits = w.bits;
-    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
-        uint32_t bits;
-        k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);
-        pl->bits += bits;
-    }
-    return BSF_OK;
-}
-
-/* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
-static void writer_end_stream(writer_t *w)
-{
-    size_t n;
-    if (w->room < 32u) {
-        const unsigned tail = (32u - w->room + 7u) / 8u; /* bytes of the partial word */
-        put_word(w, w->acc << w->room);
-        n = (size_t)(w->p - w->chunk) - (4u - tail);
-    } else {
-        n = (size_t)(w->p - w->chunk);
-    }
-    stream_payload(w->out, w->chunk, n);
-    stream_finish(w->out);
+    w->b = b;
 }
 
 /* ---- Metadata frame ------------------------------------------------------ */
@@ -851,34 +886,48 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
     return BSF_OK;
 }
 
-/* The metadata payload through w (FORMAT.md section 3.6); m was checked. */
-static void metadata_payload(writer_t *w, const bsf_metadata_t *m, uint32_t step_code)
+/* The two runs as functions of their own, each compiled for its mode. */
+static void frame_payload_write(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
+                                const bsf_result_t *res, uint32_t *table)
 {
+    frame_payload_run(w, 0, pl, info, res, table);
+}
+
+static void frame_payload_cost(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
+                               const bsf_result_t *res, uint32_t *table)
+{
+    frame_payload_run(w, 1, pl, info, res, table);
+}
+
+/* The metadata payload through w (FORMAT.md section 3.6); m was checked. */
+static void metadata_payload(writer_t *w, int costing, const bsf_metadata_t *m, uint32_t step_code)
+{
+    bits_t *b = &w->b;
     unsigned i;
-    field_u(w, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA, 8u);
-    field_eg(w, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
-    field_eg(w, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
-    field_eg(w, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
-    field_eg(w, m->method, BSF_WIRE_K_METHOD);
-    field_float(w, m->target_rms);
-    field_eg(w, step_code, BSF_WIRE_K_STEP);
-    field_eg(w, m->max_points, BSF_WIRE_K_CAP_POINTS);
-    field_eg(w, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
-    field_eg(w, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
-    field_eg(w, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
-    field_eg(w, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
-    field_eg(w, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
-    field_float(w, m->angle_min);
-    field_float(w, m->angle_increment);
-    field_float(w, m->range_min);
-    field_float(w, m->range_max);
-    field_u(w, m->has_time_origin != 0u ? 1u : 0u, 1u);
+    field_u(w, b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA, 8u);
+    field_eg(w, b, costing, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, b, costing, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, b, costing, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, b, costing, m->method, BSF_WIRE_K_METHOD);
+    field_float(w, b, costing, m->target_rms);
+    field_eg(w, b, costing, step_code, BSF_WIRE_K_STEP);
+    field_eg(w, b, costing, m->max_points, BSF_WIRE_K_CAP_POINTS);
+    field_eg(w, b, costing, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
+    field_eg(w, b, costing, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
+    field_eg(w, b, costing, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
+    field_eg(w, b, costing, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
+    field_eg(w, b, costing, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
+    field_float(w, b, costing, m->angle_min);
+    field_float(w, b, costing, m->angle_increment);
+    field_float(w, b, costing, m->range_min);
+    field_float(w, b, costing, m->range_max);
+    field_u(w, b, costing, m->has_time_origin != 0u ? 1u : 0u, 1u);
     if (m->has_time_origin != 0u) {
-        field_seg(w, m->time_origin_us, BSF_WIRE_K_TIME_ORIGIN);
+        field_eg64(w, b, costing, bsf_wire_zigzag(m->time_origin_us), BSF_WIRE_K_TIME_ORIGIN);
     }
-    field_eg(w, m->source_len, BSF_WIRE_K_SOURCE_LEN);
+    field_eg(w, b, costing, m->source_len, BSF_WIRE_K_SOURCE_LEN);
     for (i = 0; i < m->source_len; ++i) {
-        field_u(w, (uint8_t)m->source[i], 8u);
+        field_u(w, b, costing, (uint8_t)m->source[i], 8u);
     }
 }
 
@@ -890,84 +939,97 @@ typedef struct {
     const bsf_metadata_t *meta; /* or a metadata frame */
     uint32_t *table;            /* features frame: VALUE_TABLE entries */
     plan_t plan;
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
 } job_t;
 
-/* Checks the input and finds the payload's size (and the orders). */
+/* The payload through w, written or counted (the plan checked the input). */
+static void job_payload(writer_t *w, int costing, job_t *job)
+{
+    if (job->meta != NULL) {
+        metadata_payload(w, costing, job->meta, job->plan.step_code);
+    } else {
+        if (costing) {
+            frame_payload_cost(w, &job->plan, job->info, job->res, job->table);
+        } else {
+            frame_payload_write(w, &job->plan, job->info, job->res, job->table);
+        }
+    }
+}
+
+/* Checks the input and bounds the payload's size (and chooses the orders). */
 static bsf_status_t job_plan(job_t *job)
 {
     writer_t w;
     bsf_status_t st;
-    if (job->meta == NULL) {
-        return plan_frame(job->info, job->res, job->table, &job->plan, job->k_ctrl);
-    }
     memset(&job->plan, 0, sizeof job->plan);
+    if (job->meta == NULL) {
+        st = check_frame(job->info, job->res, &job->plan);
+        return st != BSF_OK ? st : plan_frame(job->info, job->res, job->table, &job->plan);
+    }
     st = check_metadata(job->meta, &job->plan.step_code);
     if (st != BSF_OK) {
         return st;
     }
-    writer_init(&w, NULL);
-    w.costing = 1;
-    metadata_payload(&w, job->meta, job->plan.step_code);
-    job->plan.bits = w.bits;
+    writer_init(&w, NULL, NULL, NULL);
+    job_payload(&w, 1, job);
+    job->plan.max_bits = w.b.bits;
     return BSF_OK;
 }
 
-/* The planned payload through w (cannot fail: the plan checked it all). */
-static void job_payload(writer_t *w, job_t *job)
+/* The exact payload bits: a costing run. */
+static uint32_t job_bits(job_t *job)
 {
-    memcpy(w->k_ctrl, job->k_ctrl, BSF_WIRE_N_CLASSES);
-    if (job->meta != NULL) {
-        metadata_payload(w, job->meta, job->plan.step_code);
-    } else {
-        (void)frame_payload(w, &job->plan, job->info, job->res, job->table, NULL);
-    }
+    writer_t w;
+    writer_init(&w, NULL, NULL, NULL);
+    job_payload(&w, 1, job);
+    return w.b.bits;
 }
 
 static void job_stream(job_t *job, stream_t *s)
 {
     writer_t w;
-    writer_init(&w, s);
-    job_payload(&w, job);
+    writer_init(&w, s, NULL, NULL);
+    job_payload(&w, 0, job);
     writer_end_stream(&w);
 }
 
-/* Body bytes of the planned frame: payload and CRC. */
-static size_t job_body(const job_t *job)
+/* COBS bound of a body of n bytes, with the delimiter. */
+static size_t frame_bound(size_t body)
 {
-    return ((size_t)job->plan.bits + 7u) / 8u + BSF_FRAME_CRC_SIZE;
+    return body + body / 254u + 2u;
 }
 
 /*
- * The frame straight into buf, which holds the bound job_body +
- * job_body / 254 + 2: the payload goes to buf + 1 (behind the first code
- * byte) and gets its CRC; a body with full COBS blocks moves up by their
- * number (a code byte each), and COBS turns it into its code in place.
- * Nothing is written beyond the frame.
+ * The frame straight into buf, which holds the frame_bound of max_bits: the
+ * payload goes to buf + 1 (behind the first code byte) and gets its CRC; a
+ * body with full COBS blocks moves up by their number (a code byte each),
+ * and COBS turns it into its code in place. Nothing is written beyond the
+ * frame.
  */
 static bsf_status_t job_direct(job_t *job, uint8_t *buf, size_t *out_len)
 {
-    const size_t body = job_body(job);
-    const size_t payload = body - BSF_FRAME_CRC_SIZE;
+    const size_t max_payload = ((size_t)job->plan.max_bits + 7u) / 8u;
     uint8_t *const start = buf + 1;
     writer_t w;
+    size_t payload;
+    size_t body;
     uint32_t crc;
     size_t full = 0;
     size_t len;
     unsigned i;
-    writer_init(&w, NULL);
-    w.p = start;
-    w.end = start + body; /* the last word may reach into the CRC's place */
-    job_payload(&w, job);
+    /* the last word may reach 3 bytes beyond the payload, into the CRC's place */
+    writer_init(&w, NULL, start, start + max_payload + BSF_FRAME_CRC_SIZE);
+    job_payload(&w, 0, job);
+    payload = (writer_bits(&w, start) + 7u) / 8u;
     writer_flush(&w);
-    if (w.overflow || (size_t)(w.p - start) != ((size_t)job->plan.bits + 31u) / 32u * 4u) {
+    if (w.overflow || payload > max_payload) {
         *out_len = 0u;
-        return BSF_ERR_BUFFER; /* not the planned size: never happens */
+        return BSF_ERR_BUFFER; /* beyond the planned bound: never happens */
     }
     crc = bsf_crc32c(0u, start, payload);
     for (i = 0; i < 4u; ++i) {
         start[payload + i] = (uint8_t)(crc >> (8u * i));
     }
+    body = payload + BSF_FRAME_CRC_SIZE;
     if (body >= 254u) {
         full = bsf_cobs_full_blocks(start, body);
         if (full > 0u) {
@@ -989,10 +1051,11 @@ static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out
         *out_len = 0u;
         return st;
     }
-    body = job_body(job);
-    if (buf != NULL && cap >= body + body / 254u + 2u) {
+    if (buf != NULL &&
+        cap >= frame_bound(((size_t)job->plan.max_bits + 7u) / 8u + BSF_FRAME_CRC_SIZE)) {
         return job_direct(job, buf, out_len);
     }
+    body = ((size_t)job_bits(job) + 7u) / 8u + BSF_FRAME_CRC_SIZE;
     if (body < 254u) {
         *out_len = body + 2u; /* exact: no block reaches 254 bytes */
     } else {
@@ -1018,7 +1081,7 @@ static bsf_status_t job_encode_sink(job_t *job, bsf_encoder_t *work, bsf_sink_fn
                                     size_t *written)
 {
     stream_t s;
-    bsf_status_t st = job_plan(job);
+    const bsf_status_t st = job_plan(job);
     if (st != BSF_OK) {
         return st;
     }

@@ -126,6 +126,17 @@ static inline unsigned bsf_wire_bitlen32(uint32_t v)
 #endif
 }
 
+/* Bit length of v < 2^31: 2v + 1 is never 0, so the count needs no test
+ * for 0 (x86 BSR); where CLZ of 0 is defined (Arm), the plain form is shorter. */
+static inline unsigned bsf_wire_bitlen31(uint32_t v)
+{
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(__arm__) && !defined(__aarch64__)
+    return 31u - (unsigned)__builtin_clz(2u * v + 1u);
+#else
+    return bsf_wire_bitlen32(v);
+#endif
+}
+
 static inline unsigned bsf_wire_bitlen(uint64_t v)
 {
     const uint32_t hi = (uint32_t)(v >> 32);
@@ -161,17 +172,17 @@ typedef uint32_t bsf_wire_eg_count_t;
 typedef struct {
     bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
     bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    uint32_t or_all;                               /* OR of the values: its bit length is max L */
+    uint32_t or_all; /* OR of the values: its bit length is the largest L */
 } bsf_wire_eg_tally_t;
 
 /* One value v < 2^26. */
 static inline void bsf_wire_eg_tally_add32(bsf_wire_eg_tally_t *t, uint32_t v)
 {
-    const unsigned len = bsf_wire_bitlen32(v);
-    /* the len low bits set (0 for v = 0) without a shift by 32 */
-    const uint32_t ones = (uint32_t)((((uint64_t)1) << len) - 1u);
+    const unsigned len = bsf_wire_bitlen31(v);
+    /* the len low bits set (none for v = 0), with no shift by 32 */
+    const uint32_t ones = (0xFFFFFFFFu >> 1) >> (31u - len);
     t->n_len[len] += 1u;
-    t->n_below[bsf_wire_bitlen32(v ^ ones)] += 1u;
+    t->n_below[bsf_wire_bitlen31(v ^ ones)] += 1u;
     t->or_all |= v;
 }
 
@@ -180,70 +191,78 @@ static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
     bsf_wire_eg_tally_add32(t, (uint32_t)v);
 }
 
-/* cost[k] for k = 0..k_max: total bits of the tallied values at order k. */
+/*
+ * The totals follow from counts: with A(k) values of L <= k, B(k) values of
+ * m <= k (m <= L, so B(k) - A(k) values carry at order k) and T(k) = the sum
+ * of L over the values with L > k plus k A(k), the code lengths 2
+ * bitlen(v + 2^k) - 1 - k sum to 2 T(k) + 2 B(k) - n (1 + k), where
+ * bitlen(v + 2^k) is max(L, k + 1) plus one for a carry. T(0) is the sum of
+ * all L and T(k) = T(k - 1) + A(k - 1).
+ */
+
+/* The number of values and the sum of their L, up to the largest L. */
+static inline uint32_t bsf_wire_eg_tally_sums(const bsf_wire_eg_tally_t *t, uint32_t *sum_len)
+{
+    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
+    uint32_t n = t->n_len[0];
+    uint32_t sum = 0;
+    unsigned len;
+    for (len = 1; len <= max_len; ++len) {
+        n += t->n_len[len];
+        sum += len * t->n_len[len];
+    }
+    *sum_len = sum;
+    return n;
+}
+
+/* cost[k] for k = 0..k_max (<= 25): total bits of the tallied values at order k. */
 static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigned k_max,
                                            uint32_t *cost)
 {
-    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
-    uint32_t n = 0;
-    uint32_t above = 0;      /* sum of (2L - 1) over the values with L > k */
-    uint32_t n_len_le = 0;   /* values with L <= k */
-    uint32_t n_below_le = 0; /* values with m <= k */
-    unsigned len;
+    uint32_t sum; /* T(k) */
+    const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
+    uint32_t a = 0;
+    uint32_t b = 0;
     unsigned k;
-    for (len = 0; len <= max_len; ++len) {
-        n += t->n_len[len];
-        if (len > 0u) {
-            above += t->n_len[len] * (2u * len - 1u);
-        }
-    }
     for (k = 0; k <= k_max; ++k) {
-        if (k <= max_len) {
-            n_len_le += t->n_len[k];
-            n_below_le += t->n_below[k];
-            if (k > 0u) {
-                above -= t->n_len[k] * (2u * k - 1u);
-            }
-        }
-        /* unsigned arithmetic: intermediate wrap-around cancels */
-        cost[k] = (k + 1u) * n_len_le + above - k * (n - n_len_le) + 2u * (n_below_le - n_len_le);
+        sum += a;
+        a += t->n_len[k];
+        b += t->n_below[k];
+        cost[k] = 2u * (sum + b) - n * (1u + k);
     }
 }
 
 /*
  * The order 0..BSF_WIRE_K_CTRL_MAX with the fewest bits for the tallied
- * values (ties to the smaller order), and those bits in *bits. Above the
- * longest value's bit length L every order costs one bit per value more than
- * the one before, so none beats order L and the search stops there.
+ * values (ties to the smaller order), and those bits in *bits. Every code
+ * at order k takes at least k + 1 bits, so the search stops once n (k + 1)
+ * reaches the best total; it never goes past the longest value's bit length
+ * L either, since above L every order costs one bit per value more than the
+ * one before.
  */
 static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint32_t *bits)
 {
     const unsigned max_len = bsf_wire_bitlen32(t->or_all);
     const unsigned k_top = max_len < BSF_WIRE_K_CTRL_MAX ? max_len : BSF_WIRE_K_CTRL_MAX;
-    uint32_t n = 0;
-    uint32_t above = 0;
-    uint32_t n_len_le = 0;
-    uint32_t n_below_le = 0;
-    uint32_t best_cost = 0;
+    uint32_t sum;
+    const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
+    uint32_t a = t->n_len[0];
+    uint32_t b = t->n_below[0];
+    uint32_t best_cost = 2u * (sum + b) - n; /* order 0 */
+    uint32_t floor_bits = 2u * n;            /* n (k + 1) for the next k */
     unsigned best = 0;
     unsigned k;
-    for (k = 1; k <= max_len; ++k) {
-        n += t->n_len[k];
-        above += t->n_len[k] * (2u * k - 1u);
-    }
-    n += t->n_len[0];
-    for (k = 0; k <= k_top; ++k) {
+    for (k = 1; k <= k_top && floor_bits < best_cost; ++k) {
         uint32_t cost;
-        n_len_le += t->n_len[k];
-        n_below_le += t->n_below[k];
-        if (k > 0u) {
-            above -= t->n_len[k] * (2u * k - 1u);
-        }
-        cost = (k + 1u) * n_len_le + above - k * (n - n_len_le) + 2u * (n_below_le - n_len_le);
-        if (k == 0u || cost < best_cost) {
+        sum += a;
+        a += t->n_len[k];
+        b += t->n_below[k];
+        cost = 2u * (sum + b) - floor_bits;
+        if (cost < best_cost) {
             best_cost = cost;
             best = k;
         }
+        floor_bits += n;
     }
     *bits = best_cost;
     return best;
