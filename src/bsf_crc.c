@@ -2,13 +2,43 @@
 #include "bsf/bsf_stream.h"
 
 /*
- * CRC-32C (Castagnoli), reflected. By default one byte per step from a
- * 256-entry table (1 KiB of read-only data): the encoder and the stream
- * decoder run every byte of every frame through it, and a byte step costs
- * about half the instructions of two nibble steps. A build short of flash can
- * define BSF_CRC32C_NIBBLE_TABLE to use a 16-entry table (64 bytes) instead;
- * the CRC is the same.
+ * CRC-32C (Castagnoli), reflected; the encoder and the stream decoder run
+ * every byte of every frame through it. Three ways to the same CRC:
+ * - x86-64 with SSE4.2 (checked at run time): the CRC32 instruction, 8 bytes
+ *   at a time (GCC and Clang; BSF_CRC32C_PORTABLE turns it off);
+ * - by default, one byte per step from a 256-entry table (1 KiB of read-only
+ *   data), about half the instructions of two nibble steps;
+ * - in size-optimised builds (-Os), or with BSF_CRC32C_NIBBLE_TABLE, two
+ *   steps of a 16-entry table (64 bytes), for flash-bound microcontrollers.
  */
+#if defined(__OPTIMIZE_SIZE__) && !defined(BSF_CRC32C_NIBBLE_TABLE) &&                             \
+    !defined(BSF_CRC32C_BYTE_TABLE)
+#define BSF_CRC32C_NIBBLE_TABLE
+#endif
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) &&                            \
+    !defined(BSF_CRC32C_PORTABLE)
+#include <string.h>
+#define BSF_CRC32C_SSE42 1
+
+__attribute__((target("sse4.2"))) static uint32_t crc32c_sse42(uint32_t reg, const uint8_t *data,
+                                                               size_t len)
+{
+    while (len >= 8u) {
+        uint64_t word;
+        memcpy(&word, data, sizeof word); /* little-endian: the first byte lowest */
+        reg = (uint32_t)__builtin_ia32_crc32di(reg, word);
+        data += 8;
+        len -= 8u;
+    }
+    while (len > 0u) {
+        reg = __builtin_ia32_crc32qi(reg, *data++);
+        --len;
+    }
+    return reg;
+}
+#endif
+
 #ifdef BSF_CRC32C_NIBBLE_TABLE
 static const uint32_t crc32c_nibble[16] = {0x00000000u, 0x105EC76Fu, 0x20BD8EDEu, 0x30E349B1u,
                                            0x417B1DBCu, 0x5125DAD3u, 0x61C69362u, 0x7198540Du,
@@ -23,6 +53,11 @@ uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len)
     if (data == NULL) {
         return crc;
     }
+#ifdef BSF_CRC32C_SSE42
+    if (__builtin_cpu_supports("sse4.2")) {
+        return ~crc32c_sse42(reg, data, len);
+    }
+#endif
     for (i = 0; i < len; ++i) {
         reg ^= data[i];
         reg = (reg >> 4) ^ crc32c_nibble[reg & 0x0Fu];
@@ -79,6 +114,11 @@ uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len)
     if (data == NULL) {
         return crc;
     }
+#ifdef BSF_CRC32C_SSE42
+    if (__builtin_cpu_supports("sse4.2")) {
+        return ~crc32c_sse42(reg, data, len);
+    }
+#endif
     /* four bytes at a time: the register takes them in at once (the first
      * byte in its low 8 bits, as the reflected CRC shifts right), then four
      * table steps without a load of data between them */

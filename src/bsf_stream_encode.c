@@ -379,13 +379,13 @@ ENC_INLINE int quantise(float v, float step, int32_t *q)
 {
     const float r = v / step + 0.5f;
     int32_t t;
-    if (!(r >= -(float)BSF_QUANT_MAX_STEPS && r < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
+    if (!(fabsf(r) < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
         *q = 0;
         return 0; /* NaN included */
     }
     t = (int32_t)r;
     *q = (float)t > r ? t - 1 : t;
-    return 1;
+    return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
 }
 
 ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
@@ -401,13 +401,15 @@ ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
 #define VALUE_CLASS_SHIFT 30u
 #define VALUE_MASK 0x3FFFFFFFu
 
-/* Table entries: the values of a typical frame (about 55 on Intel, 100 on
- * MIT and Freiburg) at 4 bytes each, and room for the values of one more
- * feature (at most 2 per stored control point) behind them, where the
- * planning run puts those of features beyond the table and the writing runs
- * make them again. */
-#define VALUE_KEEP 128u
-#define VALUE_TABLE (VALUE_KEEP + 2u * BSF_MAX_CTRL_PER_FEATURE)
+/* Table entries: per feature a head (distinct points, vertex mask in two
+ * words) and its values; those of a typical frame (about 75 on Intel, 130 on
+ * MIT and Freiburg) at 4 bytes each, and room for one more feature (at most
+ * 2 values per stored control point) behind them, where the planning run
+ * puts those of features beyond the table and the writing runs make them
+ * again. */
+#define VALUE_HEAD 3u
+#define VALUE_KEEP 144u
+#define VALUE_TABLE (VALUE_KEEP + VALUE_HEAD + 2u * BSF_MAX_CTRL_PER_FEATURE)
 
 ENC_INLINE uint32_t zigzag32(int32_t v)
 {
@@ -436,8 +438,9 @@ ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
     const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;
     int32_t q;
     if (k == 1u) {
-        q = num / 2; /* the usual case, a fragment with one precision point: a shift */
-        return a + (num - 2 * q < 0 ? q - 1 : q);
+        /* the usual case, a fragment with one precision point: floor(num / 2)
+         * as a shift of num + 2^31, which is not negative */
+        return a + ((int32_t)(((uint32_t)num ^ 0x80000000u) >> 1) - 0x40000000);
     }
     q = num / den;
     return a + (num - q * den < 0 ? q - 1 : q); /* floor */
@@ -461,15 +464,19 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
  * on the chord. Stores them in out (room for 2 n), tallies them when tally
  * is given (the planning run), and returns their number (2 per distinct
  * point), or 0 when a point cannot be represented or a flagged slot has no
- * equal partner.
+ * equal partner; *mask gets bit j for distinct point j that is a vertex.
  */
 ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
-                                   int32_t prev[2], uint32_t *out, bsf_wire_eg_tally_t *tally)
+                                   int32_t prev[2], uint32_t *out, bsf_wire_eg_tally_t *tally,
+                                   uint64_t *mask)
 {
     size_t s_a = 0;
     size_t c_a;
     uint32_t cnt = 0;
+    uint32_t j_a = 0; /* distinct index of anchor a */
     int32_t q_a[2];
+
+    *mask = 0u;
 
     if (!quantise_point(p[0], step, q_a)) {
         return 0u;
@@ -479,6 +486,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
         if (!vertex_partner_ok(p, vtx, 0u, n, step, q_a)) {
             return 0u;
         }
+        *mask = 1u;
         c_a = 2u;
     }
     cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_FIRST, q_a[0] - prev[0]);
@@ -496,11 +504,13 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
         if (!quantise_point(p[s_b], step, q_b)) {
             return 0u;
         }
+        j_a += k + 1u;
         c_a = 1u;
         if (vtx[s_b] != 0u) {
             if (!vertex_partner_ok(p, vtx, s_b, n, step, q_b)) {
                 return 0u;
             }
+            *mask |= (uint64_t)1u << j_a;
             c_a = 2u;
         }
         cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
@@ -523,25 +533,6 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
     prev[0] = q_a[0];
     prev[1] = q_a[1];
     return cnt;
-}
-
-/* Distinct points of a checked feature and its vertex mask (bit j for
- * distinct point j), from the flags: a flagged slot and its partner are one. */
-ENC_INLINE uint32_t feature_mask(const uint8_t *vtx, size_t n, uint64_t *mask)
-{
-    size_t s = 0;
-    uint32_t j = 0;
-    *mask = 0u;
-    while (s < n) {
-        if (vtx[s] != 0u) {
-            *mask |= (uint64_t)1u << j;
-            s += 2u;
-        } else {
-            s += 1u;
-        }
-        ++j;
-    }
-    return j;
 }
 
 /* The values' codes at the frame's orders: the hot loop of the writing run. */
@@ -700,7 +691,9 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
     memset(tally, 0, sizeof tally);
     for (i = 0; i < res->n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
+        uint32_t *head = table + used;
         uint32_t n_values;
+        uint64_t mask;
         if (!feature_ok(res, f)) {
             return BSF_ERR_ARG;
         }
@@ -708,14 +701,17 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
             pl->prev_resume[0] = prev[0];
             pl->prev_resume[1] = prev[1];
         }
-        /* behind the kept values: at most 2 n_ctrl values, VALUE_TABLE has room */
+        /* behind the kept entries: a head and at most 2 n_ctrl values, VALUE_TABLE has room */
         n_values = feature_values(&res->ctrl[f->ctrl_first], &res->ctrl_is_vertex[f->ctrl_first],
-                                  f->n_ctrl, step, prev, table + used, tally);
+                                  f->n_ctrl, step, prev, head + VALUE_HEAD, tally, &mask);
         if (n_values == 0u) {
             return BSF_ERR_ARG;
         }
-        if (pl->n_cached == i && used + n_values <= VALUE_KEEP) {
-            used += n_values;
+        if (pl->n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
+            head[0] = n_values / 2u;
+            head[1] = (uint32_t)mask;
+            head[2] = (uint32_t)(mask >> 32);
+            used += VALUE_HEAD + n_values;
             pl->n_cached = i + 1u;
         }
         sum_points += f->n_points;
@@ -798,15 +794,18 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
         const uint32_t span = feature_span(f, res->stats.n_beams);
         uint64_t mask;
-        const uint32_t n_unique = feature_mask(vtx, f->n_ctrl, &mask);
+        uint32_t n_unique;
         const uint32_t *values = table;
         if (i < pl->n_cached) {
-            values = table + used;
-            used += 2u * n_unique;
+            n_unique = table[used];
+            mask = table[used + 1u] | ((uint64_t)table[used + 2u] << 32);
+            values = table + used + VALUE_HEAD;
+            used += VALUE_HEAD + 2u * n_unique;
         } else {
             /* beyond the table: the same values again, into it */
-            (void)feature_values(&res->ctrl[f->ctrl_first], vtx, f->n_ctrl, pl->step, prev, table,
-                                 NULL);
+            n_unique = feature_values(&res->ctrl[f->ctrl_first], vtx, f->n_ctrl, pl->step, prev,
+                                      table, NULL, &mask) /
+                       2u;
         }
         field_u(w, &b, costing, f->kind, 1u);
         field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
