@@ -535,14 +535,32 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
     return cnt;
 }
 
+/* Per class at its order k: 2^k, and 1 - k (modulo 2^32) for the code's
+ * length 2 floor(log2(v + 2^k)) + 1 - k. */
+typedef struct {
+    uint32_t one[BSF_WIRE_N_CLASSES];
+    uint32_t adj[BSF_WIRE_N_CLASSES];
+} orders_t;
+
 /* The values' codes at the frame's orders: the hot loop of the writing run. */
 ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
-                           const uint8_t k_ctrl[BSF_WIRE_N_CLASSES])
+                           const orders_t *ord)
 {
     uint32_t i;
     for (i = 0; i < n; ++i) {
         const uint32_t v = values[i];
-        field_eg(w, b, costing, v & VALUE_MASK, k_ctrl[v >> VALUE_CLASS_SHIFT]);
+        const unsigned cls = v >> VALUE_CLASS_SHIFT;
+        const uint32_t c = (v & VALUE_MASK) + ord->one[cls];
+        const unsigned lg = log2_nz(c);
+        const unsigned len = 2u * lg + ord->adj[cls];
+        if (costing) {
+            b->bits += len;
+        } else if (len < 32u) {
+            put_bits(w, b, c, len);
+        } else {
+            put_bits(w, b, 0u, len - lg - 1u);
+            put_bits(w, b, c, lg + 1u);
+        }
     }
 }
 
@@ -741,12 +759,17 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
 {
     bits_t b = w->b;
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    orders_t ord;
     uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
     uint32_t used = 0;
     int32_t prev[2];
     uint32_t i;
 
     memcpy(k_ctrl, pl->k_ctrl, sizeof k_ctrl);
+    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
+        ord.one[i] = (uint32_t)1 << k_ctrl[i];
+        ord.adj[i] = 1u - k_ctrl[i];
+    }
     prev[0] = pl->prev_resume[0];
     prev[1] = pl->prev_resume[1];
     field_u(w, &b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
@@ -765,7 +788,9 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     }
     field_eg(w, &b, costing, pl->step_code, BSF_WIRE_K_STEP);
     field_eg(w, &b, costing, res->stats.n_valid, BSF_WIRE_K_N);
-    field_eg(w, &b, costing, (uint32_t)(((uint64_t)res->stats.time_ns + 500u) / 1000u),
+    /* round(time_ns / 1000) in 32 bits (a 64-bit division is a library call on Cortex-M) */
+    field_eg(w, &b, costing,
+             res->stats.time_ns / 1000u + (res->stats.time_ns % 1000u + 500u) / 1000u,
              BSF_WIRE_K_TIME_US);
     field_eg(w, &b, costing, res->n_features, BSF_WIRE_K_FEATURES);
     for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
@@ -824,7 +849,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         field_eg(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
         field_eg(w, &b, costing, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
                  BSF_WIRE_K_E_CURVE);
-        put_values(w, &b, costing, values, 2u * n_unique, k_ctrl);
+        put_values(w, &b, costing, values, 2u * n_unique, &ord);
         prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
     }
     if (pl->n_cached < res->n_features) {

@@ -126,12 +126,12 @@ static inline unsigned bsf_wire_bitlen32(uint32_t v)
 #endif
 }
 
-/* Bit length of v < 2^31: 2v + 1 is never 0, so the count needs no test
- * for 0 (x86 BSR); where CLZ of 0 is defined (Arm), the plain form is shorter. */
+/* Bit length of v < 2^31 as floor(log2(2v + 1)): 2v + 1 is never 0, so the
+ * count needs no test for 0 (x86 BSR, Arm CLZ). */
 static inline unsigned bsf_wire_bitlen31(uint32_t v)
 {
-#if (defined(__GNUC__) || defined(__clang__)) && !defined(__arm__) && !defined(__aarch64__)
-    return 31u - (unsigned)__builtin_clz(2u * v + 1u);
+#if defined(__GNUC__) || defined(__clang__)
+    return 31u ^ (unsigned)__builtin_clz(2u * v + 1u);
 #else
     return bsf_wire_bitlen32(v);
 #endif
