@@ -451,8 +451,13 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
                              float step, const int32_t q[2])
 {
     int32_t q2[2];
-    return s + 1u < n && vtx[s + 1u] != 0u && quantise_point(p[s + 1u], step, q2) &&
-           q2[0] == q[0] && q2[1] == q[1];
+    if (s + 1u >= n || vtx[s + 1u] == 0u) {
+        return 0;
+    }
+    if (memcmp(&p[s], &p[s + 1u], sizeof p[s]) == 0) {
+        return 1; /* the usual copy: the same bits quantise alike */
+    }
+    return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
 }
 
 /*
