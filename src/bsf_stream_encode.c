@@ -138,6 +138,12 @@ static void stream_finish(stream_t *s)
 #define ENC_INLINE static inline
 #endif
 
+#if defined(__GNUC__) || defined(__clang__)
+#define ENC_NOINLINE static __attribute__((noinline))
+#else
+#define ENC_NOINLINE static
+#endif
+
 #define CHUNK_BYTES 32u /* streaming path: payload bytes handed on at a time */
 
 /*
@@ -984,10 +990,19 @@ static void job_payload(writer_t *w, int costing, job_t *job)
     }
 }
 
+/* The exact payload bits: a costing run (a call of its own, so that its
+ * writer is not on the planning run's stack). */
+ENC_NOINLINE uint32_t job_bits(job_t *job)
+{
+    writer_t w;
+    writer_init(&w, NULL, NULL, NULL);
+    job_payload(&w, 1, job);
+    return w.b.bits;
+}
+
 /* Checks the input and bounds the payload's size (and chooses the orders). */
 static bsf_status_t job_plan(job_t *job)
 {
-    writer_t w;
     bsf_status_t st;
     memset(&job->plan, 0, sizeof job->plan);
     if (job->meta == NULL) {
@@ -995,22 +1010,10 @@ static bsf_status_t job_plan(job_t *job)
         return st != BSF_OK ? st : plan_frame(job->info, job->res, job->table, &job->plan);
     }
     st = check_metadata(job->meta, &job->plan.step_code);
-    if (st != BSF_OK) {
-        return st;
+    if (st == BSF_OK) {
+        job->plan.max_bits = job_bits(job); /* exact */
     }
-    writer_init(&w, NULL, NULL, NULL);
-    job_payload(&w, 1, job);
-    job->plan.max_bits = w.b.bits;
-    return BSF_OK;
-}
-
-/* The exact payload bits: a costing run. */
-static uint32_t job_bits(job_t *job)
-{
-    writer_t w;
-    writer_init(&w, NULL, NULL, NULL);
-    job_payload(&w, 1, job);
-    return w.b.bits;
+    return st;
 }
 
 static void job_stream(job_t *job, stream_t *s)
