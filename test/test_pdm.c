@@ -457,6 +457,31 @@ static void test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck(
     }
 }
 
+/* A straight 10.8 m wall sampled at 1 cm with 1 cm noise, one fragment of
+ * 1081 points: the windowed-mean test sees range noise only. A fixed window
+ * of 16 points is tested about 68 times on such a dense fragment, and noise
+ * alone tripped it until the control-point cap; past PDM_BIAS_MAX_WINDOWS
+ * windows the window grows with the fragment, so the wall stays a line of
+ * few control points. */
+static void test_dense_noisy_wall_is_not_refined_on_noise(void)
+{
+    const size_t n = BSF_MAX_POINTS;
+    size_t i;
+    size_t n_ctrl = 0;
+    float e = -1.0f;
+    rng_state = 2024u;
+    for (i = 0; i < n; ++i) {
+        room_pts[i].x = 0.01f * (float)i;
+        room_pts[i].y = 2.0f + 0.01f * rng_gauss();
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                              BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
+    printf("dense noisy wall: %u points, %u control points, E_curve %.4f m\n", (unsigned)n,
+           (unsigned)n_ctrl, (double)e);
+    assert_all_finite(ctrl, n_ctrl);
+    TEST_ASSERT_TRUE(n_ctrl <= 8u);
+}
+
 static void test_degenerate_inputs_give_defined_status_and_never_nan(void)
 {
     size_t n_ctrl = 77u;
@@ -583,6 +608,7 @@ int main(void)
     RUN_TEST(test_systematic_deviation_refines_a_bulge_the_rms_accepts);
     RUN_TEST(test_refinement_stops_at_the_per_fragment_cap);
     RUN_TEST(test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck);
+    RUN_TEST(test_dense_noisy_wall_is_not_refined_on_noise);
     RUN_TEST(test_degenerate_inputs_give_defined_status_and_never_nan);
     RUN_TEST(test_bad_arguments_parameters_and_capacities_are_refused);
     return UNITY_END();
