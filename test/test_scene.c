@@ -346,6 +346,52 @@ static void test_bad_input_is_refused_with_an_error(void)
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
 }
 
+/* A sensor pose is checked against every shape: inside a pillar, inside a
+ * solid box, too close to a wall, outside the room are all refused. */
+static void test_pose_check_finds_poses_inside_obstacles(void)
+{
+    static const double crate[] = {3.0, 1.0, 4.0, 1.0, 4.0, 2.0, 3.0, 2.0};
+    int pillar;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, 0.0, 0.0, 8.0, 5.0));
+    pillar = bsf_scene_add_circle(&scene, 6.0, 3.0, 0.4);
+    TEST_ASSERT_EQUAL_INT(4, pillar);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_solid(&scene, crate, 4u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_box(&scene, 1.0, 3.5, 1.6, 4.2));
+    TEST_ASSERT_EQUAL_INT(2, scene.n_solids);
+    TEST_ASSERT_EQUAL_INT(0, scene.shape[0].solid);
+    TEST_ASSERT_EQUAL_INT(1, scene.shape[5].solid);
+    TEST_ASSERT_EQUAL_INT(2, scene.shape[9].solid);
+    /* free: open floor; the room itself is a wall, not a solid */
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 2.0, 2.5, 0.3));
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 6.0, 2.2, 0.3));
+    /* inside the pillar, and just outside it but closer than the clearance */
+    TEST_ASSERT_EQUAL_INT(pillar, bsf_scene_pose_blocked(&scene, 6.1, 3.1, 0.3));
+    TEST_ASSERT_EQUAL_INT(pillar, bsf_scene_pose_blocked(&scene, 6.0, 2.45, 0.3));
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 6.0, 2.45, 0.1));
+    /* inside the crate and the box, even with clearance 0 */
+    TEST_ASSERT_TRUE(scene.shape[bsf_scene_pose_blocked(&scene, 3.5, 1.5, 0.0)].solid == 1);
+    TEST_ASSERT_TRUE(scene.shape[bsf_scene_pose_blocked(&scene, 1.3, 3.8, 0.0)].solid == 2);
+    /* against a wall */
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_pose_blocked(&scene, 2.0, 0.1, 0.3));
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_pose_blocked(NULL, 2.0, 2.5, 0.3));
+    /* enclosed inside the room, not outside it */
+    TEST_ASSERT_EQUAL_INT(1, bsf_scene_point_enclosed(&scene, 2.0, 2.5, 360u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_point_enclosed(&scene, -1.0, 2.5, 360u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_point_enclosed(&scene, 2.0, 2.5, 0u));
+}
+
+/* The demo office's cabinet is a solid box: scans are unchanged by that
+ * (the same edges in the same order), but no pose may stand inside it. */
+static void test_demo_office_cabinet_is_solid(void)
+{
+    bsf_scene_demo_office(&scene);
+    TEST_ASSERT_EQUAL_INT(1, scene.n_solids);
+    TEST_ASSERT_TRUE(bsf_scene_pose_blocked(&scene, 2.75, 7.9, 0.0) >= 0);
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 2.75, 6.9, 0.3));
+    TEST_ASSERT_TRUE(bsf_scene_pose_blocked(&scene, 10.5, 3.0, 0.0) >= 0); /* the pillar */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -362,5 +408,7 @@ int main(void)
     RUN_TEST(test_scan_points_lie_on_the_surfaces_in_the_world);
     RUN_TEST(test_distance_to_surface_and_frame_transforms);
     RUN_TEST(test_bad_input_is_refused_with_an_error);
+    RUN_TEST(test_pose_check_finds_poses_inside_obstacles);
+    RUN_TEST(test_demo_office_cabinet_is_solid);
     return UNITY_END();
 }
