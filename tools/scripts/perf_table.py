@@ -46,8 +46,10 @@ def log(msg):
 
 def run(cmd, cwd=ROOT, capture=True, check=True):
     log("  $ " + " ".join(cmd))
+    t0 = time.time()
     r = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE if capture else None,
                        stderr=subprocess.STDOUT if capture else None, text=True)
+    log(f"    ({time.time() - t0:.1f} s)")
     if check and r.returncode != 0:
         if capture:
             sys.stderr.write(r.stdout[-4000:])
