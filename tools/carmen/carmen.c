@@ -4,11 +4,13 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 #include "carmen.h"
+#include "carmen_number.h"
 
 #include <errno.h>
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -24,8 +26,13 @@
 #define CARMEN_PI 3.14159265358979323846
 #define CARMEN_FLASER_MAX_RANGE 80.0f
 
-/* Bytes read from the file (or the decompressor) per refill. */
+/* Bytes read from the file (or the decompressor) per refill. Always this
+ * many are asked for: zlib drops the data of a request that meets corrupt
+ * input, so the same requests keep the same lines before a read error. */
 #define CARMEN_BLOCK 65536u
+
+/* No position yet (of a control byte in the line). */
+#define CARMEN_NONE ((size_t)-1)
 
 struct carmen_reader {
 #ifdef BSF_HAVE_ZLIB
@@ -39,16 +46,19 @@ struct carmen_reader {
     int kind_checked; /* want_gzip was checked against the content */
     FILE *err;
     char *path;
-    char *line; /* current line, grown as needed */
-    size_t line_cap;
+    /* Data read and not yet consumed. Lines are parsed where they lie (the
+     * newline becomes the NUL that ends the line's string); only the part
+     * of a line that a refill cuts is moved, to the buffer's start. */
+    char *buf;
+    size_t buf_cap;  /* bytes allocated, grown for lines longer than a block */
+    size_t buf_pos;  /* first byte of the next line */
+    size_t buf_len;  /* bytes of data in buf */
+    char *line;      /* current line (in buf), NUL-terminated */
     size_t line_len; /* bytes in line, without the newline */
     size_t bad_byte; /* 1 + column of the first control byte, 0: none */
     unsigned char bad_value;
     unsigned long line_no;
     unsigned long malformed;
-    size_t block_pos;
-    size_t block_len;
-    unsigned char block[CARMEN_BLOCK];
     float ranges[CARMEN_MAX_BEAMS];
 };
 
@@ -72,9 +82,11 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
     r->err = err;
     r->want_gzip = ends_with_gz(path);
     r->path = malloc(strlen(path) + 1u);
-    r->line_cap = 4096;
-    r->line = malloc(r->line_cap);
-    if (r->path == NULL || r->line == NULL) {
+    /* room for a whole block after a cut line's first 4 KiB, and the final
+     * NUL; longer lines grow the buffer */
+    r->buf_cap = CARMEN_BLOCK + 4096u + 1u;
+    r->buf = malloc(r->buf_cap);
+    if (r->path == NULL || r->buf == NULL) {
         carmen_close(r);
         return NULL;
     }
@@ -156,7 +168,7 @@ void carmen_close(carmen_reader_t *reader)
         }
     }
 #endif
-    free(reader->line);
+    free(reader->buf);
     free(reader->path);
     free(reader);
 }
@@ -210,8 +222,9 @@ static int check_end(carmen_reader_t *r)
     return 0;
 }
 
-/* Refills the block. Returns the number of bytes now available, 0 at a
- * checked end of data, -1 on a (reported) read error. */
+/* Reads up to a block more after the buffer's data (make_room gave the
+ * space). Returns the number of bytes read, 0 at a checked end of data, -1
+ * on a (reported) read error. */
 static long refill(carmen_reader_t *r)
 {
     long got;
@@ -233,7 +246,7 @@ static long refill(carmen_reader_t *r)
     }
 #ifdef BSF_HAVE_ZLIB
     {
-        const int n = gzread(r->gz, r->block, (unsigned)sizeof r->block);
+        const int n = gzread(r->gz, r->buf + r->buf_len, CARMEN_BLOCK);
         int zerr = Z_OK;
         (void)gzerror(r->gz, &zerr);
         if (n < 0 || (zerr != Z_OK && zerr != Z_BUF_ERROR)) {
@@ -246,7 +259,7 @@ static long refill(carmen_reader_t *r)
     if (r->file == NULL) {
         return 0;
     }
-    got = (long)fread(r->block, 1, sizeof r->block, r->file);
+    got = (long)fread(r->buf + r->buf_len, 1, CARMEN_BLOCK, r->file);
 #endif
     if (got == 0) {
         /* Only a genuine end gives 0; a cut or failed source is an error,
@@ -257,99 +270,141 @@ static long refill(carmen_reader_t *r)
         r->at_end = 1;
         return 0;
     }
-    r->block_pos = 0;
-    r->block_len = (size_t)got;
+    r->buf_len += (size_t)got;
     return got;
 }
 
-/* Appends n bytes to the line, growing its buffer. Returns 0 or -1. */
-static int append(carmen_reader_t *r, const unsigned char *p, size_t n)
+/* Moves the unconsumed data (the start of a line) to the buffer's start and
+ * makes room after it for a whole block and a NUL, growing the buffer for
+ * a line longer than a block. Returns 0 or -1 (reported). */
+static int make_room(carmen_reader_t *r)
 {
-    size_t i;
-    if (r->line_len + n + 1u > r->line_cap) {
-        size_t cap = r->line_cap;
-        char *bigger;
-        while (r->line_len + n + 1u > cap) {
-            cap *= 2u;
-        }
-        bigger = realloc(r->line, cap);
+    if (r->buf_pos > 0u) {
+        memmove(r->buf, r->buf + r->buf_pos, r->buf_len - r->buf_pos);
+        r->buf_len -= r->buf_pos;
+        r->buf_pos = 0;
+    }
+    if (r->buf_cap - r->buf_len < CARMEN_BLOCK + 1u) {
+        const size_t cap = 2u * r->buf_cap;
+        char *bigger = cap > r->buf_cap ? realloc(r->buf, cap) : NULL;
         if (bigger == NULL) {
             if (r->err != NULL) {
                 fprintf(r->err, "%s:%lu: out of memory\n", r->path, r->line_no + 1u);
             }
             return -1;
         }
-        r->line = bigger;
-        r->line_cap = cap;
+        r->buf = bigger;
+        r->buf_cap = cap;
     }
-    for (i = 0; i < n; ++i) {
-        /* Control bytes (NUL included) make the line malformed; they are
-         * kept out of the text so that nothing can end a string early. */
-        const unsigned char c = p[i];
-        if ((c < 0x20u && c != '\t' && c != '\r') || c == 0x7fu) {
-            if (r->bad_byte == 0u) {
-                r->bad_byte = r->line_len + i + 1u;
-                r->bad_value = c;
-            }
-            r->line[r->line_len + i] = ' ';
-        } else {
-            r->line[r->line_len + i] = (char)c;
-        }
-    }
-    r->line_len += n;
     return 0;
 }
 
-/* Read one whole line (without its newline) into reader->line. Every byte
- * up to the newline belongs to the line, NUL included. Returns 1, 0 at
- * end of file, -1 on error (the partial last line of a cut file is lost
- * and reported, never returned). */
+/* Eight bytes at a time: does any of them need a closer look (a byte below
+ * 0x20: newline, tab, CR or a control byte; or DEL)? Exact as a whole-word
+ * test (the classic "has a byte less than n" and "has a zero byte"). */
+static int word_needs_look(const unsigned char *p)
+{
+    const uint64_t ones = 0x0101010101010101u;
+    const uint64_t highs = 0x8080808080808080u;
+    uint64_t w, del;
+    memcpy(&w, p, sizeof w);
+    del = w ^ (ones * 0x7fu);
+    return (((w - ones * 0x20u) & ~w) | ((del - ones) & ~del)) & highs ? 1 : 0;
+}
+
+/* The first newline in buf[i, n), or n. Notes on the way, as offsets from
+ * the line's start `from`, the first control byte other than tab and CR
+ * (and its value) and the first CR. */
+static size_t find_line_end(const carmen_reader_t *r, size_t i, size_t from, size_t *first_ctrl,
+                            unsigned char *ctrl_value, size_t *first_cr)
+{
+    const unsigned char *b = (const unsigned char *)r->buf;
+    const size_t n = r->buf_len;
+    while (i < n) {
+        size_t stop;
+        if (n - i >= 8u) {
+            if (!word_needs_look(b + i)) {
+                i += 8u;
+                continue;
+            }
+            stop = i + 8u;
+        } else {
+            stop = n;
+        }
+        for (; i < stop; ++i) {
+            const unsigned char c = b[i];
+            if (c >= 0x20u && c != 0x7fu) {
+                continue;
+            }
+            if (c == '\n') {
+                return i;
+            }
+            if (c == '\r') {
+                if (*first_cr == CARMEN_NONE) {
+                    *first_cr = i - from;
+                }
+            } else if (c != '\t' && *first_ctrl == CARMEN_NONE) {
+                *first_ctrl = i - from;
+                *ctrl_value = c;
+            }
+        }
+    }
+    return n;
+}
+
+/* Finds the next whole line (without its newline) in the buffer, reading
+ * more as needed: reader->line, NUL-terminated. Every byte up to the
+ * newline belongs to the line, NUL included. Returns 1, 0 at end of file,
+ * -1 on error (the partial last line of a cut file is lost and reported,
+ * never returned). */
 static int read_line(carmen_reader_t *r)
 {
-    size_t i;
-    r->line_len = 0;
-    r->bad_byte = 0;
+    size_t seen = 0; /* bytes of the line looked at so far */
+    size_t first_ctrl = CARMEN_NONE, first_cr = CARMEN_NONE;
+    unsigned char ctrl_value = 0;
+    size_t end, next;
     for (;;) {
-        const unsigned char *start;
-        const unsigned char *nl;
-        if (r->block_pos == r->block_len) {
-            const long got = refill(r);
+        end = find_line_end(r, r->buf_pos + seen, r->buf_pos, &first_ctrl, &ctrl_value, &first_cr);
+        if (end < r->buf_len) {
+            next = end + 1u;
+            break;
+        }
+        seen = r->buf_len - r->buf_pos;
+        {
+            long got;
+            if (make_room(r) != 0) {
+                return -1;
+            }
+            got = refill(r);
             if (got < 0) {
                 return -1;
             }
             if (got == 0) {
-                if (r->line_len == 0 && r->bad_byte == 0u) {
+                if (r->buf_len == r->buf_pos) {
                     return 0;
                 }
-                break; /* last line without a newline, end checked */
+                end = next = r->buf_len; /* last line without a newline, end checked */
+                break;
             }
         }
-        start = r->block + r->block_pos;
-        nl = memchr(start, '\n', r->block_len - r->block_pos);
-        if (nl != NULL) {
-            if (append(r, start, (size_t)(nl - start)) != 0) {
-                return -1;
-            }
-            r->block_pos += (size_t)(nl - start) + 1u;
-            break;
-        }
-        if (append(r, start, r->block_len - r->block_pos) != 0) {
-            return -1;
-        }
-        r->block_pos = r->block_len;
     }
+    r->line = r->buf + r->buf_pos;
+    r->line_len = end - r->buf_pos;
+    r->buf_pos = next;
     if (r->line_len > 0 && r->line[r->line_len - 1u] == '\r') {
         --r->line_len;
     }
-    /* A CR anywhere but at the end is a control byte too. */
-    for (i = 0; r->bad_byte == 0u && i < r->line_len; ++i) {
-        if (r->line[i] == '\r') {
-            r->bad_byte = i + 1u;
-            r->bad_value = '\r';
-            r->line[i] = ' ';
-        }
-    }
     r->line[r->line_len] = '\0';
+    /* A control byte makes the line malformed; a CR anywhere but at the end
+     * is one too, reported when there is no other. */
+    r->bad_byte = 0;
+    if (first_ctrl != CARMEN_NONE) {
+        r->bad_byte = first_ctrl + 1u;
+        r->bad_value = ctrl_value;
+    } else if (first_cr != CARMEN_NONE && first_cr < r->line_len) {
+        r->bad_byte = first_cr + 1u;
+        r->bad_value = '\r';
+    }
     ++r->line_no;
     return 1;
 }
@@ -377,14 +432,28 @@ static const char *next_token(fields_t *f, size_t *len)
     return s;
 }
 
+/* Moves the cursor to the next field's first byte (or the end). */
+static const char *skip_blanks(fields_t *f)
+{
+    while (*f->p == ' ' || *f->p == '\t') {
+        ++f->p;
+    }
+    return f->p;
+}
+
 static double get_double(fields_t *f, const char *name)
 {
     size_t len;
     char *end;
     const char *t;
+    const char *fast_end;
     double v;
     if (f->what != NULL) {
         return 0.0;
+    }
+    if (carmen_parse_double(skip_blanks(f), &fast_end, &v)) {
+        f->p = fast_end;
+        return v;
     }
     t = next_token(f, &len);
     if (t == NULL) {
@@ -404,9 +473,14 @@ static float get_float(fields_t *f, const char *name)
     size_t len;
     char *end;
     const char *t;
+    const char *fast_end;
     float v;
     if (f->what != NULL) {
         return 0.0f;
+    }
+    if (carmen_parse_float(skip_blanks(f), &fast_end, &v)) {
+        f->p = fast_end;
+        return v;
     }
     t = next_token(f, &len);
     if (t == NULL) {
@@ -427,9 +501,14 @@ static long get_count(fields_t *f, const char *name)
     size_t len;
     char *end;
     const char *t;
+    const char *fast_end;
     long v;
     if (f->what != NULL) {
         return 0;
+    }
+    if (carmen_parse_count(skip_blanks(f), &fast_end, &v)) {
+        f->p = fast_end;
+        return v;
     }
     t = next_token(f, &len);
     if (t == NULL) {
@@ -480,10 +559,31 @@ static int get_ranges(carmen_reader_t *r, fields_t *f, long n, const char *type)
         report(r, "%s: beam count %ld outside 1..8192", type, n);
         return 0;
     }
-    for (i = 0; i < n; ++i) {
-        r->ranges[i] = get_float(f, "range reading");
+    {
+        /* The readings are most of the log: the fast path inline, with the
+         * cursor in a local; anything it leaves goes through get_float. */
+        const char *p = f->p;
+        float *out = r->ranges;
+        for (i = 0; i < n; ++i) {
+            const char *end;
+            while (*p == ' ' || *p == '\t') {
+                ++p;
+            }
+            if (carmen_parse_short_float(p, &end, &out[i]) ||
+                carmen_parse_float(p, &end, &out[i])) {
+                p = end;
+                continue;
+            }
+            f->p = p;
+            out[i] = get_float(f, "range reading");
+            if (f->what != NULL) {
+                return 0;
+            }
+            p = f->p;
+        }
+        f->p = p;
     }
-    return f->what == NULL;
+    return 1;
 }
 
 static int parse_flaser(carmen_reader_t *r, fields_t *f, carmen_scan_t *s)

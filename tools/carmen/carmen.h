@@ -10,6 +10,10 @@
  * "file:line: message" to the error stream given at open, counted, and
  * skipped; reading goes on with the next line.
  *
+ * Numbers are read as strtof/strtod/strtol read them in the C locale: the
+ * forms logs write ("81.83", "-1.570796") through exact fast paths
+ * (carmen_number.h), any other form through the C library itself.
+ *
  * Damage is never read as a shorter or different log:
  *  - A line holding a control byte (NUL, any byte below 0x20 other than tab
  *    and a final CR, or DEL) is reported as malformed ("file:line: control
