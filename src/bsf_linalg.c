@@ -40,6 +40,54 @@ static int band_cholesky_bw2(float *f, size_t m, float loading)
     return 1;
 }
 
+/* The general substitutions below for half-bandwidth 2, written out (every
+ * PDM solve): same arithmetic in the same order, so the same results. */
+static bsf_status_t band_substitute_bw2(const float *f, size_t m, float *rx, float *ry)
+{
+    float zx[BSF_LINALG_MAX_M];
+    float zy[BSF_LINALG_MAX_M];
+    size_t i;
+    for (i = 0; i < m; ++i) {
+        const float *r = f + i * 3u;
+        float sx = rx[i];
+        float sy = ry[i];
+        if (i >= 2u) {
+            sx -= r[2] * zx[i - 2u];
+            sy -= r[2] * zy[i - 2u];
+        }
+        if (i >= 1u) {
+            sx -= r[1] * zx[i - 1u];
+            sy -= r[1] * zy[i - 1u];
+        }
+        zx[i] = sx / r[0];
+        zy[i] = sy / r[0];
+    }
+    for (i = m; i-- > 0u;) {
+        float sx = zx[i];
+        float sy = zy[i];
+        if (i + 1u < m) {
+            const float l = f[(i + 1u) * 3u + 1u];
+            sx -= l * zx[i + 1u];
+            sy -= l * zy[i + 1u];
+        }
+        if (i + 2u < m) {
+            const float l = f[(i + 2u) * 3u + 2u];
+            sx -= l * zx[i + 2u];
+            sy -= l * zy[i + 2u];
+        }
+        zx[i] = sx / f[i * 3u];
+        zy[i] = sy / f[i * 3u];
+        if (!finite_f(zx[i]) || !finite_f(zy[i])) {
+            return BSF_ERR_NUMERIC;
+        }
+    }
+    for (i = 0; i < m; ++i) {
+        rx[i] = zx[i];
+        ry[i] = zy[i];
+    }
+    return BSF_OK;
+}
+
 static int band_cholesky(float *f, size_t m, size_t bw, float loading)
 {
     const size_t w = bw + 1u;
@@ -114,6 +162,9 @@ bsf_status_t bsf_spd_band_solve2(const float *band, size_t m, size_t bw, float *
     }
     if (!ok) {
         return BSF_ERR_NUMERIC;
+    }
+    if (bw == 2u) {
+        return band_substitute_bw2(factor, m, rx, ry);
     }
     {
         /* Forward substitution L z = b, then back substitution L^T x = z,

@@ -494,8 +494,12 @@ static float systematic_error(const pdm_state_t *s, float rms, float window_max,
  * the RMS per fragment (a vertex point belongs to both its fragments) and
  * overall, and (when another iteration may follow) assembles the next normal
  * equations at the new parameters in the same sweep, so no basis is computed
- * twice. */
-static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next)
+ * twice. With give_up_rms > 0 the pass stops as soon as the overall RMS can
+ * no longer end below give_up_rms (the squared distances only add up) and
+ * returns 0, leaving the parameters half updated for the caller to discard;
+ * otherwise it returns 1. */
+static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next,
+                          float give_up_rms)
 {
     const size_t n_span = s->n_ctrl - 2u;
     const float fs = (float)n_span;
@@ -523,6 +527,11 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
     size_t normal_span = (size_t)-1;
     float nx = 0.0f;
     float ny = 0.0f;
+
+    /* A running total at or above this bound may already lose: checked
+     * exactly (as the caller compares) only from there on. */
+    const float give_up_total =
+        give_up_rms > 0.0f ? give_up_rms * give_up_rms * (float)s->n * 0.999f : 3.0e38f;
 
     if (assemble_next) {
         clear_normal_equations(s, w);
@@ -642,6 +651,10 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
         }
         total += best;
         frag_sum += best;
+        if (total >= give_up_total && give_up_rms > 0.0f &&
+            !(sqrtf(total / (float)s->n) < give_up_rms)) {
+            return 0;
+        }
         if (s->bias_window > 0u) {
             /* Signed residual along the normal of the span's chord (one
              * square root per span), summed over the last bias_window
@@ -698,6 +711,7 @@ static void footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, in
         sums_flush(w, &acc);
     }
     s->rms = sqrtf(total / (float)s->n);
+    return 1;
 }
 
 static float worst_fragment(const pdm_state_t *s, const bsf_pdm_work_t *w)
@@ -742,7 +756,7 @@ static bsf_status_t run_pdm(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_pdm_par
         if (st != BSF_OK) {
             return st;
         }
-        footpoint_pass(s, w, p->footpoint_steps, it + 1u < max_iterations);
+        (void)footpoint_pass(s, w, p->footpoint_steps, it + 1u < max_iterations, 0.0f);
         ++*iterations;
         if (it > 0u && s->rms > prev) {
             memcpy(w->t, w->t_prev, s->n * sizeof w->t[0]);
@@ -854,9 +868,18 @@ static bsf_status_t try_cold_start(pdm_state_t *s, bsf_pdm_work_t *w, const bsf_
     memcpy(w->ctrl_prev, w->ctrl, s->n_ctrl * sizeof w->ctrl[0]);
     memcpy(w->frag_rms_prev, w->frag_rms, s->n_frag * sizeof w->frag_rms[0]);
     start_from_arc_length(s, w, t0, t1);
-    st = run_pdm(s, w, p, 1u, p->target_rms, 1, iterations);
+    /* run_pdm's single iteration, with a footpoint pass that stops once
+     * the restart can no longer beat the warm fit. */
+    w->n_history = 0u;
+    st = solve_control_points(s, w);
     if (st != BSF_OK) {
         return st;
+    }
+    ++*iterations;
+    if (footpoint_pass(s, w, p->footpoint_steps, 0, warm)) {
+        w->rms_history[w->n_history++] = s->rms;
+    } else {
+        s->rms = warm; /* lost: restored below */
     }
     if (!(s->rms < warm)) {
         memcpy(w->t, w->t_prev, s->n * sizeof w->t[0]);
