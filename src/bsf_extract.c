@@ -82,7 +82,12 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
         !(p->no_return.code <= 3.402823466e38f)) {
         return BSF_ERR_PARAM;
     }
+    if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
+        ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) {
+        return BSF_ERR_UNSUPPORTED; /* left out of this build (bsf_config.h) */
+    }
     switch (p->method) {
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_FALKO
     case BSF_METHOD_FALKO_SVED_PDM:
         st = bsf_falko_params_check(&p->falko);
         if (st == BSF_OK) {
@@ -92,6 +97,8 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
             st = bsf_pdm_params_check(&p->pdm);
         }
         break;
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
     case BSF_METHOD_LC_SVED_PDM:
         st = bsf_lc_params_check(&p->lc);
         if (st == BSF_OK) {
@@ -101,6 +108,8 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
             st = bsf_pdm_params_check(&p->pdm);
         }
         break;
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     case BSF_METHOD_BID_SVED_PDM:
         st = bsf_bid_params_check(&p->bid);
         if (st == BSF_OK) {
@@ -110,8 +119,10 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
             st = bsf_pdm_params_check(&p->pdm);
         }
         break;
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_RPOS
     case BSF_METHOD_RPOS_LSBA: st = bsf_rpos_params_check(&p->rpos); break;
-    case BSF_METHOD_COUNT:
+#endif
     default: return BSF_ERR_PARAM;
     }
     /* A NULL inside a valid struct cannot happen, so any failure is a value. */
@@ -135,6 +146,14 @@ bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params)
     ex->ready = BSF_EXTRACTOR_READY;
     return BSF_OK;
 }
+
+/* Whether the method in use is RPOS-LSBA: constant 0 when RPOS is compiled
+ * out, so its segmenter and fitter are not linked. */
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_RPOS
+#define USES_RPOS(ex) ((ex)->params.method == BSF_METHOD_RPOS_LSBA)
+#else
+#define USES_RPOS(ex) 0
+#endif
 
 /* Tick difference to nanoseconds, saturating at 2^32 - 1 ns. */
 static uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
@@ -191,21 +210,25 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
     size_t i;
     ex->n_keypoints = 0u;
     switch (ex->params.method) {
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_FALKO
     case BSF_METHOD_FALKO_SVED_PDM:
         st = bsf_falko_detect(&ex->points, &ex->params.falko, &ex->scratch.falko, ex->keypoints,
                               BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
     case BSF_METHOD_LC_SVED_PDM:
         st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
                            BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     case BSF_METHOD_BID_SVED_PDM:
         st = bsf_bid_detect(&ex->points, &ex->params.bid, &ex->scratch.bid, ex->keypoints,
                             BSF_MAX_KEYPOINTS, &ex->n_keypoints);
         break;
-    case BSF_METHOD_RPOS_LSBA:
-    case BSF_METHOD_COUNT:
-    default: break;
+#endif
+    default: break; /* RPOS-LSBA finds no corners */
     }
     st = keep_keypoints_that_fit(st, ex, stats);
     if (st != BSF_OK) {
@@ -281,7 +304,7 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
     size_t n_all = 0u;
     bsf_status_t st;
     ex->n_segments = 0u;
-    if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
+    if (USES_RPOS(ex)) {
         size_t k;
         size_t b;
         st = bsf_segment_rpos(&ex->points, &ex->params.rpos, all, BSF_MAX_POINTS, &n_all, NULL);
@@ -305,7 +328,7 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
         return st;
     }
     keep_segments_that_fit(ex, all, n_all, stats);
-    if (ex->params.method == BSF_METHOD_RPOS_LSBA) {
+    if (USES_RPOS(ex)) {
         return BSF_OK;
     }
     return bsf_segment_classify_labelled(ex->segments, ex->n_segments, &ex->points,
@@ -378,7 +401,7 @@ static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf
     float e_curve = 0.0f;
     bsf_status_t st;
     const size_t room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
-    const int lsba = ex->params.method == BSF_METHOD_RPOS_LSBA;
+    const int lsba = USES_RPOS(ex);
 
     /* No fit when no feature could fit: a feature has at least 3 control
      * points (4 from LSBA). */

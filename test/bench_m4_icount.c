@@ -18,13 +18,23 @@
  * Also the stack high-water mark of the calls (painted stack, bytes below
  * the caller's frame; libm included, unlike tools/stack_report.py).
  *
- * Prints numbers, judges none; fails only if an extraction fails. Run:
+ * Sources (each printed under a [tag] line): synthetic rooms, a cluttered
+ * room, the demo office from 8 poses checked to stand in free space (1081
+ * beams over 270 degrees), the adversarial scans of tools/bench/bench_scenes.h
+ * (a sensor against a pillar, pure clutter; reported apart) and the Intel
+ * scans. Built with BSF_BENCH_BIG (bench_m4_icount_big, a library with room
+ * for 4096 beams) it runs the office with 3200 beams over 360 degrees and the
+ * 4000-beam long wall instead.
+ *
+ * Prints numbers, judges none; fails only if an extraction fails or a pose
+ * is not in free space. Run:
  *   ctest --test-dir build-m4 -R bench_m4_icount -V
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_scenes.h"
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
 
@@ -43,7 +53,6 @@
 
 static bsf_extractor_t g_ex;
 static bsf_result_t g_res;
-static float g_synth_ranges[N_SYNTH_SCENES * N_SYNTH_POSES * 2][361];
 
 /* Per-scan results of one method on one set. */
 static uint32_t g_whole[MAX_SCANS];
@@ -191,8 +200,15 @@ static uint32_t median_of(const uint32_t *v, size_t n, uint32_t *max_out)
 typedef struct {
     const bsf_scan_t *(*get)(size_t i, bsf_scan_t *tmp);
     size_t n;
-    const char *name;
+    const char *tag;  /* short name tools/scripts/perf_table.py looks for */
+    const char *name; /* what the scans are */
+    unsigned methods; /* bit m: run bsf_method_t m */
 } scan_source_t;
+
+#define ALL_METHODS ((1u << BSF_METHOD_COUNT) - 1u)
+/* BID is the paper's slow baseline (quadratic corner stage): left out of the
+ * long scans, where it would take minutes under QEMU and bounds nothing. */
+#define NO_BID (ALL_METHODS & ~(1u << BSF_METHOD_BID_SVED_PDM))
 
 /* Measure every scan of a source with one method; print one line. */
 static int run_method(const scan_source_t *src, bsf_method_t method)
@@ -274,19 +290,26 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
 static int run_source(const scan_source_t *src)
 {
     int m, rc = 0;
-    printf("\n%s: %u scans\n", src->name, (unsigned)src->n);
+    printf("\n[%s] %s: %u scans\n", src->tag, src->name, (unsigned)src->n);
     printf("  %-15s %9s %9s %9s | %8s %8s %8s %8s | %8s | %5s | %5s\n", "instructions", "median",
            "mean", "max", "points", "corners", "segment", "fit", "encode", "feat", "stack");
     printf("  %-15s %29s | %35s | %8s |\n", "", "whole bsf_extract per scan",
            "median per stage (with clock hook)", "frame");
     for (m = 0; m < BSF_METHOD_COUNT; ++m) {
-        rc |= run_method(src, (bsf_method_t)m);
+        if ((src->methods & (1u << m)) != 0u) {
+            rc |= run_method(src, (bsf_method_t)m);
+        }
     }
     return rc;
 }
 
+/* The scene the synthetic scans are cast in (large: BSF_SCENE_MAX_SHAPES 1024). */
+static bsf_scene_t g_clutter_scene;
+
+#ifndef BSF_BENCH_BIG
 /* ---- synthetic scenes ------------------------------------------------------ */
 
+static float g_synth_ranges[N_SYNTH_SCENES * N_SYNTH_POSES * 2][361];
 static bsf_scan_t g_synth_scans[N_SYNTH_SCENES * N_SYNTH_POSES * 2];
 
 static const bsf_scan_t *get_synth(size_t i, bsf_scan_t *tmp)
@@ -339,7 +362,6 @@ static int make_synthetic(size_t *n_out)
 
 static float g_clutter_ranges[N_CLUTTER_SCANS][1081];
 static bsf_scan_t g_clutter_scans[N_CLUTTER_SCANS];
-static bsf_scene_t g_clutter_scene;
 
 static const bsf_scan_t *get_clutter(size_t i, bsf_scan_t *tmp)
 {
@@ -380,6 +402,140 @@ static int make_clutter(size_t *n_out)
     return 0;
 }
 
+#endif /* !BSF_BENCH_BIG */
+
+/* ---- the demo office and the adversarial scans (bench_scenes.h) ---------- */
+
+#ifdef BSF_BENCH_BIG
+#define OFFICE_BEAMS 3200u
+#define OFFICE_FOV360 1
+#else
+#define OFFICE_BEAMS 1081u
+#define OFFICE_FOV360 0
+#endif
+#define ADV_MAX_BEAMS 4000u
+
+static float g_office_ranges[BENCH_OFFICE_POSES][OFFICE_BEAMS];
+static bsf_scan_t g_office_scans[BENCH_OFFICE_POSES];
+static float g_adv_ranges[BENCH_ADV_SCANS][ADV_MAX_BEAMS];
+static bsf_scan_t g_adv_scans[BENCH_ADV_SCANS];
+
+static const bsf_scan_t *get_office(size_t i, bsf_scan_t *tmp)
+{
+    (void)tmp;
+    return &g_office_scans[i];
+}
+
+static const bsf_scan_t *get_adv(size_t i, bsf_scan_t *tmp)
+{
+    (void)tmp;
+    return &g_adv_scans[i];
+}
+
+/* The demo office from poses checked to stand in free space: 1081 beams
+ * over 270 degrees, or (big build) 3200 beams over 360 degrees. */
+static int make_office(size_t *n_out)
+{
+    bsf_scene_pose_t poses[BENCH_OFFICE_POSES];
+    bsf_scene_rng_t rng;
+    size_t i;
+    int shape;
+    int bad;
+    if (BSF_MAX_POINTS < (int)OFFICE_BEAMS) {
+        return 1;
+    }
+    bsf_scene_demo_office(&g_clutter_scene);
+    for (i = 0; i < BENCH_OFFICE_POSES; ++i) {
+        poses[i] = bench_office_pose(i);
+    }
+    bad = bench_poses_check(&g_clutter_scene, poses, BENCH_OFFICE_POSES, BENCH_POSE_CLEARANCE,
+                            &shape);
+    if (bad >= 0) {
+        printf("office pose %d is not in free space (shape %d)\n", bad, shape);
+        return 2;
+    }
+    bsf_scene_rng_seed(&rng, 77u);
+    for (i = 0; i < BENCH_OFFICE_POSES; ++i) {
+        bsf_lidar_t l = bsf_lidar_default(poses[i].x, poses[i].y, poses[i].theta, OFFICE_BEAMS,
+                                          OFFICE_FOV360 ? 6.28318530717959 : 4.71238898038469);
+        if (OFFICE_FOV360) {
+            l.angle_min = -3.14159265358979;
+            l.angle_increment = 6.28318530717959 / (double)OFFICE_BEAMS;
+        }
+        l.noise_sigma = 0.01;
+        if (bsf_scene_scan(&g_clutter_scene, &l, &rng, g_office_ranges[i], NULL, OFFICE_BEAMS) !=
+            BSF_OK) {
+            return 2;
+        }
+        g_office_scans[i] = bsf_scene_lidar_scan(&l, g_office_ranges[i]);
+    }
+    *n_out = BENCH_OFFICE_POSES;
+    return 0;
+}
+
+/* One adversarial kind: 1 when it does not fit this build, 2 on a failure. */
+static int make_adv(int kind, size_t *n_out)
+{
+    size_t k;
+    if (bench_adv_beams(kind) > (size_t)BSF_MAX_POINTS || bench_adv_beams(kind) > ADV_MAX_BEAMS) {
+        return 1;
+    }
+    for (k = 0; k < BENCH_ADV_SCANS; ++k) {
+        if (bench_adv_scan(kind, k, g_adv_ranges[k], ADV_MAX_BEAMS, &g_adv_scans[k]) != BSF_OK) {
+            return 2;
+        }
+    }
+    *n_out = BENCH_ADV_SCANS;
+    return 0;
+}
+
+static int run_office_and_adversarial(void)
+{
+    static char name[96];
+    scan_source_t src;
+    int rc = 0;
+    int kind;
+    int st = make_office(&src.n);
+    if (st == 0) {
+        src.get = get_office;
+        src.tag = OFFICE_FOV360 ? "office-3200" : "office-1081";
+        src.name = OFFICE_FOV360 ? "demo office, 8 free poses, 3200 beams over 360 deg, sigma 1 cm"
+                                 : "demo office, 8 free poses, 1081 beams over 270 deg, sigma 1 cm";
+        src.methods = NO_BID;
+        rc |= run_source(&src);
+    } else if (st == 2) {
+        printf("office scans: setup failed\n");
+        return 1;
+    }
+    for (kind = 0; kind < BENCH_ADV_COUNT; ++kind) {
+#ifdef BSF_BENCH_BIG
+        if (bench_adv_beams(kind) <= 1081u) {
+            continue; /* run by bench_m4_icount, with the default caps */
+        }
+#endif
+        st = make_adv(kind, &src.n);
+        if (st == 1) {
+            printf("\n[adv-%s] SKIPPED: %u beams do not fit this build\n", bench_adv_name(kind),
+                   (unsigned)bench_adv_beams(kind));
+            continue;
+        }
+        if (st != 0) {
+            printf("adversarial %s: setup failed\n", bench_adv_name(kind));
+            return 1;
+        }
+        snprintf(name, sizeof name, "adversarial (worst case, reported apart): %s, %u beams",
+                 bench_adv_name(kind), (unsigned)bench_adv_beams(kind));
+        src.get = get_adv;
+        src.tag = kind == BENCH_ADV_PILLAR    ? "adv-pillar"
+                  : kind == BENCH_ADV_CLUTTER ? "adv-clutter"
+                                              : "adv-long-wall";
+        src.name = name;
+        src.methods = NO_BID;
+        rc |= run_source(&src);
+    }
+    return rc;
+}
+
 #ifdef BSF_BENCH_HAVE_LOG
 static const bsf_scan_t *get_log(size_t i, bsf_scan_t *tmp)
 {
@@ -396,7 +552,9 @@ static const bsf_scan_t *get_log(size_t i, bsf_scan_t *tmp)
 
 int main(void)
 {
+#ifndef BSF_BENCH_BIG
     scan_source_t src;
+#endif
     int rc = 0;
 
     systick_start();
@@ -410,31 +568,43 @@ int main(void)
         return 1;
     }
 
+#ifndef BSF_BENCH_BIG
     if (make_synthetic(&src.n) != 0) {
         printf("synthetic scene setup failed\n");
         return 1;
     }
     src.get = get_synth;
-    src.name = "synthetic: rect room, L-room, room with pillar; 2 poses; 180 and 361 beams over "
+    src.tag = "synthetic";
+    src.name = "rect room, L-room, room with pillar; 2 poses; 180 and 361 beams over "
                "180 deg; sigma 1 cm";
+    src.methods = ALL_METHODS;
     rc |= run_source(&src);
 
     if (make_clutter(&src.n) == 0) {
         src.get = get_clutter;
-        src.name = "clutter: 1081 beams over 270 deg, zig-zag shelves, posts, boxes (some scans "
+        src.tag = "clutter-room";
+        src.name = "1081 beams over 270 deg, zig-zag shelves, posts, boxes (some scans "
                    "cut by the keypoint cap)";
+        src.methods = ALL_METHODS;
         rc |= run_source(&src);
     } else {
         printf("\nSKIPPED: clutter scans (BSF_MAX_POINTS < 1081 or scene too small)\n");
     }
+#endif
 
+    rc |= run_office_and_adversarial();
+
+#ifndef BSF_BENCH_BIG
 #ifdef BSF_BENCH_HAVE_LOG
     src.get = get_log;
     src.n = bench_log_n_scans < MAX_SCANS ? bench_log_n_scans : MAX_SCANS;
+    src.tag = "intel";
     src.name = bench_log_description;
+    src.methods = ALL_METHODS;
     rc |= run_source(&src);
 #else
     printf("\nSKIPPED: intel.log.gz not found at build time: no real scans compiled in\n");
+#endif
 #endif
     return rc;
 }

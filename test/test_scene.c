@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "bsf/bsf.h"
+#include "bench_scenes.h"
 #include "bsf_scene.h"
 #include "unity.h"
 
@@ -346,6 +347,108 @@ static void test_bad_input_is_refused_with_an_error(void)
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)n);
 }
 
+/* A sensor pose is checked against every shape: inside a pillar, inside a
+ * solid box, too close to a wall, outside the room are all refused. */
+static void test_pose_check_finds_poses_inside_obstacles(void)
+{
+    static const double crate[] = {3.0, 1.0, 4.0, 1.0, 4.0, 2.0, 3.0, 2.0};
+    int pillar;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, 0.0, 0.0, 8.0, 5.0));
+    pillar = bsf_scene_add_circle(&scene, 6.0, 3.0, 0.4);
+    TEST_ASSERT_EQUAL_INT(4, pillar);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_solid(&scene, crate, 4u));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_box(&scene, 1.0, 3.5, 1.6, 4.2));
+    TEST_ASSERT_EQUAL_INT(2, scene.n_solids);
+    TEST_ASSERT_EQUAL_INT(0, scene.shape[0].solid);
+    TEST_ASSERT_EQUAL_INT(1, scene.shape[5].solid);
+    TEST_ASSERT_EQUAL_INT(2, scene.shape[9].solid);
+    /* free: open floor; the room itself is a wall, not a solid */
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 2.0, 2.5, 0.3));
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 6.0, 2.2, 0.3));
+    /* inside the pillar, and just outside it but closer than the clearance */
+    TEST_ASSERT_EQUAL_INT(pillar, bsf_scene_pose_blocked(&scene, 6.1, 3.1, 0.3));
+    TEST_ASSERT_EQUAL_INT(pillar, bsf_scene_pose_blocked(&scene, 6.0, 2.45, 0.3));
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 6.0, 2.45, 0.1));
+    /* inside the crate and the box, even with clearance 0 */
+    TEST_ASSERT_TRUE(scene.shape[bsf_scene_pose_blocked(&scene, 3.5, 1.5, 0.0)].solid == 1);
+    TEST_ASSERT_TRUE(scene.shape[bsf_scene_pose_blocked(&scene, 1.3, 3.8, 0.0)].solid == 2);
+    /* against a wall */
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_pose_blocked(&scene, 2.0, 0.1, 0.3));
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_pose_blocked(NULL, 2.0, 2.5, 0.3));
+    /* enclosed inside the room, not outside it */
+    TEST_ASSERT_EQUAL_INT(1, bsf_scene_point_enclosed(&scene, 2.0, 2.5, 360u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_point_enclosed(&scene, -1.0, 2.5, 360u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_scene_point_enclosed(&scene, 2.0, 2.5, 0u));
+}
+
+/* The demo office's cabinet is a solid box: scans are unchanged by that
+ * (the same edges in the same order), but no pose may stand inside it. */
+static void test_demo_office_cabinet_is_solid(void)
+{
+    bsf_scene_demo_office(&scene);
+    TEST_ASSERT_EQUAL_INT(1, scene.n_solids);
+    TEST_ASSERT_TRUE(bsf_scene_pose_blocked(&scene, 2.75, 7.9, 0.0) >= 0);
+    TEST_ASSERT_EQUAL_INT(-1, bsf_scene_pose_blocked(&scene, 2.75, 6.9, 0.3));
+    TEST_ASSERT_TRUE(bsf_scene_pose_blocked(&scene, 10.5, 3.0, 0.0) >= 0); /* the pillar */
+}
+
+/* The benchmark scenes (tools/bench/bench_scenes.h): every pose free, while
+ * the scaling walk of earlier releases stood inside a pillar twice. */
+static void test_benchmark_poses_are_free_and_the_old_walk_was_not(void)
+{
+    bsf_scene_pose_t poses[BENCH_SCALE_POSES];
+    size_t i;
+    int shape = 0;
+    int n_old_blocked = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bench_scaling_scene(&scene));
+    for (i = 0; i < BENCH_SCALE_POSES; ++i) {
+        poses[i] = bench_scaling_pose(i);
+        /* the walk of the first releases: y = -1.0 + 0.1 i */
+        if (bsf_scene_pose_blocked(&scene, poses[i].x, -1.0 + 0.1 * (double)i, 0.0) >= 0) {
+            ++n_old_blocked;
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(2, n_old_blocked);
+    TEST_ASSERT_EQUAL_INT(
+        -1, bench_poses_check(&scene, poses, BENCH_SCALE_POSES, BENCH_POSE_CLEARANCE, &shape));
+    TEST_ASSERT_EQUAL_INT(-1, shape);
+    bsf_scene_demo_office(&scene);
+    for (i = 0; i < BENCH_OFFICE_POSES; ++i) {
+        poses[i] = bench_office_pose(i);
+    }
+    TEST_ASSERT_EQUAL_INT(
+        -1, bench_poses_check(&scene, poses, BENCH_OFFICE_POSES, BENCH_POSE_CLEARANCE, &shape));
+    /* a pose in the cabinet, and one outside the building, are caught */
+    poses[3].x = 2.75;
+    poses[3].y = 7.9;
+    TEST_ASSERT_EQUAL_INT(3, bench_poses_check(&scene, poses, BENCH_OFFICE_POSES, 0.0, &shape));
+    TEST_ASSERT_TRUE(shape >= 0 && scene.shape[shape].solid == 1);
+    poses[3].x = 12.0;
+    poses[3].y = 8.0; /* in the notch cut from the L, outside the walls */
+    TEST_ASSERT_EQUAL_INT(3, bench_poses_check(&scene, poses, BENCH_OFFICE_POSES, 0.0, &shape));
+    TEST_ASSERT_EQUAL_INT(-1, shape);
+}
+
+/* Adversarial scans: built when they fit the caps, refused when not. */
+static void test_adversarial_scans_are_built_or_refused(void)
+{
+    static float adv[4000];
+    bsf_scan_t scan;
+    size_t k;
+    for (k = 0; k < BENCH_ADV_SCANS; ++k) {
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bench_adv_scan(BENCH_ADV_PILLAR, k, adv, 4000u, &scan));
+        TEST_ASSERT_EQUAL_UINT32(1000u, (uint32_t)scan.count);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bench_adv_scan(BENCH_ADV_CLUTTER, k, adv, 4000u, &scan));
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_MAX_POINTS >= 4000 ? BSF_OK : BSF_ERR_CAPACITY,
+                          bench_adv_scan(BENCH_ADV_LONG_WALL, 0u, adv, 4000u, &scan));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bench_adv_scan(BENCH_ADV_PILLAR, 0u, adv, 999u, &scan));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bench_adv_scan(BENCH_ADV_COUNT, 0u, adv, 4000u, &scan));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG,
+                          bench_adv_scan(BENCH_ADV_PILLAR, BENCH_ADV_SCANS, adv, 4000u, &scan));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -362,5 +465,9 @@ int main(void)
     RUN_TEST(test_scan_points_lie_on_the_surfaces_in_the_world);
     RUN_TEST(test_distance_to_surface_and_frame_transforms);
     RUN_TEST(test_bad_input_is_refused_with_an_error);
+    RUN_TEST(test_pose_check_finds_poses_inside_obstacles);
+    RUN_TEST(test_demo_office_cabinet_is_solid);
+    RUN_TEST(test_benchmark_poses_are_free_and_the_old_walk_was_not);
+    RUN_TEST(test_adversarial_scans_are_built_or_refused);
     return UNITY_END();
 }

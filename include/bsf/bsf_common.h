@@ -32,14 +32,15 @@ typedef enum {
     BSF_OK = 0,
     BSF_OK_CUT = 1,   /**< output valid, but the features that did not fit a cap were left out */
     BSF_ERR_ARG = -1, /**< NULL pointer or an argument outside its domain */
-    BSF_ERR_CAPACITY = -2,   /**< input or output larger than a compile-time cap */
-    BSF_ERR_PARAM = -3,      /**< runtime parameter out of its documented range */
-    BSF_ERR_NUMERIC = -4,    /**< a solve failed (matrix not positive definite after one retry) */
-    BSF_ERR_DEGENERATE = -5, /**< too few or coincident points for the requested fit */
-    BSF_ERR_BUFFER = -6,     /**< caller's output buffer too small */
-    BSF_ERR_FORMAT = -7,     /**< malformed frame or field */
-    BSF_ERR_CRC = -8,        /**< frame check sequence mismatch */
-    BSF_ERR_VERSION = -9     /**< unsupported frame version or type */
+    BSF_ERR_CAPACITY = -2,    /**< input or output larger than a compile-time cap */
+    BSF_ERR_PARAM = -3,       /**< runtime parameter out of its documented range */
+    BSF_ERR_NUMERIC = -4,     /**< a solve failed (matrix not positive definite after one retry) */
+    BSF_ERR_DEGENERATE = -5,  /**< too few or coincident points for the requested fit */
+    BSF_ERR_BUFFER = -6,      /**< caller's output buffer too small */
+    BSF_ERR_FORMAT = -7,      /**< malformed frame or field */
+    BSF_ERR_CRC = -8,         /**< frame check sequence mismatch */
+    BSF_ERR_VERSION = -9,     /**< unsupported frame version or type */
+    BSF_ERR_UNSUPPORTED = -10 /**< method compiled out of this build (BSF_CONFIG_METHODS) */
 } bsf_status_t;
 
 /** A point in the sensor (or world) plane, metres. */

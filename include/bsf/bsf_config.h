@@ -52,6 +52,24 @@
 #define BSF_MAX_CTRL_POINTS 512
 #endif
 
+/* Extraction methods compiled into the library: bit m of BSF_CONFIG_METHODS
+ * stands for bsf_method_t m. Firmware that only ever runs one method sets
+ * just its bit, so the link leaves the other detectors and fitters out (with
+ * -ffunction-sections and --gc-sections); bsf_params_check, hence
+ * bsf_extractor_init, then refuses a method left out with
+ * BSF_ERR_UNSUPPORTED. Set it like a cap (-DBSF_CONFIG_METHODS=BSF_CONFIG_METHOD_LC,
+ * or -DBSF_METHODS=lc-sved-pdm when configuring with CMake). Unlike the caps it
+ * changes no object's size, so a program need not see the library's value;
+ * the defaults of bsf_params_default for every method stay available. */
+#define BSF_CONFIG_METHOD_FALKO 1 /**< BSF_METHOD_FALKO_SVED_PDM */
+#define BSF_CONFIG_METHOD_BID 2   /**< BSF_METHOD_BID_SVED_PDM */
+#define BSF_CONFIG_METHOD_RPOS 4  /**< BSF_METHOD_RPOS_LSBA */
+#define BSF_CONFIG_METHOD_LC 8    /**< BSF_METHOD_LC_SVED_PDM, the default method */
+/** Methods compiled in: every one unless chosen. */
+#ifndef BSF_CONFIG_METHODS
+#define BSF_CONFIG_METHODS 15
+#endif
+
 /* Range checks: a bad value stops the build here rather than corrupting
  * memory at run time. Beam indices are stored as uint16_t. */
 #if BSF_MAX_POINTS < 8 || BSF_MAX_POINTS > 65535
@@ -68,6 +86,10 @@
 #endif
 #if BSF_MAX_CTRL_POINTS < BSF_MAX_CTRL_PER_FEATURE || BSF_MAX_CTRL_POINTS > 65535
 #error "BSF_MAX_CTRL_POINTS must be in [BSF_MAX_CTRL_PER_FEATURE, 65535]"
+#endif
+
+#if (BSF_CONFIG_METHODS) < 1 || (BSF_CONFIG_METHODS) > 15
+#error "BSF_CONFIG_METHODS must name at least one method and only BSF_CONFIG_METHOD_* bits"
 #endif
 
 /* Plain decimal spelling: the caps become part of symbol names (see above).

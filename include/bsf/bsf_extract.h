@@ -86,7 +86,9 @@ bsf_params_t bsf_params_default(bsf_method_t method);
 bsf_params_t bsf_params_paper(bsf_method_t method);
 
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
- *  NULL, BSF_ERR_PARAM for an unknown method or a value out of range. */
+ *  NULL, BSF_ERR_PARAM for an unknown method or a value out of range,
+ *  BSF_ERR_UNSUPPORTED for a method left out of this build
+ *  (BSF_CONFIG_METHODS, bsf_config.h). */
 BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
 
 /**
@@ -131,8 +133,10 @@ typedef struct {
 
 /**
  * Validate params and prepare ex (copies params; no other work).
- * @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM for bad params. On
- *         error ex is marked not ready, and bsf_extract refuses it.
+ * @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM for bad params;
+ *         BSF_ERR_UNSUPPORTED for a method left out of this build
+ *         (BSF_CONFIG_METHODS). On error ex is marked not ready, and
+ *         bsf_extract refuses it.
  */
 BSF_NODISCARD bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params);
 

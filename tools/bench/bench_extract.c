@@ -4,7 +4,8 @@
  * dataset and per method, then how the time grows with the beam count.
  *
  *   bench_extract [--passes N] [--method NAME|all] [--max-scans N]
- *                 [--no-scaling] [--scaling-only] [--beams N] [LOG ...]
+ *                 [--no-scaling] [--scaling-only] [--beams N]
+ *                 [--adversarial] [--adversarial-only] [LOG ...]
  *
  * Without LOG: the four logs in ../shared/data (BSF_SHARED_DIR overrides the
  * shared directory): intel, mit-csail, fr079 and the first 1000 scans of
@@ -23,7 +24,12 @@
  * to 4000 beams over 270 degrees; it needs a library built with
  * BSF_MAX_POINTS >= 4000 (target bench_extract links bsf_big, 4096 beams;
  * bench_extract_default links the default library and skips larger sizes).
- * --beams N runs only that size of the scaling list (for profiling).
+ * --beams N runs only that size of the scaling list (for profiling). Every
+ * pose of the scaling scene is checked to stand in free space (bench_scenes.h);
+ * the run stops if one does not.
+ * --adversarial adds the worst-case scans of bench_scenes.h (a sensor against
+ * a pillar, pure clutter, a 4000-beam long wall), reported apart;
+ * --adversarial-only runs just those.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -34,6 +40,7 @@
 
 #include "bsf/bsf.h"
 #include "bsf_port_clock.h"
+#include "bench_scenes.h"
 #include "bsf_scene.h"
 #include "carmen.h"
 
@@ -295,9 +302,31 @@ static int bench_log(const char *path, size_t max_scans, const int *methods, int
 
 /* ---- scaling on synthetic scans ---------------------------------------------- */
 
-#define SCALE_POSES 20
-static const size_t scale_beams[] = {180, 250, 500, 1000, 2000, 4000};
-#define N_SCALE (sizeof scale_beams / sizeof scale_beams[0])
+#define SCALE_POSES BENCH_SCALE_POSES
+#define N_SCALE BENCH_SCALE_SIZES
+#define scale_beams bench_scale_beams
+
+/* Every pose of the scaling scene in free space (bench_scenes.h), or stop. */
+static int check_scaling_poses(const bsf_scene_t *scene)
+{
+    bsf_scene_pose_t poses[SCALE_POSES];
+    size_t i;
+    int shape;
+    int bad;
+    for (i = 0; i < SCALE_POSES; ++i) {
+        poses[i] = bench_scaling_pose(i);
+    }
+    bad = bench_poses_check(scene, poses, SCALE_POSES, BENCH_POSE_CLEARANCE, &shape);
+    if (bad >= 0) {
+        fprintf(stderr,
+                "bench_extract: scaling pose %d (%.2f, %.2f) is not in free space (shape %d)\n",
+                bad, poses[bad].x, poses[bad].y, shape);
+        return 1;
+    }
+    printf("  all %d poses checked against all %zu shapes: free (clearance %.2f m), enclosed\n",
+           SCALE_POSES, scene->n_shapes, BENCH_POSE_CLEARANCE);
+    return 0;
+}
 
 static int bench_scaling(const int *methods, int passes, size_t only_beams)
 {
@@ -312,17 +341,16 @@ static int bench_scaling(const int *methods, int passes, size_t only_beams)
     size_t b, i;
     int m;
 
-    bsf_scene_init(&scene);
-    if (bsf_scene_add_l_room(&scene, -4.0, -3.0, 12.0, 8.0, 5.0, 3.0) != BSF_OK ||
-        bsf_scene_add_circle(&scene, 2.0, 0.5, 0.35) < 0 ||
-        bsf_scene_add_circle(&scene, 5.0, -1.5, 0.5) < 0 ||
-        bsf_scene_add_corner(&scene, -1.0, 3.0, 0.0, 1.5, -1.5707963, 1.0) != BSF_OK) {
+    if (bench_scaling_scene(&scene) != BSF_OK) {
         fprintf(stderr, "bench_extract: scene setup failed\n");
         return 1;
     }
     printf("\nscaling: synthetic L-room, 2 pillars, a free-standing corner; %d poses, 270 deg, "
            "sigma 1 cm, %d passes; BSF_MAX_POINTS %d\n",
            SCALE_POSES, passes, BSF_MAX_POINTS);
+    if (check_scaling_poses(&scene) != 0) {
+        return 1;
+    }
     printf("  %-16s", "beams");
     for (b = 0; b < N_SCALE; ++b) {
         printf(" %9zu", scale_beams[b]);
@@ -343,8 +371,9 @@ static int bench_scaling(const int *methods, int passes, size_t only_beams)
             }
             bsf_scene_rng_seed(&rng, 2022u + b);
             for (i = 0; i < SCALE_POSES; ++i) {
-                bsf_lidar_t l = bsf_lidar_default(-2.0 + 0.3 * (double)i, -1.0 + 0.1 * (double)i,
-                                                  0.3 * (double)i, scale_beams[b], 4.71238898);
+                const bsf_scene_pose_t pose = bench_scaling_pose(i);
+                bsf_lidar_t l =
+                    bsf_lidar_default(pose.x, pose.y, pose.theta, scale_beams[b], 4.71238898);
                 l.noise_sigma = 0.01;
                 if (bsf_scene_scan(&scene, &l, &rng, ranges[i], NULL, BSF_MAX_POINTS) != BSF_OK) {
                     fprintf(stderr, "bench_extract: ray-cast failed\n");
@@ -407,7 +436,7 @@ static int bench_scaling(const int *methods, int passes, size_t only_beams)
             for (q = b + 1; q < N_SCALE; ++q) {
                 if (scale_beams[q] == 4u * scale_beams[b] && median_us[m][b] > 0.0 &&
                     median_us[m][q] > 0.0) {
-                    printf("  %s: %zu -> %zu beams (4x): time x %.2f (target <= 4.5)\n",
+                    printf("  %s: %zu -> %zu beams (4x): time x %.2f (budget <= 4.3)\n",
                            bsf_method_name((bsf_method_t)m), scale_beams[b], scale_beams[q],
                            median_us[m][q] / median_us[m][b]);
                 }
@@ -417,10 +446,60 @@ static int bench_scaling(const int *methods, int passes, size_t only_beams)
     return 0;
 }
 
+/* ---- adversarial scans (bench_scenes.h), reported apart ---------------------- */
+
+static int bench_adversarial(const int *methods, int passes)
+{
+    static float ranges[BENCH_ADV_SCANS][BSF_MAX_POINTS];
+    stored_scan_t stored[BENCH_ADV_SCANS];
+    int kind, m;
+    printf("\nadversarial scans (worst cases, not part of the scaling figures), %d passes; "
+           "median us per scan of %d scans, max in brackets\n",
+           passes, BENCH_ADV_SCANS);
+    for (kind = 0; kind < BENCH_ADV_COUNT; ++kind) {
+        scan_set_t set;
+        size_t k;
+        if (bench_adv_beams(kind) > BSF_MAX_POINTS) {
+            printf("  %-10s SKIPPED: %zu beams > BSF_MAX_POINTS\n", bench_adv_name(kind),
+                   bench_adv_beams(kind));
+            continue;
+        }
+        for (k = 0; k < BENCH_ADV_SCANS; ++k) {
+            if (bench_adv_scan(kind, k, ranges[k], BSF_MAX_POINTS, &stored[k].scan) != BSF_OK) {
+                fprintf(stderr, "bench_extract: adversarial %s scan %zu failed\n",
+                        bench_adv_name(kind), k);
+                return 1;
+            }
+            stored[k].ranges = ranges[k];
+        }
+        set.scans = stored;
+        set.n = BENCH_ADV_SCANS;
+        printf("  %-10s %5zu beams:", bench_adv_name(kind), bench_adv_beams(kind));
+        for (m = 0; m < BSF_METHOD_COUNT; ++m) {
+            method_result_t res;
+            int st;
+            if (!methods[m]) {
+                continue;
+            }
+            st = bench_method(&set, (bsf_method_t)m, passes, 0, &res);
+            if (st < 0) {
+                return 1;
+            }
+            if (st == 0) {
+                printf("  %s %.1f (%.1f)", bsf_method_name((bsf_method_t)m), res.whole.median,
+                       res.whole.max);
+            }
+        }
+        printf("\n");
+    }
+    return 0;
+}
+
 static void usage(void)
 {
     fprintf(stderr, "usage: bench_extract [--passes N] [--method NAME|all] [--max-scans N]\n"
-                    "                     [--no-scaling] [--scaling-only] [--beams N] [LOG ...]\n");
+                    "                     [--no-scaling] [--scaling-only] [--beams N]\n"
+                    "                     [--adversarial] [--adversarial-only] [LOG ...]\n");
 }
 
 int main(int argc, char **argv)
@@ -429,8 +508,8 @@ int main(int argc, char **argv)
                                                "fr-clinic.log.gz"};
     static const size_t default_max[] = {0, 0, 0, 1000};
     const char *shared = getenv("BSF_SHARED_DIR");
-    int methods[BSF_METHOD_COUNT] = {1, 1, 1};
-    int passes = 5, scaling = 1, logs = 1, n_paths = 0, a, rc = 0;
+    int methods[BSF_METHOD_COUNT] = {1, 1, 1, 1};
+    int passes = 5, scaling = 1, logs = 1, adversarial = 0, n_paths = 0, a, rc = 0;
     long max_scans = 0, only_beams = 0;
     const char **paths = xmalloc((size_t)argc * sizeof *paths);
 
@@ -456,6 +535,12 @@ int main(int argc, char **argv)
             scaling = 0;
         } else if (strcmp(argv[a], "--scaling-only") == 0) {
             logs = 0;
+        } else if (strcmp(argv[a], "--adversarial") == 0) {
+            adversarial = 1;
+        } else if (strcmp(argv[a], "--adversarial-only") == 0) {
+            adversarial = 1;
+            logs = 0;
+            scaling = 0;
         } else if (argv[a][0] == '-') {
             usage();
             return 2;
@@ -486,6 +571,9 @@ int main(int argc, char **argv)
     }
     if (scaling) {
         rc |= bench_scaling(methods, passes, (size_t)only_beams);
+    }
+    if (adversarial) {
+        rc |= bench_adversarial(methods, passes);
     }
     free(paths);
     return rc;

@@ -100,9 +100,8 @@ bsf_status_t bsf_scene_add_polyline(bsf_scene_t *scene, const double *xy, size_t
     return BSF_OK;
 }
 
-bsf_status_t bsf_scene_add_rect_room(bsf_scene_t *scene, double x0, double y0, double x1, double y1)
+static bsf_status_t rect_corners(double x0, double y0, double x1, double y1, double xy[8])
 {
-    double xy[8];
     if (!(x0 != x1) || !(y0 != y1)) {
         return BSF_ERR_ARG;
     }
@@ -114,7 +113,92 @@ bsf_status_t bsf_scene_add_rect_room(bsf_scene_t *scene, double x0, double y0, d
     xy[5] = y1;
     xy[6] = x0;
     xy[7] = y1;
-    return bsf_scene_add_polyline(scene, xy, 4u, 1);
+    return BSF_OK;
+}
+
+bsf_status_t bsf_scene_add_rect_room(bsf_scene_t *scene, double x0, double y0, double x1, double y1)
+{
+    double xy[8];
+    const bsf_status_t st = rect_corners(x0, y0, x1, y1, xy);
+    return st != BSF_OK ? st : bsf_scene_add_polyline(scene, xy, 4u, 1);
+}
+
+bsf_status_t bsf_scene_add_solid(bsf_scene_t *scene, const double *xy, size_t n_vertices)
+{
+    const size_t first = scene != NULL ? scene->n_shapes : 0u;
+    size_t k;
+    bsf_status_t st = bsf_scene_add_polyline(scene, xy, n_vertices, 1);
+    if (st != BSF_OK) {
+        return st;
+    }
+    ++scene->n_solids;
+    for (k = first; k < scene->n_shapes; ++k) {
+        scene->shape[k].solid = scene->n_solids;
+    }
+    return BSF_OK;
+}
+
+bsf_status_t bsf_scene_add_box(bsf_scene_t *scene, double x0, double y0, double x1, double y1)
+{
+    double xy[8];
+    const bsf_status_t st = rect_corners(x0, y0, x1, y1, xy);
+    return st != BSF_OK ? st : bsf_scene_add_solid(scene, xy, 4u);
+}
+
+/* Whether (x,y) is inside solid polygon `id`: the edges carrying that id
+ * crossed an odd number of times by a ray towards +x. */
+static int inside_solid(const bsf_scene_t *scene, int id, double x, double y)
+{
+    int inside = 0;
+    size_t k;
+    for (k = 0; k < scene->n_shapes; ++k) {
+        const bsf_shape_t *s = &scene->shape[k];
+        if (s->kind == BSF_SHAPE_SEGMENT && s->solid == id && ((s->y0 > y) != (s->y1 > y)) &&
+            x < s->x0 + (y - s->y0) * (s->x1 - s->x0) / (s->y1 - s->y0)) {
+            inside = !inside;
+        }
+    }
+    return inside;
+}
+
+int bsf_scene_pose_blocked(const bsf_scene_t *scene, double x, double y, double clearance)
+{
+    size_t k;
+    int shape = -1;
+    if (scene == NULL || !finite_d(x) || !finite_d(y)) {
+        return 0;
+    }
+    for (k = 0; k < scene->n_shapes; ++k) {
+        const bsf_shape_t *s = &scene->shape[k];
+        if (s->kind == BSF_SHAPE_CIRCLE) {
+            const double dx = x - s->x0;
+            const double dy = y - s->y0;
+            if (sqrt(dx * dx + dy * dy) < s->r) {
+                return (int)k;
+            }
+        } else if (s->solid > 0 && inside_solid(scene, s->solid, x, y)) {
+            return (int)k;
+        }
+    }
+    if (bsf_scene_distance_to_surface(scene, x, y, &shape) < clearance) {
+        return shape;
+    }
+    return -1;
+}
+
+int bsf_scene_point_enclosed(const bsf_scene_t *scene, double x, double y, size_t n_rays)
+{
+    size_t k;
+    if (scene == NULL || n_rays == 0u) {
+        return 0;
+    }
+    for (k = 0; k < n_rays; ++k) {
+        const double a = 2.0 * SCENE_PI * (double)k / (double)n_rays;
+        if (bsf_scene_raycast(scene, x, y, a, NULL) < 0.0) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 bsf_status_t bsf_scene_add_corner(bsf_scene_t *scene, double vx, double vy, double heading_a,
@@ -570,7 +654,7 @@ void bsf_scene_demo_office(bsf_scene_t *sc)
     /* a partition wall with a doorway, a cabinet, a pillar */
     (void)bsf_scene_add_segment(sc, 5.0, 0.0, 5.0, 3.0);
     (void)bsf_scene_add_segment(sc, 5.0, 4.2, 5.0, 7.0);
-    (void)bsf_scene_add_rect_room(sc, 2.0, 7.5, 3.5, 8.3);
+    (void)bsf_scene_add_box(sc, 2.0, 7.5, 3.5, 8.3);
     (void)bsf_scene_add_circle(sc, 10.5, 3.0, 0.45);
 }
 
@@ -674,7 +758,7 @@ bsf_status_t bsf_scene_add_clutter_room(bsf_scene_t *scene, const bsf_scene_clut
         xy[5] = y - uy - ux;
         xy[6] = x + ux + uy;
         xy[7] = y + uy - ux;
-        (void)bsf_scene_add_polyline(scene, xy, 4u, 1);
+        (void)bsf_scene_add_solid(scene, xy, 4u);
     }
     return BSF_OK;
 }
@@ -699,7 +783,7 @@ void bsf_scene_truth_angles(bsf_scene_t *sc)
         box[2u * k] = 6.0 + c * bx[k] - s * by[k];
         box[2u * k + 1u] = 4.3 + s * bx[k] + c * by[k];
     }
-    (void)bsf_scene_add_polyline(sc, box, 4u, 1);
+    (void)bsf_scene_add_solid(sc, box, 4u);
     (void)bsf_scene_add_segment(sc, 8.0, 7.6, 10.0, 8.2);
     (void)bsf_scene_add_circle(sc, 2.5, 7.2, 0.3);
     (void)bsf_scene_add_circle(sc, 9.0, 1.2, 0.025);
@@ -717,7 +801,7 @@ void bsf_scene_truth_curved(bsf_scene_t *sc)
     (void)bsf_scene_add_circle(sc, -4.5, 3.5, 1.5);
     (void)bsf_scene_add_circle(sc, -1.0, 3.0, 0.4);
     (void)bsf_scene_add_circle(sc, 1.5, 2.5, 0.2);
-    (void)bsf_scene_add_rect_room(sc, -3.0, -1.2, -2.4, -0.6);
+    (void)bsf_scene_add_box(sc, -3.0, -1.2, -2.4, -0.6);
 }
 
 void bsf_scene_truth_pose(int which, long k, long n, double *x, double *y, double *theta)

@@ -46,12 +46,15 @@ typedef struct {
     double x0, y0; /**< segment start, or circle centre */
     double x1, y1; /**< segment end (unused for a circle) */
     double r;      /**< circle radius (unused for a segment) */
+    int solid;     /**< segment: 0 for a wall, k > 0 for an edge of the k-th solid
+                        polygon (bsf_scene_add_solid); circles are always solid */
 } bsf_shape_t;
 
 /** A scene: up to BSF_SCENE_MAX_SHAPES surfaces. Fixed size, caller-owned. */
 typedef struct {
     bsf_shape_t shape[BSF_SCENE_MAX_SHAPES];
     size_t n_shapes;
+    int n_solids; /**< solid polygons added so far (bsf_scene_add_solid) */
 } bsf_scene_t;
 
 /** A pose in the world frame: position in metres, heading in radians (CCW). */
@@ -125,6 +128,38 @@ int bsf_scene_add_circle(bsf_scene_t *scene, double cx, double cy, double r);
  */
 bsf_status_t bsf_scene_add_polyline(bsf_scene_t *scene, const double *xy, size_t n_vertices,
                                     int closed);
+
+/**
+ * Add a solid obstacle: the closed polygon through n_vertices points, as
+ * bsf_scene_add_polyline with closed = 1, whose inside no sensor may stand in
+ * (bsf_scene_pose_blocked). Ray-casting treats its edges as walls.
+ * @return as bsf_scene_add_polyline.
+ */
+bsf_status_t bsf_scene_add_solid(bsf_scene_t *scene, const double *xy, size_t n_vertices);
+
+/**
+ * A solid box with corners (x0,y0) and (x1,y1) (a cabinet, a crate): the
+ * edges of bsf_scene_add_rect_room, added as bsf_scene_add_solid.
+ * @return as bsf_scene_add_solid (BSF_ERR_ARG when degenerate).
+ */
+bsf_status_t bsf_scene_add_box(bsf_scene_t *scene, double x0, double y0, double x1, double y1);
+
+/**
+ * Whether a sensor may stand at world point (x,y): not inside a circle or a
+ * solid polygon, and at least `clearance` metres from every surface.
+ * @return -1 when the pose is free; otherwise the index of the first shape it
+ *         is inside of or too close to (any edge of the solid polygon it is
+ *         in). A NULL scene or a non-finite point gives 0.
+ */
+int bsf_scene_pose_blocked(const bsf_scene_t *scene, double x, double y, double clearance);
+
+/**
+ * Whether the world point (x,y) is enclosed: a ray in each of n_rays
+ * directions evenly spread over the full circle hits a surface (so the point
+ * is inside a room rather than outside it). @return 1 or 0 (0 for NULL or
+ * n_rays == 0).
+ */
+int bsf_scene_point_enclosed(const bsf_scene_t *scene, double x, double y, size_t n_rays);
 
 /**
  * Rectangular room with corners (x0,y0) and (x1,y1): four walls, four 90 degree

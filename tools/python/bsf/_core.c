@@ -40,6 +40,7 @@ static const char *status_name(bsf_status_t st)
     case BSF_ERR_FORMAT: return "BSF_ERR_FORMAT";
     case BSF_ERR_CRC: return "BSF_ERR_CRC";
     case BSF_ERR_VERSION: return "BSF_ERR_VERSION";
+    case BSF_ERR_UNSUPPORTED: return "BSF_ERR_UNSUPPORTED";
     }
     return "BSF_ERR_?";
 }
