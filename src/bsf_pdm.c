@@ -321,17 +321,19 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
     const float oy = s->origin.y;
     span_sums_t acc;
     size_t i;
+    float k0 = 1.0f; /* basis scales of span acc.span */
+    float k2 = n_span == 1u ? 1.0f : 0.5f;
     clear_normal_equations(s, w);
     sums_reset(&acc, 0u);
     for (i = 0; i < s->n; ++i) {
         float u;
         const size_t span = span_of(w->t[i], fs, n_span, &u);
-        const float k0 = span == 0u ? 1.0f : 0.5f;
-        const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
         const float v = 1.0f - u;
         if (span != acc.span) {
             sums_flush(w, acc);
             sums_reset(&acc, span);
+            k0 = span == 0u ? 1.0f : 0.5f;
+            k2 = span + 1u == n_span ? 1.0f : 0.5f;
         }
         sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
     }
@@ -352,6 +354,8 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
     const float ox = s->origin.x;
     const float oy = s->origin.y;
     span_sums_t acc;
+    float k0 = 1.0f; /* basis scales of span acc.span */
+    float k2 = n_span == 1u ? 1.0f : 0.5f;
     size_t f;
     size_t i = 0;
 
@@ -399,10 +403,10 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             if (span != acc.span) {
                 sums_flush(w, acc);
                 sums_reset(&acc, span);
+                k0 = span == 0u ? 1.0f : 0.5f;
+                k2 = span + 1u == n_span ? 1.0f : 0.5f;
             }
             {
-                const float k0 = span == 0u ? 1.0f : 0.5f;
-                const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
                 const float v = 1.0f - u;
                 sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
             }
