@@ -224,6 +224,7 @@ static inline size_t span_of(float t, float fs, size_t n_span, float *u)
 typedef struct {
     size_t span;
     float k0, k2;
+    float m0, m2; /* -2 k0 and 2 k2: the u-derivative's scales */
     float p1x, p1y;
     float ax, ay;   /* P0 - P1 */
     float bx, by;   /* P2 - P1 */
@@ -236,6 +237,8 @@ static inline void load_span(const bsf_point_t *ctrl, size_t n_span, size_t span
     c->span = span;
     c->k0 = span == 0u ? 1.0f : 0.5f;
     c->k2 = span + 1u == n_span ? 1.0f : 0.5f;
+    c->m0 = -2.0f * c->k0;
+    c->m2 = 2.0f * c->k2;
     c->p1x = p[1].x;
     c->p1y = p[1].y;
     c->ax = p[0].x - p[1].x;
@@ -510,6 +513,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     const float fs = (float)n_span;
     const float inv_fs = 1.0f / fs;
     const size_t last = s->n - 1u;
+    const size_t bias_window = s->bias_window;
     const float ox = s->origin.x;
     const float oy = s->origin.y;
     span_coef_t c;
@@ -547,7 +551,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     for (i = 0; i < s->n; ++i) {
         const float qx = s->pts[i].x - ox;
         const float qy = s->pts[i].y - oy;
-        const unsigned n_steps = (i == 0u || i == last) ? 0u : steps;
+        /* Not the end points: i - 1 wraps for i == 0. */
+        const unsigned n_steps = i - 1u < last - 1u ? steps : 0u;
         float t = w->t[i];
         float u;
         size_t span = span_of(t, fs, n_span, &u);
@@ -568,8 +573,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
         best = ex * ex + ey * ey;
         for (step = 0; step < n_steps; ++step) {
             /* Derivatives at the current u of span c. */
-            const float d0 = -2.0f * c.k0 * (1.0f - u);
-            const float d2 = 2.0f * c.k2 * u;
+            const float d0 = c.m0 * (1.0f - u);
+            const float d2 = c.m2 * u;
             const float ux = d0 * c.ax + d2 * c.bx;
             const float uy = d0 * c.ay + d2 * c.by;
             const float g = ex * ux + ey * uy;
@@ -660,7 +665,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             !(sqrtf(total / (float)s->n) < give_up_rms)) {
             return 0;
         }
-        if (s->bias_window > 0u) {
+        if (bias_window > 0u) {
             /* Signed residual along the normal of the span's chord (one
              * square root per span), summed over the last bias_window
              * points of the fragment in a ring. */
@@ -677,9 +682,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             r = ex * nx + ey * ny;
             ring_sum += r - ring[ring_at];
             ring[ring_at] = r;
-            ring_at = ring_at + 1u == s->bias_window ? 0u : ring_at + 1u;
+            ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
             ++ring_n;
-            if (ring_n >= s->bias_window && fabsf(ring_sum) > window_max) {
+            if (ring_n >= bias_window && fabsf(ring_sum) > window_max) {
                 window_max = fabsf(ring_sum);
             }
             point_max = best > point_max ? best : point_max;
