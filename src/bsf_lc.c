@@ -3,6 +3,7 @@
 #include "bsf/bsf_lc.h"
 #include "bsf_math.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -33,7 +34,10 @@ bsf_lc_params_t bsf_lc_params_default(void)
     p.apex_slack = 0.05f;
     p.min_side_points = 3u;
     p.min_side_len = 0.15f;
-    p.max_range = 30.0f;
+    /* No range limit of its own: a corner needs min_side_points points per
+     * side within max_side of the apex, so the beam spacing, not the range,
+     * decides how far corners are found (about 57 m at 0.5 deg beams). */
+    p.max_range = FLT_MAX;
     return p;
 }
 
@@ -62,6 +66,7 @@ typedef struct {
     float mx, my;
     float dx, dy;
     float rss;
+    float sx, sy; /* the coordinate sums, in order from the first point */
     size_t n;
 } lc_line_t;
 
@@ -69,14 +74,19 @@ typedef struct {
     const bsf_points_t *pts;
     const uint16_t *run;
     const bsf_lc_params_t *p;
-    bsf_point_t o; /* origin of the current judgement (the apex point) */
+    bsf_point_t o;    /* origin of the current judgement (the apex point) */
+    bsf_point_t *rel; /* run points minus o, filled by judge for its window */
+    float sin_min_turn;
 } lc_ctx_t;
 
-static bsf_point_t rel(const lc_ctx_t *c, size_t pos)
+/* Run point pos relative to the origin, also stored for the fits: judge's
+ * side walks visit every point of the window a0..b1 this way first. */
+static bsf_point_t rel_store(const lc_ctx_t *c, size_t pos)
 {
     bsf_point_t q = c->pts->pt[c->run[pos]];
     q.x -= c->o.x;
     q.y -= c->o.y;
+    c->rel[pos] = q;
     return q;
 }
 
@@ -87,39 +97,38 @@ static float dist2(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
-/* Line through positions a..b of the run, leaving out position skip (pass
- * b + 1 to keep all). Two passes: centring first keeps float sums exact
- * enough for centimetre noise on 10 m walls. Returns 0 when fewer than two
- * points. */
-static int fit_line(const lc_ctx_t *c, size_t a, size_t b, size_t skip, lc_line_t *l)
+/* Line through positions a..b of the run (from c->rel), whose coordinate
+ * sums over a..from-1, added in order from 0, are sx, sy (from = a, sums 0:
+ * all of them). Two passes: centring first keeps float sums exact enough
+ * for centimetre noise on 10 m walls. Returns 0 when fewer than two points. */
+static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, float sx, float sy,
+                         lc_line_t *l)
 {
-    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
-    float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm;
+    const bsf_point_t *rp = c->rel;
+    float sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
+    float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm, mx, my;
     size_t i;
-    size_t n = 0;
-    for (i = a; i <= b; ++i) {
-        if (i != skip) {
-            const bsf_point_t q = rel(c, i);
-            sx += q.x;
-            sy += q.y;
-            ++n;
-        }
-    }
-    if (n < 2u) {
+    const size_t n = b + 1u - a;
+    if (b < a + 1u) {
         return 0;
     }
+    for (i = from; i <= b; ++i) {
+        sx += rp[i].x;
+        sy += rp[i].y;
+    }
+    mx = sx / (float)n;
+    my = sy / (float)n;
+    l->sx = sx;
+    l->sy = sy;
     l->n = n;
-    l->mx = sx / (float)n;
-    l->my = sy / (float)n;
+    l->mx = mx;
+    l->my = my;
     for (i = a; i <= b; ++i) {
-        if (i != skip) {
-            const bsf_point_t q = rel(c, i);
-            const float x = q.x - l->mx;
-            const float y = q.y - l->my;
-            sxx += x * x;
-            sxy += x * y;
-            syy += y * y;
-        }
+        const float x = rp[i].x - mx;
+        const float y = rp[i].y - my;
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
     }
     half = 0.5f * (sxx + syy);
     diff = 0.5f * (sxx - syy);
@@ -150,19 +159,34 @@ static int fit_line(const lc_ctx_t *c, size_t a, size_t b, size_t skip, lc_line_
     return 1;
 }
 
+static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
+{
+    return fit_line_from(c, a, b, a, 0.0f, 0.0f, l);
+}
+
+/* When a partial circle residual is enough for the caller:
+ * scale * (ratio * rss + floor_rss) >= target. */
+typedef struct {
+    float scale;
+    float ratio;
+    float floor_rss;
+    float target;
+} lc_enough_t;
+
 /* Squared residual of the best circle through positions a..b (algebraic fit,
  * then geometric distances), or -1 when no sensible circle exists. */
-static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent)
+static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent,
+                        const lc_enough_t *enough)
 {
+    const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
     float n = 0.0f;
     float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
     size_t i;
     for (i = a; i <= b; ++i) {
-        const bsf_point_t q = rel(c, i);
-        const float x = q.x - cx0;
-        const float y = q.y - cy0;
+        const float x = rp[i].x - cx0;
+        const float y = rp[i].y - cy0;
         const float z = x * x + y * y;
         sxx += x * x;
         sxy += x * y;
@@ -193,26 +217,84 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     }
     r = sqrtf(r2);
     for (i = a; i <= b; ++i) {
-        const bsf_point_t q = rel(c, i);
-        const float dx = q.x - cx0 - cx;
-        const float dy = q.y - cy0 - cy;
+        const float dx = rp[i].x - cx0 - cx;
+        const float dy = rp[i].y - cy0 - cy;
         const float g = sqrtf(dx * dx + dy * dy) - r;
         rss += g * g;
+        /* The sum only grows (terms >= 0, rounding is monotonic): once the
+         * caller's test is settled by the partial sum, the rest cannot
+         * change its answer. */
+        if (enough->scale * (enough->ratio * rss + enough->floor_rss) >= enough->target) {
+            break;
+        }
     }
     return rss;
 }
 
-/* A side is straight unless a circle cuts its squared residual by more than
- * the factor curve_ratio (beyond the floor). */
+/* A side is straight unless a circle cuts its squared residual per degree of
+ * freedom (n - 2 for a line, n - 3 for a circle) by more than the factor
+ * curve_ratio (beyond the floor). A circle passes through any three points,
+ * so a side of three points or fewer shows no curvature: straight. Without
+ * the degrees of freedom a short leg past a corner (three or four points)
+ * was judged curved by its noise alone and the corner was lost. */
 static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
 {
-    const float extent = sqrtf(dist2(rel(c, a), rel(c, b)));
-    const float rss_circle = circle_rss(c, a, b, l->mx, l->my, extent);
+    const size_t n = b - a + 1u;
+    const float floor_rss = (float)n * c->p->floor * c->p->floor;
+    const float line_dof = (float)(n - 2u);
+    float extent;
+    float rss_circle;
+    lc_enough_t enough;
+    if (n <= 3u) {
+        return 1;
+    }
+    /* Straight when rss * (n - 3) <= (n - 2) * (ratio * rss_circle + floor);
+     * the circle's term is >= 0, so a residual within the floor is straight
+     * whatever the circle gives, and no circle is fitted. */
+    if (l->rss * (float)(n - 3u) <= line_dof * floor_rss) {
+        return 1;
+    }
+    extent = sqrtf(dist2(c->rel[a], c->rel[b]));
+    enough.scale = line_dof;
+    enough.ratio = c->p->curve_ratio;
+    enough.floor_rss = floor_rss;
+    enough.target = l->rss * (float)(n - 3u); /* straight from there on */
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough);
     if (rss_circle < 0.0f) {
         return 1;
     }
-    return l->rss <=
-           c->p->curve_ratio * rss_circle + (float)(b - a + 1u) * c->p->floor * c->p->floor;
+    return enough.target <= line_dof * (c->p->curve_ratio * rss_circle + floor_rss);
+}
+
+/* From position pos, step (-1 or +1) towards stop while the next point is
+ * within sqrt(side2) of the apex ap, storing the points relative to the
+ * apex; returns the last position reached. */
+static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2,
+                        bsf_point_t ap)
+{
+    /* Locals: the stores into rel[] could alias *c as far as the compiler
+     * knows. */
+    const bsf_point_t *pt = c->pts->pt;
+    const uint16_t *run = c->run;
+    bsf_point_t *rel = c->rel;
+    const float ox = c->o.x;
+    const float oy = c->o.y;
+    const int ap_zero = ap.x == 0.0f && ap.y == 0.0f; /* always, for finite points */
+    while (pos != stop) {
+        const size_t next = step > 0 ? pos + 1u : pos - 1u;
+        bsf_point_t q = pt[run[next]];
+        float d2;
+        q.x -= ox;
+        q.y -= oy;
+        rel[next] = q;
+        /* x - 0 is x: dist2(q, ap) without the subtractions */
+        d2 = ap_zero ? q.x * q.x + q.y * q.y : dist2(q, ap);
+        if (!(d2 <= side2)) {
+            break;
+        }
+        pos = next;
+    }
+    return pos;
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -231,32 +313,28 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     size_t b1 = apex;
     size_t best;
     size_t i;
-    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
+    const bsf_point_t *rp = c->rel;
+    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, lines_bound, best_d;
+    lc_enough_t enough;
     bsf_point_t x;
+    bsf_point_t ap;
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
         return 0;
     }
     c->o = c->pts->pt[c->run[apex]];
-    while (a0 > lo && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
-        --a0;
-    }
-    while (b1 < hi && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
-        ++b1;
-    }
+    ap = rel_store(c, apex);
+    a0 = walk_side(c, apex, lo, -1, side2, ap);
+    b1 = walk_side(c, apex, hi, 1, side2, ap);
     /* A side cut short by a neighbouring split reaches past it: noise often
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2(rel(c, a0), rel(c, apex)) < len2) {
-        while (a0 > 0u && dist2(rel(c, a0 - 1u), rel(c, apex)) <= side2) {
-            --a0;
-        }
+    if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
+        a0 = walk_side(c, a0, 0u, -1, side2, ap);
     }
-    if (b1 - apex < need || dist2(rel(c, b1), rel(c, apex)) < len2) {
-        while (b1 + 1u < m && dist2(rel(c, b1 + 1u), rel(c, apex)) <= side2) {
-            ++b1;
-        }
+    if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
+        b1 = walk_side(c, b1, m - 1u, 1, side2, ap);
     }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
@@ -264,14 +342,14 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2(rel(c, a0), rel(c, apex)) < len2 || dist2(rel(c, b1), rel(c, apex)) < len2) {
+    if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
         return 0;
     }
-    if (!fit_line(c, a0, apex - 1u, apex, &la) || !fit_line(c, apex + 1u, b1, apex, &lb)) {
+    if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
         return 0;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
-    if (!(fabsf(cross) >= bsf_sinf(p->min_turn))) {
+    if (!(fabsf(cross) >= c->sin_min_turn)) {
         return 0;
     }
     t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
@@ -279,9 +357,9 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     xy = la.my + t * la.dy;
     x.x = xx;
     x.y = xy;
-    spacing = sqrtf(dist2(rel(c, apex - 1u), rel(c, apex)));
+    spacing = sqrtf(dist2(rp[apex - 1u], ap));
     {
-        const float s2 = sqrtf(dist2(rel(c, apex + 1u), rel(c, apex)));
+        const float s2 = sqrtf(dist2(rp[apex + 1u], ap));
         spacing = s2 > spacing ? s2 : spacing;
     }
     if (!(xx * xx + xy * xy <=
@@ -289,17 +367,28 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     /* One smooth curve over both sides: the better of a line and a circle. */
-    if (!fit_line(c, a0, b1, b1 + 1u, &lu)) {
+    /* (the left side's sums are the first part of the whole's) */
+    if (!fit_line_from(c, a0, b1, apex, la.sx, la.sy, &lu)) {
         return 0;
     }
-    extent = sqrtf(dist2(rel(c, a0), rel(c, b1)));
+    rss_lines = la.rss + lb.rss;
+    lines_bound = p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor;
+    /* The curve's residual is at most the line's: when the line already
+     * fails the test, so does the curve, and no circle is fitted. */
+    if (!(lu.rss > lines_bound)) {
+        return 0;
+    }
+    extent = sqrtf(dist2(rp[a0], rp[b1]));
     rss_curve = lu.rss;
-    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent);
+    enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = lu.rss; /* from there on, the line is the better curve */
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough);
     if (rss_circle >= 0.0f && rss_circle < rss_curve) {
         rss_curve = rss_circle;
     }
-    rss_lines = la.rss + lb.rss;
-    if (!(rss_curve > p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor)) {
+    if (!(rss_curve > lines_bound)) {
         return 0;
     }
     /* Each side must be straight: a circle may not explain it much better
@@ -311,10 +400,10 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
     best = apex;
-    best_d = dist2(rel(c, apex), x);
+    best_d = dist2(ap, x);
     for (i = apex - 2u; i <= apex + 2u; ++i) {
         if (i > a0 && i < b1) {
-            const float d = dist2(rel(c, i), x);
+            const float d = dist2(rp[i], x);
             if (d < best_d) {
                 best_d = d;
                 best = i;
@@ -326,8 +415,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     kp->point.y = xy + c->o.y;
     kp->orientation = bsf_atan2f(la.my + lb.my - 2.0f * xy, la.mx + lb.mx - 2.0f * xx);
     {
-        const float ra = sqrtf(dist2(rel(c, a0), rel(c, apex)));
-        const float rb = sqrtf(dist2(rel(c, b1), rel(c, apex)));
+        const float ra = sqrtf(dist2(rp[a0], ap));
+        const float rb = sqrtf(dist2(rp[b1], ap));
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
@@ -341,22 +430,27 @@ static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m)
     float sum = 0.0f;
     size_t n = 0;
     size_t i;
+    bsf_point_t a;
+    bsf_point_t q;
+    if (m < 3u) {
+        return 0.0f;
+    }
+    a = pts->pt[run[0]];
+    q = pts->pt[run[1]];
     for (i = 1; i + 1u < m; ++i) {
-        const bsf_point_t a = pts->pt[run[i - 1u]];
-        const bsf_point_t q = pts->pt[run[i]];
         const bsf_point_t b = pts->pt[run[i + 1u]];
         const float ex = b.x - a.x;
         const float ey = b.y - a.y;
         const float len = sqrtf(ex * ex + ey * ey);
-        float d;
-        if (!(len > 0.0f)) {
-            continue;
+        if (len > 0.0f) {
+            const float d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
+            if (d <= LC_NOISE_CLIP) {
+                sum += d;
+                ++n;
+            }
         }
-        d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
-        if (d <= LC_NOISE_CLIP) {
-            sum += d;
-            ++n;
-        }
+        a = q; /* the window moves by one point */
+        q = b;
     }
     return n > 0u ? sum / ((float)n * LC_NOISE_MEAN_ABS) : 0.0f;
 }
@@ -385,13 +479,22 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        for (i = a + 1u; i < b; ++i) {
-            const bsf_point_t q = pts->pt[w->run[i]];
-            const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
-                                       : sqrtf(dist2(q, pa));
-            if (d > dmax) {
-                dmax = d;
-                imax = i;
+        if (len > 0.0f) {
+            for (i = a + 1u; i < b; ++i) {
+                const bsf_point_t q = pts->pt[w->run[i]];
+                const float d = fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len;
+                if (d > dmax) {
+                    dmax = d;
+                    imax = i;
+                }
+            }
+        } else {
+            for (i = a + 1u; i < b; ++i) {
+                const float d = sqrtf(dist2(pts->pt[w->run[i]], pa));
+                if (d > dmax) {
+                    dmax = d;
+                    imax = i;
+                }
             }
         }
         if (dmax > tol) {
@@ -465,20 +568,39 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
     memset(&last, 0, sizeof last);
+    for (j = 0; j < nb; ++j) {
+        w->judged_lo[j] = UINT16_MAX; /* no verdict yet */
+    }
     for (pass = 0; changed && pass < LC_MAX_PASSES; ++pass) {
         changed = 0;
         j = 0;
         while (j < nb) {
             const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
             const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-            if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
-                memmove(&w->brk[j], &w->brk[j + 1u], (nb - j - 1u) * sizeof w->brk[0]);
+            /* A verdict depends only on the split and its two neighbours:
+             * a corner whose neighbours have not moved since it was judged
+             * stays one, with its keypoint still parked. */
+            if (w->judged_lo[j] == lo && w->judged_hi[j] == hi) {
+                ++j;
+            } else if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                const size_t tail = nb - j - 1u;
+                const size_t slot = *n_found + j;
+                memmove(&w->brk[j], &w->brk[j + 1u], tail * sizeof w->brk[0]);
+                memmove(&w->judged_lo[j], &w->judged_lo[j + 1u], tail * sizeof w->judged_lo[0]);
+                memmove(&w->judged_hi[j], &w->judged_hi[j + 1u], tail * sizeof w->judged_hi[0]);
+                if (slot + 1u < out_cap) {
+                    const size_t fit = out_cap - slot - 1u;
+                    memmove(&out[slot], &out[slot + 1u], (tail < fit ? tail : fit) * sizeof out[0]);
+                }
                 --nb;
                 changed = 1;
             } else {
-                /* Parked where it lands if this pass turns out final. */
+                /* Parked where it lands if this pass turns out final; only
+                 * a parked verdict is remembered (slots only move down). */
                 if (*n_found + j < out_cap) {
                     out[*n_found + j] = kp;
+                    w->judged_lo[j] = (uint16_t)lo;
+                    w->judged_hi[j] = (uint16_t)hi;
                 }
                 ++j;
             }
@@ -512,6 +634,67 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
 }
 
+/* Point b continues the run that ends at point a: within the jump radius
+ * at b's range. */
+static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+{
+    /* r >= jump_a: the exponential is only needed past that. */
+    const float d2 = dist2(pts->pt[a], pts->pt[b]);
+    const float x = p->jump_b * pts->range[b];
+    float r;
+    if (d2 <= p->jump_a * p->jump_a) {
+        return 1;
+    }
+    if (x >= 0.0f && x <= 1.0f) {
+        /* lo <= bsf_expf(x) <= hi, and rounding is monotonic: r * r lies
+         * between the squares of jump_a * lo and jump_a * hi, so expf only
+         * for d2 between them. */
+        float lo;
+        float hi;
+        float r_lo;
+        float r_hi;
+        bsf_exp_bounds01(x, &lo, &hi);
+        r_lo = p->jump_a * lo;
+        r_hi = p->jump_a * hi;
+        if (d2 <= r_lo * r_lo) {
+            return 1;
+        }
+        if (d2 > r_hi * r_hi) {
+            return 0;
+        }
+    }
+    r = p->jump_a * bsf_expf(x);
+    return d2 <= r * r;
+}
+
+/* The run ending at point a jumps at point i. When the surface resumes
+ * within the next 2 * min_side_points beams (a valid point within the jump
+ * radius at a's range), the beams between are an occluder (a post, a chair
+ * leg) too narrow to hold a corner of its own (LC judges no run shorter
+ * than 2 * min_side_points + 1): returns the beam where the run resumes, so
+ * a corner hidden behind it is still judged from both walls (SVED's
+ * look-back keeps such a wall one segment too). Else returns i. One
+ * exponential per jump: the radius is taken at a's range. */
+static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
+{
+    const size_t span = 2u * (size_t)p->min_side_points;
+    float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
+    size_t j;
+    for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
+        if (pts->valid[j]) {
+            const float d2 = dist2(pts->pt[a], pts->pt[j]);
+            if (d2 > p->jump_a * p->jump_a && r2 < 0.0f) {
+                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[a]);
+                r2 = r * r;
+            }
+            if (d2 <= p->jump_a * p->jump_a || d2 <= r2) {
+                return j;
+            }
+        }
+    }
+    return i;
+}
+
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
 {
@@ -539,17 +722,21 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.p = p;
     c.o.x = 0.0f;
     c.o.y = 0.0f;
+    c.rel = work->rel;
+    c.sin_min_turn = bsf_sinf(p->min_turn);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
         if (!close_run && !pts->valid[i]) {
             continue;
         }
         if (!close_run && m > 0u) {
-            /* r >= jump_a: the exponential is only needed past that. */
-            const float d2 = dist2(pts->pt[work->run[m - 1u]], pts->pt[i]);
-            if (d2 > p->jump_a * p->jump_a) {
-                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[i]);
-                close_run = d2 > r * r;
+            close_run = !within_jump(pts, p, work->run[m - 1u], i);
+            if (close_run) {
+                const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
+                if (j > i) {
+                    i = j - 1u; /* the run resumes at j */
+                    continue;
+                }
             }
         }
         if (close_run) {

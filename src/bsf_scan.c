@@ -194,12 +194,23 @@ bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_
         return BSF_ERR_PARAM;
     }
     if (p->min_run > 0u) {
-        /* The largest valid reading, then its runs of equal beams. */
+        /* The largest valid reading and how many beams read it, then, when
+         * they are enough for one, its runs of equal beams. */
         size_t run = 0;
+        size_t n_top = 0;
         for (i = 0; i < pts->count; ++i) {
-            if (pts->valid[i] && pts->range[i] > top) {
-                top = pts->range[i];
+            if (pts->valid[i]) {
+                const float r = pts->range[i];
+                if (r > top) {
+                    top = r;
+                    n_top = 1u;
+                } else if (r == top) {
+                    ++n_top;
+                }
             }
+        }
+        if (n_top < (size_t)p->min_run) {
+            top = 0.0f; /* no run of min_run equal readings at the top */
         }
         for (i = 0; i < pts->count && top > 0.0f && !top_is_code; ++i) {
             run = (pts->valid[i] && pts->range[i] == top) ? run + 1u : 0u;
@@ -209,7 +220,7 @@ bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_
             }
         }
     }
-    for (i = 0; i < pts->count; ++i) {
+    for (i = 0; (p->code > 0.0f || top_is_code) && i < pts->count; ++i) {
         if (pts->valid[i] && ((p->code > 0.0f && pts->range[i] == p->code) ||
                               (top_is_code && pts->range[i] == top))) {
             invalidate(pts, i);

@@ -137,21 +137,15 @@ static bsf_status_t finish(const seg_sink_t *sink, size_t *n_out, size_t *n_wast
     return BSF_OK;
 }
 
-/* 1 + x + x^2/2 + x^3/6 + x^4/24: a lower bound of exp(x) for x >= 0. */
-static float exp_lower_bound(float x)
-{
-    return 1.0f + x * (1.0f + x * (0.5f + x * (0.16666667f + x * 0.041666668f)));
-}
-
 /* ---- SVED with look-back, radius cap, mixed pixels and full-circle scans ---- */
 
-/* One open segment of the labelled pass. */
+/* One open segment of the labelled pass (24 bytes: moved often). */
 typedef struct {
-    size_t first;    /* beam of its first point (its label) */
-    size_t last;     /* beam of its last point */
-    size_t last_pos; /* pass position of its last point */
-    size_t n;        /* points */
-    bsf_point_t end; /* its last point */
+    uint32_t first;    /* beam of its first point (its label) */
+    uint32_t last;     /* beam of its last point */
+    uint32_t last_pos; /* pass position of its last point */
+    uint32_t n;        /* points */
+    bsf_point_t end;   /* its last point */
 } open_seg_t;
 
 /* Radius test d^2 <= r(rho)^2, r = a*exp(b*rho) capped at sqrt(cap2) when
@@ -164,7 +158,76 @@ static int within_radius(float d2, float rho, float a2, float two_b, float cap2)
     if (cap2 > 0.0f && !(d2 <= cap2)) {
         return 0;
     }
-    return d2 <= a2 * exp_lower_bound(two_b * rho) || d2 <= a2 * bsf_expf(two_b * rho);
+    return d2 <= a2 * bsf_exp_taylor4(two_b * rho) || d2 <= a2 * bsf_expf(two_b * rho);
+}
+
+/* within_radius for the tests of one beam (one rho), with the beam's
+ * threshold worked out once, when a test first needs it. */
+typedef struct {
+    float a2;
+    float two_b;
+    float cap2;
+    float rho;
+    float lower; /* the threshold is >= lower ... */
+    float upper; /* ... and <= upper; both valid when have_bounds */
+    float limit; /* the threshold itself, valid when have_limit */
+    int have_bounds;
+    int have_limit;
+} beam_radius_t;
+
+static void beam_radius_start(beam_radius_t *r, float rho)
+{
+    r->rho = rho;
+    r->have_bounds = 0;
+    r->have_limit = 0;
+}
+
+/* The threshold max(a2 * taylor4(x), a2 * expf(x)), x = 2 b rho, or its
+ * bounds: at least the first term and, for x in [0, 1], at most a2 * hi
+ * (bsf_exp_bounds01), so expf is needed only for d2 between the two. */
+static int beam_within_slow(beam_radius_t *r, float d2)
+{
+    const float x = r->two_b * r->rho;
+    if (!r->have_bounds) {
+        r->lower = r->a2 * bsf_exp_taylor4(x);
+        r->upper = HUGE_VALF; /* no upper bound */
+        if (x >= 0.0f && x <= 1.0f) {
+            float lo;
+            float hi;
+            bsf_exp_bounds01(x, &lo, &hi);
+            r->upper = r->a2 * hi;
+        }
+        r->have_bounds = 1;
+    }
+    if (d2 <= r->lower) {
+        return 1;
+    }
+    if (!(d2 <= r->upper)) {
+        return 0;
+    }
+    {
+        const float exact = r->a2 * bsf_expf(x);
+        r->limit = r->lower > exact ? r->lower : exact;
+        r->have_limit = 1;
+    }
+    return d2 <= r->limit;
+}
+
+/* Same answer as within_radius(d2, r->rho, ...): past a2 and inside the cap,
+ * d2 <= A || d2 <= B is d2 <= max(A, B), and d2 <= cap2 && d2 <= M is
+ * d2 <= min(cap2, M) (a NaN bound fails both forms). */
+static inline int beam_within(beam_radius_t *r, float d2)
+{
+    if (d2 <= r->a2) {
+        return 1;
+    }
+    if (r->cap2 > 0.0f && !(d2 <= r->cap2)) {
+        return 0;
+    }
+    if (r->have_limit) {
+        return d2 <= r->limit;
+    }
+    return beam_within_slow(r, d2);
 }
 
 /* Range of beam i + k (k in -2..2) into *r, wrapping on a ring; 0 when that
@@ -198,24 +261,46 @@ static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, f
     return 1;
 }
 
-/* The mixed-pixel rule documented on bsf_segment_sved_labelled. */
-static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, float a2, float two_b,
-                          float cap2)
+/* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
+ * beam i's range. */
+static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
 {
     float r[5];
     float lo;
     float hi;
     float jump;
     int k;
-    for (k = -2; k <= 2; ++k) {
-        if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
+    if (i >= 2u && i + 2u < pts->count) {
+        /* Inside the scan (most beams): the cheap tests first. */
+        const uint8_t *v = &pts->valid[i - 2u];
+        const float *rg = &pts->range[i - 2u];
+        if (!((v[1] != 0u) & (v[2] != 0u) & (v[3] != 0u))) {
+            return 0;
+        }
+        r[1] = rg[1];
+        r[2] = rg[2];
+        r[3] = rg[3];
+        lo = r[1] < r[3] ? r[1] : r[3];
+        hi = r[1] < r[3] ? r[3] : r[1];
+        if (!(r[2] > lo && r[2] < hi) || !((v[0] != 0u) & (v[4] != 0u))) {
+            return 0;
+        }
+        r[0] = rg[0];
+        r[4] = rg[4];
+    } else {
+        for (k = -2; k <= 2; ++k) {
+            if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
+                return 0;
+            }
+        }
+        lo = r[1] < r[3] ? r[1] : r[3];
+        hi = r[1] < r[3] ? r[3] : r[1];
+        if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
     }
-    lo = r[1] < r[3] ? r[1] : r[3];
-    hi = r[1] < r[3] ? r[3] : r[1];
     jump = hi - lo;
-    if (!(r[2] > lo && r[2] < hi) || within_radius(jump * jump, r[2], a2, two_b, cap2)) {
+    if (beam_within(rad, jump * jump)) {
         return 0;
     }
     return fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
@@ -303,6 +388,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     float a2;
     float two_b;
     float cap2;
+    beam_radius_t rad;
     int reject_mixed;
     int ring;
 
@@ -321,6 +407,15 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     slots = extensions ? 1u + (size_t)p->lookback : 1u;
     reject_mixed = extensions && p->reject_mixed;
     ring = extensions && bsf_points_full_circle(pts);
+    rad.a2 = a2;
+    rad.two_b = two_b;
+    rad.cap2 = cap2;
+    rad.rho = 0.0f;
+    rad.lower = 0.0f;
+    rad.upper = 0.0f;
+    rad.limit = 0.0f;
+    rad.have_bounds = 0;
+    rad.have_limit = 0;
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
@@ -334,7 +429,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         size_t b = start + j;
         bsf_point_t q;
         float rho;
-        float best_d2 = 0.0f;
+        float best_d2 = HUGE_VALF;
         size_t best = slots; /* none */
         if (b >= pts->count) {
             b -= pts->count;
@@ -342,42 +437,68 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         if (!pts->valid[b]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
-        if (reject_mixed && is_mixed_pixel(pts, b, ring, a2, two_b, cap2)) {
+        rho = pts->range[b];
+        beam_radius_start(&rad, rho);
+        if (reject_mixed && is_mixed_pixel(pts, b, ring, &rad)) {
             sink.n_wasted++;
             continue;
         }
         q = pts->pt[b];
-        rho = pts->range[b];
         /* open[0] is the current segment (the paper's only candidate); older
-         * ones expire once their last point is more than max_gap_beams back. */
+         * ones expire once their last point is more than max_gap_beams back.
+         * The list is most recently extended first, so last_pos falls along
+         * it and the expired ones are a tail, closed first to last. */
+        if (n_open > 1u && j - open[n_open - 1u].last_pos > (size_t)p->max_gap_beams) {
+            size_t keep_n = n_open - 1u;
+            while (keep_n > 1u && j - open[keep_n - 1u].last_pos > (size_t)p->max_gap_beams) {
+                --keep_n;
+            }
+            for (k = keep_n; k < n_open; ++k) {
+                if (!close_open(&sink, &open[k], label, pts->count)) {
+                    return BSF_ERR_CAPACITY;
+                }
+            }
+            n_open = keep_n;
+        }
         for (k = 0; k < n_open; ++k) {
             float dx;
             float dy;
             float d2;
-            if (k > 0u && j - open[k].last_pos > (size_t)p->max_gap_beams) {
-                size_t m;
-                if (!close_open(&sink, &open[k], label, pts->count)) {
-                    return BSF_ERR_CAPACITY;
-                }
-                for (m = k + 1u; m < n_open; ++m) {
-                    open[m - 1u] = open[m];
-                }
-                --n_open;
-                --k;
-                continue;
-            }
             dx = q.x - open[k].end.x;
             dy = q.y - open[k].end.y;
             d2 = dx * dx + dy * dy;
-            if (within_radius(d2, rho, a2, two_b, cap2) && (best == slots || d2 < best_d2)) {
+            if (d2 < best_d2) { /* NaN and +inf never are */
                 best = k;
                 best_d2 = d2;
             }
         }
-        if (best < slots) {
+        if (best == slots) {
+            /* Only +inf or NaN distances (points at infinity): an infinite
+             * one may still pass an infinite radius. */
+            for (k = 0; k < n_open; ++k) {
+                const float dx = q.x - open[k].end.x;
+                const float dy = q.y - open[k].end.y;
+                if (dx * dx + dy * dy == HUGE_VALF) {
+                    best = k;
+                    break;
+                }
+            }
+        }
+        /* The radius test is a bound on d2 (a smaller d2 passes whenever a
+         * larger one does), so the nearest end, first of equals, is the one
+         * the nearest passing end would be, or none passes. NaN never does. */
+        if (best < slots && !beam_within(&rad, best_d2)) {
+            best = slots;
+        }
+        if (best == 0u) {
+            open[0].last = (uint32_t)b; /* the current segment goes on (most beams) */
+            open[0].last_pos = (uint32_t)j;
+            open[0].n++;
+            open[0].end = q;
+        } else if (best < slots) {
             open_seg_t s = open[best];
-            s.last = b;
-            s.last_pos = j;
+            s.last = (uint32_t)b;
+            s.last_pos = (uint32_t)j;
             s.n++;
             s.end = q;
             for (k = best; k > 0u; --k) {
@@ -394,9 +515,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             for (k = n_open; k > 0u; --k) {
                 open[k] = open[k - 1u];
             }
-            open[0].first = b;
-            open[0].last = b;
-            open[0].last_pos = j;
+            open[0].first = (uint32_t)b;
+            open[0].last = (uint32_t)b;
+            open[0].last_pos = (uint32_t)j;
             open[0].n = 1u;
             open[0].end = q;
             ++n_open;
@@ -548,17 +669,69 @@ static size_t upper_bound(const uint16_t *interest, size_t n, size_t key)
     return lo;
 }
 
-/* Is beam b one of the (strictly ascending) interest beams? */
-static int is_interest(const uint16_t *interest, size_t n, size_t b)
-{
-    const size_t j = upper_bound(interest, n, b);
-    return j > 0u && (size_t)interest[j - 1u] == b;
-}
-
 /* Is beam b a point of the segment whose first beam is first? */
 static int is_member(const bsf_points_t *pts, const uint16_t *label, size_t b, size_t first)
 {
     return label != NULL ? label[b] == (uint16_t)first : pts->valid[b] != 0u;
+}
+
+/* Interest beams among beams from..to (ascending, no seam) that are members. */
+static size_t interest_members_in(const bsf_points_t *pts, const uint16_t *label, size_t first,
+                                  const uint16_t *interest, size_t n_interest, size_t from,
+                                  size_t to)
+{
+    size_t c = 0;
+    size_t j = from > 0u ? upper_bound(interest, n_interest, from - 1u) : 0u;
+    for (; j < n_interest && (size_t)interest[j] <= to; ++j) {
+        c += (size_t)is_member(pts, label, interest[j], first);
+    }
+    return c;
+}
+
+/* Inner interest points of the segment first..last (walking on through beam
+ * 0 when first > last): interest beams among its members, not among the
+ * first two members or the last two. Those lie strictly between the second
+ * member from either end, so only the ends are walked. */
+static size_t inner_interest(const bsf_points_t *pts, const uint16_t *label, size_t first,
+                             size_t last, const uint16_t *interest, size_t n_interest)
+{
+    const size_t count = pts->count;
+    size_t seen = 0;
+    size_t lo = first; /* the second member from the start */
+    size_t hi = last;  /* the second member from the end */
+    size_t off_lo;
+    size_t off_hi;
+    for (;;) {
+        if (is_member(pts, label, lo, first) && ++seen == 2u) {
+            break;
+        }
+        if (lo == last) {
+            return 0u;
+        }
+        lo = next_beam(lo, count);
+    }
+    seen = 0;
+    for (;;) {
+        if (is_member(pts, label, hi, first) && ++seen == 2u) {
+            break;
+        }
+        if (hi == first) {
+            return 0u;
+        }
+        hi = hi > 0u ? hi - 1u : count - 1u;
+    }
+    off_lo = lo >= first ? lo - first : lo + count - first;
+    off_hi = hi >= first ? hi - first : hi + count - first;
+    if (off_lo + 1u >= off_hi) {
+        return 0u;
+    }
+    if (lo < hi) {
+        return interest_members_in(pts, label, first, interest, n_interest, lo + 1u, hi - 1u);
+    }
+    /* through the seam */
+    return interest_members_in(pts, label, first, interest, n_interest, lo + 1u, count - 1u) +
+           (hi > 0u ? interest_members_in(pts, label, first, interest, n_interest, 0u, hi - 1u)
+                    : 0u);
 }
 
 bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const bsf_points_t *pts,
@@ -584,30 +757,8 @@ bsf_status_t bsf_segment_classify_labelled(bsf_segment_t *segs, size_t n, const 
     }
     for (k = 0; k < n; ++k) {
         bsf_segment_t *s = &segs[k];
-        size_t total = 0;
-        size_t pos = 0;
-        size_t count = 0;
-        size_t b = s->first;
-        /* Two walks over the run: count the members, then test the inner ones
-         * (not among the first two or the last two). */
-        for (;;) {
-            total += (size_t)is_member(pts, label, b, s->first);
-            if (b == s->last) {
-                break;
-            }
-            b = next_beam(b, pts->count);
-        }
-        for (b = s->first;; b = next_beam(b, pts->count)) {
-            if (is_member(pts, label, b, s->first)) {
-                if (pos >= 2u && pos + 3u <= total && is_interest(interest_beams, n_interest, b)) {
-                    ++count;
-                }
-                ++pos;
-            }
-            if (b == s->last) {
-                break;
-            }
-        }
+        const size_t count =
+            inner_interest(pts, label, s->first, s->last, interest_beams, n_interest);
         s->n_interest = (uint8_t)(count > 255u ? 255u : count);
         s->kind = (uint8_t)(count > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK);
     }

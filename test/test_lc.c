@@ -19,11 +19,13 @@ static bsf_points_t points;
 static bsf_lc_work_t work;
 static bsf_keypoint_t kps[BSF_MAX_KEYPOINTS];
 static bsf_scene_t scene;
+static double range_max = 30.0; /* of the simulated sensor */
 
 void setUp(void)
 {
     bsf_scene_init(&scene);
     memset(kps, 0, sizeof kps);
+    range_max = 30.0;
 }
 
 void tearDown(void)
@@ -40,6 +42,8 @@ static size_t detect(double x, double y, double heading, size_t n, double fov, d
     const bsf_lc_params_t p = bsf_lc_params_default();
     size_t n_out = 0;
     lid.noise_sigma = sigma;
+    lid.range_max = range_max;
+    lid.no_return = (float)(range_max + 1.0);
     bsf_scene_rng_seed(&rng, 7u);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, &rng, ranges, NULL, BSF_MAX_POINTS));
     scan = bsf_scene_lidar_scan(&lid, ranges);
@@ -87,6 +91,33 @@ static void test_a_lone_far_corner_is_found_at_one_degree_beams(void)
     n = detect(0.0, 0.0, 0.0, 181u, PI, 0.01);
     TEST_ASSERT_EQUAL_size_t(1u, n);
     TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 7.0, 0.5) < 0.03);
+}
+
+/* LC has no range limit of its own (FALKO's is 30 m): a building corner at
+ * 45 m is found where the beams are dense enough for three points a side. */
+static void test_a_corner_beyond_30_m_is_found(void)
+{
+    size_t n;
+    range_max = 80.0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 45.0, 2.0, 0.75 * PI, 6.0, 1.25 * PI, 6.0));
+    n = detect(0.0, 0.0, 0.0, 1081u, 1.5 * PI, 0.03);
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+    TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 45.0, 2.0) < 0.1);
+}
+
+/* A post in front of a corner hides its apex (and breaks the run of
+ * consecutive points there): the two walls still meet in a corner, found
+ * through the gap the post leaves (SVED's look-back joins the walls too). */
+static void test_a_corner_behind_a_thin_post_is_found(void)
+{
+    size_t n;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 6.0, 0.0, 0.75 * PI, 3.0, 1.25 * PI, 3.0));
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 3.0, 0.0, 0.05) >= 0);
+    n = detect(0.0, 0.0, 0.0, 541u, 1.5 * PI, 0.01);
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+    TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
 }
 
 static void test_noisy_room_gives_its_four_corners_and_nothing_else(void)
@@ -174,6 +205,8 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_corners_of_many_angles_are_found_where_the_walls_meet);
     RUN_TEST(test_a_lone_far_corner_is_found_at_one_degree_beams);
+    RUN_TEST(test_a_corner_beyond_30_m_is_found);
+    RUN_TEST(test_a_corner_behind_a_thin_post_is_found);
     RUN_TEST(test_noisy_room_gives_its_four_corners_and_nothing_else);
     RUN_TEST(test_straight_walls_pillars_and_curved_walls_give_no_corner);
     RUN_TEST(test_refused_calls);

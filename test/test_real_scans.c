@@ -488,12 +488,12 @@ static void test_outdoor_scene_up_to_80_m_keeps_points_near_their_curves(void)
     printf("outdoor, default method %s: %lu features, %.1f %% within 0.3 m, farthest point "
            "%.1f m\n",
            bsf_method_name(BSF_METHOD_DEFAULT), (unsigned long)n, 100.0 * share, far);
-    /* LC finds the far outline corners FALKO's range limit misses: 98.9 %
-     * (177 of 179; FALKO-SVED-PDM's defaults above: 97.8 %, below this bound).
-     * The two left are outlines seen with two or three points past the
-     * corner, too few for a line on that side. */
+    /* LC finds the outline corners FALKO misses: 100 % (179 of 179). Before
+     * 98.9 %: LC stopped at 30 m (FALKO's range limit), judged a side of three
+     * points curved (a circle fits any three points), and lost a corner
+     * hidden behind a post; FALKO-SVED-PDM's defaults above: 97.8 %. */
     TEST_ASSERT_TRUE(n >= 100u);
-    TEST_ASSERT_TRUE(share >= 0.985);
+    TEST_ASSERT_TRUE(share >= 0.99);
 }
 
 /* ---- full-circle scans ------------------------------------------------------- */

@@ -22,6 +22,9 @@
  *       both sides together) is above curve_ratio times that of the two
  *       lines, plus (count x floor^2). So round pillars, curved walls and
  *       noise on straight walls give no corner, whatever the beam spacing;
+ *     - each side is straight: a circle does not explain it curve_ratio times
+ *       better per degree of freedom (n - 2 for a line, n - 3 for a circle;
+ *       a side of three points passes, since any circle fits three points);
  *     a rejected split merges its two pieces and the neighbours are judged
  *     again;
  *  3. report each corner at its apex beam, with the intersection of the two
@@ -50,7 +53,9 @@ typedef struct {
     float max_side;     /**< length of each side used for the line fits, metres (1.5) */
     float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
     float min_side_len; /**< length each side must reach from the apex, metres (0.15) */
-    float max_range;    /**< no corner at an apex farther than this, metres (30, FALKO's) */
+    float max_range;    /**< no corner at an apex farther than this, metres (FLT_MAX: no
+                             limit; the side tests already need min_side_points points
+                             within max_side of the apex, which the beam spacing decides) */
     uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3); one
                                    fewer where a side reaches the end of its run */
 } bsf_lc_params_t;
@@ -64,13 +69,17 @@ bsf_lc_params_t bsf_lc_params_default(void);
  *  min_side_points in 2..64). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
-/** Scratch memory of bsf_lc_detect (about 9 bytes per beam). */
+/** Scratch memory of bsf_lc_detect (about 21 bytes per beam; in the
+ *  extractor it shares its space with the larger BID scratch). */
 typedef struct {
     uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
     uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
     uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
     uint16_t stack_b[BSF_MAX_POINTS];
-    uint8_t is_brk[BSF_MAX_POINTS]; /**< split marks, positions in run */
+    uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner verdict */
+    uint16_t judged_hi[BSF_MAX_POINTS];
+    bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
+    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run */
 } bsf_lc_work_t;
 
 /**
