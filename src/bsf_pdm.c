@@ -526,10 +526,12 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     size_t i;
     /* Systematic deviation (bias_window > 0): the last bias_window signed
      * residuals of the fragment (a ring), their sum, the fragment's largest
-     * |sum| and its largest squared distance. */
-    float ring[BSF_PDM_MAX_BIAS_WINDOW] = {0.0f};
+     * |sum| and its largest squared distance. Only ring[0..bias_window) is
+     * used, so only that part is cleared. ring_wait counts the points still
+     * missing before the window is full. */
+    float ring[BSF_PDM_MAX_BIAS_WINDOW];
     size_t ring_at = 0;
-    size_t ring_n = 0;
+    size_t ring_wait = bias_window;
     float ring_sum = 0.0f;
     float window_max = 0.0f;
     float point_max = 0.0f;
@@ -542,6 +544,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     const float give_up_total =
         give_up_rms > 0.0f ? give_up_rms * give_up_rms * (float)s->n * 0.999f : 3.0e38f;
 
+    memset(ring, 0, bias_window * sizeof ring[0]);
     if (assemble_next) {
         clear_normal_equations(s, w);
     }
@@ -683,8 +686,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             ring_sum += r - ring[ring_at];
             ring[ring_at] = r;
             ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
-            ++ring_n;
-            if (ring_n >= bias_window && fabsf(ring_sum) > window_max) {
+            ring_wait -= ring_wait > 0u ? 1u : 0u;
+            if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
                 window_max = fabsf(ring_sum);
             }
             point_max = best > point_max ? best : point_max;
@@ -694,11 +697,11 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 w->frag_rms[f] = systematic_error(s, rms, window_max, point_max);
                 frag_sum = best; /* the vertex point opens the next fragment */
                 point_max = best;
-                memset(ring, 0, sizeof ring);
+                memset(ring, 0, bias_window * sizeof ring[0]);
                 ring[0] = r;
                 ring_sum = r;
                 ring_at = 1u;
-                ring_n = 1u;
+                ring_wait = bias_window - 1u;
                 window_max = 0.0f;
                 if (f + 1u < s->n_frag) {
                     ++f;
