@@ -1,6 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_stream.h"
 
+#include <string.h>
+
+#include "bsf_wire.h"
+
 bsf_status_t bsf_cobs_encode(const uint8_t *in, size_t len, uint8_t *out, size_t cap,
                              size_t *out_len)
 {
@@ -47,6 +51,74 @@ bsf_status_t bsf_cobs_encode(const uint8_t *in, size_t len, uint8_t *out, size_t
     }
     out[code_pos] = code;
     return BSF_OK;
+}
+
+/* Non-zero bytes at s before the first zero, at most limit: a machine word
+ * at a time (a word has a zero byte when subtracting 1 from every byte
+ * borrows into a byte whose top bit was clear), then byte by byte. */
+static size_t nonzero_run(const uint8_t *s, size_t limit)
+{
+    const size_t ones = (size_t)-1 / 0xFFu; /* 0x01 in every byte */
+    const size_t highs = ones * 0x80u;
+    size_t i = 0;
+    while (limit - i >= sizeof(size_t)) {
+        size_t word;
+        memcpy(&word, s + i, sizeof word);
+        if (((word - ones) & ~word & highs) != 0u) {
+            break;
+        }
+        i += sizeof(size_t);
+    }
+    while (i < limit && s[i] != 0u) {
+        ++i;
+    }
+    return i;
+}
+
+size_t bsf_cobs_full_blocks(const uint8_t *body, size_t n)
+{
+    size_t full = 0;
+    size_t i = 0;
+    for (;;) {
+        const size_t left = n - i;
+        const size_t run = nonzero_run(body + i, left < 254u ? left : 254u);
+        i += run;
+        if (run == 254u) {
+            ++full;
+        } else if (i == n) {
+            return full;
+        } else {
+            ++i; /* the zero */
+        }
+    }
+}
+
+/* Blocks as in bsf_cobs_encode; a block's data moves only when an earlier
+ * block of 254 bytes inserted a code byte (bodies of 254 bytes or more). */
+size_t bsf_cobs_encode_in_place(uint8_t *buf, size_t offset, size_t n)
+{
+    const uint8_t *src = buf + offset;
+    const uint8_t *const src_end = src + n;
+    uint8_t *code_at = buf;
+    uint8_t *out = buf + 1;
+    for (;;) {
+        const size_t left = (size_t)(src_end - src);
+        const size_t run = nonzero_run(src, left < 254u ? left : 254u);
+        if (out != src) {
+            memmove(out, src, run);
+        }
+        out += run;
+        src += run;
+        *code_at = (uint8_t)(run + 1u);
+        if (run < 254u) {
+            if (src == src_end) {
+                break;
+            }
+            ++src; /* the zero: the next block's code byte takes its place */
+        }
+        code_at = out++;
+    }
+    return (size_t)(out - buf);
 }
 
 bsf_status_t bsf_cobs_decode(const uint8_t *in, size_t len, uint8_t *out, size_t cap,

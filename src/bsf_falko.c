@@ -38,6 +38,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "bsf_math.h"
 #include "bsf_nms.h"
@@ -171,12 +172,20 @@ typedef struct {
  * clamped to the scan, with A >= alpha from a bound that costs one division,
  * asin(s) <= s / sqrt(1 - s^2) <= s / (1 - s^2) = r rho / (rho^2 - r^2)
  * (r <= 0.8 rho keeps the denominator positive), with a rounding margin. */
-static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
+static float window_alpha_f(float rho, float r, float inv_inc)
 {
-    const float rho = pts->range[i];
-    const float a = r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
+    return r * rho / (rho * rho - r * r) * inv_inc * (1.0f + 1e-5f);
+}
+
+static size_t window_clamp(float a)
+{
     /* a >= 0; BSF_MAX_POINTS fits int, and int conversion is one instruction */
     return (a < (float)BSF_MAX_POINTS) ? (size_t)(int)a : (size_t)BSF_MAX_POINTS;
+}
+
+static size_t window_alpha(const bsf_points_t *pts, size_t i, float r, float inv_inc)
+{
+    return window_clamp(window_alpha_f(pts->range[i], r, inv_inc));
 }
 
 static void neigh_window(const bsf_points_t *pts, size_t i, size_t alpha, int ring, neigh_t *nb)
@@ -323,18 +332,58 @@ static int sector_distance(int a, int b, int sectors, int circular)
     }
 }
 
+/* Sector values lie in -S/2 - 1 .. 3S/2 (S <= 64): the clamped angle is
+ * within (-pi, pi), theta within [-pi, pi], so (ang + pi - theta) / width
+ * lies within (-S/2 - 1, 3S/2 + 1). Offset into sector_count[]. */
+#define FALKO_SECTOR_OFFSET 33
+/* Differences of two sector values lie in -129 .. 129: offset into
+ * sector_dist[]. */
+#define FALKO_SECTOR_SPAN 129
+
+/* Step 8 for one side: the sum of sector distances over pairs of its
+ * neighbours, the first of each pair the one nearer the apex. Neighbours are
+ * visited from the apex outwards (sec[0], sec[step], ...); each adds its
+ * distances to all nearer ones, taken per sector value with its count, so the
+ * cost is n times the number of distinct values (a side along a wall covers
+ * one to three sectors), not n^2 / 2. Integer sums: the same total. */
+static long side_score(const int8_t *sec, int n, int step, const bsf_falko_params_t *p,
+                       bsf_falko_work_t *work)
+{
+    long score = 0;
+    int n_seen = 0;
+    int k, m;
+    for (k = 0; k < n; ++k) {
+        const int s = sec[k * step];
+        uint16_t *count = &work->sector_count[s + FALKO_SECTOR_OFFSET];
+        for (m = 0; m < n_seen; ++m) {
+            const int t = work->sector_seen[m];
+            /* sector_distance depends on t - s only: remembered per call. */
+            int8_t *d = &work->sector_dist[t - s + FALKO_SECTOR_SPAN];
+            if (*d < 0) {
+                *d = (int8_t)sector_distance(t, s, p->grid_sectors, p->circular_sector_distance);
+            }
+            score += (long)work->sector_count[t + FALKO_SECTOR_OFFSET] * *d;
+        }
+        if (*count == 0u) {
+            work->sector_seen[n_seen++] = (int8_t)s;
+        }
+        ++*count;
+    }
+    for (m = 0; m < n_seen; ++m) {
+        work->sector_count[work->sector_seen[m] + FALKO_SECTOR_OFFSET] = 0u;
+    }
+    return score;
+}
+
 /* Steps 7-9 for an apex that passed steps 1-6: the raw integer score. */
 static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float theta,
-                         const bsf_falko_params_t *p, int8_t *sector)
+                         const bsf_falko_params_t *p, bsf_falko_work_t *work)
 {
     const ball_t ball = make_ball(pts->pt[i], r);
     const bsf_point_t c = ball.c;
     const float width = 2.0f * FALKO_PI / (float)p->grid_sectors;
-    const int nl = nb->n_left;
-    const int nr = nb->n_right;
+    int8_t *sector = work->sector;
     int k = 0;
-    int a, b;
-    long score = 0;
     ptrdiff_t j;
 
     /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
@@ -343,20 +392,9 @@ static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, f
             sector[k++] = (int8_t)sector_of(pts->pt[beam_at(pts, j)], c, theta, width);
         }
     }
-    /* Ordered pairs: the first of each pair is the one nearer the apex. */
-    for (a = nl - 1; a >= 0; --a) {
-        for (b = a - 1; b >= 0; --b) {
-            score +=
-                sector_distance(sector[a], sector[b], p->grid_sectors, p->circular_sector_distance);
-        }
-    }
-    for (a = 0; a < nr; ++a) {
-        for (b = a + 1; b < nr; ++b) {
-            score += sector_distance(sector[nl + a], sector[nl + b], p->grid_sectors,
-                                     p->circular_sector_distance);
-        }
-    }
-    return score;
+    /* Left: nearest is sector[nl - 1], walking down; right: sector[nl] up. */
+    return side_score(&sector[nb->n_left - 1], nb->n_left, -1, p, work) +
+           side_score(&sector[nb->n_left], nb->n_right, 1, p, work);
 }
 
 /* Total-least-squares line through beams [from, to] that are neighbours of
@@ -416,17 +454,189 @@ static bsf_point_t subbeam_corner(const bsf_points_t *pts, size_t i, const neigh
     return q;
 }
 
-/* Is beam i an apex candidate at all (step 1)? */
-static int in_extraction_range(const bsf_points_t *pts, size_t i, const bsf_falko_params_t *p)
+/* Certain rejection without the exact radius. Nearly every apex of a scan
+ * is rejected by steps 3-5 (an apex on a wall fails the triangle test), and
+ * each of those would need bsf_expf for its radius. Here the radius is only
+ * bracketed, lo <= r <= hi, from a short exp: every test that decides a
+ * rejection is monotone in r, so a rejection that holds for the bracket holds
+ * for r, and one that does not (a neighbour too near the ball's edge, a
+ * triangle that might pass) goes to the exact path. Results are therefore
+ * those of the exact path alone. */
+
+/* work->win_hi of a beam whose bracket is not cheap: the exact path decides;
+ * and of a beam that is no apex (step 1: invalid or out of the extraction
+ * range). Windows are at most BSF_MAX_POINTS. */
+#define FALKO_WIN_EXACT 0xFFFFu
+#define FALKO_WIN_NONE 0xFFFEu
+
+/* Float bits of a non-negative float: they order as the values do, so the
+ * loop below compares and clamps them as integers (no branches). */
+static int32_t float_bits(float v)
 {
-    const float rho = pts->range[i];
-    return pts->valid[i] && rho >= p->min_range && rho <= p->max_range;
+    int32_t b;
+    memcpy(&b, &v, sizeof b);
+    return b;
+}
+
+static float bits_float(int32_t b)
+{
+    float v;
+    memcpy(&v, &b, sizeof v);
+    return v;
+}
+
+/* window_clamp for any value (negative, NaN and garbage give 0 or the cap). */
+static int32_t window_clamp_any(float a)
+{
+    int32_t b = float_bits(a);
+    b = (b > 0) ? b : 0;
+    b = (b < float_bits((float)BSF_MAX_POINTS)) ? b : float_bits((float)BSF_MAX_POINTS);
+    return (int32_t)bits_float(b);
+}
+
+/* The bracket of every beam (valid or not: the others go unused) in one loop
+ * without branches, so that compilers run several beams per instruction:
+ * the squared distances certainly inside / outside the exact ball (see
+ * make_ball), the smallest triangle limit lo / b_ratio, the window of hi (or
+ * FALKO_WIN_EXACT) and a window the ends may reach without a second look. */
+static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p, float inv_inc,
+                            bsf_falko_work_t *work)
+{
+    const float a = p->neigh_a;
+    const float b = p->neigh_b;
+    const float b_ratio = p->b_ratio;
+    /* Step 1, is beam i an apex at all: valid, min_range <= rho <= max_range
+     * (both >= 0, as ranges are; -0.0 min_range compares as below all). */
+    const int32_t min_range_bits = float_bits(p->min_range);
+    const int32_t max_range_bits = float_bits(p->max_range);
+    const size_t n = pts->count;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        const float rho = pts->range[i];
+        /* The same float product neigh_radius passes to bsf_expf, capped at
+         * 80 so that the conversion below stays defined (x >= 80 takes the
+         * exact path). x >= 0 (b >= 0, rho >= 0). */
+        const int32_t x_bits = float_bits(b * rho);
+        const float x = bits_float((x_bits < 0x42a00000) ? x_bits : 0x42a00000); /* 80.0f */
+        /* exp(x) = 2^k exp(f), |f| <= ln2 / 2 + 1e-5: degree-5 Taylor
+         * series, truncation below 5e-6 relative; the rounding of k ln2
+         * (k <= 116) adds below 4e-6, the other roundings and bsf_expf's own
+         * error below 1e-6. The bracket's margin, 1e-4, is ten times their
+         * sum. */
+        const int32_t k = (int32_t)(x * 1.44269504f + 0.5f);
+        const float f = x - (float)k * 0.693147182f;
+        const float e =
+            1.0f +
+            f * (1.0f + f * (0.5f + f * (1.0f / 6.0f + f * (1.0f / 24.0f + f * (1.0f / 120.0f)))));
+        const float m = a * (e * bits_float((k + 127) << 23));
+        const float lo = m * (1.0f - 1e-4f);
+        const float hi = m * (1.0f + 1e-4f);
+        /* Windows grow with r (every operation of window_alpha is
+         * monotone), so the exact window lies between those of lo and hi.
+         * lo's window is at least 0.999 hi's when lo >= hi (1 - 2e-4) and
+         * hi <= 0.8 rho (rho^2 - r^2 then changes by under 7.2e-4 relative
+         * between them). */
+        const float a_hi = window_alpha_f(rho, hi, inv_inc);
+        /* r = a exp(b rho) itself when hi < rho; otherwise (r may be
+         * neigh_radius's cap), for x >= 80 and for radii so small that their
+         * squares leave float's normal range (lo < 1e-15) the exact path
+         * decides. */
+        const int32_t apex = -((pts->valid[i] != 0u) & (float_bits(rho) >= min_range_bits) &
+                               (float_bits(rho) <= max_range_bits));
+        const int32_t cheap = -((x_bits < 0x42a00000) & (float_bits(hi) < float_bits(rho)) &
+                                (float_bits(lo) >= float_bits(1e-15f)));
+        const int32_t near = -(float_bits(hi) <= float_bits(0.8f * rho));
+        /* Selections by masks: conversions inside a branch would not run
+         * four at a time. */
+        const int32_t win = (window_clamp_any(a_hi) & cheap) | ((int32_t)FALKO_WIN_EXACT & ~cheap);
+        work->win_hi[i] = (uint16_t)((win & apex) | ((int32_t)FALKO_WIN_NONE & ~apex));
+        work->win_inner[i] = (uint16_t)(window_clamp_any(a_hi * 0.999f) & near);
+        work->in2[i] = lo * lo * (1.0f - 1e-6f);
+        work->out2[i] = hi * hi * (1.0f + 1e-6f);
+        work->lim[i] = lo / b_ratio;
+    }
+}
+
+enum { FALKO_REJECT = 0, FALKO_MAYBE = 1 };
+
+/* The outermost neighbour on one side, walking from window position `from`
+ * towards the apex by `step`: FALKO_REJECT when no beam can be a neighbour
+ * for any r in the bracket, else *end = the outermost certain neighbour, or
+ * FALKO_MAYBE (*end = apex) when a beam on the way is undecided. */
+static int bracket_end(const bsf_points_t *pts, ptrdiff_t from, ptrdiff_t i, ptrdiff_t step,
+                       bsf_point_t c, float in2, float out2, ptrdiff_t *end)
+{
+    /* Windows that stay inside the scan (all but a few on a full circle)
+     * need no wrapping. */
+    const int wraps = from < 0 || from >= (ptrdiff_t)pts->count;
+    ptrdiff_t v;
+    for (v = from; v != i; v += step) {
+        const size_t j = wraps ? beam_at(pts, v) : (size_t)v;
+        float dx, dy, d2;
+        if (!pts->valid[j]) {
+            continue;
+        }
+        dx = c.x - pts->pt[j].x;
+        dy = c.y - pts->pt[j].y;
+        d2 = dx * dx + dy * dy;
+        if (d2 > out2) {
+            continue;
+        }
+        *end = (d2 <= in2) ? v : i;
+        return FALKO_MAYBE;
+    }
+    return FALKO_REJECT;
+}
+
+/* FALKO_REJECT when steps 3-5 certainly reject apex i (see radius_brackets);
+ * FALKO_MAYBE when only the exact path can tell. */
+static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
+                              const bsf_falko_work_t *work)
+{
+    const bsf_point_t c = pts->pt[i];
+    const size_t w = work->win_hi[i];
+    const size_t inner = work->win_inner[i];
+    const float in2 = work->in2[i];
+    const float out2 = work->out2[i];
+    const float lim = work->lim[i];
+    neigh_t win;
+    ptrdiff_t first, last;
+    if (w == FALKO_WIN_EXACT) {
+        return FALKO_MAYBE;
+    }
+    neigh_window(pts, i, w, ring, &win);
+    if (bracket_end(pts, win.beg, (ptrdiff_t)i, 1, c, in2, out2, &first) == FALKO_REJECT ||
+        bracket_end(pts, win.end, (ptrdiff_t)i, -1, c, in2, out2, &last) == FALKO_REJECT) {
+        return FALKO_REJECT;
+    }
+    /* Certain neighbours inside lo's window are the exact ends: the exact
+     * search meets only certain outsiders before them. Ends beyond `inner`
+     * (rare) are left to the exact path. */
+    if (first == (ptrdiff_t)i || last == (ptrdiff_t)i || (size_t)((ptrdiff_t)i - first) > inner ||
+        (size_t)(last - (ptrdiff_t)i) > inner) {
+        return FALKO_MAYBE;
+    }
+    /* Step 5 with the smallest limit: r / b_ratio >= lo / b_ratio. */
+    {
+        const int wraps = first < 0 || last >= (ptrdiff_t)pts->count;
+        const bsf_point_t f = pts->pt[wraps ? beam_at(pts, first) : (size_t)first];
+        const bsf_point_t l = pts->pt[wraps ? beam_at(pts, last) : (size_t)last];
+        const float bx = l.x - f.x;
+        const float by = l.y - f.y;
+        const float base = sqrtf(bx * bx + by * by);
+        float area2;
+        if (base < lim) {
+            return FALKO_REJECT;
+        }
+        area2 = (f.x - c.x) * (l.y - c.y) - (f.y - c.y) * (l.x - c.x);
+        return (fabsf(area2) / base < lim) ? FALKO_REJECT : FALKO_MAYBE;
+    }
 }
 
 /* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
  * FALKO_REJECTED. */
 static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
-                        const bsf_falko_params_t *p, int8_t *sector)
+                        const bsf_falko_params_t *p, bsf_falko_work_t *work)
 {
     float theta;
     neigh_t nb;
@@ -434,7 +644,7 @@ static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
-    return (float)corner_score(pts, i, &nb, r, theta, p, sector);
+    return (float)corner_score(pts, i, &nb, r, theta, p, work);
 }
 
 bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
@@ -442,7 +652,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
                               size_t *n_out)
 {
     size_t i, k, n_peak;
-    float inc;
+    float inc, inv_inc;
     long score_max = 0;
     long min_val;
     bsf_status_t st;
@@ -466,31 +676,26 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     if (!finite_f(inc) || inc == 0.0f) {
         return BSF_ERR_ARG;
     }
+    inv_inc = 1.0f / inc;
     ring = bsf_points_full_circle(pts);
+    memset(work->sector_count, 0, sizeof work->sector_count);
+    memset(work->sector_dist, -1, sizeof work->sector_dist);
+    radius_brackets(pts, p, inv_inc, work);
 
-    /* Radius and window of every apex first, in a loop without hard branches
-     * (the exp, division and conversion latencies of successive beams
-     * overlap): r in score[], alpha in peak[]; 0 marks a beam that is no apex. */
     for (i = 0; i < pts->count; ++i) {
-        float r = 0.0f;
-        size_t alpha = 0;
-        if (in_extraction_range(pts, i, p)) {
-            r = neigh_radius(p, pts->range[i]);
-            alpha = window_alpha(pts, i, r, 1.0f / inc);
-        }
-        work->score[i] = r;
-        work->peak[i] = (uint16_t)alpha;
-    }
-    for (i = 0; i < pts->count; ++i) {
-        const float r = work->score[i];
-        const float s = (r > 0.0f) ? beam_score(pts, i, r, work->peak[i], ring, p, work->sector)
-                                   : FALKO_REJECTED;
-        work->score[i] = s;
-        if (s > (float)score_max) {
-            if (s > (float)FALKO_SCORE_LIMIT) {
-                return BSF_ERR_CAPACITY;
+        const size_t w = work->win_hi[i];
+        work->score[i] = FALKO_REJECTED;
+        if (w != FALKO_WIN_NONE &&
+            (w == FALKO_WIN_EXACT || certainly_rejected(pts, i, ring, work) == FALKO_MAYBE)) {
+            const float r = neigh_radius(p, pts->range[i]);
+            const float sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
+            work->score[i] = sc;
+            if (sc > (float)score_max) {
+                if (sc > (float)FALKO_SCORE_LIMIT) {
+                    return BSF_ERR_CAPACITY;
+                }
+                score_max = (long)sc;
             }
-            score_max = (long)s;
         }
     }
     if (score_max == 0) {
@@ -532,7 +737,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, 1.0f / inc), ring, p,
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, inv_inc), ring, p,
                             &nb); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);

@@ -2,12 +2,29 @@
 #include "bsf_nms.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "bsf_math.h"
 
 /* asin(0.8): the reference's window angle when the radius reaches the range. */
 #define BSF_ASIN_0_8 0.927295218f
+
+/* An integer whose order is the order of the float v (not NaN), and back. */
+static int32_t float_key(float v)
+{
+    int32_t b;
+    memcpy(&b, &v, sizeof b);
+    return b ^ ((b >> 31) & INT32_MAX);
+}
+
+static float key_float(int32_t key)
+{
+    const int32_t b = key ^ ((key >> 31) & INT32_MAX);
+    float v;
+    memcpy(&v, &b, sizeof v);
+    return v;
+}
 
 /* What every window of one scan shares. */
 typedef struct {
@@ -85,25 +102,83 @@ size_t bsf_nms_beams(const bsf_points_t *pts, const float *score, bsf_nms_order_
     size_t i = 0;
     size_t imax = 0;
     size_t run_end = 0; /* end (exclusive) of the run of equal scores from i */
-    size_t k, i2, n_peak, run;
+    size_t k, i2, n_peak, run, w_max, next_better, last_better;
+    float bottom, min_range;
+    int close;
 
-    /* All windows first, in a loop whose latencies overlap, into peak[]:
-     * the candidate list written below stays at or behind the beam being
-     * read (n_cand <= i), so one array serves both. */
-    for (i = 0; i < n; ++i) {
-        peak[i] = (uint16_t)half_window(pts, i, &ctx);
+    /* Beams no better than the worst score ("bottom") only matter near
+     * better ones: a step at beam i whose window holds only bottom scores,
+     * with the running maximum at the bottom too, just makes i the running
+     * maximum and moves on (bottom must not pass the threshold). So the loop
+     * jumps over every stretch farther than the largest window from any
+     * better beam, and windows are computed only where it stops. */
+    if (n == 0u) {
+        return 0u;
     }
+    {
+        /* One loop without branches (compilers run several beams per
+         * instruction): float comparisons as integer ones on keys that
+         * order as the floats do (sign-magnitude to two's complement; ranges
+         * are non-negative, so their bits already do). */
+        const int32_t radius_bits = float_key(radius);
+        int32_t bottom_key = INT32_MAX;
+        int32_t range_key = INT32_MAX; /* smallest valid range above the radius */
+        int32_t close_any = 0;         /* a valid range at or below the radius */
+        for (k = 0; k < n; ++k) {
+            const int32_t v = float_key(sign * score[k]);
+            const int32_t r = float_key(pts->range[k]);
+            const int32_t valid = -(int32_t)(pts->valid[k] != 0u);
+            const int32_t above = -(int32_t)(r > radius_bits) & valid;
+            const int32_t r_above = (r & above) | (INT32_MAX & ~above);
+            bottom_key = (v < bottom_key) ? v : bottom_key;
+            range_key = (r_above < range_key) ? r_above : range_key;
+            close_any |= valid & ~above;
+        }
+        bottom = key_float(bottom_key);
+        min_range = (range_key == INT32_MAX) ? -1.0f : key_float(range_key);
+        close = close_any != 0;
+    }
+    if (bottom > min_val) {
+        w_max = n; /* every bottom beam could be a candidate: no jumps */
+    } else {
+        /* The largest window: asin(s) <= s / sqrt(1 - s^2) at the smallest
+         * range above the radius (bounds half_window's result), or the
+         * window of a range at or below the radius. */
+        w_max = close ? ctx.close : 0u;
+        if (min_range > 0.0f) {
+            const float s = radius / min_range;
+            const size_t w = clamp_window(s / sqrtf(1.0f - s * s) * ctx.inv_inc * 1.001f) + 1u;
+            w_max = (w > w_max) ? w : w_max;
+        }
+    }
+    next_better = 0;
+    while (next_better < n && !(sign * score[next_better] > bottom)) {
+        ++next_better;
+    }
+    last_better = n; /* none yet */
     i = 0;
     while (i < n) {
-        const size_t win = peak[i];
-        size_t j, jbeg, jend;
+        size_t win, j, jbeg, jend;
         size_t jmax = i;
+
+        while (next_better < i) {
+            last_better = next_better++;
+            while (next_better < n && !(sign * score[next_better] > bottom)) {
+                ++next_better;
+            }
+        }
+        if (w_max < n && sign * score[imax] == bottom &&
+            (last_better == n || i > last_better + w_max) && next_better > i + w_max) {
+            i = (next_better == n) ? n : next_better - w_max;
+            imax = i - 1u;
+            continue;
+        }
+        win = half_window(pts, i, &ctx);
 
         /* Fast path, same outcome as the general step below: the previous
          * beam is the running maximum, and the whole window [i, i + win]
          * holds its score, which does not pass the threshold. Then nothing
-         * beats beam i, it becomes imax, is no candidate, and i moves on.
-         * Most beams of a scan (rejected ones) go this way. */
+         * beats beam i, it becomes imax, is no candidate, and i moves on. */
         if (run_end <= i) {
             run_end = i + 1u;
             while (run_end < n && score[run_end] == score[i]) {

@@ -8,186 +8,369 @@
 #include "bsf_wire.h"
 
 /*
- * One writer serves four uses: costing (nothing is emitted: the bits of
- * everything but the control point values are summed, and those values are
- * tallied per class to cost every Exp-Golomb order at once), counting (buf ==
- * NULL, sink == NULL), writing to a buffer (COBS code bytes are patched in
- * place once their block ends) and feeding a sink (a block is collected in
- * work->block and handed over whole, because its code byte must go first).
- * The payload's bit stream goes through put_bits, whole bytes through put_u8.
+ * How a features frame is made (two runs over the result, docs/PERFORMANCE.md):
+ *
+ * 1. Planning: validates the whole input, sums the bits of every field but
+ *    the control point values, quantises each control point once into a
+ *    per-frame table of wire values (zigzag value and class) and tallies
+ *    those per class, from which each class's shortest Exp-Golomb order and
+ *    the payload's exact size follow.
+ * 2. Writing: when the caller's buffer holds the size bound, a bit writer
+ *    that stores whole 32-bit words writes the payload straight into it,
+ *    behind room for COBS's extra bytes, taking the values from the table
+ *    (a feature beyond the table is quantised again); then CRC-32C over the
+ *    payload and COBS in place.
+ *
+ * Sinks, metadata frames and buffers smaller than the bound take the
+ * streaming path: the same bit writer fills a small chunk whose bytes go
+ * through CRC and COBS to a counter, the buffer or the sink.
+ */
+
+/* ---- Streaming output: COBS blocks to a counter, a buffer or a sink ---- */
+
+typedef struct {
+    uint8_t *buf;    /* buffer mode, else NULL */
+    size_t cap;      /* size of buf */
+    size_t pos;      /* bytes of the frame produced so far */
+    size_t code_pos; /* buffer mode: where the current block's code byte goes */
+    uint8_t code;    /* 1 + data bytes in the current block */
+    uint32_t crc;    /* CRC-32C of the payload so far */
+    bsf_encoder_t *work;
+    bsf_sink_fn sink; /* sink mode: a block is collected in work->block, its code byte first */
+    void *ctx;
+    int failed; /* the sink refused bytes */
+} stream_t;
+
+static void emit(stream_t *s, const uint8_t *data, size_t len)
+{
+    if (!s->failed) {
+        if (s->sink(s->ctx, data, len) != 0) {
+            s->failed = 1;
+        } else {
+            s->pos += len;
+        }
+    }
+}
+
+static void block_start(stream_t *s)
+{
+    s->code = 1u;
+    if (s->sink == NULL) {
+        s->code_pos = s->pos++;
+    }
+}
+
+static void block_end(stream_t *s)
+{
+    if (s->sink != NULL) {
+        s->work->block[0] = s->code;
+        emit(s, s->work->block, s->code);
+    } else if (s->buf != NULL && s->code_pos < s->cap) {
+        s->buf[s->code_pos] = s->code;
+    }
+}
+
+static void stream_init(stream_t *s)
+{
+    memset(s, 0, sizeof *s);
+    block_start(s);
+}
+
+/* One body byte (payload or CRC) through COBS. */
+static void stream_byte(stream_t *s, uint8_t b)
+{
+    if (b == 0u) {
+        block_end(s);
+        block_start(s);
+        return;
+    }
+    if (s->sink != NULL) {
+        s->work->block[s->code] = b;
+    } else {
+        if (s->buf != NULL && s->pos < s->cap) {
+            s->buf[s->pos] = b;
+        }
+        ++s->pos;
+    }
+    if (++s->code == 0xFFu) {
+        block_end(s);
+        block_start(s);
+    }
+}
+
+static void stream_payload(stream_t *s, const uint8_t *data, size_t len)
+{
+    size_t i;
+    s->crc = bsf_crc32c(s->crc, data, len);
+    for (i = 0; i < len; ++i) {
+        stream_byte(s, data[i]);
+    }
+}
+
+/* The CRC (not itself checksummed), the last block and the 0x00. */
+static void stream_finish(stream_t *s)
+{
+    unsigned i;
+    const uint32_t crc = s->crc;
+    for (i = 0; i < 4u; ++i) {
+        stream_byte(s, (uint8_t)(crc >> (8u * i)));
+    }
+    if (s->sink != NULL) {
+        s->work->block[0] = s->code;
+        s->work->block[s->code] = 0u;
+        emit(s, s->work->block, (size_t)s->code + 1u);
+    } else {
+        block_end(s);
+        if (s->buf != NULL && s->pos < s->cap) {
+            s->buf[s->pos] = 0u;
+        }
+        ++s->pos;
+    }
+}
+
+/* ---- Bit writer ---------------------------------------------------------- */
+
+/* The hot paths inline their helpers so that the writer's state lives in
+ * registers; a size-optimised build (-Os) leaves that to the compiler. */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
+#define ENC_INLINE static inline __attribute__((always_inline))
+#else
+#define ENC_INLINE static inline
+#endif
+
+#if defined(__GNUC__) || defined(__clang__)
+#define ENC_NOINLINE static __attribute__((noinline))
+#else
+#define ENC_NOINLINE static
+#endif
+
+#define CHUNK_BYTES 32u /* streaming path: payload bytes handed on at a time */
+
+/*
+ * The payload's bits, most significant first, gather in acc and leave as
+ * whole big-endian 32-bit words. A run copies this into a local, so that it
+ * stays in registers. In a costing run nothing is written: bits sums the
+ * fields' lengths.
  */
 typedef struct {
-    uint8_t *buf;
-    size_t cap;
-    size_t pos;       /* bytes of the frame produced so far */
-    size_t code_pos;  /* buffer mode: where the current block's code byte goes */
-    uint8_t code;     /* 1 + data bytes in the current block */
-    uint32_t crc_reg; /* CRC-32C register: the CRC is its complement */
-    bsf_encoder_t *work;
-    bsf_sink_fn sink;
-    void *ctx;
-    int failed;
-    uint64_t acc;   /* pending bits of the payload's bit stream, MSB first */
-    unsigned n_acc; /* number of pending bits (< 8 between calls) */
-    /* Costing run (costing != 0): nothing is emitted; bits sums the payload
-     * bits outside the control point values, tally counts those per class. */
-    int costing;
-    uint32_t bits;
-    bsf_wire_eg_tally_t *tally; /* costing run only: BSF_WIRE_N_CLASSES entries (the
-                                 * writing runs do not carry them on the stack) */
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    uint8_t *p;    /* the next word goes here */
+    uint8_t *end;  /* words must end at or before this */
+    uint32_t acc;  /* pending bits in the low 32 - room bits (higher bits: leftovers) */
+    unsigned room; /* free bits in acc, 1..32 */
+    uint32_t bits; /* costing run: payload bits so far */
+} bits_t;
+
+/* Where the words go. */
+typedef struct {
+    bits_t b;
+    stream_t *out; /* streaming path; NULL when writing straight into a buffer */
+    uint8_t *end;  /* the end after a spill */
+    int overflow;  /* direct writing reached its end (a planning bug: never written) */
+    uint8_t chunk[CHUNK_BYTES];
 } writer_t;
 
-static void emit(writer_t *w, const uint8_t *data, size_t len)
+static void writer_init(writer_t *w, stream_t *out, uint8_t *start, uint8_t *end)
 {
-    if (!w->failed) {
-        if (w->sink(w->ctx, data, len) != 0) {
-            w->failed = 1;
-        } else {
-            w->pos += len;
-        }
-    }
-}
-
-static void block_start(writer_t *w)
-{
-    w->code = 1u;
-    if (w->sink == NULL) {
-        w->code_pos = w->pos++;
-    }
-}
-
-static void block_end(writer_t *w)
-{
-    if (w->sink != NULL) {
-        w->work->block[0] = w->code;
-        emit(w, w->work->block, w->code);
-    } else if (w->buf != NULL && w->code_pos < w->cap) {
-        w->buf[w->code_pos] = w->code;
-    }
-}
-
-static void put_u8(writer_t *w, uint8_t b)
-{
-    if (w->costing) {
-        w->bits += 8u;
-        return;
-    }
-    w->crc_reg = bsf_wire_crc32c_step(w->crc_reg, b);
-    if (b == 0u) {
-        block_end(w);
-        block_start(w);
-        return;
-    }
-    if (w->sink != NULL) {
-        w->work->block[w->code] = b;
+    w->out = out;
+    w->overflow = 0;
+    w->b.acc = 0u;
+    w->b.room = 32u;
+    w->b.bits = 0u;
+    if (start != NULL) {
+        w->b.p = start;
+        w->b.end = end;
     } else {
-        if (w->buf != NULL && w->pos < w->cap) {
-            w->buf[w->pos] = b;
-        }
-        ++w->pos;
-    }
-    if (++w->code == 0xFFu) {
-        block_end(w);
-        block_start(w);
+        w->b.p = w->chunk;
+        w->b.end = w->chunk + CHUNK_BYTES;
     }
 }
 
-/* The n (<= 32) low bits of v, most significant first, whole bytes out. */
-static void put_bits(writer_t *w, uint32_t v, unsigned n)
+ENC_INLINE void store_be32(uint8_t *p, uint32_t v)
 {
-    if (w->costing) {
-        w->bits += n;
-        return;
-    }
-    w->acc = (w->acc << n) | ((uint64_t)v & ((((uint64_t)1) << n) - 1u));
-    w->n_acc += n;
-    while (w->n_acc >= 8u) {
-        w->n_acc -= 8u;
-        put_u8(w, (uint8_t)(w->acc >> w->n_acc));
-    }
+#if defined(__BYTE_ORDER__) && defined(__ORDER_BIG_ENDIAN__) &&                                    \
+    __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+    memcpy(p, &v, 4u);
+#elif defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                               \
+    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__ && (defined(__GNUC__) || defined(__clang__))
+    v = __builtin_bswap32(v);
+    memcpy(p, &v, 4u);
+#else
+    p[0] = (uint8_t)(v >> 24);
+    p[1] = (uint8_t)(v >> 16);
+    p[2] = (uint8_t)(v >> 8);
+    p[3] = (uint8_t)v;
+#endif
 }
 
-/* The n (<= 64) low bits of v. */
-static void put_bits_wide(writer_t *w, uint64_t v, unsigned n)
+/* No room for a word at p: hand the chunk on (streaming), or stop writing
+ * (direct). Returns where the next word goes; w->end is its end. */
+static uint8_t *writer_spill(writer_t *w, uint8_t *p)
 {
-    if (n > 32u) {
-        put_bits(w, (uint32_t)(v >> 32), n - 32u);
-        n = 32u;
+    if (w->out != NULL) {
+        stream_payload(w->out, w->chunk, (size_t)(p - w->chunk));
+    } else {
+        w->overflow = 1;
     }
-    put_bits(w, (uint32_t)v, n);
+    w->end = w->chunk + CHUNK_BYTES;
+    return w->chunk;
 }
 
-/* Exp-Golomb code of order k: for u = (v >> k) + 1 of b bits, b - 1 zeros,
- * u itself, then the k low bits of v; short codes as one field. */
-static void put_eg_bits(writer_t *w, uint64_t v, unsigned k)
+ENC_INLINE void put_word(writer_t *w, bits_t *b, uint32_t word)
+{
+    if ((size_t)(b->end - b->p) < 4u) {
+        b->p = writer_spill(w, b->p);
+        b->end = w->end;
+    }
+    store_be32(b->p, word);
+    b->p += 4;
+}
+
+/* The n (0..31) bits of v (v < 2^n). */
+ENC_INLINE void put_bits(writer_t *w, bits_t *b, uint32_t v, unsigned n)
+{
+    if (n < b->room) {
+        b->acc = (b->acc << n) | v;
+        b->room -= n;
+    } else {
+        const unsigned rest = n - b->room; /* bits of v for the next word; room <= n <= 31 */
+        put_word(w, b, (b->acc << b->room) | (v >> rest));
+        b->acc = v; /* the bits of v above rest leave with the next word's shifts */
+        b->room = 32u - rest;
+    }
+}
+
+/* floor(log2(c)) for 1 <= c < 2^31 (x86 BSR). */
+ENC_INLINE unsigned log2_nz(uint32_t c)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return 31u ^ (unsigned)__builtin_clz(c);
+#else
+    return bsf_wire_bitlen31(c) - 1u;
+#endif
+}
+
+/* Exp-Golomb code of order k (<= 25) of v < 2^30: v + 2^k in 2 b - 1 - k
+ * bits, b its bit length (b - 1 - k leading zeros, then v + 2^k). */
+ENC_INLINE void put_eg(writer_t *w, bits_t *b, uint32_t v, unsigned k)
+{
+    const uint32_t c = v + ((uint32_t)1 << k);
+    const unsigned lg = log2_nz(c);
+    const unsigned len = 2u * lg + 1u - k;
+    if (len < 32u) {
+        put_bits(w, b, c, len);
+    } else {
+        put_bits(w, b, 0u, lg - k);
+        put_bits(w, b, c, lg + 1u);
+    }
+}
+
+ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
+{
+    return 2u * log2_nz(v + ((uint32_t)1 << k)) + 1u - k;
+}
+
+/* Fields, written or (costing) counted: u(n) with n <= 31. */
+ENC_INLINE void field_u(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned n)
+{
+    if (costing) {
+        b->bits += n;
+    } else {
+        put_bits(w, b, v, n);
+    }
+}
+
+/* EGk of v < 2^30, k <= 25. */
+ENC_INLINE void field_eg(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned k)
+{
+    if (costing) {
+        b->bits += eg_len(v, k);
+    } else {
+        put_eg(w, b, v, k);
+    }
+}
+
+/* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
+ * wide fields. State in and out by value, so that the caller's stays in
+ * registers. */
+static bits_t put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k)
 {
     const uint64_t u = (v >> k) + 1u;
-    const unsigned b = bsf_wire_bitlen(u);
-    const uint64_t low = k == 0u ? 0u : v & (~(uint64_t)0 >> (64u - k));
-    if (2u * b - 1u + k <= 32u) {
-        /* the b - 1 zeros come out as the leading zeros of the field */
-        put_bits(w, (uint32_t)((u << k) | low), 2u * b - 1u + k);
-        return;
-    }
-    put_bits_wide(w, 0u, b - 1u);
-    put_bits_wide(w, u, b);
-    put_bits_wide(w, low, k);
-}
-
-/* Costing runs only add the code's length (inline: most fields pass here). */
-static inline void put_eg(writer_t *w, uint64_t v, unsigned k)
-{
-    if (w->costing) {
-        w->bits += 2u * bsf_wire_bitlen((v >> k) + 1u) - 1u + k;
-    } else {
-        put_eg_bits(w, v, k);
-    }
-}
-
-static void put_seg(writer_t *w, int64_t v, unsigned k)
-{
-    put_eg(w, bsf_wire_zigzag(v), k);
-}
-
-/* A control point value of class cls: costed or written at the frame's order. */
-static void put_ctrl_value(writer_t *w, unsigned cls, int64_t v)
-{
-    const uint64_t z = bsf_wire_zigzag(v);
-    if (w->costing) {
-        bsf_wire_eg_tally_add(&w->tally[cls], z);
-    } else {
-        put_eg(w, z, w->k_ctrl[cls]);
-    }
-}
-
-/* Ends the frame: the CRC (not itself checksummed), the last block, 0x00. */
-static void finish(writer_t *w)
-{
-    uint32_t crc;
+    const unsigned n = bsf_wire_bitlen(u);
     unsigned i;
-    if (w->costing) {
-        return; /* the caller adds padding and CRC */
+    if (costing) {
+        b.bits += 2u * n - 1u + k;
+        return b;
     }
-    if (w->n_acc > 0u) {
-        put_bits(w, 0u, 8u - w->n_acc); /* pad the last byte with zeros */
+    for (i = 1u; i < n; ++i) {
+        put_bits(w, &b, 0u, 1u); /* the n - 1 zeros */
     }
-    crc = ~w->crc_reg;
-    for (i = 0; i < 4u; ++i) {
-        put_u8(w, (uint8_t)(crc >> (8u * i)));
+    for (i = n; i > 0u;) { /* u, then the k low bits of v: 16 bits at a time */
+        const unsigned take = i > 16u ? 16u : i;
+        i -= take;
+        put_bits(w, &b, (uint32_t)(u >> i) & ((1u << take) - 1u), take);
     }
-    if (w->sink != NULL) {
-        w->work->block[0] = w->code;
-        w->work->block[w->code] = 0u;
-        emit(w, w->work->block, (size_t)w->code + 1u);
+    for (i = k; i > 0u;) {
+        const unsigned take = i > 16u ? 16u : i;
+        i -= take;
+        put_bits(w, &b, (uint32_t)(v >> i) & ((1u << take) - 1u), take);
+    }
+    return b;
+}
+
+ENC_INLINE void field_eg64(writer_t *w, bits_t *b, int costing, uint64_t v, unsigned k)
+{
+    if (v < ((uint64_t)1 << 30) && k <= 25u) {
+        field_eg(w, b, costing, (uint32_t)v, k);
     } else {
-        block_end(w);
-        if (w->buf != NULL && w->pos < w->cap) {
-            w->buf[w->pos] = 0u;
-        }
-        ++w->pos;
+        *b = put_eg_wide(w, *b, costing, v, k);
     }
 }
+
+static uint32_t float_bits(float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
+{
+    const uint32_t u = float_bits(v);
+    field_u(w, b, costing, u >> 16, 16u);
+    field_u(w, b, costing, u & 0xFFFFu, 16u);
+}
+
+/* Bits written so far. */
+static size_t writer_bits(const writer_t *w, const uint8_t *start)
+{
+    return (size_t)(w->b.p - start) * 8u + (32u - w->b.room);
+}
+
+/* Pads the payload to whole bytes and pushes out its last, partial word
+ * (its unused bytes are overwritten by what follows). */
+static void writer_flush(writer_t *w)
+{
+    if (w->b.room < 32u) {
+        put_word(w, &w->b, w->b.acc << w->b.room);
+    }
+}
+
+/* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
+static void writer_end_stream(writer_t *w)
+{
+    size_t n;
+    if (w->b.room < 32u) {
+        const unsigned tail = (32u - w->b.room + 7u) / 8u; /* bytes of the partial word */
+        put_word(w, &w->b, w->b.acc << w->b.room);
+        n = (size_t)(w->b.p - w->chunk) - (4u - tail);
+    } else {
+        n = (size_t)(w->b.p - w->chunk);
+    }
+    stream_payload(w->out, w->chunk, n);
+    stream_finish(w->out);
+}
+
+/* ---- Quantisation and checks ------------------------------------------- */
 
 static int is_finite_f(float v)
 {
@@ -198,31 +381,202 @@ static int is_finite_f(float v)
  * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
  * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
  * one lower for a negative r with a fraction. */
-static int quantise(float v, float step, int32_t *q)
+ENC_INLINE int quantise(float v, float step, int32_t *q)
 {
     const float r = v / step + 0.5f;
     int32_t t;
-    if (!(r >= -(float)BSF_QUANT_MAX_STEPS && r < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
+    if (!(fabsf(r) < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
         *q = 0;
         return 0; /* NaN included */
     }
     t = (int32_t)r;
     *q = (float)t > r ? t - 1 : t;
-    return 1;
+    return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
 }
 
-static int quantise_point(bsf_point_t p, float step, int32_t q[2])
+ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
 {
     const int ok_x = quantise(p.x, step, &q[0]);
     const int ok_y = quantise(p.y, step, &q[1]);
     return ok_x && ok_y;
 }
 
+/* ---- Control point values ------------------------------------------------ */
+
+/* A value in the per-frame table: zigzag code (below 2^26) | class << 30. */
+#define VALUE_CLASS_SHIFT 30u
+#define VALUE_MASK 0x3FFFFFFFu
+
+/* Table entries: per feature a head (distinct points, vertex mask in two
+ * words) and its values; those of a typical frame (about 75 on Intel, 130 on
+ * MIT and Freiburg) at 4 bytes each, and room for one more feature (at most
+ * 2 values per stored control point) behind them, where the planning run
+ * puts those of features beyond the table and the writing runs make them
+ * again. */
+#define VALUE_HEAD 3u
+#define VALUE_KEEP 144u
+#define VALUE_TABLE (VALUE_KEEP + VALUE_HEAD + 2u * BSF_MAX_CTRL_PER_FEATURE)
+
+ENC_INLINE uint32_t zigzag32(int32_t v)
+{
+    const uint32_t twice = (uint32_t)v << 1;
+    return v < 0 ? ~twice : twice; /* -2v - 1 for v < 0 */
+}
+
+/* One value of class cls: stored, and tallied in the planning run. */
+ENC_INLINE uint32_t add_value(uint32_t *out, uint32_t cnt, bsf_wire_eg_tally_t *tally, unsigned cls,
+                              int32_t v)
+{
+    const uint32_t z = zigzag32(v);
+    if (tally != NULL) {
+        bsf_wire_eg_tally_add32(&tally[cls], z);
+    }
+    out[cnt] = z | ((uint32_t)cls << VALUE_CLASS_SHIFT);
+    return cnt + 1u;
+}
+
+/* bsf_wire_predict in 32 bits: quantised coordinates within 2^23 - 1 make
+ * |b - a| <= 2^24 - 2, and k <= BSF_MAX_CTRL_PER_FEATURE - 2 <= 62 (bsf_stream.h
+ * caps it at 64), so (b - a)(2s - 1) + k stays below 2^24 * 123 + 62 < 2^31. */
+ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
+{
+    const int32_t den = 2 * (int32_t)k;
+    const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;
+    int32_t q;
+    if (k == 1u) {
+        /* the usual case, a fragment with one precision point: floor(num / 2)
+         * as a shift of num + 2^31, which is not negative */
+        return a + ((int32_t)(((uint32_t)num ^ 0x80000000u) >> 1) - 0x40000000);
+    }
+    q = num / den;
+    return a + (num - q * den < 0 ? q - 1 : q); /* floor */
+}
+
+/* A flagged slot s needs a flagged partner s + 1 that quantises to q. */
+static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s, size_t n,
+                             float step, const int32_t q[2])
+{
+    int32_t q2[2];
+    if (s + 1u >= n || vtx[s + 1u] == 0u) {
+        return 0;
+    }
+    if (memcmp(&p[s], &p[s + 1u], sizeof p[s]) == 0) {
+        return 1; /* the usual copy: the same bits quantise alike */
+    }
+    return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
+}
+
 /*
- * Checks one feature and finds its unique control points: a flagged slot
- * must be followed by a flagged partner with the same quantised value;
- * the pair is one vertex, bit j of *mask for unique point j.
+ * The values of one feature's n control points in wire order (FORMAT.md
+ * section 3.3): the first distinct point as a delta from prev (the last
+ * anchor of the previous feature, updated here), then per fragment the next
+ * anchor (vertex or last point) as a delta from the previous anchor, then
+ * the fragment's precision points as residuals from their predicted places
+ * on the chord. Stores them in out (room for 2 n), tallies them when tally
+ * is given (the planning run), and returns their number (2 per distinct
+ * point), or 0 when a point cannot be represented or a flagged slot has no
+ * equal partner; *mask gets bit j for distinct point j that is a vertex.
  */
+ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
+                                   int32_t prev[2], uint32_t *out, bsf_wire_eg_tally_t *tally,
+                                   uint64_t *mask)
+{
+    size_t s_a = 0;
+    size_t c_a;
+    uint32_t cnt = 0;
+    uint32_t j_a = 0; /* distinct index of anchor a */
+    int32_t q_a[2];
+
+    *mask = 0u;
+
+    if (!quantise_point(p[0], step, q_a)) {
+        return 0u;
+    }
+    c_a = 1u;
+    if (vtx[0] != 0u) {
+        if (!vertex_partner_ok(p, vtx, 0u, n, step, q_a)) {
+            return 0u;
+        }
+        *mask = 1u;
+        c_a = 2u;
+    }
+    cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_FIRST, q_a[0] - prev[0]);
+    cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_FIRST, q_a[1] - prev[1]);
+    while (s_a + c_a < n) {
+        const size_t t = s_a + c_a;
+        size_t s_b = t;
+        size_t i;
+        int32_t q_b[2];
+        uint32_t k;
+        while (s_b < n - 1u && vtx[s_b] == 0u) {
+            ++s_b;
+        }
+        k = (uint32_t)(s_b - t);
+        if (!quantise_point(p[s_b], step, q_b)) {
+            return 0u;
+        }
+        j_a += k + 1u;
+        c_a = 1u;
+        if (vtx[s_b] != 0u) {
+            if (!vertex_partner_ok(p, vtx, s_b, n, step, q_b)) {
+                return 0u;
+            }
+            *mask |= (uint64_t)1u << j_a;
+            c_a = 2u;
+        }
+        cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
+        cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[1] - q_a[1]);
+        for (i = t; i < s_b; ++i) {
+            const uint32_t s = (uint32_t)(i - t) + 1u;
+            int32_t q[2];
+            if (!quantise_point(p[i], step, q)) {
+                return 0u;
+            }
+            cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_PREC,
+                            q[0] - predict32(q_a[0], q_b[0], s, k));
+            cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_PREC,
+                            q[1] - predict32(q_a[1], q_b[1], s, k));
+        }
+        s_a = s_b;
+        q_a[0] = q_b[0];
+        q_a[1] = q_b[1];
+    }
+    prev[0] = q_a[0];
+    prev[1] = q_a[1];
+    return cnt;
+}
+
+/* Per class at its order k: 2^k, and 1 - k (modulo 2^32) for the code's
+ * length 2 floor(log2(v + 2^k)) + 1 - k. */
+typedef struct {
+    uint32_t one[BSF_WIRE_N_CLASSES];
+    uint32_t adj[BSF_WIRE_N_CLASSES];
+} orders_t;
+
+/* The values' codes at the frame's orders: the hot loop of the writing run. */
+ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
+                           const orders_t *ord)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i) {
+        const uint32_t v = values[i];
+        const unsigned cls = v >> VALUE_CLASS_SHIFT;
+        const uint32_t c = (v & VALUE_MASK) + ord->one[cls];
+        const unsigned lg = log2_nz(c);
+        const unsigned len = 2u * lg + ord->adj[cls];
+        if (costing) {
+            b->bits += len;
+        } else if (len < 32u) {
+            put_bits(w, b, c, len);
+        } else {
+            put_bits(w, b, 0u, len - lg - 1u);
+            put_bits(w, b, c, lg + 1u);
+        }
+    }
+}
+
+/* ---- Features frame ------------------------------------------------------ */
+
 /* Beams minus one of a feature's run: last - first, or through the seam of
  * a full-circle scan of n_beams beams when first > last. */
 static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
@@ -233,100 +587,17 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
     return (uint32_t)(f->last_beam - f->first_beam);
 }
 
-static bsf_status_t scan_feature(const bsf_result_t *res, const bsf_feature_t *f, float step,
-                                 int check_points, uint32_t *n_unique, uint64_t *mask)
+/* A feature's own fields (not its points) within the result and the caps. */
+static int feature_ok(const bsf_result_t *res, const bsf_feature_t *f)
 {
     const size_t n = f->n_ctrl;
     const uint32_t n_beams = res->stats.n_beams;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
-    size_t s = 0;
-    uint32_t j = 0;
-
-    if (f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
-        (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
-        f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
-        f->n_points > feature_span(f, n_beams) + 1u ||
-        !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX)) {
-        return BSF_ERR_ARG;
-    }
-    *mask = 0u;
-    while (s < n) {
-        const size_t slot = (size_t)f->ctrl_first + s;
-        int32_t q[2];
-        if (check_points && !quantise_point(res->ctrl[slot], step, q)) {
-            return BSF_ERR_ARG;
-        }
-        if (res->ctrl_is_vertex[slot] != 0u) {
-            int32_t q2[2];
-            if (check_points && (s + 1u >= n || res->ctrl_is_vertex[slot + 1u] == 0u ||
-                                 !quantise_point(res->ctrl[slot + 1u], step, q2) || q2[0] != q[0] ||
-                                 q2[1] != q[1])) {
-                return BSF_ERR_ARG;
-            }
-            *mask |= (uint64_t)1u << j;
-            s += 2u;
-        } else {
-            s += 1u;
-        }
-        ++j;
-    }
-    *n_unique = j;
-    return BSF_OK;
-}
-
-static void put_delta(writer_t *w, unsigned cls, const int32_t q[2], const int64_t ref[2])
-{
-    put_ctrl_value(w, cls, (int64_t)q[0] - ref[0]);
-    put_ctrl_value(w, cls, (int64_t)q[1] - ref[1]);
-}
-
-/*
- * Control points of one (already checked) feature: the first unique point
- * as a delta from *prev, then per fragment the next anchor (vertex or last
- * point) as a delta from the previous anchor, then the fragment's precision
- * points as residuals from their predicted places on the chord.
- */
-static void put_ctrl(writer_t *w, const bsf_result_t *res, const bsf_feature_t *f, float step,
-                     int64_t prev[2])
-{
-    const bsf_point_t *p = &res->ctrl[f->ctrl_first];
-    const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
-    const size_t n = f->n_ctrl;
-    size_t s_a = 0;
-    size_t c_a = vtx[0] != 0u ? 2u : 1u;
-    int32_t q_a[2];
-    int64_t ref[2];
-
-    (void)quantise_point(p[0], step, q_a);
-    put_delta(w, BSF_WIRE_CLASS_FIRST, q_a, prev);
-    while (s_a + c_a < n) {
-        const size_t t = s_a + c_a;
-        size_t s_b = t;
-        size_t i;
-        int32_t q_b[2];
-        while (s_b < n - 1u && vtx[s_b] == 0u) {
-            ++s_b;
-        }
-        (void)quantise_point(p[s_b], step, q_b);
-        ref[0] = q_a[0];
-        ref[1] = q_a[1];
-        put_delta(w, BSF_WIRE_CLASS_ANCHOR, q_b, ref);
-        for (i = t; i < s_b; ++i) {
-            const uint32_t k = (uint32_t)(s_b - t);
-            const uint32_t s = (uint32_t)(i - t) + 1u;
-            int32_t q[2];
-            (void)quantise_point(p[i], step, q);
-            ref[0] = bsf_wire_predict(q_a[0], q_b[0], s, k);
-            ref[1] = bsf_wire_predict(q_a[1], q_b[1], s, k);
-            put_delta(w, BSF_WIRE_CLASS_PREC, q, ref);
-        }
-        s_a = s_b;
-        c_a = vtx[s_b] != 0u ? 2u : 1u;
-        q_a[0] = q_b[0];
-        q_a[1] = q_b[1];
-    }
-    prev[0] = q_a[0];
-    prev[1] = q_a[1];
+    return !(f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
+             (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
+             f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
+             f->n_points > feature_span(f, n_beams) + 1u ||
+             !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX));
 }
 
 static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code)
@@ -379,29 +650,33 @@ static int32_t round_to_int(float v)
     return (int32_t)bsf_floorf(v + 0.5f);
 }
 
-static void put_float(writer_t *w, float v);
+/* Header bits at most, and per feature bits at most outside the control
+ * point values (FORMAT.md section 7). */
+#define HEADER_MAX_BITS 619u
+#define FEATURE_MAX_BITS 211u
 
-/* The whole frame through w. It may fail half-way, so every caller runs it
- * in costing and counting mode first and writes only when those passes
- * succeeded. */
-static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const bsf_result_t *res)
-{
+/* What the planning run learns for the writing runs. */
+typedef struct {
     uint32_t step_code;
     float step;
-    uint32_t i;
-    uint32_t sum_points = 0;
-    int64_t prev_last_beam = -1;
-    int64_t prev[2] = {0, 0};
-    uint32_t wraps = 0u;
     int has_beams;
     int has_ext;
-    bsf_status_t st;
+    uint32_t n_cached;      /* leading features whose values are all in the table */
+    int32_t prev_resume[2]; /* the last anchor before feature n_cached */
+    uint32_t max_bits;      /* payload bits at most (exact for a metadata frame) */
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+} plan_t;
 
+/* The checks that come before any feature. */
+static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t *res, plan_t *pl)
+{
+    uint32_t i;
+    bsf_status_t st;
     if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS ||
         res->n_ctrl > (uint32_t)BSF_MAX_CTRL_POINTS) {
         return BSF_ERR_CAPACITY;
     }
-    st = check_info(info, &step_code);
+    st = check_info(info, &pl->step_code);
     if (st != BSF_OK) {
         return st;
     }
@@ -412,256 +687,189 @@ static bsf_status_t write_frame(writer_t *w, const bsf_frame_info_t *info, const
     if (info->has_geometry != 0u && res->stats.n_beams == 0u) {
         return BSF_ERR_ARG;
     }
-    step = (float)step_code * BSF_QUANT_STEP_UNIT;
+    pl->step = (float)pl->step_code * BSF_QUANT_STEP_UNIT;
+    pl->has_beams = info->has_geometry != 0u;
     for (i = 0; i < res->n_features; ++i) {
         if (res->features[i].first_beam > res->features[i].last_beam) {
-            wraps = 1u;
+            pl->has_beams = 1;
         }
     }
-    has_beams = wraps != 0u || info->has_geometry != 0u;
-    has_ext = has_beams || res->stats.cut != 0u;
+    pl->has_ext = pl->has_beams || res->stats.cut != 0u;
+    return BSF_OK;
+}
 
-    block_start(w);
-    put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES));
-    put_bits(w, info->has_pose != 0u ? 1u : 0u, 1u);
-    put_bits(w, has_ext ? 1u : 0u, 1u);
-    put_eg(w, info->seq, BSF_WIRE_K_SEQ);
-    put_eg(w, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
-    if (info->has_pose != 0u) {
-        const uint32_t theta =
-            (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
-        put_seg(w, round_to_int(info->pose_x * 1000.0f), BSF_WIRE_K_POSE);
-        put_seg(w, round_to_int(info->pose_y * 1000.0f), BSF_WIRE_K_POSE);
-        put_bits(w, theta, 16u);
-    }
-    put_eg(w, step_code, BSF_WIRE_K_STEP);
-    put_eg(w, res->stats.n_valid, BSF_WIRE_K_N);
-    put_eg(w, ((uint64_t)res->stats.time_ns + 500u) / 1000u, BSF_WIRE_K_TIME_US);
-    put_eg(w, res->n_features, BSF_WIRE_K_FEATURES);
-    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
-        put_bits(w, w->k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
-    }
-    if (has_ext) {
-        put_bits(w, has_beams ? 1u : 0u, 1u);
-        put_bits(w, info->has_geometry != 0u ? 1u : 0u, 1u);
-        put_bits(w, res->stats.cut, BSF_WIRE_CUT_BITS);
-        if (has_beams) {
-            put_eg(w, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
-        }
-        if (info->has_geometry != 0u) {
-            put_float(w, info->angle_min);
-            put_float(w, info->angle_increment);
-        }
-        if (res->stats.cut != 0u) {
-            put_eg(w, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
-            put_eg(w, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
-            put_eg(w, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
-        }
-    }
+/*
+ * Planning run: checks everything, quantises the control points into the
+ * value table (while it has room) and tallies them per class, takes each
+ * class's shortest order (ties to the smaller one; never longer than order
+ * 25, which bounds every value by 26 bits, BSF_FRAME_CTRL_MAX_BITS), and
+ * bounds the payload's size: the values' exact bits plus the most the
+ * header and feature fields can take.
+ */
+static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t *res,
+                               uint32_t *table, plan_t *pl)
+{
+    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
+    const float step = pl->step;
+    int32_t prev[2] = {0, 0};
+    uint32_t used = 0; /* table entries of the leading features */
+    uint32_t sum_points = 0;
+    uint32_t i;
+    unsigned cls;
 
+    memset(tally, 0, sizeof tally);
     for (i = 0; i < res->n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
-        uint32_t n_unique = 0;
-        uint64_t mask = 0;
-        uint32_t span;
-        uint32_t j;
-
-        /* the points were checked by the costing run that precedes every
-         * other run (a vertex pair's flags alone then give the mask) */
-        st = scan_feature(res, f, step, w->costing, &n_unique, &mask);
-        if (st != BSF_OK) {
-            return st;
+        uint32_t *head = table + used;
+        uint32_t n_values;
+        uint64_t mask;
+        if (!feature_ok(res, f)) {
+            return BSF_ERR_ARG;
         }
-        span = feature_span(f, res->stats.n_beams);
+        if (pl->n_cached == i) {
+            pl->prev_resume[0] = prev[0];
+            pl->prev_resume[1] = prev[1];
+        }
+        /* behind the kept entries: a head and at most 2 n_ctrl values, VALUE_TABLE has room */
+        n_values = feature_values(&res->ctrl[f->ctrl_first], &res->ctrl_is_vertex[f->ctrl_first],
+                                  f->n_ctrl, step, prev, head + VALUE_HEAD, tally, &mask);
+        if (n_values == 0u) {
+            return BSF_ERR_ARG;
+        }
+        if (pl->n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
+            head[0] = n_values / 2u;
+            head[1] = (uint32_t)mask;
+            head[2] = (uint32_t)(mask >> 32);
+            used += VALUE_HEAD + n_values;
+            pl->n_cached = i + 1u;
+        }
         sum_points += f->n_points;
-        put_bits(w, f->kind, 1u);
-        put_eg(w, n_unique - 2u, BSF_WIRE_K_M);
-        put_bits(w, mask != 0u ? 1u : 0u, 1u);
-        for (j = 0; mask != 0u && j < n_unique; ++j) {
-            put_bits(w, (uint32_t)(mask >> j) & 1u, 1u);
-        }
-        put_seg(w, (int64_t)f->first_beam - prev_last_beam - 1, BSF_WIRE_K_GAP);
-        put_eg(w, span, BSF_WIRE_K_SPAN);
-        put_eg(w, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        put_eg(w, (uint64_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
-               BSF_WIRE_K_E_CURVE);
-        put_ctrl(w, res, f, step, prev);
-        prev_last_beam = f->last_beam;
     }
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
-    finish(w);
-    return BSF_OK;
-}
-
-void bsf_frame_info_init(bsf_frame_info_t *info)
-{
-    if (info != NULL) {
-        info->seq = 0u;
-        info->timestamp_ms = 0u;
-        info->has_pose = 0u;
-        info->pose_x = 0.0f;
-        info->pose_y = 0.0f;
-        info->pose_theta = 0.0f;
-        info->quant_step = BSF_QUANT_STEP_DEFAULT;
-        info->has_geometry = 0u;
-        info->angle_min = 0.0f;
-        info->angle_increment = 0.0f;
+    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * (uint32_t)res->n_features;
+    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
+        uint32_t bits;
+        pl->k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);
+        pl->max_bits += bits;
     }
-}
-
-static void writer_init(writer_t *w)
-{
-    w->buf = NULL;
-    w->cap = 0u;
-    w->pos = 0u;
-    w->code_pos = 0u;
-    w->code = 1u;
-    w->crc_reg = 0xFFFFFFFFu;
-    w->work = NULL;
-    w->sink = NULL;
-    w->ctx = NULL;
-    w->failed = 0;
-    w->acc = 0u;
-    w->n_acc = 0u;
-    w->costing = 0;
-    w->tally = NULL;
-    w->bits = 0u;
-    memset(w->k_ctrl, 0, sizeof w->k_ctrl);
+    (void)info;
+    return BSF_OK;
 }
 
 /*
- * The Exp-Golomb order of each control point class that makes the frame
- * shortest (one costing run; ties go to the smaller order), and an upper
- * bound on the frame's size. The chosen total never exceeds the total at
- * order 25, which bounds every value by 26 bits (BSF_FRAME_CTRL_MAX_BITS).
+ * The features payload through w, written or (costing) counted, after the
+ * planning run: the values of the leading features come from the table,
+ * the others are made again into it.
  */
-static bsf_status_t choose_orders(const bsf_frame_info_t *info, const bsf_result_t *res,
-                                  uint8_t k_ctrl[BSF_WIRE_N_CLASSES], size_t *size_bound)
+ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
+                                  const bsf_frame_info_t *info, const bsf_result_t *res,
+                                  uint32_t *table)
 {
-    writer_t w;
-    bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
-    unsigned cls;
-    uint32_t bits;
-    size_t body;
-    bsf_status_t st;
-    writer_init(&w);
-    w.costing = 1;
-    memset(tally, 0, sizeof tally);
-    w.tally = tally;
-    st = write_frame(&w, info, res);
-    if (st != BSF_OK) {
-        return st;
+    bits_t b = w->b;
+    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
+    orders_t ord;
+    uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
+    uint32_t used = 0;
+    int32_t prev[2];
+    uint32_t i;
+
+    memcpy(k_ctrl, pl->k_ctrl, sizeof k_ctrl);
+    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
+        ord.one[i] = (uint32_t)1 << k_ctrl[i];
+        ord.adj[i] = 1u - k_ctrl[i];
     }
-    bits = w.bits;
-    for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
-        uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
-        unsigned k;
-        unsigned best = 0;
-        /* above the longest value's bit length L every order costs one bit
-         * per value more than the one before, so none beats order L */
-        const unsigned k_top =
-            tally[cls].max_len < BSF_WIRE_K_CTRL_MAX ? tally[cls].max_len : BSF_WIRE_K_CTRL_MAX;
-        bsf_wire_eg_tally_costs(&tally[cls], k_top, cost);
-        for (k = 1; k <= k_top; ++k) {
-            if (cost[k] < cost[best]) {
-                best = k;
+    prev[0] = pl->prev_resume[0];
+    prev[1] = pl->prev_resume[1];
+    field_u(w, &b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
+    field_u(w, &b, costing, info->has_pose != 0u ? 1u : 0u, 1u);
+    field_u(w, &b, costing, pl->has_ext ? 1u : 0u, 1u);
+    field_eg64(w, &b, costing, info->seq, BSF_WIRE_K_SEQ);
+    field_eg64(w, &b, costing, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
+    if (info->has_pose != 0u) {
+        const uint32_t theta =
+            (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
+        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose_x * 1000.0f)),
+                   BSF_WIRE_K_POSE);
+        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose_y * 1000.0f)),
+                   BSF_WIRE_K_POSE);
+        field_u(w, &b, costing, theta, 16u);
+    }
+    field_eg(w, &b, costing, pl->step_code, BSF_WIRE_K_STEP);
+    field_eg(w, &b, costing, res->stats.n_valid, BSF_WIRE_K_N);
+    /* round(time_ns / 1000) in 32 bits (a 64-bit division is a library call on Cortex-M) */
+    field_eg(w, &b, costing,
+             res->stats.time_ns / 1000u + (res->stats.time_ns % 1000u + 500u) / 1000u,
+             BSF_WIRE_K_TIME_US);
+    field_eg(w, &b, costing, res->n_features, BSF_WIRE_K_FEATURES);
+    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
+        field_u(w, &b, costing, k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
+    }
+    if (pl->has_ext) {
+        field_u(w, &b, costing, pl->has_beams ? 1u : 0u, 1u);
+        field_u(w, &b, costing, info->has_geometry != 0u ? 1u : 0u, 1u);
+        field_u(w, &b, costing, res->stats.cut, BSF_WIRE_CUT_BITS);
+        if (pl->has_beams) {
+            field_eg(w, &b, costing, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
+        }
+        if (info->has_geometry != 0u) {
+            field_float(w, &b, costing, info->angle_min);
+            field_float(w, &b, costing, info->angle_increment);
+        }
+        if (res->stats.cut != 0u) {
+            field_eg(w, &b, costing, res->stats.n_cut_keypoints, BSF_WIRE_K_CUT_KEYPOINTS);
+            field_eg(w, &b, costing, res->stats.n_cut_segments, BSF_WIRE_K_CUT_SEGMENTS);
+            field_eg(w, &b, costing, res->stats.n_cut_points, BSF_WIRE_K_CUT_POINTS);
+        }
+    }
+
+    for (i = 0; i < res->n_features; ++i) {
+        const bsf_feature_t *f = &res->features[i];
+        const uint8_t *vtx = &res->ctrl_is_vertex[f->ctrl_first];
+        const uint32_t span = feature_span(f, res->stats.n_beams);
+        uint64_t mask;
+        uint32_t n_unique;
+        const uint32_t *values = table;
+        if (i < pl->n_cached) {
+            n_unique = table[used];
+            mask = table[used + 1u] | ((uint64_t)table[used + 2u] << 32);
+            values = table + used + VALUE_HEAD;
+            used += VALUE_HEAD + 2u * n_unique;
+        } else {
+            /* beyond the table: the same values again, into it */
+            n_unique = feature_values(&res->ctrl[f->ctrl_first], vtx, f->n_ctrl, pl->step, prev,
+                                      table, NULL, &mask) /
+                       2u;
+        }
+        field_u(w, &b, costing, f->kind, 1u);
+        field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
+        if (mask == 0u) {
+            field_u(w, &b, costing, 0u, 1u);
+        } else {
+            uint32_t j;
+            field_u(w, &b, costing, 1u, 1u);
+            for (j = 0; j < n_unique; ++j) {
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & 1u, 1u);
             }
         }
-        k_ctrl[cls] = (uint8_t)best;
-        bits += cost[best];
+        field_eg(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
+                 BSF_WIRE_K_GAP);
+        field_eg(w, &b, costing, span, BSF_WIRE_K_SPAN);
+        field_eg(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
+        field_eg(w, &b, costing, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
+                 BSF_WIRE_K_E_CURVE);
+        put_values(w, &b, costing, values, 2u * n_unique, &ord);
+        prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
     }
-    /* payload bytes and CRC, one COBS code byte first and one per 254
-     * bytes at most (a zero byte is replaced by one), the 0x00 delimiter */
-    body = ((size_t)bits + 7u) / 8u + 4u;
-    *size_bound = body + body / 254u + 2u;
-    return BSF_OK;
-}
-
-/* Write a validated frame with the chosen orders into buf (cap bytes). */
-static bsf_status_t write_frame_into(uint8_t *buf, size_t cap,
-                                     const uint8_t k_ctrl[BSF_WIRE_N_CLASSES],
-                                     const bsf_frame_info_t *info, const bsf_result_t *res,
-                                     writer_t *w)
-{
-    writer_init(w);
-    memcpy(w->k_ctrl, k_ctrl, BSF_WIRE_N_CLASSES);
-    w->buf = buf;
-    w->cap = cap;
-    return write_frame(w, info, res);
-}
-
-bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
-                              uint8_t *buf, size_t cap, size_t *out_len)
-{
-    writer_t w;
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
-    size_t bound = 0;
-    bsf_status_t st;
-
-    if (info == NULL || result == NULL || out_len == NULL) {
-        return BSF_ERR_ARG;
+    if (pl->n_cached < res->n_features) {
+        /* values made again overwrote the table: a further run makes all again */
+        pl->n_cached = 0u;
+        pl->prev_resume[0] = 0;
+        pl->prev_resume[1] = 0;
     }
-    st = choose_orders(info, result, k_ctrl, &bound);
-    if (st == BSF_OK && buf != NULL && cap >= bound) {
-        /* validated, and fits whatever its COBS blocks: write at once */
-        st = write_frame_into(buf, cap, k_ctrl, info, result, &w);
-        *out_len = st == BSF_OK ? w.pos : 0u;
-        return st;
-    }
-    if (st == BSF_OK) {
-        writer_init(&w);
-        memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
-        st = write_frame(&w, info, result);
-    }
-    if (st != BSF_OK) {
-        *out_len = 0u;
-        return st;
-    }
-    *out_len = w.pos;
-    if (buf == NULL) {
-        return BSF_OK;
-    }
-    if (w.pos > cap) {
-        return BSF_ERR_BUFFER;
-    }
-    return write_frame_into(buf, cap, k_ctrl, info, result, &w);
-}
-
-bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,
-                                   const bsf_result_t *result, bsf_sink_fn sink, void *ctx,
-                                   size_t *written)
-{
-    writer_t w;
-    uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
-    size_t bound;
-    bsf_status_t st;
-
-    if (written != NULL) {
-        *written = 0u;
-    }
-    if (work == NULL || info == NULL || result == NULL || sink == NULL) {
-        return BSF_ERR_ARG;
-    }
-    st = choose_orders(info, result, k_ctrl, &bound);
-    if (st != BSF_OK) {
-        return st;
-    }
-    writer_init(&w);
-    memcpy(w.k_ctrl, k_ctrl, sizeof k_ctrl);
-    w.work = work;
-    w.sink = sink;
-    w.ctx = ctx;
-    st = write_frame(&w, info, result);
-    if (written != NULL) {
-        *written = w.pos;
-    }
-    if (st == BSF_OK && w.failed) {
-        st = BSF_ERR_BUFFER;
-    }
-    return st;
+    w->b = b;
 }
 
 /* ---- Metadata frame ------------------------------------------------------ */
@@ -680,20 +888,6 @@ void bsf_metadata_init(bsf_metadata_t *m)
         m->max_ctrl_per_feature = (uint32_t)BSF_MAX_CTRL_PER_FEATURE;
         m->max_ctrl_points = (uint32_t)BSF_MAX_CTRL_POINTS;
     }
-}
-
-static uint32_t float_bits(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
-static void put_float(writer_t *w, float v)
-{
-    const uint32_t u = float_bits(v);
-    put_bits(w, u >> 16, 16u);
-    put_bits(w, u & 0xFFFFu, 16u);
 }
 
 static int cap_ok(uint32_t v)
@@ -727,99 +921,286 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
     return BSF_OK;
 }
 
-/* The whole metadata frame through w (FORMAT.md section 3.6). */
-static bsf_status_t write_metadata(writer_t *w, const bsf_metadata_t *m)
+/* The two runs as functions of their own, each compiled for its mode. */
+static void frame_payload_write(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
+                                const bsf_result_t *res, uint32_t *table)
 {
-    uint32_t step_code;
+    frame_payload_run(w, 0, pl, info, res, table);
+}
+
+static void frame_payload_cost(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
+                               const bsf_result_t *res, uint32_t *table)
+{
+    frame_payload_run(w, 1, pl, info, res, table);
+}
+
+/* The metadata payload through w (FORMAT.md section 3.6); m was checked. */
+static void metadata_payload(writer_t *w, int costing, const bsf_metadata_t *m, uint32_t step_code)
+{
+    bits_t *b = &w->b;
     unsigned i;
-    const bsf_status_t st = check_metadata(m, &step_code);
-    if (st != BSF_OK) {
-        return st;
-    }
-    block_start(w);
-    put_u8(w, (uint8_t)((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA));
-    put_eg(w, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
-    put_eg(w, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
-    put_eg(w, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
-    put_eg(w, m->method, BSF_WIRE_K_METHOD);
-    put_float(w, m->target_rms);
-    put_eg(w, step_code, BSF_WIRE_K_STEP);
-    put_eg(w, m->max_points, BSF_WIRE_K_CAP_POINTS);
-    put_eg(w, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
-    put_eg(w, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
-    put_eg(w, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
-    put_eg(w, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
-    put_eg(w, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
-    put_float(w, m->angle_min);
-    put_float(w, m->angle_increment);
-    put_float(w, m->range_min);
-    put_float(w, m->range_max);
-    put_bits(w, m->has_time_origin != 0u ? 1u : 0u, 1u);
+    field_u(w, b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA, 8u);
+    field_eg(w, b, costing, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, b, costing, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, b, costing, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
+    field_eg(w, b, costing, m->method, BSF_WIRE_K_METHOD);
+    field_float(w, b, costing, m->target_rms);
+    field_eg(w, b, costing, step_code, BSF_WIRE_K_STEP);
+    field_eg(w, b, costing, m->max_points, BSF_WIRE_K_CAP_POINTS);
+    field_eg(w, b, costing, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
+    field_eg(w, b, costing, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
+    field_eg(w, b, costing, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
+    field_eg(w, b, costing, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
+    field_eg(w, b, costing, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
+    field_float(w, b, costing, m->angle_min);
+    field_float(w, b, costing, m->angle_increment);
+    field_float(w, b, costing, m->range_min);
+    field_float(w, b, costing, m->range_max);
+    field_u(w, b, costing, m->has_time_origin != 0u ? 1u : 0u, 1u);
     if (m->has_time_origin != 0u) {
-        put_seg(w, m->time_origin_us, BSF_WIRE_K_TIME_ORIGIN);
+        field_eg64(w, b, costing, bsf_wire_zigzag(m->time_origin_us), BSF_WIRE_K_TIME_ORIGIN);
     }
-    put_eg(w, m->source_len, BSF_WIRE_K_SOURCE_LEN);
+    field_eg(w, b, costing, m->source_len, BSF_WIRE_K_SOURCE_LEN);
     for (i = 0; i < m->source_len; ++i) {
-        put_bits(w, (uint8_t)m->source[i], 8u);
+        field_u(w, b, costing, (uint8_t)m->source[i], 8u);
     }
-    finish(w);
+}
+
+/* ---- Both frame types: plan, then write to a buffer or a sink ------------ */
+
+typedef struct {
+    const bsf_frame_info_t *info; /* features frame: info and res */
+    const bsf_result_t *res;
+    const bsf_metadata_t *meta; /* or a metadata frame */
+    uint32_t *table;            /* features frame: VALUE_TABLE entries */
+    plan_t plan;
+} job_t;
+
+/* The payload through w, written or counted (the plan checked the input). */
+static void job_payload(writer_t *w, int costing, job_t *job)
+{
+    if (job->meta != NULL) {
+        metadata_payload(w, costing, job->meta, job->plan.step_code);
+    } else {
+        if (costing) {
+            frame_payload_cost(w, &job->plan, job->info, job->res, job->table);
+        } else {
+            frame_payload_write(w, &job->plan, job->info, job->res, job->table);
+        }
+    }
+}
+
+/* The exact payload bits: a costing run (a call of its own, so that its
+ * writer is not on the planning run's stack). */
+ENC_NOINLINE uint32_t job_bits(job_t *job)
+{
+    writer_t w;
+    writer_init(&w, NULL, NULL, NULL);
+    job_payload(&w, 1, job);
+    return w.b.bits;
+}
+
+/* Checks the input and bounds the payload's size (and chooses the orders). */
+static bsf_status_t job_plan(job_t *job)
+{
+    bsf_status_t st;
+    memset(&job->plan, 0, sizeof job->plan);
+    if (job->meta == NULL) {
+        st = check_frame(job->info, job->res, &job->plan);
+        return st != BSF_OK ? st : plan_frame(job->info, job->res, job->table, &job->plan);
+    }
+    st = check_metadata(job->meta, &job->plan.step_code);
+    if (st == BSF_OK) {
+        job->plan.max_bits = job_bits(job); /* exact */
+    }
+    return st;
+}
+
+static void job_stream(job_t *job, stream_t *s)
+{
+    writer_t w;
+    writer_init(&w, s, NULL, NULL);
+    job_payload(&w, 0, job);
+    writer_end_stream(&w);
+}
+
+/* COBS bound of a body of n bytes, with the delimiter. */
+static size_t frame_bound(size_t body)
+{
+    return body + body / 254u + 2u;
+}
+
+/*
+ * The frame straight into buf, which holds the frame_bound of max_bits: the
+ * payload goes to buf + 1 (behind the first code byte) and gets its CRC; a
+ * body with full COBS blocks moves up by their number (a code byte each),
+ * and COBS turns it into its code in place. Nothing is written beyond the
+ * frame.
+ */
+static bsf_status_t job_direct(job_t *job, uint8_t *buf, size_t *out_len)
+{
+    const size_t max_payload = ((size_t)job->plan.max_bits + 7u) / 8u;
+    uint8_t *const start = buf + 1;
+    writer_t w;
+    size_t payload;
+    size_t body;
+    uint32_t crc;
+    size_t full = 0;
+    size_t len;
+    unsigned i;
+    /* the last word may reach 3 bytes beyond the payload, into the CRC's place */
+    writer_init(&w, NULL, start, start + max_payload + BSF_FRAME_CRC_SIZE);
+    job_payload(&w, 0, job);
+    payload = (writer_bits(&w, start) + 7u) / 8u;
+    writer_flush(&w);
+    if (w.overflow || payload > max_payload) {
+        *out_len = 0u;
+        return BSF_ERR_BUFFER; /* beyond the planned bound: never happens */
+    }
+    crc = bsf_crc32c(0u, start, payload);
+    for (i = 0; i < 4u; ++i) {
+        start[payload + i] = (uint8_t)(crc >> (8u * i));
+    }
+    body = payload + BSF_FRAME_CRC_SIZE;
+    if (body >= 254u) {
+        full = bsf_cobs_full_blocks(start, body);
+        if (full > 0u) {
+            memmove(start + full, start, body);
+        }
+    }
+    len = bsf_cobs_encode_in_place(buf, 1u + full, body);
+    buf[len] = 0u;
+    *out_len = len + 1u;
     return BSF_OK;
 }
 
-bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap, size_t *out_len)
+static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out_len)
 {
-    writer_t w;
-    bsf_status_t st;
-
-    if (m == NULL || out_len == NULL) {
-        return BSF_ERR_ARG;
-    }
-    writer_init(&w);
-    st = write_metadata(&w, m);
+    const bsf_status_t st = job_plan(job);
+    size_t body;
+    stream_t s;
     if (st != BSF_OK) {
         *out_len = 0u;
         return st;
     }
-    *out_len = w.pos;
+    if (buf != NULL &&
+        cap >= frame_bound(((size_t)job->plan.max_bits + 7u) / 8u + BSF_FRAME_CRC_SIZE)) {
+        return job_direct(job, buf, out_len);
+    }
+    body = ((size_t)job_bits(job) + 7u) / 8u + BSF_FRAME_CRC_SIZE;
+    if (body < 254u) {
+        *out_len = body + 2u; /* exact: no block reaches 254 bytes */
+    } else {
+        stream_init(&s); /* count */
+        job_stream(job, &s);
+        *out_len = s.pos;
+    }
     if (buf == NULL) {
         return BSF_OK;
     }
-    if (w.pos > cap) {
+    if (*out_len > cap) {
         return BSF_ERR_BUFFER;
     }
-    writer_init(&w);
-    w.buf = buf;
-    w.cap = cap;
-    return write_metadata(&w, m);
+    stream_init(&s);
+    s.buf = buf;
+    s.cap = cap;
+    job_stream(job, &s);
+    *out_len = s.pos;
+    return BSF_OK;
+}
+
+static bsf_status_t job_encode_sink(job_t *job, bsf_encoder_t *work, bsf_sink_fn sink, void *ctx,
+                                    size_t *written)
+{
+    stream_t s;
+    const bsf_status_t st = job_plan(job);
+    if (st != BSF_OK) {
+        return st;
+    }
+    memset(&s, 0, sizeof s);
+    s.work = work;
+    s.sink = sink;
+    s.ctx = ctx;
+    block_start(&s);
+    job_stream(job, &s);
+    if (written != NULL) {
+        *written = s.pos;
+    }
+    return s.failed ? BSF_ERR_BUFFER : BSF_OK;
+}
+
+void bsf_frame_info_init(bsf_frame_info_t *info)
+{
+    if (info != NULL) {
+        info->seq = 0u;
+        info->timestamp_ms = 0u;
+        info->has_pose = 0u;
+        info->pose_x = 0.0f;
+        info->pose_y = 0.0f;
+        info->pose_theta = 0.0f;
+        info->quant_step = BSF_QUANT_STEP_DEFAULT;
+        info->has_geometry = 0u;
+        info->angle_min = 0.0f;
+        info->angle_increment = 0.0f;
+    }
+}
+
+bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
+                              uint8_t *buf, size_t cap, size_t *out_len)
+{
+    uint32_t table[VALUE_TABLE];
+    job_t job;
+    if (info == NULL || result == NULL || out_len == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&job, 0, sizeof job);
+    job.info = info;
+    job.res = result;
+    job.table = table;
+    return job_encode(&job, buf, cap, out_len);
+}
+
+bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,
+                                   const bsf_result_t *result, bsf_sink_fn sink, void *ctx,
+                                   size_t *written)
+{
+    uint32_t table[VALUE_TABLE];
+    job_t job;
+    if (written != NULL) {
+        *written = 0u;
+    }
+    if (work == NULL || info == NULL || result == NULL || sink == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&job, 0, sizeof job);
+    job.info = info;
+    job.res = result;
+    job.table = table;
+    return job_encode_sink(&job, work, sink, ctx, written);
+}
+
+bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap, size_t *out_len)
+{
+    job_t job;
+    if (m == NULL || out_len == NULL) {
+        return BSF_ERR_ARG;
+    }
+    memset(&job, 0, sizeof job);
+    job.meta = m;
+    return job_encode(&job, buf, cap, out_len);
 }
 
 bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const bsf_metadata_t *m,
                                       bsf_sink_fn sink, void *ctx, size_t *written)
 {
-    writer_t w;
-    uint32_t step_code;
-    bsf_status_t st;
-
+    job_t job;
     if (written != NULL) {
         *written = 0u;
     }
     if (work == NULL || m == NULL || sink == NULL) {
         return BSF_ERR_ARG;
     }
-    st = check_metadata(m, &step_code);
-    if (st != BSF_OK) {
-        return st;
-    }
-    writer_init(&w);
-    w.work = work;
-    w.sink = sink;
-    w.ctx = ctx;
-    st = write_metadata(&w, m);
-    if (written != NULL) {
-        *written = w.pos;
-    }
-    if (st == BSF_OK && w.failed) {
-        st = BSF_ERR_BUFFER;
-    }
-    return st;
+    memset(&job, 0, sizeof job);
+    job.meta = m;
+    return job_encode_sink(&job, work, sink, ctx, written);
 }

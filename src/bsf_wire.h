@@ -9,6 +9,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bsf/bsf_config.h"
+
 /* Exp-Golomb orders of the fixed-parameter fields (FORMAT.md section 3). */
 #define BSF_WIRE_K_SEQ 8u
 #define BSF_WIRE_K_TIMESTAMP 20u
@@ -124,23 +126,21 @@ static inline unsigned bsf_wire_bitlen32(uint32_t v)
 #endif
 }
 
+/* Bit length of v < 2^31 as floor(log2(2v + 1)): 2v + 1 is never 0, so the
+ * count needs no test for 0 (x86 BSR, Arm CLZ). */
+static inline unsigned bsf_wire_bitlen31(uint32_t v)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return 31u ^ (unsigned)__builtin_clz(2u * v + 1u);
+#else
+    return bsf_wire_bitlen32(v);
+#endif
+}
+
 static inline unsigned bsf_wire_bitlen(uint64_t v)
 {
     const uint32_t hi = (uint32_t)(v >> 32);
     return hi != 0u ? 32u + bsf_wire_bitlen32(hi) : bsf_wire_bitlen32((uint32_t)v);
-}
-
-/* CRC-32C register (not inverted) after one more byte: two steps of a
- * 16-entry table (64 bytes of ROM where 256 entries would take 1 KiB). */
-static inline uint32_t bsf_wire_crc32c_step(uint32_t reg, uint8_t b)
-{
-    static const uint32_t nibble[16] = {0x00000000u, 0x105EC76Fu, 0x20BD8EDEu, 0x30E349B1u,
-                                        0x417B1DBCu, 0x5125DAD3u, 0x61C69362u, 0x7198540Du,
-                                        0x82F63B78u, 0x92A8FC17u, 0xA24BB5A6u, 0xB21572C9u,
-                                        0xC38D26C4u, 0xD3D3E1ABu, 0xE330A81Au, 0xF36E6F75u};
-    reg ^= b;
-    reg = (reg >> 4) ^ nibble[reg & 0x0Fu];
-    return (reg >> 4) ^ nibble[reg & 0x0Fu];
 }
 
 /* Length in bits of the Exp-Golomb code of order k of v (v >> k < 2^63). */
@@ -162,51 +162,123 @@ static inline unsigned bsf_wire_eg_bits(uint64_t v, unsigned k)
  * and residuals within 2^24, zigzag within 2^25). */
 #define BSF_WIRE_EG_HIST 27u
 
+/* Counts per class: a frame has at most 2 * BSF_MAX_CTRL_POINTS values. */
+#if BSF_MAX_CTRL_POINTS <= 32767
+typedef uint16_t bsf_wire_eg_count_t;
+#else
+typedef uint32_t bsf_wire_eg_count_t;
+#endif
+
 typedef struct {
-    uint32_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
-    uint32_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    unsigned max_len;                   /* largest L counted */
+    bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
+    bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
+    uint32_t or_all; /* OR of the values: its bit length is the largest L */
 } bsf_wire_eg_tally_t;
+
+/* One value v < 2^26. */
+static inline void bsf_wire_eg_tally_add32(bsf_wire_eg_tally_t *t, uint32_t v)
+{
+    const unsigned len = bsf_wire_bitlen31(v);
+    /* the len low bits set (none for v = 0), with no shift by 32 */
+    const uint32_t ones = (0xFFFFFFFFu >> 1) >> (31u - len);
+    t->n_len[len] += 1u;
+    t->n_below[bsf_wire_bitlen31(v ^ ones)] += 1u;
+    t->or_all |= v;
+}
 
 static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
 {
-    const unsigned len = bsf_wire_bitlen(v);
-    const uint64_t ones = len == 0u ? 0u : (~(uint64_t)0 >> (64u - len));
-    t->n_len[len] += 1u;
-    t->n_below[bsf_wire_bitlen(v ^ ones)] += 1u;
-    if (len > t->max_len) {
-        t->max_len = len;
-    }
+    bsf_wire_eg_tally_add32(t, (uint32_t)v);
 }
 
-/* cost[k] for k = 0..k_max: total bits of the tallied values at order k. */
+/*
+ * The totals follow from counts: with A(k) values of L <= k, B(k) values of
+ * m <= k (m <= L, so B(k) - A(k) values carry at order k) and T(k) = the sum
+ * of L over the values with L > k plus k A(k), the code lengths 2
+ * bitlen(v + 2^k) - 1 - k sum to 2 T(k) + 2 B(k) - n (1 + k), where
+ * bitlen(v + 2^k) is max(L, k + 1) plus one for a carry. T(0) is the sum of
+ * all L and T(k) = T(k - 1) + A(k - 1).
+ */
+
+/* The number of values and the sum of their L, up to the largest L. */
+static inline uint32_t bsf_wire_eg_tally_sums(const bsf_wire_eg_tally_t *t, uint32_t *sum_len)
+{
+    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
+    uint32_t n = t->n_len[0];
+    uint32_t sum = 0;
+    unsigned len;
+    for (len = 1; len <= max_len; ++len) {
+        n += t->n_len[len];
+        sum += len * t->n_len[len];
+    }
+    *sum_len = sum;
+    return n;
+}
+
+/* cost[k] for k = 0..k_max (<= 25): total bits of the tallied values at order k. */
 static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigned k_max,
                                            uint32_t *cost)
 {
-    uint32_t n = 0;
-    uint32_t above = 0;      /* sum of (2L - 1) over the values with L > k */
-    uint32_t n_len_le = 0;   /* values with L <= k */
-    uint32_t n_below_le = 0; /* values with m <= k */
-    unsigned len;
+    uint32_t sum; /* T(k) */
+    const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
+    uint32_t a = 0;
+    uint32_t b = 0;
     unsigned k;
-    for (len = 0; len <= t->max_len; ++len) {
-        n += t->n_len[len];
-        if (len > 0u) {
-            above += t->n_len[len] * (2u * len - 1u);
-        }
-    }
     for (k = 0; k <= k_max; ++k) {
-        if (k <= t->max_len) {
-            n_len_le += t->n_len[k];
-            n_below_le += t->n_below[k];
-            if (k > 0u) {
-                above -= t->n_len[k] * (2u * k - 1u);
-            }
-        }
-        /* unsigned arithmetic: intermediate wrap-around cancels */
-        cost[k] = (k + 1u) * n_len_le + above - k * (n - n_len_le) + 2u * (n_below_le - n_len_le);
+        sum += a;
+        a += t->n_len[k];
+        b += t->n_below[k];
+        cost[k] = 2u * (sum + b) - n * (1u + k);
     }
 }
+
+/*
+ * The order 0..BSF_WIRE_K_CTRL_MAX with the fewest bits for the tallied
+ * values (ties to the smaller order), and those bits in *bits. Every code
+ * at order k takes at least k + 1 bits, so the search stops once n (k + 1)
+ * reaches the best total; it never goes past the longest value's bit length
+ * L either, since above L every order costs one bit per value more than the
+ * one before.
+ */
+static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint32_t *bits)
+{
+    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
+    const unsigned k_top = max_len < BSF_WIRE_K_CTRL_MAX ? max_len : BSF_WIRE_K_CTRL_MAX;
+    uint32_t sum;
+    const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
+    uint32_t a = t->n_len[0];
+    uint32_t b = t->n_below[0];
+    uint32_t best_cost = 2u * (sum + b) - n; /* order 0 */
+    uint32_t floor_bits = 2u * n;            /* n (k + 1) for the next k */
+    unsigned best = 0;
+    unsigned k;
+    for (k = 1; k <= k_top && floor_bits < best_cost; ++k) {
+        uint32_t cost;
+        sum += a;
+        a += t->n_len[k];
+        b += t->n_below[k];
+        cost = 2u * (sum + b) - floor_bits;
+        if (cost < best_cost) {
+            best_cost = cost;
+            best = k;
+        }
+        floor_bits += n;
+    }
+    *bits = best_cost;
+    return best;
+}
+
+/*
+ * COBS of a body of n bytes takes 1 + n + F bytes (without the 0x00
+ * delimiter), F the number of full blocks (254 data bytes, code 0xFF):
+ * bsf_cobs_full_blocks counts them (bsf_cobs.c). bsf_cobs_encode_in_place
+ * turns the body buf[offset .. offset + n - 1], offset >= 1 + F, into its
+ * code in buf[0 ..] and returns the code's length; with offset = 1 + F the
+ * code ends where the body ended. The output never overtakes the input it
+ * still has to read.
+ */
+size_t bsf_cobs_full_blocks(const uint8_t *body, size_t n);
+size_t bsf_cobs_encode_in_place(uint8_t *buf, size_t offset, size_t n);
 
 /*
  * A metadata source name: well-formed UTF-8 (RFC 3629: shortest form, no

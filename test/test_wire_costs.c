@@ -5,6 +5,7 @@
  * as costing each value at each order. White-box. */
 #include <string.h>
 
+#include "bsf/bsf_stream.h"
 #include "bsf_wire.h"
 #include "unity.h"
 
@@ -65,6 +66,74 @@ static void test_tally_costs_equal_the_sum_of_code_lengths_at_every_order(void)
     }
 }
 
+/* The order search stops early (no order above k can beat n (k + 1) bits):
+ * it still finds the first order with the fewest bits, and those bits. */
+static void test_best_order_is_the_first_cheapest_of_all_orders(void)
+{
+    unsigned trial;
+    for (trial = 0; trial < 400u; ++trial) {
+        bsf_wire_eg_tally_t t;
+        uint32_t cost[BSF_WIRE_K_CTRL_MAX + 1u];
+        const unsigned n = trial % 60u;
+        unsigned i;
+        unsigned k;
+        unsigned want = 0;
+        uint32_t bits = 0;
+        memset(&t, 0, sizeof t);
+        for (i = 0; i < n; ++i) {
+            /* small values too: many orders tie there */
+            const uint64_t v = (trial & 1u) != 0u ? random_value() : (uint64_t)(next_random() % 9u);
+            bsf_wire_eg_tally_add(&t, v);
+        }
+        bsf_wire_eg_tally_costs(&t, BSF_WIRE_K_CTRL_MAX, cost);
+        for (k = 1; k <= BSF_WIRE_K_CTRL_MAX; ++k) {
+            if (cost[k] < cost[want]) {
+                want = k;
+            }
+        }
+        TEST_ASSERT_EQUAL_UINT(want, bsf_wire_eg_tally_best(&t, &bits));
+        TEST_ASSERT_EQUAL_UINT32(cost[want], bits);
+    }
+}
+
+/* COBS in place (the encoder's direct path) gives bsf_cobs_encode's bytes,
+ * ends where the body ended when it starts behind 1 + full blocks, and
+ * writes nothing beyond: bodies with zeros, and with runs of 254 bytes and
+ * more (full blocks), some ending exactly after one. */
+static void test_cobs_in_place_equals_cobs_encode(void)
+{
+    static uint8_t body[800];
+    static uint8_t want[900];
+    static uint8_t buf[900];
+    unsigned trial;
+    for (trial = 0; trial < 600u; ++trial) {
+        const size_t n =
+            trial < 8u ? 254u * (1u + trial % 3u) - (trial / 3u) % 2u : 1u + next_random() % 700u;
+        const uint32_t zero_every = trial % 4u == 0u ? 0u : 1u + next_random() % 300u;
+        size_t i;
+        size_t want_len = 0;
+        size_t full;
+        size_t len;
+        for (i = 0; i < n; ++i) {
+            body[i] = (uint8_t)(1u + next_random() % 255u);
+            if (zero_every != 0u && next_random() % zero_every == 0u) {
+                body[i] = 0u;
+            }
+        }
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_encode(body, n, want, sizeof want, &want_len));
+        full = bsf_cobs_full_blocks(body, n);
+        TEST_ASSERT_EQUAL_size_t(want_len, 1u + n + full);
+        memset(buf, 0xA5, sizeof buf);
+        memcpy(buf + 1u + full, body, n);
+        len = bsf_cobs_encode_in_place(buf, 1u + full, n);
+        TEST_ASSERT_EQUAL_size_t(want_len, len);
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(want, buf, len);
+        for (i = len; i < sizeof buf; ++i) {
+            TEST_ASSERT_EQUAL_HEX8(0xA5, buf[i]);
+        }
+    }
+}
+
 /* The prediction's 32-bit fast path gives the 64-bit floor division's
  * result, on both sides of the switch between them. */
 static int64_t predict_reference(int64_t a, int64_t b, uint32_t s, uint32_t k)
@@ -111,6 +180,8 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_tally_costs_equal_the_sum_of_code_lengths_at_every_order);
+    RUN_TEST(test_best_order_is_the_first_cheapest_of_all_orders);
+    RUN_TEST(test_cobs_in_place_equals_cobs_encode);
     RUN_TEST(test_prediction_is_the_floor_division_at_every_size);
     RUN_TEST(test_bit_length_is_one_plus_floor_log2);
     return UNITY_END();

@@ -66,13 +66,25 @@ BSF_NODISCARD bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p);
 
 /**
  * Scratch memory of bsf_falko_detect, owned by the caller (static or on a
- * task's stack); its content between calls is irrelevant. About 7.4 KiB at
+ * task's stack); its content between calls is irrelevant. About 25 KiB at
  * BSF_MAX_POINTS = 1081.
  */
 typedef struct {
     float score[BSF_MAX_POINTS];   /**< per-beam raw score, then NMS strength */
     uint16_t peak[BSF_MAX_POINTS]; /**< NMS candidates, then keypoint beams */
     int8_t sector[BSF_MAX_POINTS]; /**< angular sectors of one neighbourhood */
+    /* Per beam, a bracket of its neighbourhood radius (see bsf_falko.c). */
+    float in2[BSF_MAX_POINTS];          /**< squared distance certainly inside */
+    float out2[BSF_MAX_POINTS];         /**< squared distance certainly outside */
+    float lim[BSF_MAX_POINTS];          /**< smallest triangle limit */
+    uint16_t win_hi[BSF_MAX_POINTS];    /**< window of the largest radius */
+    uint16_t win_inner[BSF_MAX_POINTS]; /**< window of the smallest radius, at least */
+    /** How often each sector value occurs among the neighbours seen so far
+     *  (sector values lie in -33..96, stored offset by 33), and the values that
+     *  occur: the score sums sector distances per value, not per pair. */
+    uint16_t sector_count[130];
+    int8_t sector_seen[130];
+    int8_t sector_dist[259]; /**< sector distance per difference of sector values, or -1 */
 } bsf_falko_work_t;
 
 /**
