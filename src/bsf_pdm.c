@@ -285,9 +285,8 @@ static inline void sums_add(span_sums_t *a, float b0, float b2, float px, float 
  * three stored control points map to non-decreasing unknowns; at a vertex
  * two of them are one unknown, whose weight is the sum of both basis values,
  * so the cross product of the two copies lands twice on its diagonal. */
-static void sums_flush(bsf_pdm_work_t *w, span_sums_t sums)
+static void sums_flush(bsf_pdm_work_t *w, const span_sums_t *a)
 {
-    const span_sums_t *a = &sums;
     const uint8_t *unk = &w->unknown_of[a->span];
     const size_t u0 = unk[0];
     const size_t u1 = unk[1];
@@ -333,14 +332,14 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
         const size_t span = span_of(w->t[i], fs, n_span, &u);
         const float v = 1.0f - u;
         if (span != acc.span) {
-            sums_flush(w, acc);
+            sums_flush(w, &acc);
             sums_reset(&acc, span);
             k0 = span == 0u ? 1.0f : 0.5f;
             k2 = span + 1u == n_span ? 1.0f : 0.5f;
         }
         sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
     }
-    sums_flush(w, acc);
+    sums_flush(w, &acc);
 }
 
 /* Start of a fit (a new layout, or a restart): each point's parameter is
@@ -404,7 +403,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             w->t[i] = t;
             span = span_of(t, fs, n_span, &u);
             if (span != acc.span) {
-                sums_flush(w, acc);
+                sums_flush(w, &acc);
                 sums_reset(&acc, span);
                 k0 = span == 0u ? 1.0f : 0.5f;
                 k2 = span + 1u == n_span ? 1.0f : 0.5f;
@@ -415,7 +414,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             }
         }
     }
-    sums_flush(w, acc);
+    sums_flush(w, &acc);
 }
 
 /* Step (a): add the bending term to the assembled normal equations and solve
@@ -447,7 +446,7 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             r.s20 = weight * c2 * c0;
             r.s21 = weight * c2 * c1;
             r.s22 = weight * c2 * c2;
-            sums_flush(w, r);
+            sums_flush(w, &r);
         }
     }
     if (s->anchor != NULL) {
@@ -657,7 +656,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             b0 = c.k0 * (1.0f - u) * (1.0f - u);
             b2 = c.k2 * u * u;
             if (c.span != acc.span) {
-                sums_flush(w, acc);
+                sums_flush(w, &acc);
                 sums_reset(&acc, c.span);
             }
             sums_add(&acc, b0, b2, qx, qy);
@@ -721,7 +720,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
         }
     }
     if (assemble_next) {
-        sums_flush(w, acc);
+        sums_flush(w, &acc);
     }
     s->rms = sqrtf(total / (float)s->n);
     return 1;
