@@ -234,6 +234,7 @@ static inline size_t span_of(float t, float fs, size_t n_span, float *u)
 typedef struct {
     size_t span;
     float k0, k2;
+    float m0, m2; /* -2 k0 and 2 k2: the u-derivative's scales */
     float p1x, p1y;
     float ax, ay;   /* P0 - P1 */
     float bx, by;   /* P2 - P1 */
@@ -246,6 +247,8 @@ static inline void load_span(const bsf_point_t *ctrl, size_t n_span, size_t span
     c->span = span;
     c->k0 = span == 0u ? 1.0f : 0.5f;
     c->k2 = span + 1u == n_span ? 1.0f : 0.5f;
+    c->m0 = -2.0f * c->k0;
+    c->m2 = 2.0f * c->k2;
     c->p1x = p[1].x;
     c->p1y = p[1].y;
     c->ax = p[0].x - p[1].x;
@@ -330,17 +333,19 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
     const float oy = s->origin.y;
     span_sums_t acc;
     size_t i;
+    float k0 = 1.0f; /* basis scales of span acc.span */
+    float k2 = n_span == 1u ? 1.0f : 0.5f;
     clear_normal_equations(s, w);
     sums_reset(&acc, 0u);
     for (i = 0; i < s->n; ++i) {
         float u;
         const size_t span = span_of(w->t[i], fs, n_span, &u);
-        const float k0 = span == 0u ? 1.0f : 0.5f;
-        const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
         const float v = 1.0f - u;
         if (span != acc.span) {
             sums_flush(w, &acc);
             sums_reset(&acc, span);
+            k0 = span == 0u ? 1.0f : 0.5f;
+            k2 = span + 1u == n_span ? 1.0f : 0.5f;
         }
         sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
     }
@@ -361,6 +366,8 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
     const float ox = s->origin.x;
     const float oy = s->origin.y;
     span_sums_t acc;
+    float k0 = 1.0f; /* basis scales of span acc.span */
+    float k2 = n_span == 1u ? 1.0f : 0.5f;
     size_t f;
     size_t i = 0;
 
@@ -408,10 +415,10 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
             if (span != acc.span) {
                 sums_flush(w, &acc);
                 sums_reset(&acc, span);
+                k0 = span == 0u ? 1.0f : 0.5f;
+                k2 = span + 1u == n_span ? 1.0f : 0.5f;
             }
             {
-                const float k0 = span == 0u ? 1.0f : 0.5f;
-                const float k2 = span + 1u == n_span ? 1.0f : 0.5f;
                 const float v = 1.0f - u;
                 sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
             }
@@ -527,6 +534,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     const float fs = (float)n_span;
     const float inv_fs = 1.0f / fs;
     const size_t last = s->n - 1u;
+    const size_t bias_window = s->bias_window;
     const float ox = s->origin.x;
     const float oy = s->origin.y;
     span_coef_t c;
@@ -539,10 +547,12 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     size_t i;
     /* Systematic deviation (bias_window > 0): the last bias_window signed
      * residuals of the fragment (a ring), their sum, the fragment's largest
-     * |sum| and its largest squared distance. */
-    float ring[BSF_PDM_MAX_BIAS_WINDOW] = {0.0f};
+     * |sum| and its largest squared distance. Only ring[0..bias_window) is
+     * used, so only that part is cleared. ring_wait counts the points still
+     * missing before the window is full. */
+    float ring[BSF_PDM_MAX_BIAS_WINDOW];
     size_t ring_at = 0;
-    size_t ring_n = 0;
+    size_t ring_wait = bias_window;
     float ring_sum = 0.0f;
     float window_max = 0.0f;
     float point_max = 0.0f;
@@ -558,6 +568,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     const float give_up_total =
         give_up_rms > 0.0f ? give_up_rms * give_up_rms * (float)s->n * 0.999f : 3.0e38f;
 
+    memset(ring, 0, bias_window * sizeof ring[0]);
     if (assemble_next) {
         clear_normal_equations(s, w);
     }
@@ -567,7 +578,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     for (i = 0; i < s->n; ++i) {
         const float qx = s->pts[i].x - ox;
         const float qy = s->pts[i].y - oy;
-        const unsigned n_steps = (i == 0u || i == last) ? 0u : steps;
+        /* Not the end points: i - 1 wraps for i == 0. */
+        const unsigned n_steps = i - 1u < last - 1u ? steps : 0u;
         float t = w->t[i];
         float u;
         size_t span = span_of(t, fs, n_span, &u);
@@ -588,8 +600,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
         best = ex * ex + ey * ey;
         for (step = 0; step < n_steps; ++step) {
             /* Derivatives at the current u of span c. */
-            const float d0 = -2.0f * c.k0 * (1.0f - u);
-            const float d2 = 2.0f * c.k2 * u;
+            const float d0 = c.m0 * (1.0f - u);
+            const float d2 = c.m2 * u;
             const float ux = d0 * c.ax + d2 * c.bx;
             const float uy = d0 * c.ay + d2 * c.by;
             const float g = ex * ux + ey * uy;
@@ -680,7 +692,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             !(sqrtf(total / (float)s->n) < give_up_rms)) {
             return 0;
         }
-        if (s->bias_window > 0u) {
+        if (bias_window > 0u) {
             /* Signed residual along the normal of the span's chord (one
              * square root per span), summed over the last bias_window
              * points of the fragment in a ring. */
@@ -711,9 +723,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             if (!slot_open) {
                 ring_sum += slot - ring[ring_at];
                 ring[ring_at] = slot;
-                ring_at = ring_at + 1u == s->bias_window ? 0u : ring_at + 1u;
-                ++ring_n;
-                if (ring_n >= s->bias_window && fabsf(ring_sum) > window_max) {
+                ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
+                ring_wait -= ring_wait > 0u ? 1u : 0u;
+                if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
                     window_max = fabsf(ring_sum);
                 }
             }
@@ -724,7 +736,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 w->frag_rms[f] = systematic_error(s, rms, window_max, point_max, block);
                 frag_sum = best; /* the vertex point opens the next fragment */
                 point_max = best;
-                memset(ring, 0, sizeof ring);
+                memset(ring, 0, bias_window * sizeof ring[0]);
                 window_max = 0.0f;
                 if (f + 1u < s->n_frag) {
                     ++f;
@@ -734,14 +746,14 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 /* A trailing partial slot is dropped. */
                 ring_sum = 0.0f;
                 ring_at = 0u;
-                ring_n = 0u;
+                ring_wait = bias_window;
                 block_sum = r;
                 block_n = 1u;
                 if (block == 1u) {
                     ring[0] = r;
                     ring_sum = r;
                     ring_at = 1u;
-                    ring_n = 1u;
+                    ring_wait = bias_window - 1u;
                     block_n = 0u;
                     block_sum = 0.0f;
                 }
