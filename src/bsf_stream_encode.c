@@ -340,6 +340,7 @@ ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
     field_u(w, b, costing, u & 0xFFFFu, 16u);
 }
 
+#if !defined(__OPTIMIZE_SIZE__) /* the direct writer only (job_direct) */
 /* Bits written so far. */
 static size_t writer_bits(const writer_t *w, const uint8_t *start)
 {
@@ -354,6 +355,7 @@ static void writer_flush(writer_t *w)
         put_word(w, &w->b, w->b.acc << w->b.room);
     }
 }
+#endif
 
 /* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
 static void writer_end_stream(writer_t *w)
@@ -1024,6 +1026,7 @@ static void job_stream(job_t *job, stream_t *s)
     writer_end_stream(&w);
 }
 
+#if !defined(__OPTIMIZE_SIZE__)
 /* COBS bound of a body of n bytes, with the delimiter. */
 static size_t frame_bound(size_t body)
 {
@@ -1073,6 +1076,7 @@ static bsf_status_t job_direct(job_t *job, uint8_t *buf, size_t *out_len)
     *out_len = len + 1u;
     return BSF_OK;
 }
+#endif
 
 static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out_len)
 {
@@ -1083,10 +1087,14 @@ static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out
         *out_len = 0u;
         return st;
     }
+#if !defined(__OPTIMIZE_SIZE__)
+    /* The direct writer is for speed only: a size-optimised build (-Os)
+     * leaves it out and always streams, which gives the same frame. */
     if (buf != NULL &&
         cap >= frame_bound(((size_t)job->plan.max_bits + 7u) / 8u + BSF_FRAME_CRC_SIZE)) {
         return job_direct(job, buf, out_len);
     }
+#endif
     body = ((size_t)job_bits(job) + 7u) / 8u + BSF_FRAME_CRC_SIZE;
     if (body < 254u) {
         *out_len = body + 2u; /* exact: no block reaches 254 bytes */
