@@ -1,11 +1,12 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf_linalg.h"
+#include "bsf_math.h"
 
 #include <math.h>
 
 static int finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 /* In-place banded Cholesky of factor (holding A + loading * I). Returns 0 on

@@ -17,7 +17,7 @@
 static int is_finite_f(float v)
 {
     /* NaN fails both comparisons; +-inf fails the second. */
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 int bsf_range_is_valid(float r, float range_min, float range_max)

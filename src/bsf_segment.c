@@ -9,7 +9,7 @@
 
 static int is_finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 bsf_sved_params_t bsf_sved_params_paper(void)

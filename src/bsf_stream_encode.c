@@ -376,7 +376,7 @@ static void writer_end_stream(writer_t *w)
 
 static int is_finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 /* Nearest multiple of step, in steps: floor(v / step + 0.5); 0 when v is
