@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_bspline.h"
+#include "bsf_math.h"
 #include "bsf/bsf_fit.h"
 #include "bsf_fit_internal.h"
 
@@ -7,7 +8,7 @@
 
 static int finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 size_t bsf_bspline_span(size_t n_ctrl, float t, float *u_out)

@@ -69,7 +69,7 @@ bsf_falko_params_t bsf_falko_params_default(void)
 
 static int finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p)

@@ -645,6 +645,7 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
     if (d2 <= p->jump_a * p->jump_a) {
         return 1;
     }
+#if !defined(__OPTIMIZE_SIZE__) /* -Os: expf every time (the bounds only decide early) */
     if (x >= 0.0f && x <= 1.0f) {
         /* lo <= bsf_expf(x) <= hi, and rounding is monotonic: r * r lies
          * between the squares of jump_a * lo and jump_a * hi, so expf only
@@ -663,6 +664,7 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
             return 0;
         }
     }
+#endif
     r = p->jump_a * bsf_expf(x);
     return d2 <= r * r;
 }

@@ -1,15 +1,26 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf_linalg.h"
+#include "bsf_math.h"
 
 #include <math.h>
 
 static int finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 /* In-place banded Cholesky of factor (holding A + loading * I). Returns 0 on
  * a bad pivot. */
+/* The written-out half-bandwidth-2 paths below are for speed only: a
+ * size-optimised build (-Os) leaves them out and runs the general loops,
+ * which do the same arithmetic in the same order (same results). */
+#if !defined(__OPTIMIZE_SIZE__)
+#define BSF_LINALG_BW2 1
+#else
+#define BSF_LINALG_BW2 0
+#endif
+
+#if BSF_LINALG_BW2
 /* band_cholesky for half-bandwidth 2 (every PDM solve), written out: row i
  * holds (L[i][i], L[i][i-1], L[i][i-2]) at f[3i], f[3i+1], f[3i+2]. Same
  * arithmetic order and pivot test as the general loop. */
@@ -87,6 +98,7 @@ static bsf_status_t band_substitute_bw2(const float *f, size_t m, float *rx, flo
     }
     return BSF_OK;
 }
+#endif
 
 static int band_cholesky(float *f, size_t m, size_t bw, float loading)
 {
@@ -95,9 +107,11 @@ static int band_cholesky(float *f, size_t m, size_t bw, float loading)
     size_t j;
     size_t k;
 
+#if BSF_LINALG_BW2
     if (bw == 2u) {
         return band_cholesky_bw2(f, m, loading);
     }
+#endif
 
     for (i = 0; i < m; ++i) {
         const size_t j0 = i > bw ? i - bw : 0u;
@@ -163,9 +177,11 @@ bsf_status_t bsf_spd_band_solve2(const float *band, size_t m, size_t bw, float *
     if (!ok) {
         return BSF_ERR_NUMERIC;
     }
+#if BSF_LINALG_BW2
     if (bw == 2u) {
         return band_substitute_bw2(factor, m, rx, ry);
     }
+#endif
     {
         /* Forward substitution L z = b, then back substitution L^T x = z,
          * both right-hand sides in the same sweep. The results go to the

@@ -646,17 +646,32 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                     u_new = u_try;
                     nex = ex + du_try * (ux + 0.5f * du_try * c.uux);
                     ney = ey + du_try * (uy + 0.5f * du_try * c.uuy);
-                } else if ((span_new = span_of(t_new, fs, n_span, &u_new)) == c.span) {
-                    nb0 = c.k0 * (1.0f - u_new) * (1.0f - u_new);
-                    nb2 = c.k2 * u_new * u_new;
-                    nex = c.p1x + nb0 * c.ax + nb2 * c.bx - qx;
-                    ney = c.p1y + nb0 * c.ay + nb2 * c.by - qy;
                 } else {
-                    load_span(w->ctrl, n_span, span_new, &cn);
-                    nb0 = cn.k0 * (1.0f - u_new) * (1.0f - u_new);
-                    nb2 = cn.k2 * u_new * u_new;
-                    nex = cn.p1x + nb0 * cn.ax + nb2 * cn.bx - qx;
-                    ney = cn.p1y + nb0 * cn.ay + nb2 * cn.by - qy;
+#if defined(__OPTIMIZE_SIZE__)
+                    /* -Os: one copy of the evaluation, on span c or the new span */
+                    const span_coef_t *e = &c;
+                    if ((span_new = span_of(t_new, fs, n_span, &u_new)) != c.span) {
+                        load_span(w->ctrl, n_span, span_new, &cn);
+                        e = &cn;
+                    }
+                    nb0 = e->k0 * (1.0f - u_new) * (1.0f - u_new);
+                    nb2 = e->k2 * u_new * u_new;
+                    nex = e->p1x + nb0 * e->ax + nb2 * e->bx - qx;
+                    ney = e->p1y + nb0 * e->ay + nb2 * e->by - qy;
+#else
+                    if ((span_new = span_of(t_new, fs, n_span, &u_new)) == c.span) {
+                        nb0 = c.k0 * (1.0f - u_new) * (1.0f - u_new);
+                        nb2 = c.k2 * u_new * u_new;
+                        nex = c.p1x + nb0 * c.ax + nb2 * c.bx - qx;
+                        ney = c.p1y + nb0 * c.ay + nb2 * c.by - qy;
+                    } else {
+                        load_span(w->ctrl, n_span, span_new, &cn);
+                        nb0 = cn.k0 * (1.0f - u_new) * (1.0f - u_new);
+                        nb2 = cn.k2 * u_new * u_new;
+                        nex = cn.p1x + nb0 * cn.ax + nb2 * cn.bx - qx;
+                        ney = cn.p1y + nb0 * cn.ay + nb2 * cn.by - qy;
+                    }
+#endif
                 }
                 d = nex * nex + ney * ney;
                 if (d < best) {

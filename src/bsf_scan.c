@@ -17,7 +17,7 @@
 static int is_finite_f(float v)
 {
     /* NaN fails both comparisons; +-inf fails the second. */
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 int bsf_range_is_valid(float r, float range_min, float range_max)
@@ -108,11 +108,16 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
     /* every beam angle within bsf_sincosf_bounded's domain (a margin of
      * 384 rad covers the rounding of this bound and of the angles): one loop
      * without the checks only huge angles need, chosen once per scan */
+#if !defined(__OPTIMIZE_SIZE__)
     if (fabsf(scan->angle_min) + (float)scan->count * fabsf(scan->angle_increment) <= 16000.0f) {
         n_valid = fill_points(scan, out, 1);
     } else {
         n_valid = fill_points(scan, out, 0);
     }
+#else
+    /* -Os: the out-of-line functions for every angle (the same bits) */
+    n_valid = fill_points(scan, out, 0);
+#endif
     out->count = scan->count;
     out->n_valid = n_valid;
     out->angle_min = scan->angle_min;

@@ -9,7 +9,7 @@
 
 static int is_finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 bsf_sved_params_t bsf_sved_params_paper(void)
@@ -188,6 +188,17 @@ static void beam_radius_start(beam_radius_t *r, float rho)
 static int beam_within_slow(beam_radius_t *r, float d2)
 {
     const float x = r->two_b * r->rho;
+#if defined(__OPTIMIZE_SIZE__)
+    /* -Os: the threshold itself, without the bounds that spare expf (same
+     * answers: the bounds only decide early) */
+    {
+        const float lower = r->a2 * bsf_exp_taylor4(x);
+        const float exact = r->a2 * bsf_expf(x);
+        r->limit = lower > exact ? lower : exact;
+        r->have_limit = 1;
+    }
+    return d2 <= r->limit;
+#else
     if (!r->have_bounds) {
         r->lower = r->a2 * bsf_exp_taylor4(x);
         r->upper = HUGE_VALF; /* no upper bound */
@@ -211,6 +222,7 @@ static int beam_within_slow(beam_radius_t *r, float d2)
         r->have_limit = 1;
     }
     return d2 <= r->limit;
+#endif
 }
 
 /* Same answer as within_radius(d2, r->rho, ...): past a2 and inside the cap,

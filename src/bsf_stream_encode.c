@@ -340,6 +340,7 @@ ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
     field_u(w, b, costing, u & 0xFFFFu, 16u);
 }
 
+#if !defined(__OPTIMIZE_SIZE__) /* the direct writer only (job_direct) */
 /* Bits written so far. */
 static size_t writer_bits(const writer_t *w, const uint8_t *start)
 {
@@ -354,6 +355,7 @@ static void writer_flush(writer_t *w)
         put_word(w, &w->b, w->b.acc << w->b.room);
     }
 }
+#endif
 
 /* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
 static void writer_end_stream(writer_t *w)
@@ -374,7 +376,7 @@ static void writer_end_stream(writer_t *w)
 
 static int is_finite_f(float v)
 {
-    return v == v && fabsf(v) <= 3.402823466e38f;
+    return bsf_finite_bits(v);
 }
 
 /* Nearest multiple of step, in steps: floor(v / step + 0.5); 0 when v is
@@ -968,26 +970,41 @@ static void metadata_payload(writer_t *w, int costing, const bsf_metadata_t *m, 
 
 /* ---- Both frame types: plan, then write to a buffer or a sink ------------ */
 
-typedef struct {
+typedef struct job job_t;
+
+/* What differs between the frame types, as functions that the job calls:
+ * a firmware that encodes only features frames links no metadata code. */
+typedef bsf_status_t (*job_plan_fn)(job_t *job);
+typedef void (*job_payload_fn)(writer_t *w, int costing, job_t *job);
+
+struct job {
     const bsf_frame_info_t *info; /* features frame: info and res */
     const bsf_result_t *res;
     const bsf_metadata_t *meta; /* or a metadata frame */
     uint32_t *table;            /* features frame: VALUE_TABLE entries */
+    job_plan_fn plan_fn;        /* checks the input, bounds the payload (and chooses the orders) */
+    job_payload_fn payload_fn;  /* the payload through w, written or counted */
     plan_t plan;
-} job_t;
+};
 
 /* The payload through w, written or counted (the plan checked the input). */
 static void job_payload(writer_t *w, int costing, job_t *job)
 {
-    if (job->meta != NULL) {
-        metadata_payload(w, costing, job->meta, job->plan.step_code);
+    job->payload_fn(w, costing, job);
+}
+
+static void frame_job_payload(writer_t *w, int costing, job_t *job)
+{
+    if (costing) {
+        frame_payload_cost(w, &job->plan, job->info, job->res, job->table);
     } else {
-        if (costing) {
-            frame_payload_cost(w, &job->plan, job->info, job->res, job->table);
-        } else {
-            frame_payload_write(w, &job->plan, job->info, job->res, job->table);
-        }
+        frame_payload_write(w, &job->plan, job->info, job->res, job->table);
     }
+}
+
+static void metadata_job_payload(writer_t *w, int costing, job_t *job)
+{
+    metadata_payload(w, costing, job->meta, job->plan.step_code);
 }
 
 /* The exact payload bits: a costing run (a call of its own, so that its
@@ -1000,20 +1017,26 @@ ENC_NOINLINE uint32_t job_bits(job_t *job)
     return w.b.bits;
 }
 
-/* Checks the input and bounds the payload's size (and chooses the orders). */
-static bsf_status_t job_plan(job_t *job)
+static bsf_status_t frame_job_plan(job_t *job)
 {
-    bsf_status_t st;
-    memset(&job->plan, 0, sizeof job->plan);
-    if (job->meta == NULL) {
-        st = check_frame(job->info, job->res, &job->plan);
-        return st != BSF_OK ? st : plan_frame(job->info, job->res, job->table, &job->plan);
-    }
-    st = check_metadata(job->meta, &job->plan.step_code);
+    const bsf_status_t st = check_frame(job->info, job->res, &job->plan);
+    return st != BSF_OK ? st : plan_frame(job->info, job->res, job->table, &job->plan);
+}
+
+static bsf_status_t metadata_job_plan(job_t *job)
+{
+    const bsf_status_t st = check_metadata(job->meta, &job->plan.step_code);
     if (st == BSF_OK) {
         job->plan.max_bits = job_bits(job); /* exact */
     }
     return st;
+}
+
+/* Checks the input and bounds the payload's size (and chooses the orders). */
+static bsf_status_t job_plan(job_t *job)
+{
+    memset(&job->plan, 0, sizeof job->plan);
+    return job->plan_fn(job);
 }
 
 static void job_stream(job_t *job, stream_t *s)
@@ -1024,6 +1047,7 @@ static void job_stream(job_t *job, stream_t *s)
     writer_end_stream(&w);
 }
 
+#if !defined(__OPTIMIZE_SIZE__)
 /* COBS bound of a body of n bytes, with the delimiter. */
 static size_t frame_bound(size_t body)
 {
@@ -1073,6 +1097,7 @@ static bsf_status_t job_direct(job_t *job, uint8_t *buf, size_t *out_len)
     *out_len = len + 1u;
     return BSF_OK;
 }
+#endif
 
 static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out_len)
 {
@@ -1083,10 +1108,14 @@ static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out
         *out_len = 0u;
         return st;
     }
+#if !defined(__OPTIMIZE_SIZE__)
+    /* The direct writer is for speed only: a size-optimised build (-Os)
+     * leaves it out and always streams, which gives the same frame. */
     if (buf != NULL &&
         cap >= frame_bound(((size_t)job->plan.max_bits + 7u) / 8u + BSF_FRAME_CRC_SIZE)) {
         return job_direct(job, buf, out_len);
     }
+#endif
     body = ((size_t)job_bits(job) + 7u) / 8u + BSF_FRAME_CRC_SIZE;
     if (body < 254u) {
         *out_len = body + 2u; /* exact: no block reaches 254 bytes */
@@ -1157,6 +1186,8 @@ bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *
     job.info = info;
     job.res = result;
     job.table = table;
+    job.plan_fn = frame_job_plan;
+    job.payload_fn = frame_job_payload;
     return job_encode(&job, buf, cap, out_len);
 }
 
@@ -1176,6 +1207,8 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
     job.info = info;
     job.res = result;
     job.table = table;
+    job.plan_fn = frame_job_plan;
+    job.payload_fn = frame_job_payload;
     return job_encode_sink(&job, work, sink, ctx, written);
 }
 
@@ -1187,6 +1220,8 @@ bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t c
     }
     memset(&job, 0, sizeof job);
     job.meta = m;
+    job.plan_fn = metadata_job_plan;
+    job.payload_fn = metadata_job_payload;
     return job_encode(&job, buf, cap, out_len);
 }
 
@@ -1202,5 +1237,7 @@ bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const bsf_metadata_t 
     }
     memset(&job, 0, sizeof job);
     job.meta = m;
+    job.plan_fn = metadata_job_plan;
+    job.payload_fn = metadata_job_payload;
     return job_encode_sink(&job, work, sink, ctx, written);
 }
