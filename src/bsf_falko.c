@@ -541,10 +541,13 @@ static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p
          * neigh_radius's cap), for x >= 80 and for radii so small that their
          * squares leave float's normal range (lo < 1e-15) the exact path
          * decides. */
-        const int32_t apex = -((pts->valid[i] != 0u) & (float_bits(rho) >= min_range_bits) &
-                               (float_bits(rho) <= max_range_bits));
-        const int32_t cheap = -((x_bits < 0x42a00000) & (float_bits(hi) < float_bits(rho)) &
-                                (float_bits(lo) >= float_bits(1e-15f)));
+        /* Each comparison as an int (0 or 1), combined without branches. */
+        const int32_t apex =
+            -((int32_t)(pts->valid[i] != 0u) & (int32_t)(float_bits(rho) >= min_range_bits) &
+              (int32_t)(float_bits(rho) <= max_range_bits));
+        const int32_t cheap =
+            -((int32_t)(x_bits < 0x42a00000) & (int32_t)(float_bits(hi) < float_bits(rho)) &
+              (int32_t)(float_bits(lo) >= float_bits(1e-15f)));
         const int32_t near = -(float_bits(hi) <= float_bits(0.8f * rho));
         /* Selections by masks: conversions inside a branch would not run
          * four at a time. */
