@@ -158,7 +158,13 @@ int main(void)
     FILE *probe;
     size_t d;
     bsf_test_shared_dir(shared_dir, sizeof shared_dir);
-    snprintf(data_dir, sizeof data_dir, "%s/data", shared_dir);
+    {
+        const int len = snprintf(data_dir, sizeof data_dir, "%s/data", shared_dir);
+        if (len < 0 || (size_t)len >= sizeof data_dir) {
+            printf("shared data path too long: %s/data\n", shared_dir);
+            return 1;
+        }
+    }
     for (d = 0; d < 4u; ++d) {
         snprintf(probe_path, sizeof probe_path, "%s/%s", data_dir, datasets[d].file);
         probe = fopen(probe_path, "rb");
