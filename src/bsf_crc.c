@@ -45,25 +45,16 @@ static const uint32_t crc32c_nibble[16] = {0x00000000u, 0x105EC76Fu, 0x20BD8EDEu
                                            0x82F63B78u, 0x92A8FC17u, 0xA24BB5A6u, 0xB21572C9u,
                                            0xC38D26C4u, 0xD3D3E1ABu, 0xE330A81Au, 0xF36E6F75u};
 
-uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len)
+/* The register after taking in len bytes, two nibble steps per byte. */
+static uint32_t crc32c_soft(uint32_t reg, const uint8_t *data, size_t len)
 {
     size_t i;
-    uint32_t reg = ~crc;
-
-    if (data == NULL) {
-        return crc;
-    }
-#ifdef BSF_CRC32C_SSE42
-    if (__builtin_cpu_supports("sse4.2")) {
-        return ~crc32c_sse42(reg, data, len);
-    }
-#endif
     for (i = 0; i < len; ++i) {
         reg ^= data[i];
         reg = (reg >> 4) ^ crc32c_nibble[reg & 0x0Fu];
         reg = (reg >> 4) ^ crc32c_nibble[reg & 0x0Fu];
     }
-    return ~reg;
+    return reg;
 }
 #else
 /* crc32c_byte[i]: the register after eight reflected steps from i. */
@@ -107,18 +98,9 @@ static const uint32_t crc32c_byte[256] = {
     0xBE2DA0A5u, 0x4C4623A6u, 0x5F16D052u, 0xAD7D5351u,
 };
 
-uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len)
+/* The register after taking in len bytes, one table step per byte. */
+static uint32_t crc32c_soft(uint32_t reg, const uint8_t *data, size_t len)
 {
-    uint32_t reg = ~crc;
-
-    if (data == NULL) {
-        return crc;
-    }
-#ifdef BSF_CRC32C_SSE42
-    if (__builtin_cpu_supports("sse4.2")) {
-        return ~crc32c_sse42(reg, data, len);
-    }
-#endif
     /* four bytes at a time: the register takes them in at once (the first
      * byte in its low 8 bits, as the reflected CRC shifts right), then four
      * table steps without a load of data between them */
@@ -136,6 +118,19 @@ uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len)
         reg = (reg >> 8) ^ crc32c_byte[(reg ^ *data++) & 0xFFu];
         --len;
     }
-    return ~reg;
+    return reg;
 }
 #endif
+
+uint32_t bsf_crc32c(uint32_t crc, const uint8_t *data, size_t len)
+{
+    if (data == NULL) {
+        return crc;
+    }
+#ifdef BSF_CRC32C_SSE42
+    if (__builtin_cpu_supports("sse4.2")) {
+        return ~crc32c_sse42(~crc, data, len);
+    }
+#endif
+    return ~crc32c_soft(~crc, data, len);
+}

@@ -88,42 +88,25 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
     }
     switch (p->method) {
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_FALKO
-    case BSF_METHOD_FALKO_SVED_PDM:
-        st = bsf_falko_params_check(&p->falko);
-        if (st == BSF_OK) {
-            st = bsf_sved_params_check(&p->sved);
-        }
-        if (st == BSF_OK) {
-            st = bsf_pdm_params_check(&p->pdm);
-        }
-        break;
+    case BSF_METHOD_FALKO_SVED_PDM: st = bsf_falko_params_check(&p->falko); break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    case BSF_METHOD_LC_SVED_PDM:
-        st = bsf_lc_params_check(&p->lc);
-        if (st == BSF_OK) {
-            st = bsf_sved_params_check(&p->sved);
-        }
-        if (st == BSF_OK) {
-            st = bsf_pdm_params_check(&p->pdm);
-        }
-        break;
+    case BSF_METHOD_LC_SVED_PDM: st = bsf_lc_params_check(&p->lc); break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
-    case BSF_METHOD_BID_SVED_PDM:
-        st = bsf_bid_params_check(&p->bid);
-        if (st == BSF_OK) {
-            st = bsf_sved_params_check(&p->sved);
-        }
-        if (st == BSF_OK) {
-            st = bsf_pdm_params_check(&p->pdm);
-        }
-        break;
+    case BSF_METHOD_BID_SVED_PDM: st = bsf_bid_params_check(&p->bid); break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_RPOS
     case BSF_METHOD_RPOS_LSBA: st = bsf_rpos_params_check(&p->rpos); break;
 #endif
     default: return BSF_ERR_PARAM;
+    }
+    /* Every method but RPOS-LSBA segments with SVED and fits with PDM. */
+    if (st == BSF_OK && p->method != BSF_METHOD_RPOS_LSBA) {
+        st = bsf_sved_params_check(&p->sved);
+        if (st == BSF_OK) {
+            st = bsf_pdm_params_check(&p->pdm);
+        }
     }
     /* A NULL inside a valid struct cannot happen, so any failure is a value. */
     return st == BSF_OK ? BSF_OK : BSF_ERR_PARAM;

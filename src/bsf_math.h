@@ -56,14 +56,20 @@ static inline float bsf_floorf(float x)
     return x; /* integral already, infinite or NaN */
 }
 
+/* The binary32 bit pattern of v (memcpy: no aliasing questions). */
+static inline uint32_t bsf_float_bits(float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    return bits;
+}
+
 /* Whether v is finite (not NaN, not +-inf): its exponent bits are not all
  * ones. The same answer as v == v && fabsf(v) <= FLT_MAX, in fewer
  * instructions on Cortex-M. */
 static inline int bsf_finite_bits(float v)
 {
-    uint32_t bits;
-    memcpy(&bits, &v, sizeof bits);
-    return (bits & 0x7F800000u) != 0x7F800000u;
+    return (bsf_float_bits(v) & 0x7F800000u) != 0x7F800000u;
 }
 
 /* Internals of bsf_sinf, bsf_cosf and bsf_sincosf, inline so that a hot loop

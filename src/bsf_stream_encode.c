@@ -326,16 +326,9 @@ ENC_INLINE void field_eg64(writer_t *w, bits_t *b, int costing, uint64_t v, unsi
     }
 }
 
-static uint32_t float_bits(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return u;
-}
-
 ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
 {
-    const uint32_t u = float_bits(v);
+    const uint32_t u = bsf_float_bits(v);
     field_u(w, b, costing, u >> 16, 16u);
     field_u(w, b, costing, u & 0xFFFFu, 16u);
 }
@@ -1174,6 +1167,18 @@ void bsf_frame_info_init(bsf_frame_info_t *info)
     }
 }
 
+/* A features-frame job over result, quantising into table. */
+static void frame_job_init(job_t *job, const bsf_frame_info_t *info, const bsf_result_t *result,
+                           uint32_t *table)
+{
+    memset(job, 0, sizeof *job);
+    job->info = info;
+    job->res = result;
+    job->table = table;
+    job->plan_fn = frame_job_plan;
+    job->payload_fn = frame_job_payload;
+}
+
 bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
                               uint8_t *buf, size_t cap, size_t *out_len)
 {
@@ -1182,12 +1187,7 @@ bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *
     if (info == NULL || result == NULL || out_len == NULL) {
         return BSF_ERR_ARG;
     }
-    memset(&job, 0, sizeof job);
-    job.info = info;
-    job.res = result;
-    job.table = table;
-    job.plan_fn = frame_job_plan;
-    job.payload_fn = frame_job_payload;
+    frame_job_init(&job, info, result, table);
     return job_encode(&job, buf, cap, out_len);
 }
 
@@ -1203,12 +1203,7 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
     if (work == NULL || info == NULL || result == NULL || sink == NULL) {
         return BSF_ERR_ARG;
     }
-    memset(&job, 0, sizeof job);
-    job.info = info;
-    job.res = result;
-    job.table = table;
-    job.plan_fn = frame_job_plan;
-    job.payload_fn = frame_job_payload;
+    frame_job_init(&job, info, result, table);
     return job_encode_sink(&job, work, sink, ctx, written);
 }
 
