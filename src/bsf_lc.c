@@ -267,10 +267,9 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
 }
 
 /* From position pos, step (-1 or +1) towards stop while the next point is
- * within sqrt(side2) of the apex ap, storing the points relative to the
- * apex; returns the last position reached. */
-static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2,
-                        bsf_point_t ap)
+ * within sqrt(side2) of the apex (the origin c->o), storing the points
+ * relative to the apex; returns the last position reached. */
+static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
 {
     /* Locals: the stores into rel[] could alias *c as far as the compiler
      * knows. */
@@ -279,7 +278,6 @@ static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, fl
     bsf_point_t *rel = c->rel;
     const float ox = c->o.x;
     const float oy = c->o.y;
-    const int ap_zero = ap.x == 0.0f && ap.y == 0.0f; /* always, for finite points */
     while (pos != stop) {
         const size_t next = step > 0 ? pos + 1u : pos - 1u;
         bsf_point_t q = pt[run[next]];
@@ -287,8 +285,9 @@ static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, fl
         q.x -= ox;
         q.y -= oy;
         rel[next] = q;
-        /* x - 0 is x: dist2(q, ap) without the subtractions */
-        d2 = ap_zero ? q.x * q.x + q.y * q.y : dist2(q, ap);
+        /* The apex relative to itself is (0, 0), and x - 0 is x: this is
+         * dist2(q, apex) without the subtractions. */
+        d2 = q.x * q.x + q.y * q.y;
         if (!(d2 <= side2)) {
             break;
         }
@@ -324,17 +323,17 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
-    a0 = walk_side(c, apex, lo, -1, side2, ap);
-    b1 = walk_side(c, apex, hi, 1, side2, ap);
+    a0 = walk_side(c, apex, lo, -1, side2);
+    b1 = walk_side(c, apex, hi, 1, side2);
     /* A side cut short by a neighbouring split reaches past it: noise often
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
     if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
-        a0 = walk_side(c, a0, 0u, -1, side2, ap);
+        a0 = walk_side(c, a0, 0u, -1, side2);
     }
     if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
-        b1 = walk_side(c, b1, m - 1u, 1, side2, ap);
+        b1 = walk_side(c, b1, m - 1u, 1, side2);
     }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
