@@ -77,8 +77,10 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
-    /* block summaries of the current run, or NULL (short runs, -Os) */
+#if !defined(__OPTIMIZE_SIZE__)
+    /* block summaries of the current run, or NULL (short runs) */
     const bsf_lc_block_t *blk;
+#endif
 } lc_ctx_t;
 
 /* Run point pos relative to the origin, also stored for the fits: judge's
@@ -844,8 +846,8 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
-    c->blk = NULL;
 #if !defined(__OPTIMIZE_SIZE__)
+    c->blk = NULL;
     if (m >= LC_BLOCK_MIN_RUN) {
         build_blocks(c->pts, w->run, m, w->block);
         c->blk = w->block;
@@ -1012,7 +1014,9 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.y = 0.0f;
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
+#if !defined(__OPTIMIZE_SIZE__)
     c.blk = NULL;
+#endif
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
         if (!close_run && !pts->valid[i]) {
