@@ -273,7 +273,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
 /* From position pos, step (-1 or +1) towards stop while the next point is
  * within sqrt(side2) of the apex (the origin c->o), storing the points
  * relative to the apex; returns the last position reached. */
-static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
+static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
 {
     /* Locals: the stores into rel[] could alias *c as far as the compiler
      * knows. */
@@ -313,6 +313,19 @@ static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, fl
 #define LC_B ((size_t)BSF_LC_BLOCK)
 /* float's unit roundoff, 2^-24 */
 #define LC_ROUNDOFF 5.9604645e-08f
+
+/* Whether a side of max_side holds at least four whole blocks of the run
+ * (its length measured block by block, which smooths the noise): only then
+ * do the summaries pay for themselves. */
+static int dense_run(const bsf_points_t *pts, const uint16_t *run, size_t m, float max_side)
+{
+    float path = 0.0f;
+    size_t i;
+    for (i = LC_B; i < m; i += LC_B) {
+        path += sqrtf(dist2(pts->pt[run[i]], pts->pt[run[i - LC_B]]));
+    }
+    return (float)m * max_side >= 4.0f * (float)LC_B * path;
+}
 
 /* Bounding box and sums of the points of each block of the run (positions
  * k * LC_B on; the last block may be partial). */
@@ -558,7 +571,7 @@ static int surely_no_turn(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1)
 #endif
 
 /* walk_side, by blocks when the run has them. */
-static size_t walk(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
+static inline size_t walk(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
 {
 #if !defined(__OPTIMIZE_SIZE__)
     if (c->blk != NULL) {
@@ -848,7 +861,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
 #if !defined(__OPTIMIZE_SIZE__)
     c->blk = NULL;
-    if (m >= LC_BLOCK_MIN_RUN) {
+    if (m >= LC_BLOCK_MIN_RUN && dense_run(c->pts, w->run, m, c->p->max_side)) {
         build_blocks(c->pts, w->run, m, w->block);
         c->blk = w->block;
     }
