@@ -82,7 +82,7 @@ typedef struct {
     float ext2;           /**< squared diagonal of the box (slightly enlarged) */
 } bsf_lc_block_t;
 
-/** Scratch memory of bsf_lc_detect (about 23 bytes per beam; in the
+/** Scratch memory of bsf_lc_detect (about 24 bytes per beam; in the
  *  extractor it shares its space with the larger BID scratch). */
 typedef struct {
     uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
