@@ -314,7 +314,7 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
 /* float's unit roundoff, 2^-24 */
 #define LC_ROUNDOFF 5.9604645e-08f
 
-/* Whether a side of max_side holds at least four whole blocks of the run
+/* Whether a side of max_side holds at least eight whole blocks of the run
  * (its length measured block by block, which smooths the noise): only then
  * do the summaries pay for themselves. */
 static int dense_run(const bsf_points_t *pts, const uint16_t *run, size_t m, float max_side)
@@ -324,7 +324,7 @@ static int dense_run(const bsf_points_t *pts, const uint16_t *run, size_t m, flo
     for (i = LC_B; i < m; i += LC_B) {
         path += sqrtf(dist2(pts->pt[run[i]], pts->pt[run[i - LC_B]]));
     }
-    return (float)m * max_side >= 4.0f * (float)LC_B * path;
+    return (float)m * max_side >= 8.0f * (float)LC_B * path;
 }
 
 /* Bounding box and sums of the points of each block of the run (positions
