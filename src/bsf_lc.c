@@ -78,8 +78,10 @@ typedef struct {
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
 #if !defined(__OPTIMIZE_SIZE__)
-    /* block summaries of the current run, or NULL (short runs) */
-    const bsf_lc_block_t *blk;
+    /* room for block summaries of the current run, or NULL (short runs);
+     * built when a judge first needs them */
+    bsf_lc_block_t *blk;
+    int blk_built;
 #endif
 } lc_ctx_t;
 
@@ -313,19 +315,6 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
 #define LC_B ((size_t)BSF_LC_BLOCK)
 /* float's unit roundoff, 2^-24 */
 #define LC_ROUNDOFF 5.9604645e-08f
-
-/* Whether a side of max_side holds at least eight whole blocks of the run
- * (its length measured block by block, which smooths the noise): only then
- * do the summaries pay for themselves. */
-static int dense_run(const bsf_points_t *pts, const uint16_t *run, size_t m, float max_side)
-{
-    float path = 0.0f;
-    size_t i;
-    for (i = LC_B; i < m; i += LC_B) {
-        path += sqrtf(dist2(pts->pt[run[i]], pts->pt[run[i - LC_B]]));
-    }
-    return (float)m * max_side >= 8.0f * (float)LC_B * path;
-}
 
 /* Bounding box and sums of the points of each block of the run (positions
  * k * LC_B on; the last block may be partial). */
@@ -568,15 +557,35 @@ static int surely_no_turn(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1)
     cross = da.dx * db.dy - da.dy * db.dx;
     return fabsf(cross) + 2.0f * (da.phi + db.phi) + 1e-5f < c->sin_min_turn;
 }
+
+/* Whether the run is dense around the apex: the points a block away lie
+ * within max_side / 8, so a side holds about eight whole blocks or more
+ * (below that the bound rarely decides and the exact fits are cheap). */
+static int dense_at(const lc_ctx_t *c, size_t apex, size_t m, float side2)
+{
+    const bsf_point_t *pt = c->pts->pt;
+    const bsf_point_t a = pt[c->run[apex]];
+    const float near2 = side2 * (1.0f / 64.0f);
+    if (apex >= LC_B && !(dist2(pt[c->run[apex - LC_B]], a) <= near2)) {
+        return 0;
+    }
+    if (apex + LC_B < m && !(dist2(pt[c->run[apex + LC_B]], a) <= near2)) {
+        return 0;
+    }
+    return 1;
+}
 #endif
 
-/* walk_side, by blocks when the run has them. */
-static inline size_t walk(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
+/* walk_side, by blocks when the judge uses them. */
+static inline size_t walk(const lc_ctx_t *c, int blocks, size_t pos, size_t stop, int step,
+                          float side2)
 {
 #if !defined(__OPTIMIZE_SIZE__)
-    if (c->blk != NULL) {
+    if (blocks) {
         return walk_side_blocks(c, pos, stop, step, side2);
     }
+#else
+    (void)blocks;
 #endif
     return walk_side(c, pos, stop, step, side2);
 }
@@ -602,23 +611,33 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     lc_enough_t enough;
     bsf_point_t x;
     bsf_point_t ap;
+    int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
         return 0;
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
-    a0 = walk(c, apex, lo, -1, side2);
-    b1 = walk(c, apex, hi, 1, side2);
+#if !defined(__OPTIMIZE_SIZE__)
+    if (c->blk != NULL && dense_at(c, apex, m, side2)) {
+        if (!c->blk_built) {
+            build_blocks(c->pts, c->run, m, c->blk);
+            c->blk_built = 1;
+        }
+        blocks = 1;
+    }
+#endif
+    a0 = walk(c, blocks, apex, lo, -1, side2);
+    b1 = walk(c, blocks, apex, hi, 1, side2);
     /* A side cut short by a neighbouring split reaches past it: noise often
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
     if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
-        a0 = walk(c, a0, 0u, -1, side2);
+        a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
     if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
-        b1 = walk(c, b1, m - 1u, 1, side2);
+        b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
@@ -630,7 +649,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
 #if !defined(__OPTIMIZE_SIZE__)
-    if (c->blk != NULL) {
+    if (blocks) {
         /* every path from here to the turn test ends in "no corner" */
         if (surely_no_turn(c, a0, apex, b1)) {
             return 0;
@@ -861,8 +880,8 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
 #if !defined(__OPTIMIZE_SIZE__)
     c->blk = NULL;
-    if (m >= LC_BLOCK_MIN_RUN && dense_run(c->pts, w->run, m, c->p->max_side)) {
-        build_blocks(c->pts, w->run, m, w->block);
+    c->blk_built = 0;
+    if (m >= LC_BLOCK_MIN_RUN) {
         c->blk = w->block;
     }
 #endif
@@ -1029,6 +1048,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.sin_min_turn = bsf_sinf(p->min_turn);
 #if !defined(__OPTIMIZE_SIZE__)
     c.blk = NULL;
+    c.blk_built = 0;
 #endif
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
