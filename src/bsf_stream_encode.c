@@ -7,6 +7,11 @@
 #include "bsf_math.h"
 #include "bsf_wire.h"
 
+#if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
+    !defined(BSF_ENC_PORTABLE)
+#include <emmintrin.h>
+#endif
+
 /*
  * How a features frame is made (two runs over the result, docs/PERFORMANCE.md):
  *
@@ -389,12 +394,35 @@ ENC_INLINE int quantise(float v, float step, int32_t *q)
     return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
 }
 
+#if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
+    !defined(BSF_ENC_PORTABLE)
+/* Both coordinates at once with the same IEEE single operations as
+ * quantise (divide, add, truncate, compare), so the same q and verdict. */
+ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
+{
+    const __m128 r =
+        _mm_add_ps(_mm_div_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)&p)),
+                              _mm_set1_ps(step)),
+                   _mm_set1_ps(0.5f));
+    const __m128 in_range = _mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), r),
+                                         _mm_set1_ps((float)BSF_QUANT_MAX_STEPS + 1.0f));
+    const __m128i t = _mm_cvttps_epi32(r);
+    /* floor: one lower where the truncation rounded up (a negative r with a fraction) */
+    const __m128i fl = _mm_add_epi32(t, _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(t), r)));
+    const __m128i above_min =
+        _mm_cmpgt_epi32(fl, _mm_set1_epi32(-(int32_t)BSF_QUANT_MAX_STEPS - 1));
+    q[0] = _mm_cvtsi128_si32(fl);
+    q[1] = _mm_cvtsi128_si32(_mm_shuffle_epi32(fl, 1));
+    return (_mm_movemask_ps(_mm_and_ps(in_range, _mm_castsi128_ps(above_min))) & 3) == 3;
+}
+#else
 ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
 {
     const int ok_x = quantise(p.x, step, &q[0]);
     const int ok_y = quantise(p.y, step, &q[1]);
     return ok_x && ok_y;
 }
+#endif
 
 /* ---- Control point values ------------------------------------------------ */
 
