@@ -172,7 +172,9 @@ typedef uint32_t bsf_wire_eg_count_t;
 typedef struct {
     bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
     bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    uint32_t or_all; /* OR of the values: its bit length is the largest L */
+    uint32_t or_all;  /* OR of the values: its bit length is the largest L */
+    uint32_t n;       /* values */
+    uint32_t sum_len; /* sum of their L */
 } bsf_wire_eg_tally_t;
 
 /* One value v < 2^26. */
@@ -184,6 +186,8 @@ static inline void bsf_wire_eg_tally_add32(bsf_wire_eg_tally_t *t, uint32_t v)
     t->n_len[len] += 1u;
     t->n_below[bsf_wire_bitlen31(v ^ ones)] += 1u;
     t->or_all |= v;
+    t->n += 1u;
+    t->sum_len += len;
 }
 
 static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
@@ -200,19 +204,11 @@ static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
  * all L and T(k) = T(k - 1) + A(k - 1).
  */
 
-/* The number of values and the sum of their L, up to the largest L. */
+/* The number of values and the sum of their L (kept as they are tallied). */
 static inline uint32_t bsf_wire_eg_tally_sums(const bsf_wire_eg_tally_t *t, uint32_t *sum_len)
 {
-    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
-    uint32_t n = t->n_len[0];
-    uint32_t sum = 0;
-    unsigned len;
-    for (len = 1; len <= max_len; ++len) {
-        n += t->n_len[len];
-        sum += len * t->n_len[len];
-    }
-    *sum_len = sum;
-    return n;
+    *sum_len = t->sum_len;
+    return t->n;
 }
 
 /* cost[k] for k = 0..k_max (<= 25): total bits of the tallied values at order k. */
