@@ -576,7 +576,49 @@ typedef struct {
     uint32_t adj[BSF_WIRE_N_CLASSES];
 } orders_t;
 
+/* One value's code at its class's order, from its c = v + 2^k and lg = floor(log2(c)). */
+ENC_INLINE void put_value_code(writer_t *w, bits_t *b, uint32_t c, unsigned lg, unsigned len)
+{
+    if (len < 32u) {
+        put_bits(w, b, c, len);
+    } else {
+        put_bits(w, b, 0u, len - lg - 1u);
+        put_bits(w, b, c, lg + 1u);
+    }
+}
+
 /* The values' codes at the frame's orders: the hot loop of the writing run. */
+#if !defined(__OPTIMIZE_SIZE__)
+/* Values come in pairs of one class (x, then y of a point): the two codes
+ * go out as one field when they fit in 31 bits together (the usual case),
+ * which saves a class lookup and a field per point. */
+ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
+                           const orders_t *ord)
+{
+    uint32_t i;
+    for (i = 0; i < n; i += 2u) {
+        const uint32_t v0 = values[i];
+        const unsigned cls = v0 >> VALUE_CLASS_SHIFT;
+        const uint32_t one = ord->one[cls];
+        const uint32_t adj = ord->adj[cls];
+        const uint32_t c0 = (v0 & VALUE_MASK) + one;
+        const uint32_t c1 = (values[i + 1u] & VALUE_MASK) + one;
+        const unsigned lg0 = log2_nz(c0);
+        const unsigned lg1 = log2_nz(c1);
+        const unsigned len0 = 2u * lg0 + adj;
+        const unsigned len1 = 2u * lg1 + adj;
+        if (costing) {
+            b->bits += len0 + len1;
+        } else if (len0 + len1 < 32u) {
+            /* c0 has lg0 + 1 <= len0 bits: the zero run and c0, then c1's */
+            put_bits(w, b, (c0 << len1) | c1, len0 + len1);
+        } else {
+            put_value_code(w, b, c0, lg0, len0);
+            put_value_code(w, b, c1, lg1, len1);
+        }
+    }
+}
+#else
 ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
                            const orders_t *ord)
 {
@@ -589,14 +631,12 @@ ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *
         const unsigned len = 2u * lg + ord->adj[cls];
         if (costing) {
             b->bits += len;
-        } else if (len < 32u) {
-            put_bits(w, b, c, len);
         } else {
-            put_bits(w, b, 0u, len - lg - 1u);
-            put_bits(w, b, c, lg + 1u);
+            put_value_code(w, b, c, lg, len);
         }
     }
 }
+#endif
 
 /* ---- Features frame ------------------------------------------------------ */
 
