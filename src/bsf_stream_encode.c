@@ -733,7 +733,6 @@ typedef struct {
 /* The checks that come before any feature. */
 static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t *res, plan_t *pl)
 {
-    uint32_t i;
     bsf_status_t st;
     if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS ||
         res->n_ctrl > (uint32_t)BSF_MAX_CTRL_POINTS) {
@@ -751,13 +750,7 @@ static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t
         return BSF_ERR_ARG;
     }
     pl->step = (float)pl->step_code * BSF_QUANT_STEP_UNIT;
-    pl->has_beams = info->has_geometry != 0u;
-    for (i = 0; i < res->n_features; ++i) {
-        if (res->features[i].first_beam > res->features[i].last_beam) {
-            pl->has_beams = 1;
-        }
-    }
-    pl->has_ext = pl->has_beams || res->stats.cut != 0u;
+    pl->has_beams = info->has_geometry != 0u; /* or a feature wraps: plan_frame */
     return BSF_OK;
 }
 
@@ -807,7 +800,11 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
             pl->n_cached = i + 1u;
         }
         sum_points += f->n_points;
+        if (f->first_beam > f->last_beam) {
+            pl->has_beams = 1;
+        }
     }
+    pl->has_ext = pl->has_beams || res->stats.cut != 0u;
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
