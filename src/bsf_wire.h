@@ -172,7 +172,6 @@ typedef uint32_t bsf_wire_eg_count_t;
 typedef struct {
     bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
     bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    uint32_t or_all;  /* OR of the values: its bit length is the largest L */
     uint32_t n;       /* values */
     uint32_t sum_len; /* sum of their L */
 } bsf_wire_eg_tally_t;
@@ -185,7 +184,6 @@ static inline void bsf_wire_eg_tally_add32(bsf_wire_eg_tally_t *t, uint32_t v)
     const uint32_t ones = (0xFFFFFFFFu >> 1) >> (31u - len);
     t->n_len[len] += 1u;
     t->n_below[bsf_wire_bitlen31(v ^ ones)] += 1u;
-    t->or_all |= v;
     t->n += 1u;
     t->sum_len += len;
 }
@@ -232,14 +230,12 @@ static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigne
  * The order 0..BSF_WIRE_K_CTRL_MAX with the fewest bits for the tallied
  * values (ties to the smaller order), and those bits in *bits. Every code
  * at order k takes at least k + 1 bits, so the search stops once n (k + 1)
- * reaches the best total; it never goes past the longest value's bit length
- * L either, since above L every order costs one bit per value more than the
- * one before.
+ * reaches the best total. That also ends it at most one order past the
+ * longest value's bit length L: at k >= L every code takes exactly k + 1
+ * bits, so order L costs n (L + 1), which the next floor n (L + 2) exceeds.
  */
 static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint32_t *bits)
 {
-    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
-    const unsigned k_top = max_len < BSF_WIRE_K_CTRL_MAX ? max_len : BSF_WIRE_K_CTRL_MAX;
     uint32_t sum;
     const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
     uint32_t a = t->n_len[0];
@@ -248,7 +244,7 @@ static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint
     uint32_t floor_bits = 2u * n;            /* n (k + 1) for the next k */
     unsigned best = 0;
     unsigned k;
-    for (k = 1; k <= k_top && floor_bits < best_cost; ++k) {
+    for (k = 1; k <= BSF_WIRE_K_CTRL_MAX && floor_bits < best_cost; ++k) {
         uint32_t cost;
         sum += a;
         a += t->n_len[k];
