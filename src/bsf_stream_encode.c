@@ -671,13 +671,12 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 /* A feature's own fields (not its points) within the result and the caps. */
-static int feature_ok(const bsf_result_t *res, const bsf_feature_t *f)
+static int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
 {
     const size_t n = f->n_ctrl;
-    const uint32_t n_beams = res->stats.n_beams;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
     return !(f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
-             (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
+             (size_t)f->ctrl_first + n > n_ctrl || f->first_beam >= beam_limit ||
              f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
              f->n_points > feature_span(f, n_beams) + 1u ||
              !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX));
@@ -787,6 +786,12 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
 {
     bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     const float step = pl->step;
+    /* locals, not loads through res and pl, which the table's stores may alias */
+    const uint32_t n_features = res->n_features;
+    const uint32_t n_beams = res->stats.n_beams;
+    const size_t n_ctrl = res->n_ctrl;
+    uint32_t n_cached = 0;
+    int wraps = 0;
     int32_t prev[2] = {0, 0};
     uint32_t used = 0; /* table entries of the leading features */
     uint32_t sum_points = 0;
@@ -794,15 +799,15 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
     unsigned cls;
 
     memset(tally, 0, sizeof tally);
-    for (i = 0; i < res->n_features; ++i) {
+    for (i = 0; i < n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
         uint32_t *head = table + used;
         uint32_t n_values;
         uint64_t mask;
-        if (!feature_ok(res, f)) {
+        if (!feature_ok(f, n_beams, n_ctrl)) {
             return BSF_ERR_ARG;
         }
-        if (pl->n_cached == i) {
+        if (n_cached == i) {
             pl->prev_resume[0] = prev[0];
             pl->prev_resume[1] = prev[1];
         }
@@ -812,24 +817,26 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
         if (n_values == 0u) {
             return BSF_ERR_ARG;
         }
-        if (pl->n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
+        if (n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
             head[0] = n_values / 2u;
             head[1] = (uint32_t)mask;
             head[2] = (uint32_t)(mask >> 32);
             used += VALUE_HEAD + n_values;
-            pl->n_cached = i + 1u;
+            n_cached = i + 1u;
         }
         sum_points += f->n_points;
-        if (f->first_beam > f->last_beam) {
-            pl->has_beams = 1;
-        }
+        wraps |= f->first_beam > f->last_beam;
+    }
+    pl->n_cached = n_cached;
+    if (wraps) {
+        pl->has_beams = 1;
     }
     pl->has_ext = pl->has_beams || res->stats.cut != 0u;
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
-    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * (uint32_t)res->n_features;
+    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * n_features;
     for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
         uint32_t bits;
         pl->k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);

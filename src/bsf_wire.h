@@ -172,8 +172,8 @@ typedef uint32_t bsf_wire_eg_count_t;
 typedef struct {
     bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
     bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    uint32_t n;       /* values */
-    uint32_t sum_len; /* sum of their L */
+    uint32_t n;                                    /* values */
+    uint32_t sum_len;                              /* sum of their L */
 } bsf_wire_eg_tally_t;
 
 /* One value v < 2^26. */
