@@ -104,11 +104,13 @@ static size_t cobs_short_in_place(uint8_t *buf, size_t n)
 {
     const uint64_t low7 = 0x7F7F7F7F7F7F7F7Full;
     uint8_t *code_at = buf;
-    size_t i = 1;
-    for (; i + 8u <= n + 1u; i += 8u) {
+    const uint8_t *const words_end = buf + 1 + (n & ~(size_t)7u);
+    const uint8_t *at = buf + 1;
+    size_t i;
+    for (; at != words_end; at += 8) {
         uint64_t w;
         uint64_t zeros;
-        memcpy(&w, buf + i, sizeof w);
+        memcpy(&w, at, sizeof w);
         zeros = ~(((w & low7) + low7) | w | low7);
         while (zeros != 0u) {
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                                 \
@@ -117,7 +119,7 @@ static size_t cobs_short_in_place(uint8_t *buf, size_t n)
 #else
             const unsigned byte = (unsigned)__builtin_clzll(zeros) / 8u;
 #endif
-            uint8_t *const zero = buf + i + byte;
+            uint8_t *const zero = buf + (at - buf) + byte;
             *code_at = (uint8_t)(zero - code_at);
             code_at = zero;
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                                 \
@@ -128,7 +130,7 @@ static size_t cobs_short_in_place(uint8_t *buf, size_t n)
 #endif
         }
     }
-    for (; i <= n; ++i) {
+    for (i = (size_t)(at - buf); i <= n; ++i) {
         if (buf[i] == 0u) {
             *code_at = (uint8_t)(buf + i - code_at);
             code_at = buf + i;
