@@ -518,7 +518,8 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
  * on the chord. Stores them in out (room for 2 n), tallies them when tally
  * is given (the planning run), and returns their number (2 per distinct
  * point), or 0 when a point cannot be represented or a flagged slot has no
- * equal partner; *mask gets bit j for distinct point j that is a vertex.
+ * equal partner; *mask gets the vertex mask in wire order: one bit per
+ * distinct point, point 0 the highest of the m (FORMAT.md section 3.2).
  */
 ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
                                    int32_t prev[2], uint32_t *out, bsf_wire_eg_tally_t *tally,
@@ -527,7 +528,6 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
     size_t s_a = 0;
     size_t c_a;
     uint32_t cnt = 0;
-    uint32_t j_a = 0; /* distinct index of anchor a */
     int32_t q_a[2];
 
     *mask = 0u;
@@ -558,13 +558,13 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
         if (!quantise_point(p[s_b], step, q_b)) {
             return 0u;
         }
-        j_a += k + 1u;
+        *mask <<= k + 1u; /* k + 1 <= 63: the k precision points and anchor b */
         c_a = 1u;
         if (vtx[s_b] != 0u) {
             if (!vertex_partner_ok(p, vtx, s_b, n, step, q_b)) {
                 return 0u;
             }
-            *mask |= (uint64_t)1u << j_a;
+            *mask |= 1u; /* anchor b: the mask's lowest bit for now */
             c_a = 2u;
         }
         cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
@@ -935,11 +935,13 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         if (mask == 0u) {
             field_u(w, &b, costing, 0u, 1u);
         } else {
-            uint32_t j;
+            uint32_t j = n_unique; /* bits left, the highest first */
             field_u(w, &b, costing, 1u, 1u);
-            for (j = 0; j < n_unique; ++j) {
-                field_u(w, &b, costing, (uint32_t)(mask >> j) & 1u, 1u);
+            while (j > 16u) {
+                j -= 16u;
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & 0xFFFFu, 16u);
             }
+            field_u(w, &b, costing, (uint32_t)mask & ((1u << j) - 1u), j);
         }
         field_eg(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
                  BSF_WIRE_K_GAP);
