@@ -947,7 +947,9 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                  BSF_WIRE_K_GAP);
         field_eg(w, &b, costing, span, BSF_WIRE_K_SPAN);
         field_eg(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        field_eg(w, &b, costing, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
+        /* rounded half up: the planning run checked 0 <= e_curve <= BSF_E_CURVE_MAX,
+         * so the conversion's truncation is the floor */
+        field_eg(w, &b, costing, (uint32_t)(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
                  BSF_WIRE_K_E_CURVE);
         put_values(w, &b, costing, values, 2u * n_unique, &ord);
         prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
