@@ -238,18 +238,16 @@ static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint
 {
     uint32_t sum;
     const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
-    uint32_t a = t->n_len[0];
-    uint32_t b = t->n_below[0];
-    uint32_t best_cost = 2u * (sum + b) - n; /* order 0 */
-    uint32_t floor_bits = 2u * n;            /* n (k + 1) for the next k */
+    uint32_t a = t->n_len[0];                       /* A(k - 1) */
+    uint32_t cost = 2u * (sum + t->n_below[0]) - n; /* order 0 */
+    uint32_t best_cost = cost;
+    uint32_t floor_bits = 2u * n; /* n (k + 1) for the next k */
     unsigned best = 0;
     unsigned k;
     for (k = 1; k <= BSF_WIRE_K_CTRL_MAX && floor_bits < best_cost; ++k) {
-        uint32_t cost;
-        sum += a;
+        /* cost(k) - cost(k - 1) = 2 (A(k - 1) + B(k) - B(k - 1)) - n */
+        cost += 2u * (a + t->n_below[k]) - n;
         a += t->n_len[k];
-        b += t->n_below[k];
-        cost = 2u * (sum + b) - floor_bits;
         if (cost < best_cost) {
             best_cost = cost;
             best = k;
