@@ -791,7 +791,6 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
     const uint32_t n_beams = res->stats.n_beams;
     const size_t n_ctrl = res->n_ctrl;
     uint32_t n_cached = 0;
-    int wraps = 0;
     int32_t prev[2] = {0, 0};
     uint32_t used = 0; /* table entries of the leading features */
     uint32_t sum_points = 0;
@@ -825,12 +824,11 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
             n_cached = i + 1u;
         }
         sum_points += f->n_points;
-        wraps |= f->first_beam > f->last_beam;
+        if (f->first_beam > f->last_beam) {
+            pl->has_beams = 1;
+        }
     }
     pl->n_cached = n_cached;
-    if (wraps) {
-        pl->has_beams = 1;
-    }
     pl->has_ext = pl->has_beams || res->stats.cut != 0u;
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
@@ -937,11 +935,11 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         } else {
             uint32_t j = n_unique; /* bits left, the highest first */
             field_u(w, &b, costing, 1u, 1u);
-            while (j > 16u) {
-                j -= 16u;
-                field_u(w, &b, costing, (uint32_t)(mask >> j) & 0xFFFFu, 16u);
-            }
-            field_u(w, &b, costing, (uint32_t)mask & ((1u << j) - 1u), j);
+            do {
+                const unsigned take = j > 16u ? 16u : j;
+                j -= take;
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
+            } while (j > 0u);
         }
         field_eg(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
                  BSF_WIRE_K_GAP);
