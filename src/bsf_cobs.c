@@ -105,7 +105,7 @@ static size_t cobs_short_in_place(uint8_t *buf, size_t n)
     const uint64_t low7 = 0x7F7F7F7F7F7F7F7Full;
     uint8_t *code_at = buf;
     const uint8_t *const words_end = buf + 1 + (n & ~(size_t)7u);
-    const uint8_t *at = buf + 1;
+    uint8_t *at = buf + 1;
     size_t i;
     for (; at != words_end; at += 8) {
         uint64_t w;
@@ -119,7 +119,7 @@ static size_t cobs_short_in_place(uint8_t *buf, size_t n)
 #else
             const unsigned byte = (unsigned)__builtin_clzll(zeros) / 8u;
 #endif
-            uint8_t *const zero = buf + (at - buf) + byte;
+            uint8_t *const zero = at + byte;
             *code_at = (uint8_t)(zero - code_at);
             code_at = zero;
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                                 \
