@@ -314,6 +314,34 @@ ENC_INLINE void field_eg(writer_t *w, bits_t *b, int costing, uint32_t v, unsign
     }
 }
 
+/* Two EG fields, v0 (order k0) then v1 (order k1), each v < 2^30 and k <= 25:
+ * one field when both codes fit in 31 bits together (feature fields). */
+#if !defined(__OPTIMIZE_SIZE__)
+ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsigned k0,
+                          uint32_t v1, unsigned k1)
+{
+    const uint32_t c0 = v0 + ((uint32_t)1 << k0);
+    const uint32_t c1 = v1 + ((uint32_t)1 << k1);
+    const unsigned len0 = 2u * log2_nz(c0) + 1u - k0;
+    const unsigned len1 = 2u * log2_nz(c1) + 1u - k1;
+    if (costing) {
+        b->bits += len0 + len1;
+    } else if (len0 + len1 < 32u) {
+        put_bits(w, b, (c0 << len1) | c1, len0 + len1);
+    } else {
+        put_eg(w, b, v0, k0);
+        put_eg(w, b, v1, k1);
+    }
+}
+#else
+ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsigned k0,
+                          uint32_t v1, unsigned k1)
+{
+    field_eg(w, b, costing, v0, k0);
+    field_eg(w, b, costing, v1, k1);
+}
+#endif
+
 /* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
  * wide fields. State in and out by value, so that the caller's stays in
  * registers. */
@@ -941,14 +969,12 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                 field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
             } while (j > 0u);
         }
-        field_eg(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
-                 BSF_WIRE_K_GAP);
-        field_eg(w, &b, costing, span, BSF_WIRE_K_SPAN);
-        field_eg(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        /* rounded half up: the planning run checked 0 <= e_curve <= BSF_E_CURVE_MAX,
-         * so the conversion's truncation is the floor */
-        field_eg(w, &b, costing, (uint32_t)(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
-                 BSF_WIRE_K_E_CURVE);
+        field_eg2(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
+                  BSF_WIRE_K_GAP, span, BSF_WIRE_K_SPAN);
+        /* E_curve rounded half up: the planning run checked 0 <= e_curve <=
+         * BSF_E_CURVE_MAX, so the conversion's truncation is the floor */
+        field_eg2(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING,
+                  (uint32_t)(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f), BSF_WIRE_K_E_CURVE);
         put_values(w, &b, costing, values, 2u * n_unique, &ord);
         prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
     }
