@@ -956,6 +956,27 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                                       table, NULL, &mask) /
                        2u;
         }
+#if !defined(__OPTIMIZE_SIZE__)
+#if BSF_WIRE_K_M != 1u
+#error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
+#endif
+        {
+            /* kind, m - 2 (EG1: the code is m in 2 floor(log2 m) bits) and the
+             * mask flag as one field of at most 14 bits */
+            const unsigned m_len = 2u * log2_nz(n_unique);
+            field_u(w, &b, costing,
+                    ((uint32_t)f->kind << (m_len + 1u)) | (n_unique << 1) | (mask != 0u ? 1u : 0u),
+                    m_len + 2u);
+        }
+        if (mask != 0u) {
+            uint32_t j = n_unique; /* bits left, the highest first */
+            do {
+                const unsigned take = j > 16u ? 16u : j;
+                j -= take;
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
+            } while (j > 0u);
+        }
+#else
         field_u(w, &b, costing, f->kind, 1u);
         field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
         if (mask == 0u) {
@@ -969,6 +990,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                 field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
             } while (j > 0u);
         }
+#endif
         field_eg2(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
                   BSF_WIRE_K_GAP, span, BSF_WIRE_K_SPAN);
         /* E_curve rounded half up: the planning run checked 0 <= e_curve <=
