@@ -334,12 +334,12 @@ ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsi
     }
 }
 #else
-ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsigned k0,
-                          uint32_t v1, unsigned k1)
-{
-    field_eg(w, b, costing, v0, k0);
-    field_eg(w, b, costing, v1, k1);
-}
+/* -Os: the two fields one after the other (a macro: no function of its own) */
+#define field_eg2(w, b, costing, v0, k0, v1, k1)                                                   \
+    do {                                                                                           \
+        field_eg(w, b, costing, v0, k0);                                                           \
+        field_eg(w, b, costing, v1, k1);                                                           \
+    } while (0)
 #endif
 
 /* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
