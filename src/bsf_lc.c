@@ -77,6 +77,12 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
+#if !defined(__OPTIMIZE_SIZE__)
+    /* room for block summaries of the current run, or NULL (short runs);
+     * built when a judge first needs them */
+    bsf_lc_block_t *blk;
+    int blk_built;
+#endif
 } lc_ctx_t;
 
 /* Run point pos relative to the origin, also stored for the fits: judge's
@@ -269,7 +275,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
 /* From position pos, step (-1 or +1) towards stop while the next point is
  * within sqrt(side2) of the apex (the origin c->o), storing the points
  * relative to the apex; returns the last position reached. */
-static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
+static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
 {
     /* Locals: the stores into rel[] could alias *c as far as the compiler
      * knows. */
@@ -296,6 +302,294 @@ static size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int step, fl
     return pos;
 }
 
+#if !defined(__OPTIMIZE_SIZE__)
+/* Speed only, same answers: on long runs (dense scans) the side walks step
+ * over whole blocks of points that are provably within the side radius, and
+ * a bound from the blocks' coordinate sums rejects most splits of a straight
+ * wall (the turn test) before the exact fits. Every shortcut only skips work whose
+ * result is proved to be what the exact code computes. */
+
+/* Runs at least this long get block summaries (below, a side holds too few
+ * whole blocks to pay for them). */
+#define LC_BLOCK_MIN_RUN 128u
+#define LC_B ((size_t)BSF_LC_BLOCK)
+/* float's unit roundoff, 2^-24 */
+#define LC_ROUNDOFF 5.9604645e-08f
+
+/* Bounding box and sums of the points of each block of the run (positions
+ * k * LC_B on; the last block may be partial). */
+static void build_blocks(const bsf_points_t *pts, const uint16_t *run, size_t m,
+                         bsf_lc_block_t *blk)
+{
+    size_t s;
+    for (s = 0; s < m; s += LC_B) {
+        const size_t e = s + LC_B < m ? s + LC_B : m;
+        bsf_lc_block_t *b = &blk[s / LC_B];
+        float x0 = pts->pt[run[s]].x;
+        float y0 = pts->pt[run[s]].y;
+        float x1 = x0;
+        float y1 = y0;
+        float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
+        size_t i;
+        for (i = s + 1u; i < e; ++i) {
+            const bsf_point_t q = pts->pt[run[i]];
+            x0 = q.x < x0 ? q.x : x0;
+            x1 = q.x > x1 ? q.x : x1;
+            y0 = q.y < y0 ? q.y : y0;
+            y1 = q.y > y1 ? q.y : y1;
+        }
+        for (i = s; i < e; ++i) {
+            const float x = pts->pt[run[i]].x - x0;
+            const float y = pts->pt[run[i]].y - y0;
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            sxy += x * y;
+            syy += y * y;
+        }
+        b->x0 = x0;
+        b->y0 = y0;
+        b->x1 = x1;
+        b->y1 = y1;
+        b->sx = sx;
+        b->sy = sy;
+        b->sxx = sxx;
+        b->sxy = sxy;
+        b->syy = syy;
+        /* 1.01: room for the rounding of this and of the rel[] differences */
+        b->ext2 = 1.01f * ((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0));
+    }
+}
+
+/* The square of the farthest corner of block b's box from (ox, oy), in the
+ * walk's arithmetic. fl(p - o) is monotonic in p, so each coordinate of a
+ * point relative to o lies between those of the box's corners, and squares
+ * and sums round monotonically: no point of the block has a larger d2 as
+ * walk_side computes it. */
+static float block_far2(const bsf_lc_block_t *b, float ox, float oy)
+{
+    const float lx = fabsf(b->x0 - ox);
+    const float hx = fabsf(b->x1 - ox);
+    const float ly = fabsf(b->y0 - oy);
+    const float hy = fabsf(b->y1 - oy);
+    const float mx = lx > hx ? lx : hx;
+    const float my = ly > hy ? ly : hy;
+    return mx * mx + my * my;
+}
+
+/* walk_side's answer, stepping over whole blocks within sqrt(side2); stores
+ * only the point it stops at in rel[] (fill_rel does the rest when the exact
+ * fits need them). */
+static size_t walk_side_blocks(const lc_ctx_t *c, size_t pos, size_t stop, int step, float side2)
+{
+    const bsf_point_t *pt = c->pts->pt;
+    const uint16_t *run = c->run;
+    const bsf_lc_block_t *blk = c->blk;
+    const float ox = c->o.x;
+    const float oy = c->o.y;
+    while (pos != stop) {
+        size_t next;
+        bsf_point_t q;
+        if (step > 0) {
+            next = pos + 1u;
+            if (next % LC_B == 0u && stop - next >= LC_B - 1u &&
+                block_far2(&blk[next / LC_B], ox, oy) <= side2) {
+                pos = next + (LC_B - 1u);
+                continue;
+            }
+        } else {
+            next = pos - 1u;
+            if (next % LC_B == LC_B - 1u && next - stop >= LC_B - 1u &&
+                block_far2(&blk[next / LC_B], ox, oy) <= side2) {
+                pos = next - (LC_B - 1u);
+                continue;
+            }
+        }
+        q = pt[run[next]];
+        q.x -= ox;
+        q.y -= oy;
+        if (!(q.x * q.x + q.y * q.y <= side2)) {
+            break;
+        }
+        pos = next;
+    }
+    {
+        bsf_point_t q = pt[run[pos]];
+        q.x -= ox;
+        q.y -= oy;
+        c->rel[pos] = q;
+    }
+    return pos;
+}
+
+/* rel[] for positions a..b, as walk_side stores them. */
+static void fill_rel(const lc_ctx_t *c, size_t a, size_t b)
+{
+    const bsf_point_t *pt = c->pts->pt;
+    const uint16_t *run = c->run;
+    bsf_point_t *rel = c->rel;
+    const float ox = c->o.x;
+    const float oy = c->o.y;
+    size_t i;
+    for (i = a; i <= b; ++i) {
+        bsf_point_t q = pt[run[i]];
+        q.x -= ox;
+        q.y -= oy;
+        rel[i] = q;
+    }
+}
+
+/* Direction of positions s..e's total-least-squares line from the block
+ * sums, and a bound phi on its angle to the direction fit_line computes for
+ * the same points (radians); returns 0 when no useful bound exists.
+ *
+ * Why the bound holds (u the unit roundoff): let T be the exact scatter
+ * matrix of the points (their rel[] values), F fit_line's float one and P
+ * this one, and eps a bound on each entry of |F - T| + |P - T|. Let R_i be
+ * the largest distance from the apex within point i's block (its own
+ * distance for a point summed alone); R_i <= |q_i| + the block's diagonal,
+ * so sum R_i^2 <= M = 2 sum |q_i|^2 + 32 sum ext2. Here each coordinate is
+ * within 4 u R_i of its rel[] value, a block's own sums within 190 u R_i^2
+ * per point and their shift to the apex within 36 u R_i^2, and summing t
+ * terms (whole blocks and single points) and centring add 3 t u M: P is
+ * within (3 t + 240) u M of T. fit_line sums n centred terms recursively
+ * from a rounded mean: F is within (n + 3) u trace(T) + 2 n^3 u^2 M of T,
+ * trace(T) <= |trace(P)| + 2 |P - T|. The top eigenvector's angle is half
+ * that of (a - c, 2b), a vector of length gap = lmax - lmin that moves by at
+ * most 2 sqrt(2) eps, so the two directions differ by at most
+ * 2.22 eps / (gap - 2.83 eps); the eigenvector formulas' own rounding adds
+ * about 17 u trace / gap, within the 16 u trace term below. The constants
+ * used are larger than these. */
+typedef struct {
+    float dx, dy;
+    float phi;
+} lc_side_dir_t;
+
+static int side_dir_bound(const lc_ctx_t *c, size_t s, size_t e, lc_side_dir_t *d)
+{
+    const bsf_point_t *pt = c->pts->pt;
+    const uint16_t *run = c->run;
+    const float ox = c->o.x;
+    const float oy = c->o.y;
+    const float n = (float)(e + 1u - s);
+    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f, ext2 = 0.0f;
+    float terms = 0.0f;
+    float cxx, cxy, cyy, half, diff, root, lmax, gap, trace, v1x, v1y, v2x, v2y, nrm, mass;
+    float eps_p, eps;
+    size_t i = s;
+    while (i <= e) {
+        if (i % LC_B == 0u && e - i >= LC_B - 1u) {
+            const bsf_lc_block_t *b = &c->blk[i / LC_B];
+            const float bx = b->x0 - ox;
+            const float by = b->y0 - oy;
+            const float k = (float)LC_B;
+            sx += b->sx + k * bx;
+            sy += b->sy + k * by;
+            sxx += b->sxx + 2.0f * bx * b->sx + k * bx * bx;
+            syy += b->syy + 2.0f * by * b->sy + k * by * by;
+            sxy += b->sxy + bx * b->sy + by * b->sx + k * bx * by;
+            ext2 += b->ext2;
+            i += LC_B;
+        } else {
+            const float x = pt[run[i]].x - ox;
+            const float y = pt[run[i]].y - oy;
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            sxy += x * y;
+            syy += y * y;
+            ++i;
+        }
+        terms += 1.0f;
+    }
+    /* M, with 1 % for the rounding of the sums it is made of */
+    mass = 1.01f * (2.0f * (sxx + syy) + 32.0f * ext2);
+    cxx = sxx - sx * sx / n;
+    cxy = sxy - sx * sy / n;
+    cyy = syy - sy * sy / n;
+    half = 0.5f * (cxx + cyy);
+    diff = 0.5f * (cxx - cyy);
+    root = sqrtf(diff * diff + cxy * cxy);
+    lmax = half + root;
+    gap = 2.0f * root;
+    trace = fabsf(cxx + cyy);
+    v1x = cxy;
+    v1y = lmax - cxx;
+    v2x = lmax - cyy;
+    v2y = cxy;
+    if (v1x * v1x + v1y * v1y >= v2x * v2x + v2y * v2y) {
+        nrm = sqrtf(v1x * v1x + v1y * v1y);
+        d->dx = v1x;
+        d->dy = v1y;
+    } else {
+        nrm = sqrtf(v2x * v2x + v2y * v2y);
+        d->dx = v2x;
+        d->dy = v2y;
+    }
+    if (!(nrm > 0.0f)) {
+        return 0;
+    }
+    d->dx /= nrm;
+    d->dy /= nrm;
+    eps_p = (4.0f * terms + 512.0f) * LC_ROUNDOFF * mass;
+    eps = eps_p + (4.0f * (n + 3.0f) + 16.0f) * LC_ROUNDOFF * (trace + 4.0f * eps_p) +
+          2.0f * n * n * n * LC_ROUNDOFF * LC_ROUNDOFF * mass;
+    if (!(gap > 6.0f * eps)) {
+        return 0; /* NaN and infinities end here too */
+    }
+    d->phi = 2.3f * eps / (gap - 3.0f * eps);
+    return 1;
+}
+
+/* 1 when the exact fits of the sides a0..apex-1 and apex+1..b1 are sure to
+ * fail the turn test |cross| >= sin(min_turn): their directions' cross
+ * product differs from the one here by at most phi_a + phi_b (|sin x - sin y|
+ * <= |x - y|) plus a few roundings of unit vectors (1e-5 covers them); the
+ * factor 2 leaves room for the rounding of the bounds themselves. */
+static int surely_no_turn(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1)
+{
+    lc_side_dir_t da;
+    lc_side_dir_t db;
+    float cross;
+    if (!side_dir_bound(c, a0, apex - 1u, &da) || !side_dir_bound(c, apex + 1u, b1, &db)) {
+        return 0;
+    }
+    cross = da.dx * db.dy - da.dy * db.dx;
+    return fabsf(cross) + 2.0f * (da.phi + db.phi) + 1e-5f < c->sin_min_turn;
+}
+
+/* Whether the run is dense around the apex: the points a block away lie
+ * within max_side / 8, so a side holds about eight whole blocks or more
+ * (below that the bound rarely decides and the exact fits are cheap). */
+static int dense_at(const lc_ctx_t *c, size_t apex, size_t m, float side2)
+{
+    const bsf_point_t *pt = c->pts->pt;
+    const bsf_point_t a = pt[c->run[apex]];
+    const float near2 = side2 * (1.0f / 64.0f);
+    if (apex >= LC_B && !(dist2(pt[c->run[apex - LC_B]], a) <= near2)) {
+        return 0;
+    }
+    if (apex + LC_B < m && !(dist2(pt[c->run[apex + LC_B]], a) <= near2)) {
+        return 0;
+    }
+    return 1;
+}
+#endif
+
+/* walk_side, by blocks when the judge uses them. */
+static inline size_t walk(const lc_ctx_t *c, int blocks, size_t pos, size_t stop, int step,
+                          float side2)
+{
+#if !defined(__OPTIMIZE_SIZE__)
+    if (blocks) {
+        return walk_side_blocks(c, pos, stop, step, side2);
+    }
+#else
+    (void)blocks;
+#endif
+    return walk_side(c, pos, stop, step, side2);
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
  * corner, 0 otherwise. */
@@ -317,23 +611,33 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     lc_enough_t enough;
     bsf_point_t x;
     bsf_point_t ap;
+    int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
         return 0;
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
-    a0 = walk_side(c, apex, lo, -1, side2);
-    b1 = walk_side(c, apex, hi, 1, side2);
+#if !defined(__OPTIMIZE_SIZE__)
+    if (c->blk != NULL && dense_at(c, apex, m, side2)) {
+        if (!c->blk_built) {
+            build_blocks(c->pts, c->run, m, c->blk);
+            c->blk_built = 1;
+        }
+        blocks = 1;
+    }
+#endif
+    a0 = walk(c, blocks, apex, lo, -1, side2);
+    b1 = walk(c, blocks, apex, hi, 1, side2);
     /* A side cut short by a neighbouring split reaches past it: noise often
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
     if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
-        a0 = walk_side(c, a0, 0u, -1, side2);
+        a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
     if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
-        b1 = walk_side(c, b1, m - 1u, 1, side2);
+        b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
@@ -344,6 +648,15 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
         return 0;
     }
+#if !defined(__OPTIMIZE_SIZE__)
+    if (blocks) {
+        /* every path from here to the turn test ends in "no corner" */
+        if (surely_no_turn(c, a0, apex, b1)) {
+            return 0;
+        }
+        fill_rel(c, a0, b1);
+    }
+#endif
     if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
         return 0;
     }
@@ -456,6 +769,7 @@ static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m)
 
 /* Douglas-Peucker split of run positions 0..m-1 with an explicit stack;
  * returns the number of splits, ascending in w->brk. */
+
 static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, float tol)
 {
     size_t top = 0;
@@ -564,6 +878,13 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
+#if !defined(__OPTIMIZE_SIZE__)
+    c->blk = NULL;
+    c->blk_built = 0;
+    if (m >= LC_BLOCK_MIN_RUN) {
+        c->blk = w->block;
+    }
+#endif
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
     memset(&last, 0, sizeof last);
@@ -725,6 +1046,10 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.y = 0.0f;
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
+#if !defined(__OPTIMIZE_SIZE__)
+    c.blk = NULL;
+    c.blk_built = 0;
+#endif
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
         if (!close_run && !pts->valid[i]) {

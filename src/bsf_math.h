@@ -64,6 +64,14 @@ static inline uint32_t bsf_float_bits(float v)
     return bits;
 }
 
+/* The float whose binary32 bit pattern is bits. */
+static inline float bsf_bits_float(uint32_t bits)
+{
+    float v;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
 /* Whether v is finite (not NaN, not +-inf): its exponent bits are not all
  * ones. The same answer as v == v && fabsf(v) <= FLT_MAX, in fewer
  * instructions on Cortex-M. */

@@ -69,7 +69,20 @@ bsf_lc_params_t bsf_lc_params_default(void);
  *  min_side_points in 2..64). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
-/** Scratch memory of bsf_lc_detect (about 21 bytes per beam; in the
+/** Points of a run per summary block of bsf_lc_work_t. */
+#define BSF_LC_BLOCK 16
+
+/** Summary of BSF_LC_BLOCK consecutive points of a run (bsf_lc_detect's
+ *  internal bookkeeping on long runs): their bounding box and coordinate
+ *  sums relative to its lower corner. */
+typedef struct {
+    float x0, y0, x1, y1; /**< bounding box, sensor frame, metres */
+    float sx, sy;         /**< sums of the coordinates minus (x0, y0) */
+    float sxx, sxy, syy;  /**< sums of their products */
+    float ext2;           /**< squared diagonal of the box (slightly enlarged) */
+} bsf_lc_block_t;
+
+/** Scratch memory of bsf_lc_detect (about 24 bytes per beam; in the
  *  extractor it shares its space with the larger BID scratch). */
 typedef struct {
     uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
@@ -80,6 +93,9 @@ typedef struct {
     uint16_t judged_hi[BSF_MAX_POINTS];
     bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
     uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run */
+    /** summaries of the current run's points, block k holding positions
+     *  k * BSF_LC_BLOCK on (long runs only) */
+    bsf_lc_block_t block[(BSF_MAX_POINTS + BSF_LC_BLOCK - 1) / BSF_LC_BLOCK];
 } bsf_lc_work_t;
 
 /**
