@@ -720,6 +720,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     float inc, inv_inc;
     long score_max = 0;
     long min_val;
+    float raw_min = (float)FALKO_SCORE_LIMIT; /* smallest raw score of an accepted apex */
     bsf_status_t st;
     int ring;
 
@@ -763,6 +764,9 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
             const float r = neigh_radius(p, pts->range[i]);
             const float sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
             work->score[i] = sc;
+            if (sc >= 0.0f && sc < raw_min) {
+                raw_min = sc;
+            }
             if (sc > (float)score_max) {
                 if (sc > (float)FALKO_SCORE_LIMIT) {
                     return BSF_ERR_CAPACITY;
@@ -771,8 +775,11 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
             }
         }
     }
-    if (score_max == 0) {
-        /* Every strength would be 0 and the threshold >= 0: nothing passes. */
+    min_val = score_max * (long)p->min_score_th / 100L;
+    if (score_max == 0 || (float)score_max - raw_min <= (float)min_val) {
+        /* No strength passes the threshold (>= 0): the strongest beam has
+         * scoreMax - (smallest raw score), rejected ones 0. Exact: integers
+         * below 2^24 in float. */
         return BSF_OK;
     }
 
@@ -782,7 +789,6 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const float s = work->score[i];
         work->score[i] = (s < 0.0f) ? 0.0f : (float)score_max - s;
     }
-    min_val = score_max * (long)p->min_score_th / 100L;
     n_peak = bsf_nms_beams(pts, work->score, BSF_NMS_HIGHER_IS_BETTER, (float)min_val,
                            p->nms_radius, work->peak);
     if (ring && n_peak >= 2u) {
