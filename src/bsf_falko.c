@@ -224,11 +224,15 @@ static int find_ends(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neig
     return 1;
 }
 
-/* Counts and sums of both sides, between the ends found by find_ends. */
-static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neigh_t *nb)
+/* Counts and sums of both sides, between the ends found by find_ends; when
+ * list is not NULL, the neighbours' beams too, left ones then right ones,
+ * each side in scan order (corner_score's order). */
+static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neigh_t *nb,
+                        uint16_t *list)
 {
     const bsf_point_t c = b->c;
     ptrdiff_t j;
+    int k = 0;
     nb->n_left = 0;
     nb->n_right = 0;
     nb->sum_lx = 0.0f;
@@ -237,18 +241,26 @@ static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, n
     nb->sum_ry = 0.0f;
     for (j = nb->first; j < i; ++j) {
         if (in_ball(pts, j, b)) {
-            const bsf_point_t q = pts->pt[beam_at(pts, j)];
+            const size_t q_beam = beam_at(pts, j);
+            const bsf_point_t q = pts->pt[q_beam];
             ++nb->n_left;
             nb->sum_lx += q.x - c.x;
             nb->sum_ly += q.y - c.y;
+            if (list != NULL) {
+                list[k++] = (uint16_t)q_beam;
+            }
         }
     }
     for (j = i + 1; j <= nb->last; ++j) {
         if (in_ball(pts, j, b)) {
-            const bsf_point_t q = pts->pt[beam_at(pts, j)];
+            const size_t q_beam = beam_at(pts, j);
+            const bsf_point_t q = pts->pt[q_beam];
             ++nb->n_right;
             nb->sum_rx += q.x - c.x;
             nb->sum_ry += q.y - c.y;
+            if (list != NULL) {
+                list[k++] = (uint16_t)q_beam;
+            }
         }
     }
 }
@@ -280,14 +292,14 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
  * rejections are alike, so the cheap ends-and-triangle test runs first and
  * the full count only for its survivors. */
 static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
-                         const bsf_falko_params_t *p, neigh_t *nb)
+                         const bsf_falko_params_t *p, neigh_t *nb, uint16_t *list)
 {
     const ball_t b = make_ball(pts->pt[i], r);
     neigh_window(pts, i, alpha, ring, nb);
     if (!find_ends(pts, (ptrdiff_t)i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
         return 0;
     }
-    count_sides(pts, (ptrdiff_t)i, &b, nb);
+    count_sides(pts, (ptrdiff_t)i, &b, nb, list);
     return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
 }
 
@@ -376,21 +388,19 @@ static long side_score(const int8_t *sec, int n, int step, const bsf_falko_param
 }
 
 /* Steps 7-9 for an apex that passed steps 1-6: the raw integer score. */
-static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float theta,
-                         const bsf_falko_params_t *p, bsf_falko_work_t *work)
+static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float theta,
+                         const uint16_t *list, const bsf_falko_params_t *p, bsf_falko_work_t *work)
 {
-    const ball_t ball = make_ball(pts->pt[i], r);
-    const bsf_point_t c = ball.c;
+    const bsf_point_t c = pts->pt[i];
     const float width = 2.0f * FALKO_PI / (float)p->grid_sectors;
+    const int n = nb->n_left + nb->n_right;
     int8_t *sector = work->sector;
-    int k = 0;
-    ptrdiff_t j;
+    int k;
 
-    /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
-    for (j = nb->first; j <= nb->last; ++j) {
-        if (j != (ptrdiff_t)i && in_ball(pts, j, &ball)) {
-            sector[k++] = (int8_t)sector_of(pts->pt[beam_at(pts, j)], c, theta, width);
-        }
+    /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right
+     * (count_sides listed them so). */
+    for (k = 0; k < n; ++k) {
+        sector[k] = (int8_t)sector_of(pts->pt[list[k]], c, theta, width);
     }
     /* Left: nearest is sector[nl - 1], walking down; right: sector[nl] up. */
     return side_score(&sector[nb->n_left - 1], nb->n_left, -1, p, work) +
@@ -705,11 +715,12 @@ static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha
 {
     float theta;
     neigh_t nb;
-    if (!neighbourhood(pts, i, r, alpha, ring, p, &nb)) {
+    /* work->peak is free until suppression: the neighbours' beams. */
+    if (!neighbourhood(pts, i, r, alpha, ring, p, &nb, work->peak)) {
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
-    return (float)corner_score(pts, i, &nb, r, theta, p, work);
+    return (float)corner_score(pts, i, &nb, theta, work->peak, p, work);
 }
 
 bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
@@ -816,8 +827,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, inv_inc), ring, p,
-                            &nb); /* passed before */
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, inv_inc), ring, p, &nb,
+                            NULL); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);
         out[k].radius = r;
