@@ -761,10 +761,16 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
 
     for (i = 0; i < pts->count; ++i) {
         const size_t w = work->win_hi[i];
+        /* -Os: certainly_rejected alone (same results, less code). The
+         * markers FALKO_WIN_NONE and FALKO_WIN_EXACT exceed any i. */
+#if !defined(__OPTIMIZE_SIZE__)
+        const int inside = w <= i && i + w < pts->count;
+#else
+        const int inside = 0;
+#endif
         int verdict;
         work->score[i] = FALKO_REJECTED;
-        /* The markers FALKO_WIN_NONE and FALKO_WIN_EXACT exceed any i. */
-        if (w <= i && i + w < pts->count) {
+        if (inside) {
             verdict = certainly_rejected_inside(pts, i, w, work);
         } else if (w == FALKO_WIN_NONE) {
             verdict = FALKO_REJECT;
