@@ -30,9 +30,10 @@
  * without hard branches, so the exp and division latencies of successive
  * beams overlap; each apex then runs the cheap tests first (outermost
  * neighbours on each side, then the triangle test), and only the few that
- * pass count their neighbours and compute sectors with atan2f. All
- * rejections are alike in the reference (score -10), so the order of the
- * tests does not change any result.
+ * pass count their neighbours (listing them for the sectors, computed with
+ * atan2f). All rejections are alike in the reference (score -10), so the
+ * order of the tests does not change any result. Suppression runs only when
+ * some strength can pass its threshold.
  */
 #include "bsf/bsf_falko.h"
 
