@@ -289,6 +289,19 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
     return !(fabsf(area2) / base < lim);
 }
 
+/* Steps 5 and 6 for apex i whose outermost neighbours nb->first and
+ * nb->last are known; 0 when rejected. */
+static int sides(const bsf_points_t *pts, size_t i, float r, const bsf_falko_params_t *p,
+                 neigh_t *nb, uint16_t *list)
+{
+    const ball_t b = make_ball(pts->pt[i], r);
+    if (!triangle_ok(pts, i, nb, r, p->b_ratio)) {
+        return 0;
+    }
+    count_sides(pts, (ptrdiff_t)i, &b, nb, list);
+    return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
+}
+
 /* Steps 3-5 and the sums of step 6 for apex i; 0 when rejected. All
  * rejections are alike, so the cheap ends-and-triangle test runs first and
  * the full count only for its survivors. */
@@ -297,11 +310,10 @@ static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alph
 {
     const ball_t b = make_ball(pts->pt[i], r);
     neigh_window(pts, i, alpha, ring, nb);
-    if (!find_ends(pts, (ptrdiff_t)i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
+    if (!find_ends(pts, (ptrdiff_t)i, &b, nb)) {
         return 0;
     }
-    count_sides(pts, (ptrdiff_t)i, &b, nb, list);
-    return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
+    return sides(pts, i, r, p, nb, list);
 }
 
 /* Step 6: orientation of the corner (mean left vector + mean right vector). */
@@ -571,7 +583,9 @@ static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p
     }
 }
 
-enum { FALKO_REJECT = 0, FALKO_MAYBE = 1 };
+/* FALKO_MAYBE_ENDS: only the exact path can tell, and the outermost
+ * neighbours are known (certain, inside the exact window). */
+enum { FALKO_REJECT = 0, FALKO_MAYBE = 1, FALKO_MAYBE_ENDS = 2 };
 
 /* The outermost neighbour on one side, walking from window position `from`
  * towards the apex by `step`: FALKO_REJECT when no beam can be a neighbour
@@ -655,7 +669,7 @@ static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
  * d2 > out2 and is skipped by bracket_end too; the beam it stops at, when
  * valid, is bracket_end's. */
 static int certainly_rejected_inside(const bsf_points_t *pts, size_t i, size_t w,
-                                     const bsf_falko_work_t *work)
+                                     const bsf_falko_work_t *work, neigh_t *ends)
 {
     const bsf_point_t *pt = pts->pt;
     const bsf_point_t c = pt[i];
@@ -705,7 +719,13 @@ static int certainly_rejected_inside(const bsf_points_t *pts, size_t i, size_t w
             return FALKO_REJECT;
         }
         area2 = (f.x - c.x) * (l.y - c.y) - (f.y - c.y) * (l.x - c.x);
-        return (fabsf(area2) / base < lim) ? FALKO_REJECT : FALKO_MAYBE;
+        if (fabsf(area2) / base < lim) {
+            return FALKO_REJECT;
+        }
+        /* The exact search would find these ends (certainly_rejected). */
+        ends->first = (ptrdiff_t)first;
+        ends->last = (ptrdiff_t)last;
+        return FALKO_MAYBE_ENDS;
     }
 }
 
@@ -722,6 +742,19 @@ static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha
     }
     theta = corner_orientation(&nb);
     return (float)corner_score(pts, i, &nb, theta, work->peak, p, work);
+}
+
+/* beam_score for an apex whose outermost neighbours nb->first, nb->last are
+ * known (FALKO_MAYBE_ENDS). */
+static float beam_score_ends(const bsf_points_t *pts, size_t i, float r,
+                             const bsf_falko_params_t *p, neigh_t *nb, bsf_falko_work_t *work)
+{
+    float theta;
+    if (!sides(pts, i, r, p, nb, work->peak)) {
+        return FALKO_REJECTED;
+    }
+    theta = corner_orientation(nb);
+    return (float)corner_score(pts, i, nb, theta, work->peak, p, work);
 }
 
 bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
@@ -770,17 +803,21 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const int inside = 0;
 #endif
         int verdict;
+        neigh_t ends;
         work->score[i] = FALKO_REJECTED;
         if (inside) {
-            verdict = certainly_rejected_inside(pts, i, w, work);
+            verdict = certainly_rejected_inside(pts, i, w, work, &ends);
         } else if (w == FALKO_WIN_NONE) {
             verdict = FALKO_REJECT;
         } else {
             verdict = certainly_rejected(pts, i, ring, work);
         }
-        if (verdict == FALKO_MAYBE) {
+        if (verdict != FALKO_REJECT) {
             const float r = neigh_radius(p, pts->range[i]);
-            const float sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
+            const float sc =
+                (verdict == FALKO_MAYBE_ENDS)
+                    ? beam_score_ends(pts, i, r, p, &ends, work)
+                    : beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
             work->score[i] = sc;
             if (sc >= 0.0f && sc < raw_min) {
                 raw_min = sc;
