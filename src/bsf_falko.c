@@ -815,7 +815,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         if (verdict != FALKO_REJECT) {
             const float r = neigh_radius(p, pts->range[i]);
             const float sc =
-                (verdict == FALKO_MAYBE_ENDS)
+                (inside && verdict == FALKO_MAYBE_ENDS)
                     ? beam_score_ends(pts, i, r, p, &ends, work)
                     : beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
             work->score[i] = sc;
