@@ -30,9 +30,10 @@
  * without hard branches, so the exp and division latencies of successive
  * beams overlap; each apex then runs the cheap tests first (outermost
  * neighbours on each side, then the triangle test), and only the few that
- * pass count their neighbours and compute sectors with atan2f. All
- * rejections are alike in the reference (score -10), so the order of the
- * tests does not change any result.
+ * pass count their neighbours (listing them for the sectors, computed with
+ * atan2f). All rejections are alike in the reference (score -10), so the
+ * order of the tests does not change any result. Suppression runs only when
+ * some strength can pass its threshold.
  */
 #include "bsf/bsf_falko.h"
 
@@ -224,11 +225,15 @@ static int find_ends(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neig
     return 1;
 }
 
-/* Counts and sums of both sides, between the ends found by find_ends. */
-static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neigh_t *nb)
+/* Counts and sums of both sides, between the ends found by find_ends; when
+ * list is not NULL, the neighbours' beams too, left ones then right ones,
+ * each side in scan order (corner_score's order). */
+static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, neigh_t *nb,
+                        uint16_t *list)
 {
     const bsf_point_t c = b->c;
     ptrdiff_t j;
+    int k = 0;
     nb->n_left = 0;
     nb->n_right = 0;
     nb->sum_lx = 0.0f;
@@ -237,18 +242,26 @@ static void count_sides(const bsf_points_t *pts, ptrdiff_t i, const ball_t *b, n
     nb->sum_ry = 0.0f;
     for (j = nb->first; j < i; ++j) {
         if (in_ball(pts, j, b)) {
-            const bsf_point_t q = pts->pt[beam_at(pts, j)];
+            const size_t q_beam = beam_at(pts, j);
+            const bsf_point_t q = pts->pt[q_beam];
             ++nb->n_left;
             nb->sum_lx += q.x - c.x;
             nb->sum_ly += q.y - c.y;
+            if (list != NULL) {
+                list[k++] = (uint16_t)q_beam;
+            }
         }
     }
     for (j = i + 1; j <= nb->last; ++j) {
         if (in_ball(pts, j, b)) {
-            const bsf_point_t q = pts->pt[beam_at(pts, j)];
+            const size_t q_beam = beam_at(pts, j);
+            const bsf_point_t q = pts->pt[q_beam];
             ++nb->n_right;
             nb->sum_rx += q.x - c.x;
             nb->sum_ry += q.y - c.y;
+            if (list != NULL) {
+                list[k++] = (uint16_t)q_beam;
+            }
         }
     }
 }
@@ -276,19 +289,31 @@ static int triangle_ok(const bsf_points_t *pts, size_t i, const neigh_t *nb, flo
     return !(fabsf(area2) / base < lim);
 }
 
+/* Steps 5 and 6 for apex i whose outermost neighbours nb->first and
+ * nb->last are known; 0 when rejected. */
+static int sides(const bsf_points_t *pts, size_t i, float r, const bsf_falko_params_t *p,
+                 neigh_t *nb, uint16_t *list)
+{
+    const ball_t b = make_ball(pts->pt[i], r);
+    if (!triangle_ok(pts, i, nb, r, p->b_ratio)) {
+        return 0;
+    }
+    count_sides(pts, (ptrdiff_t)i, &b, nb, list);
+    return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
+}
+
 /* Steps 3-5 and the sums of step 6 for apex i; 0 when rejected. All
  * rejections are alike, so the cheap ends-and-triangle test runs first and
  * the full count only for its survivors. */
 static int neighbourhood(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
-                         const bsf_falko_params_t *p, neigh_t *nb)
+                         const bsf_falko_params_t *p, neigh_t *nb, uint16_t *list)
 {
     const ball_t b = make_ball(pts->pt[i], r);
     neigh_window(pts, i, alpha, ring, nb);
-    if (!find_ends(pts, (ptrdiff_t)i, &b, nb) || !triangle_ok(pts, i, nb, r, p->b_ratio)) {
+    if (!find_ends(pts, (ptrdiff_t)i, &b, nb)) {
         return 0;
     }
-    count_sides(pts, (ptrdiff_t)i, &b, nb);
-    return nb->n_left >= p->neigh_min_points && nb->n_right >= p->neigh_min_points;
+    return sides(pts, i, r, p, nb, list);
 }
 
 /* Step 6: orientation of the corner (mean left vector + mean right vector). */
@@ -376,21 +401,19 @@ static long side_score(const int8_t *sec, int n, int step, const bsf_falko_param
 }
 
 /* Steps 7-9 for an apex that passed steps 1-6: the raw integer score. */
-static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float r, float theta,
-                         const bsf_falko_params_t *p, bsf_falko_work_t *work)
+static long corner_score(const bsf_points_t *pts, size_t i, const neigh_t *nb, float theta,
+                         const uint16_t *list, const bsf_falko_params_t *p, bsf_falko_work_t *work)
 {
-    const ball_t ball = make_ball(pts->pt[i], r);
-    const bsf_point_t c = ball.c;
+    const bsf_point_t c = pts->pt[i];
     const float width = 2.0f * FALKO_PI / (float)p->grid_sectors;
+    const int n = nb->n_left + nb->n_right;
     int8_t *sector = work->sector;
-    int k = 0;
-    ptrdiff_t j;
+    int k;
 
-    /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right. */
-    for (j = nb->first; j <= nb->last; ++j) {
-        if (j != (ptrdiff_t)i && in_ball(pts, j, &ball)) {
-            sector[k++] = (int8_t)sector_of(pts->pt[beam_at(pts, j)], c, theta, width);
-        }
+    /* sector[0..nl-1]: left neighbours in scan order; sector[nl..]: right
+     * (count_sides listed them so). */
+    for (k = 0; k < n; ++k) {
+        sector[k] = (int8_t)sector_of(pts->pt[list[k]], c, theta, width);
     }
     /* Left: nearest is sector[nl - 1], walking down; right: sector[nl] up. */
     return side_score(&sector[nb->n_left - 1], nb->n_left, -1, p, work) +
@@ -560,7 +583,9 @@ static void radius_brackets(const bsf_points_t *pts, const bsf_falko_params_t *p
     }
 }
 
-enum { FALKO_REJECT = 0, FALKO_MAYBE = 1 };
+/* FALKO_MAYBE_ENDS: only the exact path can tell, and the outermost
+ * neighbours are known (certain, inside the exact window). */
+enum { FALKO_REJECT = 0, FALKO_MAYBE = 1, FALKO_MAYBE_ENDS = 2 };
 
 /* The outermost neighbour on one side, walking from window position `from`
  * towards the apex by `step`: FALKO_REJECT when no beam can be a neighbour
@@ -636,6 +661,74 @@ static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
     }
 }
 
+/* certainly_rejected for a window [i - w, i + w] inside the scan (no
+ * clamping, no wrapping: nearly every apex), in fewer instructions. The end
+ * searches skip the validity test: an invalid beam is (0, 0) (bsf_points_t),
+ * and when one is nevertheless met within the bracket the exact path decides,
+ * so the outcome never depends on that. Every beam the walk passes has
+ * d2 > out2 and is skipped by bracket_end too; the beam it stops at, when
+ * valid, is bracket_end's. */
+static int certainly_rejected_inside(const bsf_points_t *pts, size_t i, size_t w,
+                                     const bsf_falko_work_t *work, neigh_t *ends)
+{
+    const bsf_point_t *pt = pts->pt;
+    const bsf_point_t c = pt[i];
+    const float out2 = work->out2[i];
+    const float in2 = work->in2[i];
+    const size_t inner = work->win_inner[i];
+    size_t first = i - w;
+    size_t last = i + w;
+    float d2f, d2l;
+    for (;; ++first) {
+        float dx, dy;
+        if (first == i) {
+            return FALKO_REJECT;
+        }
+        dx = c.x - pt[first].x;
+        dy = c.y - pt[first].y;
+        d2f = dx * dx + dy * dy;
+        if (d2f <= out2) {
+            break;
+        }
+    }
+    for (;; --last) {
+        float dx, dy;
+        if (last == i) {
+            return FALKO_REJECT;
+        }
+        dx = c.x - pt[last].x;
+        dy = c.y - pt[last].y;
+        d2l = dx * dx + dy * dy;
+        if (d2l <= out2) {
+            break;
+        }
+    }
+    if (!pts->valid[first] || !pts->valid[last] || d2f > in2 || d2l > in2 || i - first > inner ||
+        last - i > inner) {
+        return FALKO_MAYBE;
+    }
+    {
+        const float lim = work->lim[i];
+        const bsf_point_t f = pt[first];
+        const bsf_point_t l = pt[last];
+        const float bx = l.x - f.x;
+        const float by = l.y - f.y;
+        const float base = sqrtf(bx * bx + by * by);
+        float area2;
+        if (base < lim) {
+            return FALKO_REJECT;
+        }
+        area2 = (f.x - c.x) * (l.y - c.y) - (f.y - c.y) * (l.x - c.x);
+        if (fabsf(area2) / base < lim) {
+            return FALKO_REJECT;
+        }
+        /* The exact search would find these ends (certainly_rejected). */
+        ends->first = (ptrdiff_t)first;
+        ends->last = (ptrdiff_t)last;
+        return FALKO_MAYBE_ENDS;
+    }
+}
+
 /* Steps 3-9 for apex i with radius r and window alpha: its raw score, or
  * FALKO_REJECTED. */
 static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha, int ring,
@@ -643,11 +736,25 @@ static float beam_score(const bsf_points_t *pts, size_t i, float r, size_t alpha
 {
     float theta;
     neigh_t nb;
-    if (!neighbourhood(pts, i, r, alpha, ring, p, &nb)) {
+    /* work->peak is free until suppression: the neighbours' beams. */
+    if (!neighbourhood(pts, i, r, alpha, ring, p, &nb, work->peak)) {
         return FALKO_REJECTED;
     }
     theta = corner_orientation(&nb);
-    return (float)corner_score(pts, i, &nb, r, theta, p, work);
+    return (float)corner_score(pts, i, &nb, theta, work->peak, p, work);
+}
+
+/* beam_score for an apex whose outermost neighbours nb->first, nb->last are
+ * known (FALKO_MAYBE_ENDS). */
+static float beam_score_ends(const bsf_points_t *pts, size_t i, float r,
+                             const bsf_falko_params_t *p, neigh_t *nb, bsf_falko_work_t *work)
+{
+    float theta;
+    if (!sides(pts, i, r, p, nb, work->peak)) {
+        return FALKO_REJECTED;
+    }
+    theta = corner_orientation(nb);
+    return (float)corner_score(pts, i, nb, theta, work->peak, p, work);
 }
 
 bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t *p,
@@ -658,6 +765,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
     float inc, inv_inc;
     long score_max = 0;
     long min_val;
+    float raw_min = (float)FALKO_SCORE_LIMIT; /* smallest raw score of an accepted apex */
     bsf_status_t st;
     int ring;
 
@@ -687,12 +795,33 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
 
     for (i = 0; i < pts->count; ++i) {
         const size_t w = work->win_hi[i];
+        /* -Os: certainly_rejected alone (same results, less code). The
+         * markers FALKO_WIN_NONE and FALKO_WIN_EXACT exceed any i. */
+#if !defined(__OPTIMIZE_SIZE__)
+        const int inside = w <= i && i + w < pts->count;
+#else
+        const int inside = 0;
+#endif
+        int verdict;
+        neigh_t ends;
         work->score[i] = FALKO_REJECTED;
-        if (w != FALKO_WIN_NONE &&
-            (w == FALKO_WIN_EXACT || certainly_rejected(pts, i, ring, work) == FALKO_MAYBE)) {
+        if (inside) {
+            verdict = certainly_rejected_inside(pts, i, w, work, &ends);
+        } else if (w == FALKO_WIN_NONE) {
+            verdict = FALKO_REJECT;
+        } else {
+            verdict = certainly_rejected(pts, i, ring, work);
+        }
+        if (verdict != FALKO_REJECT) {
             const float r = neigh_radius(p, pts->range[i]);
-            const float sc = beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
+            const float sc =
+                (inside && verdict == FALKO_MAYBE_ENDS)
+                    ? beam_score_ends(pts, i, r, p, &ends, work)
+                    : beam_score(pts, i, r, window_alpha(pts, i, r, inv_inc), ring, p, work);
             work->score[i] = sc;
+            if (sc >= 0.0f && sc < raw_min) {
+                raw_min = sc;
+            }
             if (sc > (float)score_max) {
                 if (sc > (float)FALKO_SCORE_LIMIT) {
                     return BSF_ERR_CAPACITY;
@@ -701,8 +830,11 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
             }
         }
     }
-    if (score_max == 0) {
-        /* Every strength would be 0 and the threshold >= 0: nothing passes. */
+    min_val = score_max * (long)p->min_score_th / 100L;
+    if (score_max == 0 || (float)score_max - raw_min <= (float)min_val) {
+        /* No strength passes the threshold (>= 0): the strongest beam has
+         * scoreMax - (smallest raw score), rejected ones 0. Exact: integers
+         * below 2^24 in float. */
         return BSF_OK;
     }
 
@@ -712,7 +844,6 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const float s = work->score[i];
         work->score[i] = (s < 0.0f) ? 0.0f : (float)score_max - s;
     }
-    min_val = score_max * (long)p->min_score_th / 100L;
     n_peak = bsf_nms_beams(pts, work->score, BSF_NMS_HIGHER_IS_BETTER, (float)min_val,
                            p->nms_radius, work->peak);
     if (ring && n_peak >= 2u) {
@@ -740,8 +871,8 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
         const size_t b = work->peak[k];
         const float r = neigh_radius(p, pts->range[b]);
         neigh_t nb;
-        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, inv_inc), ring, p,
-                            &nb); /* passed before */
+        (void)neighbourhood(pts, b, r, window_alpha(pts, b, r, inv_inc), ring, p, &nb,
+                            NULL); /* passed before */
         out[k].index = (uint16_t)b;
         out[k].orientation = corner_orientation(&nb);
         out[k].radius = r;

@@ -235,6 +235,45 @@ static void test_empty_all_invalid_and_single_beam_scans_give_no_keypoint(void)
     TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)detect_default(&s));
 }
 
+/* bsf_points_t documents an invalid beam as the point (0, 0), but points
+ * filled by hand may leave anything there: the detector must ignore it. Each
+ * beam near the corner in turn is made invalid, once at (0, 0) and once
+ * holding a stale point (the corner's, or a wall point beside it) that the
+ * end searches would take for a neighbour; the keypoints must be the same. */
+static void test_invalid_beam_coordinates_never_change_keypoints(void)
+{
+    static bsf_points_t clean;
+    static bsf_keypoint_t ref[BSF_MAX_KEYPOINTS];
+    const bsf_scan_t s = cast_180(corner_walls, 2, NULL, 0);
+    const bsf_falko_params_t p = bsf_falko_params_default();
+    size_t j, k, n_ref, n;
+    size_t n_found = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &clean));
+    for (j = 80u; j <= 100u; ++j) {
+        const bsf_point_t stale[3] = {clean.pt[90], clean.pt[86], clean.pt[94]};
+        points = clean;
+        points.valid[j] = 0u;
+        points.pt[j].x = 0.0f;
+        points.pt[j].y = 0.0f;
+        points.range[j] = 0.0f;
+        points.n_valid = clean.n_valid - 1u;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_falko_detect(&points, &p, &work, ref, BSF_MAX_KEYPOINTS, &n_ref));
+        for (k = 0; k < 3u; ++k) {
+            points.pt[j] = stale[k];
+            TEST_ASSERT_EQUAL_INT(BSF_OK,
+                                  bsf_falko_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n));
+            TEST_ASSERT_EQUAL_UINT32((uint32_t)n_ref, (uint32_t)n);
+            if (n > 0u) {
+                TEST_ASSERT_EQUAL_MEMORY(ref, kps, n * sizeof kps[0]);
+            }
+        }
+        n_found += (n_ref > 0u) ? 1u : 0u;
+    }
+    /* Not vacuous: the corner survives most single invalid beams. */
+    TEST_ASSERT_GREATER_THAN_UINT32(15u, (uint32_t)n_found);
+}
+
 static void test_nan_ranges_are_skipped_not_propagated(void)
 {
     bsf_scan_t s = cast_180(corner_walls, 2, NULL, 0);
@@ -510,6 +549,7 @@ int main(void)
     RUN_TEST(test_circle_around_sensor_yields_no_keypoint);
     RUN_TEST(test_pillar_yields_no_keypoint);
     RUN_TEST(test_empty_all_invalid_and_single_beam_scans_give_no_keypoint);
+    RUN_TEST(test_invalid_beam_coordinates_never_change_keypoints);
     RUN_TEST(test_nan_ranges_are_skipped_not_propagated);
     RUN_TEST(test_null_arguments_are_refused);
     RUN_TEST(test_bad_geometry_and_oversized_scan_are_refused);

@@ -71,7 +71,8 @@ BSF_NODISCARD bsf_status_t bsf_falko_params_check(const bsf_falko_params_t *p);
  */
 typedef struct {
     float score[BSF_MAX_POINTS];   /**< per-beam raw score, then NMS strength */
-    uint16_t peak[BSF_MAX_POINTS]; /**< NMS candidates, then keypoint beams */
+    uint16_t peak[BSF_MAX_POINTS]; /**< one neighbourhood's beams, then NMS candidates, then
+                                        keypoint beams */
     int8_t sector[BSF_MAX_POINTS]; /**< angular sectors of one neighbourhood */
     /* Per beam, a bracket of its neighbourhood radius (see bsf_falko.c). */
     float in2[BSF_MAX_POINTS];          /**< squared distance certainly inside */
