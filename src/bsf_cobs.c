@@ -93,6 +93,54 @@ size_t bsf_cobs_full_blocks(const uint8_t *body, size_t n)
     }
 }
 
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
+/* A body of fewer than 254 bytes right behind its first code byte: no block
+ * is full and no byte moves, so each zero byte becomes the distance to the
+ * next zero (or to the end), and buf[0] the distance to the first. Zero
+ * bytes are found a 64-bit word at a time: (w & 0x7F..) + 0x7F.. sets the
+ * top bit of every byte whose low 7 bits are not all 0, which with w's own
+ * top bits leaves exactly the zero bytes' top bits clear (no false hits). */
+static size_t cobs_short_in_place(uint8_t *buf, size_t n)
+{
+    const uint64_t low7 = 0x7F7F7F7F7F7F7F7Full;
+    uint8_t *code_at = buf;
+    const uint8_t *const words_end = buf + 1 + (n & ~(size_t)7u);
+    uint8_t *at = buf + 1;
+    size_t i;
+    for (; at != words_end; at += 8) {
+        uint64_t w;
+        uint64_t zeros;
+        memcpy(&w, at, sizeof w);
+        zeros = ~(((w & low7) + low7) | w | low7);
+        while (zeros != 0u) {
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                                 \
+    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            const unsigned byte = (unsigned)__builtin_ctzll(zeros) / 8u;
+#else
+            const unsigned byte = (unsigned)__builtin_clzll(zeros) / 8u;
+#endif
+            uint8_t *const zero = at + byte;
+            *code_at = (uint8_t)(zero - code_at);
+            code_at = zero;
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                                 \
+    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            zeros &= zeros - 1u; /* the first byte is the lowest */
+#else
+            zeros &= ~((uint64_t)0x80u << (8u * (7u - byte))); /* the first byte is the highest */
+#endif
+        }
+    }
+    for (i = (size_t)(at - buf); i <= n; ++i) {
+        if (buf[i] == 0u) {
+            *code_at = (uint8_t)(buf + i - code_at);
+            code_at = buf + i;
+        }
+    }
+    *code_at = (uint8_t)(buf + n + 1u - code_at);
+    return n + 1u;
+}
+#endif
+
 /* Blocks as in bsf_cobs_encode; a block's data moves only when an earlier
  * block of 254 bytes inserted a code byte (bodies of 254 bytes or more). */
 size_t bsf_cobs_encode_in_place(uint8_t *buf, size_t offset, size_t n)
@@ -101,6 +149,11 @@ size_t bsf_cobs_encode_in_place(uint8_t *buf, size_t offset, size_t n)
     const uint8_t *const src_end = src + n;
     uint8_t *code_at = buf;
     uint8_t *out = buf + 1;
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
+    if (offset == 1u && n < 254u) {
+        return cobs_short_in_place(buf, n);
+    }
+#endif
     for (;;) {
         const size_t left = (size_t)(src_end - src);
         const size_t run = nonzero_run(src, left < 254u ? left : 254u);

@@ -7,6 +7,11 @@
 #include "bsf_math.h"
 #include "bsf_wire.h"
 
+#if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
+    !defined(BSF_ENC_PORTABLE)
+#include <emmintrin.h>
+#endif
+
 /*
  * How a features frame is made (two runs over the result, docs/PERFORMANCE.md):
  *
@@ -152,10 +157,19 @@ static void stream_finish(stream_t *s)
  * stays in registers. In a costing run nothing is written: bits sums the
  * fields' lengths.
  */
+#if UINTPTR_MAX > 0xFFFFFFFFu && !defined(__OPTIMIZE_SIZE__)
+/* 64-bit hosts: a field that completes a word stays whole in acc, and the
+ * word is the 32 bits above the field's rest (fewer shifts per word). */
+#define ENC_ACC64 1
+typedef uint64_t acc_t;
+#else
+typedef uint32_t acc_t;
+#endif
+
 typedef struct {
     uint8_t *p;    /* the next word goes here */
     uint8_t *end;  /* words must end at or before this */
-    uint32_t acc;  /* pending bits in the low 32 - room bits (higher bits: leftovers) */
+    acc_t acc;     /* pending bits in the low 32 - room bits (higher bits: leftovers) */
     unsigned room; /* free bits in acc, 1..32 */
     uint32_t bits; /* costing run: payload bits so far */
 } bits_t;
@@ -228,6 +242,16 @@ ENC_INLINE void put_word(writer_t *w, bits_t *b, uint32_t word)
 /* The n (0..31) bits of v (v < 2^n). */
 ENC_INLINE void put_bits(writer_t *w, bits_t *b, uint32_t v, unsigned n)
 {
+#ifdef ENC_ACC64
+    b->acc = (b->acc << n) | v;
+    if (n < b->room) {
+        b->room -= n;
+    } else {
+        const unsigned rest = n - b->room; /* bits of v for the next word; room <= n <= 31 */
+        put_word(w, b, (uint32_t)(b->acc >> rest));
+        b->room = 32u - rest;
+    }
+#else
     if (n < b->room) {
         b->acc = (b->acc << n) | v;
         b->room -= n;
@@ -237,6 +261,7 @@ ENC_INLINE void put_bits(writer_t *w, bits_t *b, uint32_t v, unsigned n)
         b->acc = v; /* the bits of v above rest leave with the next word's shifts */
         b->room = 32u - rest;
     }
+#endif
 }
 
 /* floor(log2(c)) for 1 <= c < 2^31 (x86 BSR). */
@@ -288,6 +313,34 @@ ENC_INLINE void field_eg(writer_t *w, bits_t *b, int costing, uint32_t v, unsign
         put_eg(w, b, v, k);
     }
 }
+
+/* Two EG fields, v0 (order k0) then v1 (order k1), each v < 2^30 and k <= 25:
+ * one field when both codes fit in 31 bits together (feature fields). */
+#if !defined(__OPTIMIZE_SIZE__)
+ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsigned k0,
+                          uint32_t v1, unsigned k1)
+{
+    const uint32_t c0 = v0 + ((uint32_t)1 << k0);
+    const uint32_t c1 = v1 + ((uint32_t)1 << k1);
+    const unsigned len0 = 2u * log2_nz(c0) + 1u - k0;
+    const unsigned len1 = 2u * log2_nz(c1) + 1u - k1;
+    if (costing) {
+        b->bits += len0 + len1;
+    } else if (len0 + len1 < 32u) {
+        put_bits(w, b, (c0 << len1) | c1, len0 + len1);
+    } else {
+        put_eg(w, b, v0, k0);
+        put_eg(w, b, v1, k1);
+    }
+}
+#else
+/* -Os: the two fields one after the other (a macro: no function of its own) */
+#define field_eg2(w, b, costing, v0, k0, v1, k1)                                                   \
+    do {                                                                                           \
+        field_eg(w, b, costing, v0, k0);                                                           \
+        field_eg(w, b, costing, v1, k1);                                                           \
+    } while (0)
+#endif
 
 /* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
  * wide fields. State in and out by value, so that the caller's stays in
@@ -345,7 +398,7 @@ static size_t writer_bits(const writer_t *w, const uint8_t *start)
 static void writer_flush(writer_t *w)
 {
     if (w->b.room < 32u) {
-        put_word(w, &w->b, w->b.acc << w->b.room);
+        put_word(w, &w->b, (uint32_t)(w->b.acc << w->b.room));
     }
 }
 #endif
@@ -356,7 +409,7 @@ static void writer_end_stream(writer_t *w)
     size_t n;
     if (w->b.room < 32u) {
         const unsigned tail = (32u - w->b.room + 7u) / 8u; /* bytes of the partial word */
-        put_word(w, &w->b, w->b.acc << w->b.room);
+        put_word(w, &w->b, (uint32_t)(w->b.acc << w->b.room));
         n = (size_t)(w->b.p - w->chunk) - (4u - tail);
     } else {
         n = (size_t)(w->b.p - w->chunk);
@@ -389,12 +442,35 @@ ENC_INLINE int quantise(float v, float step, int32_t *q)
     return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
 }
 
+#if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
+    !defined(BSF_ENC_PORTABLE)
+/* Both coordinates at once with the same IEEE single operations as
+ * quantise (divide, add, truncate, compare), so the same q and verdict. */
+ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
+{
+    const __m128 r =
+        _mm_add_ps(_mm_div_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)&p)),
+                              _mm_set1_ps(step)),
+                   _mm_set1_ps(0.5f));
+    const __m128 in_range = _mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), r),
+                                         _mm_set1_ps((float)BSF_QUANT_MAX_STEPS + 1.0f));
+    const __m128i t = _mm_cvttps_epi32(r);
+    /* floor: one lower where the truncation rounded up (a negative r with a fraction) */
+    const __m128i fl = _mm_add_epi32(t, _mm_castps_si128(_mm_cmpgt_ps(_mm_cvtepi32_ps(t), r)));
+    const __m128i above_min =
+        _mm_cmpgt_epi32(fl, _mm_set1_epi32(-(int32_t)BSF_QUANT_MAX_STEPS - 1));
+    q[0] = _mm_cvtsi128_si32(fl);
+    q[1] = _mm_cvtsi128_si32(_mm_shuffle_epi32(fl, 1));
+    return (_mm_movemask_ps(_mm_and_ps(in_range, _mm_castsi128_ps(above_min))) & 3) == 3;
+}
+#else
 ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
 {
     const int ok_x = quantise(p.x, step, &q[0]);
     const int ok_y = quantise(p.y, step, &q[1]);
     return ok_x && ok_y;
 }
+#endif
 
 /* ---- Control point values ------------------------------------------------ */
 
@@ -470,7 +546,8 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
  * on the chord. Stores them in out (room for 2 n), tallies them when tally
  * is given (the planning run), and returns their number (2 per distinct
  * point), or 0 when a point cannot be represented or a flagged slot has no
- * equal partner; *mask gets bit j for distinct point j that is a vertex.
+ * equal partner; *mask gets the vertex mask in wire order: one bit per
+ * distinct point, point 0 the highest of the m (FORMAT.md section 3.2).
  */
 ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, size_t n, float step,
                                    int32_t prev[2], uint32_t *out, bsf_wire_eg_tally_t *tally,
@@ -479,7 +556,6 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
     size_t s_a = 0;
     size_t c_a;
     uint32_t cnt = 0;
-    uint32_t j_a = 0; /* distinct index of anchor a */
     int32_t q_a[2];
 
     *mask = 0u;
@@ -510,13 +586,13 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
         if (!quantise_point(p[s_b], step, q_b)) {
             return 0u;
         }
-        j_a += k + 1u;
+        *mask <<= k + 1u; /* k + 1 <= 63: the k precision points and anchor b */
         c_a = 1u;
         if (vtx[s_b] != 0u) {
             if (!vertex_partner_ok(p, vtx, s_b, n, step, q_b)) {
                 return 0u;
             }
-            *mask |= (uint64_t)1u << j_a;
+            *mask |= 1u; /* anchor b: the mask's lowest bit for now */
             c_a = 2u;
         }
         cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_ANCHOR, q_b[0] - q_a[0]);
@@ -548,7 +624,49 @@ typedef struct {
     uint32_t adj[BSF_WIRE_N_CLASSES];
 } orders_t;
 
+/* One value's code at its class's order, from its c = v + 2^k and lg = floor(log2(c)). */
+ENC_INLINE void put_value_code(writer_t *w, bits_t *b, uint32_t c, unsigned lg, unsigned len)
+{
+    if (len < 32u) {
+        put_bits(w, b, c, len);
+    } else {
+        put_bits(w, b, 0u, len - lg - 1u);
+        put_bits(w, b, c, lg + 1u);
+    }
+}
+
 /* The values' codes at the frame's orders: the hot loop of the writing run. */
+#if !defined(__OPTIMIZE_SIZE__)
+/* Values come in pairs of one class (x, then y of a point): the two codes
+ * go out as one field when they fit in 31 bits together (the usual case),
+ * which saves a class lookup and a field per point. */
+ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
+                           const orders_t *ord)
+{
+    uint32_t i;
+    for (i = 0; i < n; i += 2u) {
+        const uint32_t v0 = values[i];
+        const unsigned cls = v0 >> VALUE_CLASS_SHIFT;
+        const uint32_t one = ord->one[cls];
+        const uint32_t adj = ord->adj[cls];
+        const uint32_t c0 = (v0 & VALUE_MASK) + one;
+        const uint32_t c1 = (values[i + 1u] & VALUE_MASK) + one;
+        const unsigned lg0 = log2_nz(c0);
+        const unsigned lg1 = log2_nz(c1);
+        const unsigned len0 = 2u * lg0 + adj;
+        const unsigned len1 = 2u * lg1 + adj;
+        if (costing) {
+            b->bits += len0 + len1;
+        } else if (len0 + len1 < 32u) {
+            /* c0 has lg0 + 1 <= len0 bits: the zero run and c0, then c1's */
+            put_bits(w, b, (c0 << len1) | c1, len0 + len1);
+        } else {
+            put_value_code(w, b, c0, lg0, len0);
+            put_value_code(w, b, c1, lg1, len1);
+        }
+    }
+}
+#else
 ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *values, uint32_t n,
                            const orders_t *ord)
 {
@@ -561,14 +679,12 @@ ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *
         const unsigned len = 2u * lg + ord->adj[cls];
         if (costing) {
             b->bits += len;
-        } else if (len < 32u) {
-            put_bits(w, b, c, len);
         } else {
-            put_bits(w, b, 0u, len - lg - 1u);
-            put_bits(w, b, c, lg + 1u);
+            put_value_code(w, b, c, lg, len);
         }
     }
 }
+#endif
 
 /* ---- Features frame ------------------------------------------------------ */
 
@@ -583,13 +699,12 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 /* A feature's own fields (not its points) within the result and the caps. */
-static int feature_ok(const bsf_result_t *res, const bsf_feature_t *f)
+static int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
 {
     const size_t n = f->n_ctrl;
-    const uint32_t n_beams = res->stats.n_beams;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
     return !(f->kind > 1u || n < 3u || n > (size_t)BSF_MAX_CTRL_PER_FEATURE ||
-             (size_t)f->ctrl_first + n > (size_t)res->n_ctrl || f->first_beam >= beam_limit ||
+             (size_t)f->ctrl_first + n > n_ctrl || f->first_beam >= beam_limit ||
              f->last_beam >= beam_limit || (f->first_beam > f->last_beam && n_beams == 0u) ||
              f->n_points > feature_span(f, n_beams) + 1u ||
              !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX));
@@ -665,7 +780,6 @@ typedef struct {
 /* The checks that come before any feature. */
 static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t *res, plan_t *pl)
 {
-    uint32_t i;
     bsf_status_t st;
     if (res->n_features > (uint32_t)BSF_MAX_SEGMENTS ||
         res->n_ctrl > (uint32_t)BSF_MAX_CTRL_POINTS) {
@@ -683,13 +797,7 @@ static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t
         return BSF_ERR_ARG;
     }
     pl->step = (float)pl->step_code * BSF_QUANT_STEP_UNIT;
-    pl->has_beams = info->has_geometry != 0u;
-    for (i = 0; i < res->n_features; ++i) {
-        if (res->features[i].first_beam > res->features[i].last_beam) {
-            pl->has_beams = 1;
-        }
-    }
-    pl->has_ext = pl->has_beams || res->stats.cut != 0u;
+    pl->has_beams = info->has_geometry != 0u; /* or a feature wraps: plan_frame */
     return BSF_OK;
 }
 
@@ -706,6 +814,11 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
 {
     bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     const float step = pl->step;
+    /* locals, not loads through res and pl, which the table's stores may alias */
+    const uint32_t n_features = res->n_features;
+    const uint32_t n_beams = res->stats.n_beams;
+    const size_t n_ctrl = res->n_ctrl;
+    uint32_t n_cached = 0;
     int32_t prev[2] = {0, 0};
     uint32_t used = 0; /* table entries of the leading features */
     uint32_t sum_points = 0;
@@ -713,15 +826,15 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
     unsigned cls;
 
     memset(tally, 0, sizeof tally);
-    for (i = 0; i < res->n_features; ++i) {
+    for (i = 0; i < n_features; ++i) {
         const bsf_feature_t *f = &res->features[i];
         uint32_t *head = table + used;
         uint32_t n_values;
         uint64_t mask;
-        if (!feature_ok(res, f)) {
+        if (!feature_ok(f, n_beams, n_ctrl)) {
             return BSF_ERR_ARG;
         }
-        if (pl->n_cached == i) {
+        if (n_cached == i) {
             pl->prev_resume[0] = prev[0];
             pl->prev_resume[1] = prev[1];
         }
@@ -731,20 +844,25 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
         if (n_values == 0u) {
             return BSF_ERR_ARG;
         }
-        if (pl->n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
+        if (n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
             head[0] = n_values / 2u;
             head[1] = (uint32_t)mask;
             head[2] = (uint32_t)(mask >> 32);
             used += VALUE_HEAD + n_values;
-            pl->n_cached = i + 1u;
+            n_cached = i + 1u;
         }
         sum_points += f->n_points;
+        if (f->first_beam > f->last_beam) {
+            pl->has_beams = 1;
+        }
     }
+    pl->n_cached = n_cached;
+    pl->has_ext = pl->has_beams || res->stats.cut != 0u;
     if (sum_points > res->stats.n_valid ||
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
-    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * (uint32_t)res->n_features;
+    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * n_features;
     for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
         uint32_t bits;
         pl->k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);
@@ -838,23 +956,47 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                                       table, NULL, &mask) /
                        2u;
         }
+#if !defined(__OPTIMIZE_SIZE__)
+#if BSF_WIRE_K_M != 1u
+#error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
+#endif
+        {
+            /* kind, m - 2 (EG1: the code is m in 2 floor(log2 m) bits) and the
+             * mask flag as one field of at most 14 bits */
+            const unsigned m_len = 2u * log2_nz(n_unique);
+            field_u(w, &b, costing,
+                    ((uint32_t)f->kind << (m_len + 1u)) | (n_unique << 1) | (mask != 0u ? 1u : 0u),
+                    m_len + 2u);
+        }
+        if (mask != 0u) {
+            uint32_t j = n_unique; /* bits left, the highest first */
+            do {
+                const unsigned take = j > 16u ? 16u : j;
+                j -= take;
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
+            } while (j > 0u);
+        }
+#else
         field_u(w, &b, costing, f->kind, 1u);
         field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
         if (mask == 0u) {
             field_u(w, &b, costing, 0u, 1u);
         } else {
-            uint32_t j;
+            uint32_t j = n_unique; /* bits left, the highest first */
             field_u(w, &b, costing, 1u, 1u);
-            for (j = 0; j < n_unique; ++j) {
-                field_u(w, &b, costing, (uint32_t)(mask >> j) & 1u, 1u);
-            }
+            do {
+                const unsigned take = j > 16u ? 16u : j;
+                j -= take;
+                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
+            } while (j > 0u);
         }
-        field_eg(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
-                 BSF_WIRE_K_GAP);
-        field_eg(w, &b, costing, span, BSF_WIRE_K_SPAN);
-        field_eg(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING);
-        field_eg(w, &b, costing, (uint32_t)bsf_floorf(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f),
-                 BSF_WIRE_K_E_CURVE);
+#endif
+        field_eg2(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
+                  BSF_WIRE_K_GAP, span, BSF_WIRE_K_SPAN);
+        /* E_curve rounded half up: the planning run checked 0 <= e_curve <=
+         * BSF_E_CURVE_MAX, so the conversion's truncation is the floor */
+        field_eg2(w, &b, costing, span + 1u - f->n_points, BSF_WIRE_K_MISSING,
+                  (uint32_t)(f->e_curve * BSF_WIRE_E_CURVE_PER_M + 0.5f), BSF_WIRE_K_E_CURVE);
         put_values(w, &b, costing, values, 2u * n_unique, &ord);
         prev_last_beam_plus1 = (uint32_t)f->last_beam + 1u;
     }

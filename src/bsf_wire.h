@@ -172,7 +172,8 @@ typedef uint32_t bsf_wire_eg_count_t;
 typedef struct {
     bsf_wire_eg_count_t n_len[BSF_WIRE_EG_HIST];   /* values per bit length L */
     bsf_wire_eg_count_t n_below[BSF_WIRE_EG_HIST]; /* values per m */
-    uint32_t or_all; /* OR of the values: its bit length is the largest L */
+    uint32_t n;                                    /* values */
+    uint32_t sum_len;                              /* sum of their L */
 } bsf_wire_eg_tally_t;
 
 /* One value v < 2^26. */
@@ -183,7 +184,8 @@ static inline void bsf_wire_eg_tally_add32(bsf_wire_eg_tally_t *t, uint32_t v)
     const uint32_t ones = (0xFFFFFFFFu >> 1) >> (31u - len);
     t->n_len[len] += 1u;
     t->n_below[bsf_wire_bitlen31(v ^ ones)] += 1u;
-    t->or_all |= v;
+    t->n += 1u;
+    t->sum_len += len;
 }
 
 static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
@@ -200,19 +202,11 @@ static inline void bsf_wire_eg_tally_add(bsf_wire_eg_tally_t *t, uint64_t v)
  * all L and T(k) = T(k - 1) + A(k - 1).
  */
 
-/* The number of values and the sum of their L, up to the largest L. */
+/* The number of values and the sum of their L (kept as they are tallied). */
 static inline uint32_t bsf_wire_eg_tally_sums(const bsf_wire_eg_tally_t *t, uint32_t *sum_len)
 {
-    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
-    uint32_t n = t->n_len[0];
-    uint32_t sum = 0;
-    unsigned len;
-    for (len = 1; len <= max_len; ++len) {
-        n += t->n_len[len];
-        sum += len * t->n_len[len];
-    }
-    *sum_len = sum;
-    return n;
+    *sum_len = t->sum_len;
+    return t->n;
 }
 
 /* cost[k] for k = 0..k_max (<= 25): total bits of the tallied values at order k. */
@@ -236,28 +230,24 @@ static inline void bsf_wire_eg_tally_costs(const bsf_wire_eg_tally_t *t, unsigne
  * The order 0..BSF_WIRE_K_CTRL_MAX with the fewest bits for the tallied
  * values (ties to the smaller order), and those bits in *bits. Every code
  * at order k takes at least k + 1 bits, so the search stops once n (k + 1)
- * reaches the best total; it never goes past the longest value's bit length
- * L either, since above L every order costs one bit per value more than the
- * one before.
+ * reaches the best total. That also ends it at most one order past the
+ * longest value's bit length L: at k >= L every code takes exactly k + 1
+ * bits, so order L costs n (L + 1), which the next floor n (L + 2) exceeds.
  */
 static inline unsigned bsf_wire_eg_tally_best(const bsf_wire_eg_tally_t *t, uint32_t *bits)
 {
-    const unsigned max_len = bsf_wire_bitlen32(t->or_all);
-    const unsigned k_top = max_len < BSF_WIRE_K_CTRL_MAX ? max_len : BSF_WIRE_K_CTRL_MAX;
     uint32_t sum;
     const uint32_t n = bsf_wire_eg_tally_sums(t, &sum);
-    uint32_t a = t->n_len[0];
-    uint32_t b = t->n_below[0];
-    uint32_t best_cost = 2u * (sum + b) - n; /* order 0 */
-    uint32_t floor_bits = 2u * n;            /* n (k + 1) for the next k */
+    uint32_t a = t->n_len[0];                       /* A(k - 1) */
+    uint32_t cost = 2u * (sum + t->n_below[0]) - n; /* order 0 */
+    uint32_t best_cost = cost;
+    uint32_t floor_bits = 2u * n; /* n (k + 1) for the next k */
     unsigned best = 0;
     unsigned k;
-    for (k = 1; k <= k_top && floor_bits < best_cost; ++k) {
-        uint32_t cost;
-        sum += a;
+    for (k = 1; k <= BSF_WIRE_K_CTRL_MAX && floor_bits < best_cost; ++k) {
+        /* cost(k) - cost(k - 1) = 2 (A(k - 1) + B(k) - B(k - 1)) - n */
+        cost += 2u * (a + t->n_below[k]) - n;
         a += t->n_len[k];
-        b += t->n_below[k];
-        cost = 2u * (sum + b) - floor_bits;
         if (cost < best_cost) {
             best_cost = cost;
             best = k;

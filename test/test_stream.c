@@ -449,6 +449,44 @@ static void test_encoder_rejects_values_it_cannot_represent(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_frame_encode(&info, &res, buf, sizeof buf, NULL));
 }
 
+/* The edges of the representable range, in x and in y, for an anchor and a
+ * precision point: at a step of 1 m, floor(v + 1/2) must stay within
+ * +-(2^23 - 1); -8388608 rounds to -2^23 and is refused like 8388607.5. */
+static void test_quantisation_range_edges_in_both_coordinates(void)
+{
+    static const struct {
+        float v;
+        bsf_status_t want;
+    } edge[] = {{8388606.5f, BSF_OK},       {8388607.0f, BSF_OK},      {8388607.5f, BSF_ERR_ARG},
+                {-8388607.0f, BSF_OK},      {-8388607.5f, BSF_OK},     {-8388608.0f, BSF_ERR_ARG},
+                {-8388608.5f, BSF_ERR_ARG}, {-8388609.0f, BSF_ERR_ARG}};
+    bsf_frame_info_t info;
+    unsigned e;
+    unsigned slot;
+    for (e = 0; e < sizeof edge / sizeof edge[0]; ++e) {
+        for (slot = 0; slot < 4u; ++slot) { /* point 0 or 1 (anchor, precision), x or y */
+            size_t n = 0;
+            fx_example_minimal(&info, &res);
+            info.quant_step = 1.0f;
+            if (slot % 2u == 0u) {
+                res.ctrl[slot / 2u].x = edge[e].v;
+            } else {
+                res.ctrl[slot / 2u].y = edge[e].v;
+            }
+            TEST_ASSERT_EQUAL_INT_MESSAGE(
+                edge[e].want, bsf_frame_encode(&info, &res, buf, sizeof buf, &n), "edge");
+            TEST_ASSERT_EQUAL_INT(edge[e].want, bsf_frame_encode(&info, &res, NULL, 0u, &n));
+            if (edge[e].want == BSF_OK) {
+                TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_encode(&info, &res, buf, sizeof buf, &n));
+                TEST_ASSERT_EQUAL_UINT32(1u, feed_all(buf, n, 64u));
+                TEST_ASSERT_EQUAL_FLOAT(floorf(edge[e].v + 0.5f),
+                                        slot % 2u == 0u ? frame.result.ctrl[slot / 2u].x
+                                                        : frame.result.ctrl[slot / 2u].y);
+            }
+        }
+    }
+}
+
 static void test_worst_case_frame_fits_the_max_size_macro(void)
 {
     bsf_frame_info_t info;
@@ -1201,6 +1239,7 @@ int main(void)
     RUN_TEST(test_random_results_round_trip_within_half_a_step);
     RUN_TEST(test_vertex_travels_once_and_is_expanded_on_decode);
     RUN_TEST(test_encoder_rejects_values_it_cannot_represent);
+    RUN_TEST(test_quantisation_range_edges_in_both_coordinates);
     RUN_TEST(test_worst_case_frame_fits_the_max_size_macro);
     RUN_TEST(test_decoder_delivers_each_of_two_frames_in_one_chunk);
     RUN_TEST(test_truncated_frames_are_never_delivered);
