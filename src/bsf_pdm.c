@@ -264,8 +264,9 @@ static inline void load_span(const bsf_point_t *ctrl, size_t n_span, size_t span
  * change instead of once per point. */
 typedef struct {
     size_t span;
-    float s00, s10, s11, s20, s21, s22;
-    float x0, x1, x2, y0, y1, y2;
+    float s[6]; /* products b0 b0, b1 b0, b1 b1, b2 b0, b2 b1, b2 b2 */
+    float x[3];
+    float y[3];
 } span_sums_t;
 
 static inline void sums_reset(span_sums_t *a, size_t span)
@@ -277,18 +278,18 @@ static inline void sums_reset(span_sums_t *a, size_t span)
 static inline void sums_add(span_sums_t *a, float b0, float b2, float px, float py)
 {
     const float b1 = 1.0f - b0 - b2;
-    a->s00 += b0 * b0;
-    a->s10 += b1 * b0;
-    a->s11 += b1 * b1;
-    a->s20 += b2 * b0;
-    a->s21 += b2 * b1;
-    a->s22 += b2 * b2;
-    a->x0 += b0 * px;
-    a->x1 += b1 * px;
-    a->x2 += b2 * px;
-    a->y0 += b0 * py;
-    a->y1 += b1 * py;
-    a->y2 += b2 * py;
+    a->s[0] += b0 * b0;
+    a->s[1] += b1 * b0;
+    a->s[2] += b1 * b1;
+    a->s[3] += b2 * b0;
+    a->s[4] += b2 * b1;
+    a->s[5] += b2 * b2;
+    a->x[0] += b0 * px;
+    a->x[1] += b1 * px;
+    a->x[2] += b2 * px;
+    a->y[0] += b0 * py;
+    a->y[1] += b1 * py;
+    a->y[2] += b2 * py;
 }
 
 /* Add a span's sums to the lower band (stride 3) and right-hand sides. Its
@@ -302,18 +303,39 @@ static void sums_flush(bsf_pdm_work_t *w, const span_sums_t *a)
     const size_t u1 = unk[1];
     const size_t u2 = unk[2];
     float *band = w->band;
-    band[u0 * 3u] += a->s00;
-    band[u1 * 3u] += a->s11;
-    band[u2 * 3u] += a->s22;
-    band[u1 * 3u + (u1 - u0)] += (u1 == u0 ? 2.0f : 1.0f) * a->s10;
-    band[u2 * 3u + (u2 - u0)] += (u2 == u0 ? 2.0f : 1.0f) * a->s20;
-    band[u2 * 3u + (u2 - u1)] += (u2 == u1 ? 2.0f : 1.0f) * a->s21;
-    w->rhs_x[u0] += a->x0;
-    w->rhs_x[u1] += a->x1;
-    w->rhs_x[u2] += a->x2;
-    w->rhs_y[u0] += a->y0;
-    w->rhs_y[u1] += a->y1;
-    w->rhs_y[u2] += a->y2;
+#if defined(__OPTIMIZE_SIZE__)
+    /* -Os: the same additions in the same order, from tables (the three
+     * diagonal products, then the three below it). */
+    static const uint8_t row[6] = {0u, 1u, 2u, 1u, 2u, 2u};
+    static const uint8_t col[6] = {0u, 1u, 2u, 0u, 0u, 1u};
+    static const uint8_t prod[6] = {0u, 2u, 5u, 1u, 3u, 4u};
+    size_t k;
+    (void)u0;
+    (void)u1;
+    (void)u2;
+    for (k = 0; k < 6u; ++k) {
+        const size_t ur = unk[row[k]];
+        const size_t uc = unk[col[k]];
+        band[ur * 3u + (ur - uc)] += (k >= 3u && ur == uc ? 2.0f : 1.0f) * a->s[prod[k]];
+    }
+    for (k = 0; k < 3u; ++k) {
+        w->rhs_x[unk[k]] += a->x[k];
+        w->rhs_y[unk[k]] += a->y[k];
+    }
+#else
+    band[u0 * 3u] += a->s[0];
+    band[u1 * 3u] += a->s[2];
+    band[u2 * 3u] += a->s[5];
+    band[u1 * 3u + (u1 - u0)] += (u1 == u0 ? 2.0f : 1.0f) * a->s[1];
+    band[u2 * 3u + (u2 - u0)] += (u2 == u0 ? 2.0f : 1.0f) * a->s[3];
+    band[u2 * 3u + (u2 - u1)] += (u2 == u1 ? 2.0f : 1.0f) * a->s[4];
+    w->rhs_x[u0] += a->x[0];
+    w->rhs_x[u1] += a->x[1];
+    w->rhs_x[u2] += a->x[2];
+    w->rhs_y[u0] += a->y[0];
+    w->rhs_y[u1] += a->y[1];
+    w->rhs_y[u2] += a->y[2];
+#endif
 }
 
 static void clear_normal_equations(const pdm_state_t *s, bsf_pdm_work_t *w)
@@ -450,12 +472,12 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             const float c1 = -(c0 + c2);
             span_sums_t r;
             sums_reset(&r, k);
-            r.s00 = weight * c0 * c0;
-            r.s10 = weight * c1 * c0;
-            r.s11 = weight * c1 * c1;
-            r.s20 = weight * c2 * c0;
-            r.s21 = weight * c2 * c1;
-            r.s22 = weight * c2 * c2;
+            r.s[0] = weight * c0 * c0;
+            r.s[1] = weight * c1 * c0;
+            r.s[2] = weight * c1 * c1;
+            r.s[3] = weight * c2 * c0;
+            r.s[4] = weight * c2 * c1;
+            r.s[5] = weight * c2 * c2;
             sums_flush(w, &r);
         }
     }
@@ -588,6 +610,7 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
         float ex;
         float ey;
         float best;
+        float r = 0.0f; /* signed residual (bias_window) */
         unsigned step;
 
         if (span != c.span) {
@@ -711,7 +734,6 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             /* Signed residual along the normal of the span's chord (one
              * square root per span), summed over the last bias_window
              * points of the fragment in a ring. */
-            float r;
             float slot;
             int slot_open = 0;
             if (c.span != normal_span) {
@@ -745,43 +767,35 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 }
             }
             point_max = best > point_max ? best : point_max;
-            if (i == frag_end) {
-                const size_t count = frag_end - w->frag_first[f] + 1u;
-                const float rms = sqrtf(frag_sum / (float)count);
-                w->frag_rms[f] = systematic_error(s, rms, window_max, point_max, block);
-                frag_sum = best; /* the vertex point opens the next fragment */
-                point_max = best;
-                memset(ring, 0, bias_window * sizeof ring[0]);
-                window_max = 0.0f;
-                if (f + 1u < s->n_frag) {
-                    ++f;
-                    frag_end = w->frag_last[f];
-                    block = bias_block(s, w, f);
-                }
-                /* A trailing partial slot is dropped. */
-                ring_sum = 0.0f;
-                ring_at = 0u;
-                ring_wait = bias_window;
-                block_sum = r;
-                block_n = 1u;
-                if (block == 1u) {
-                    ring[0] = r;
-                    ring_sum = r;
-                    ring_at = 1u;
-                    ring_wait = bias_window - 1u;
-                    block_n = 0u;
-                    block_sum = 0.0f;
-                }
-            }
-            continue;
         }
         if (i == frag_end) {
             const size_t count = frag_end - w->frag_first[f] + 1u;
-            w->frag_rms[f] = sqrtf(frag_sum / (float)count);
+            const float rms = sqrtf(frag_sum / (float)count);
+            w->frag_rms[f] =
+                bias_window > 0u ? systematic_error(s, rms, window_max, point_max, block) : rms;
             frag_sum = best; /* the vertex point opens the next fragment */
+            point_max = best;
+            memset(ring, 0, bias_window * sizeof ring[0]);
+            window_max = 0.0f;
             if (f + 1u < s->n_frag) {
                 ++f;
                 frag_end = w->frag_last[f];
+                block = bias_window > 0u ? bias_block(s, w, f) : 1u;
+            }
+            /* A trailing partial slot is dropped (the ring is unused
+             * without bias_window). */
+            ring_sum = 0.0f;
+            ring_at = 0u;
+            ring_wait = bias_window;
+            block_sum = r;
+            block_n = 1u;
+            if (block == 1u) {
+                ring[0] = r;
+                ring_sum = r;
+                ring_at = 1u;
+                ring_wait = bias_window - 1u;
+                block_n = 0u;
+                block_sum = 0.0f;
             }
         }
     }
