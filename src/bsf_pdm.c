@@ -73,7 +73,8 @@ typedef struct {
     size_t bias_window;                           /* 0: refinement on RMS alone */
     float bias_floor;                             /* bias_ratio * target_rms */
     float target;                                 /* target_rms */
-    uint8_t frag_stray[BSF_PDM_MAX_FRAGMENTS];    /* only a lone point fails (lone_stray) */
+    uint8_t frag_stray[BSF_PDM_MAX_FRAGMENTS];    /* only a lone point fails (lone_stray),
+                                                     as of the last footpoint pass */
     const bsf_point_t *anchor;                    /* vertex anchors (absolute), or NULL */
     uint8_t vertex_unknown[BSF_PDM_MAX_VERTICES]; /* unknown index of each vertex */
 } pdm_state_t;
