@@ -174,10 +174,14 @@ typedef struct {
  * stay stuck on a corner the vertices miss); nearer the target, by exactly one point with a
  * warm start (parameters remapped fragment by fragment, refine_iterations
  * iterations), plus a fresh fit from arc length kept when it is better if the
- * fragment's RMS fell by less than 5 %. This repeats until every fragment
- * meets the target or none can grow; the last point added is always a single
- * step. A result above target_rms is therefore not an error: compare
- * e_curve_out.
+ * fragment's RMS fell by less than 5 %. When that point gained less than 5 %
+ * and, with bias_window on, only the point test keeps the fragment above
+ * target, its farthest point lying alone (at least two points inside the
+ * fragment, both neighbours under a quarter of its distance from the curve:
+ * a stray return), the fragment is settled instead (no fresh fit, no more
+ * points). This repeats until every fragment meets the target or none can
+ * grow; the last point added is always a single step. A result above target_rms is therefore not an
+ * error: compare e_curve_out.
  *
  * @param pts           n points of the segment in scan order, metres
  * @param n             3..BSF_MAX_POINTS
