@@ -671,7 +671,7 @@ static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
 
 #ifdef FALKO_SSE2_WALKS
 /* d2 = (c - q)^2 summed over x and y for the 4 points from q (interleaved x,
- * y), and the mask of those with d2 <= out2. */
+ * y), and the mask of those with !(d2 > out2). */
 static int near4(const bsf_point_t *q, __m128 cx, __m128 cy, __m128 o2, __m128 *d2)
 {
     const __m128 a = _mm_loadu_ps(&q[0].x); /* x0 y0 x1 y1 */
@@ -679,10 +679,10 @@ static int near4(const bsf_point_t *q, __m128 cx, __m128 cy, __m128 o2, __m128 *
     const __m128 dx = _mm_sub_ps(cx, _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)));
     const __m128 dy = _mm_sub_ps(cy, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
     *d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
-    return _mm_movemask_ps(_mm_cmple_ps(*d2, o2));
+    return _mm_movemask_ps(_mm_cmpngt_ps(*d2, o2));
 }
 
-/* The first position from `first` upwards with d2 <= out2, and its d2. */
+/* The first position from `first` upwards with !(d2 > out2), and its d2. */
 static size_t walk_up4(const bsf_point_t *pt, bsf_point_t c, float out2, size_t first, float *d2)
 {
     const __m128 cx = _mm_set1_ps(c.x);
@@ -700,7 +700,7 @@ static size_t walk_up4(const bsf_point_t *pt, bsf_point_t c, float out2, size_t 
     return first + (size_t)k;
 }
 
-/* The first position from `last` downwards with d2 <= out2, and its d2. */
+/* The first position from `last` downwards with !(d2 > out2), and its d2. */
 static size_t walk_down4(const bsf_point_t *pt, bsf_point_t c, float out2, size_t last, float *d2)
 {
     const __m128 cx = _mm_set1_ps(c.x);
@@ -737,14 +737,19 @@ static int certainly_rejected_inside(const bsf_points_t *pts, size_t i, size_t w
     size_t first = i - w;
     size_t last = i + w;
     float d2f, d2l;
-    /* The apex stops each walk: its d2 is 0 and out2 > 0 (the bracket is
-     * cheap only for finite radii above 1e-15), so the loops need no bound. */
+    /* The apex stops each walk, so the loops need no bound: its d2 is 0 and
+     * out2 > 0 (the bracket is cheap only for finite radii above 1e-15), or
+     * NaN when the apex is not finite. A walk also stops at a NaN d2 (a
+     * non-finite point), which the exact path then decides (!(d2 <= in2)). */
 #ifdef FALKO_SSE2_WALKS
     if (w >= FALKO_WIDE_WINDOW) {
         /* Four beams per step, each d2 computed as below (the same float
          * operations per lane). Steps read at most 3 beams past the apex,
          * which lie inside the window. */
         first = walk_up4(pt, c, out2, first, &d2f);
+        if (first == i) {
+            return FALKO_REJECT;
+        }
         last = walk_down4(pt, c, out2, last, &d2l);
     } else
 #endif
@@ -753,24 +758,27 @@ static int certainly_rejected_inside(const bsf_points_t *pts, size_t i, size_t w
             const float dx = c.x - pt[first].x;
             const float dy = c.y - pt[first].y;
             d2f = dx * dx + dy * dy;
-            if (d2f <= out2) {
+            if (!(d2f > out2)) {
                 break;
             }
+        }
+        if (first == i) {
+            return FALKO_REJECT;
         }
         for (;; --last) {
             const float dx = c.x - pt[last].x;
             const float dy = c.y - pt[last].y;
             d2l = dx * dx + dy * dy;
-            if (d2l <= out2) {
+            if (!(d2l > out2)) {
                 break;
             }
         }
     }
-    if (first == i || last == i) {
+    if (last == i) {
         return FALKO_REJECT;
     }
-    if (!pts->valid[first] || !pts->valid[last] || d2f > in2 || d2l > in2 || i - first > inner ||
-        last - i > inner) {
+    if (!pts->valid[first] || !pts->valid[last] || !(d2f <= in2) || !(d2l <= in2) ||
+        i - first > inner || last - i > inner) {
         return FALKO_MAYBE;
     }
     {
