@@ -425,23 +425,6 @@ static int is_finite_f(float v)
     return bsf_finite_bits(v);
 }
 
-/* Nearest multiple of step, in steps: floor(v / step + 0.5); 0 when v is
- * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
- * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
- * one lower for a negative r with a fraction. */
-ENC_INLINE int quantise(float v, float step, int32_t *q)
-{
-    const float r = v / step + 0.5f;
-    int32_t t;
-    if (!(fabsf(r) < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
-        *q = 0;
-        return 0; /* NaN included */
-    }
-    t = (int32_t)r;
-    *q = (float)t > r ? t - 1 : t;
-    return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
-}
-
 #if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
     !defined(BSF_ENC_PORTABLE)
 /* Both coordinates at once with the same IEEE single operations as
@@ -464,6 +447,23 @@ ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
     return (_mm_movemask_ps(_mm_and_ps(in_range, _mm_castsi128_ps(above_min))) & 3) == 3;
 }
 #else
+/* Nearest multiple of step, in steps: floor(v / step + 0.5); 0 when v is
+ * not finite or too far. |floor(r)| <= BSF_QUANT_MAX_STEPS = 2^23 - 1 is
+ * -(2^23 - 1) <= r < 2^23, where the floor is a truncation toward zero,
+ * one lower for a negative r with a fraction. */
+ENC_INLINE int quantise(float v, float step, int32_t *q)
+{
+    const float r = v / step + 0.5f;
+    int32_t t;
+    if (!(fabsf(r) < (float)BSF_QUANT_MAX_STEPS + 1.0f)) {
+        *q = 0;
+        return 0; /* NaN included */
+    }
+    t = (int32_t)r;
+    *q = (float)t > r ? t - 1 : t;
+    return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
+}
+
 ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
 {
     const int ok_x = quantise(p.x, step, &q[0]);
