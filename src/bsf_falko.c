@@ -44,6 +44,14 @@
 #include "bsf_math.h"
 #include "bsf_nms.h"
 
+#if !defined(__OPTIMIZE_SIZE__) && defined(__SSE2__)
+#include <emmintrin.h>
+#define FALKO_SSE2_WALKS 1
+/* Windows this wide (at least 3: see certainly_rejected_inside) walk four
+ * beams per step; on narrower ones the ends are a beam or two in. */
+#define FALKO_WIDE_WINDOW 12u
+#endif
+
 #define FALKO_PI 3.14159265358979f
 /* FALKOLib clamps atan2 results to just inside +-pi (by 1e-6 rad). */
 #define FALKO_ANGLE_LIMIT (FALKO_PI - 0.000001f)
@@ -661,6 +669,56 @@ static int certainly_rejected(const bsf_points_t *pts, size_t i, int ring,
     }
 }
 
+#ifdef FALKO_SSE2_WALKS
+/* d2 = (c - q)^2 summed over x and y for the 4 points from q (interleaved x,
+ * y), and the mask of those with !(d2 > out2). */
+static int near4(const bsf_point_t *q, __m128 cx, __m128 cy, __m128 o2, __m128 *d2)
+{
+    const __m128 a = _mm_loadu_ps(&q[0].x); /* x0 y0 x1 y1 */
+    const __m128 b = _mm_loadu_ps(&q[2].x); /* x2 y2 x3 y3 */
+    const __m128 dx = _mm_sub_ps(cx, _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)));
+    const __m128 dy = _mm_sub_ps(cy, _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+    *d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+    return _mm_movemask_ps(_mm_cmpngt_ps(*d2, o2));
+}
+
+/* The first position from `first` upwards with !(d2 > out2), and its d2. */
+static size_t walk_up4(const bsf_point_t *pt, bsf_point_t c, float out2, size_t first, float *d2)
+{
+    const __m128 cx = _mm_set1_ps(c.x);
+    const __m128 cy = _mm_set1_ps(c.y);
+    const __m128 o2 = _mm_set1_ps(out2);
+    float lane[4];
+    __m128 v;
+    int m, k;
+    while ((m = near4(&pt[first], cx, cy, o2, &v)) == 0) {
+        first += 4u;
+    }
+    k = (m & 1) ? 0 : (m & 2) ? 1 : (m & 4) ? 2 : 3;
+    _mm_storeu_ps(lane, v);
+    *d2 = lane[k];
+    return first + (size_t)k;
+}
+
+/* The first position from `last` downwards with !(d2 > out2), and its d2. */
+static size_t walk_down4(const bsf_point_t *pt, bsf_point_t c, float out2, size_t last, float *d2)
+{
+    const __m128 cx = _mm_set1_ps(c.x);
+    const __m128 cy = _mm_set1_ps(c.y);
+    const __m128 o2 = _mm_set1_ps(out2);
+    float lane[4];
+    __m128 v;
+    int m, k;
+    while ((m = near4(&pt[last - 3u], cx, cy, o2, &v)) == 0) {
+        last -= 4u;
+    }
+    k = (m & 8) ? 3 : (m & 4) ? 2 : (m & 2) ? 1 : 0;
+    _mm_storeu_ps(lane, v);
+    *d2 = lane[k];
+    return last - 3u + (size_t)k;
+}
+#endif
+
 /* certainly_rejected for a window [i - w, i + w] inside the scan (no
  * clamping, no wrapping: nearly every apex), in fewer instructions. The end
  * searches skip the validity test: an invalid beam is (0, 0) (bsf_points_t),
@@ -679,32 +737,48 @@ static int certainly_rejected_inside(const bsf_points_t *pts, size_t i, size_t w
     size_t first = i - w;
     size_t last = i + w;
     float d2f, d2l;
-    for (;; ++first) {
-        float dx, dy;
+    /* The apex stops each walk, so the loops need no bound: its d2 is 0 and
+     * out2 > 0 (the bracket is cheap only for finite radii above 1e-15), or
+     * NaN when the apex is not finite. A walk also stops at a NaN d2 (a
+     * non-finite point), which the exact path then decides (!(d2 <= in2)). */
+#ifdef FALKO_SSE2_WALKS
+    if (w >= FALKO_WIDE_WINDOW) {
+        /* Four beams per step, each d2 computed as below (the same float
+         * operations per lane). Steps read at most 3 beams past the apex,
+         * which lie inside the window. */
+        first = walk_up4(pt, c, out2, first, &d2f);
         if (first == i) {
             return FALKO_REJECT;
         }
-        dx = c.x - pt[first].x;
-        dy = c.y - pt[first].y;
-        d2f = dx * dx + dy * dy;
-        if (d2f <= out2) {
-            break;
+        last = walk_down4(pt, c, out2, last, &d2l);
+    } else
+#endif
+    {
+        for (;; ++first) {
+            const float dx = c.x - pt[first].x;
+            const float dy = c.y - pt[first].y;
+            d2f = dx * dx + dy * dy;
+            if (!(d2f > out2)) {
+                break;
+            }
         }
-    }
-    for (;; --last) {
-        float dx, dy;
-        if (last == i) {
+        if (first == i) {
             return FALKO_REJECT;
         }
-        dx = c.x - pt[last].x;
-        dy = c.y - pt[last].y;
-        d2l = dx * dx + dy * dy;
-        if (d2l <= out2) {
-            break;
+        for (;; --last) {
+            const float dx = c.x - pt[last].x;
+            const float dy = c.y - pt[last].y;
+            d2l = dx * dx + dy * dy;
+            if (!(d2l > out2)) {
+                break;
+            }
         }
     }
-    if (!pts->valid[first] || !pts->valid[last] || d2f > in2 || d2l > in2 || i - first > inner ||
-        last - i > inner) {
+    if (last == i) {
+        return FALKO_REJECT;
+    }
+    if (!pts->valid[first] || !pts->valid[last] || !(d2f <= in2) || !(d2l <= in2) ||
+        i - first > inner || last - i > inner) {
         return FALKO_MAYBE;
     }
     {

@@ -274,6 +274,39 @@ static void test_invalid_beam_coordinates_never_change_keypoints(void)
     TEST_ASSERT_GREATER_THAN_UINT32(15u, (uint32_t)n_found);
 }
 
+/* A valid beam whose point is not finite (a caller's own bsf_points_t) is
+ * never a neighbour nor a keypoint, and the end searches, which stop at the
+ * apex itself, still stop there. Windows here span about 40 beams (the
+ * four-beam walks on x86); the corner beam's own neighbours are poisoned too. */
+static void test_non_finite_points_of_valid_beams_are_never_neighbours(void)
+{
+    static bsf_points_t clean;
+    static const size_t poisoned[] = {100u, 300u, 480u, 520u, 700u, 900u};
+    const bsf_scan_t s = cast_scan(1001u, -45.0f * DEG, 0.09f * DEG, corner_walls, 2, NULL, 0);
+    const bsf_falko_params_t p = bsf_falko_params_default();
+    int variant;
+    size_t k, n;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&s, &clean));
+    for (variant = 0; variant < 4; ++variant) {
+        const float bad = (variant == 0) ? NAN : (variant == 1) ? INFINITY : -INFINITY;
+        points = clean;
+        for (k = 0; k < sizeof poisoned / sizeof poisoned[0]; ++k) {
+            TEST_ASSERT_EQUAL_UINT8(1u, points.valid[poisoned[k]]);
+            if (variant == 3) {
+                points.pt[poisoned[k]].y = NAN;
+            } else {
+                points.pt[poisoned[k]].x = bad;
+            }
+        }
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_falko_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n));
+        TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)n);
+        TEST_ASSERT_INT_WITHIN(2, 500, kps[0].index);
+        TEST_ASSERT_TRUE(isfinite(kps[0].point.x) && isfinite(kps[0].point.y));
+        TEST_ASSERT_TRUE(isfinite(kps[0].orientation));
+    }
+}
+
 static void test_nan_ranges_are_skipped_not_propagated(void)
 {
     bsf_scan_t s = cast_180(corner_walls, 2, NULL, 0);
@@ -550,6 +583,7 @@ int main(void)
     RUN_TEST(test_pillar_yields_no_keypoint);
     RUN_TEST(test_empty_all_invalid_and_single_beam_scans_give_no_keypoint);
     RUN_TEST(test_invalid_beam_coordinates_never_change_keypoints);
+    RUN_TEST(test_non_finite_points_of_valid_beams_are_never_neighbours);
     RUN_TEST(test_nan_ranges_are_skipped_not_propagated);
     RUN_TEST(test_null_arguments_are_refused);
     RUN_TEST(test_bad_geometry_and_oversized_scan_are_refused);
