@@ -103,6 +103,34 @@ static float dist2(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
+/* Unit eigenvector (*dx, *dy) of the scatter [sxx sxy; sxy syy] for its
+ * larger eigenvalue lmax: of the two equivalent forms, the one with the
+ * larger norm is the better conditioned. 0 when both vanish (all points
+ * coincide). */
+static inline int major_axis(float sxx, float sxy, float syy, float lmax, float *dx, float *dy)
+{
+    const float v1x = sxy;
+    const float v1y = lmax - sxx;
+    const float v2x = lmax - syy;
+    const float v2y = sxy;
+    float nrm;
+    if (v1x * v1x + v1y * v1y >= v2x * v2x + v2y * v2y) {
+        nrm = sqrtf(v1x * v1x + v1y * v1y);
+        *dx = v1x;
+        *dy = v1y;
+    } else {
+        nrm = sqrtf(v2x * v2x + v2y * v2y);
+        *dx = v2x;
+        *dy = v2y;
+    }
+    if (!(nrm > 0.0f)) {
+        return 0;
+    }
+    *dx /= nrm;
+    *dy /= nrm;
+    return 1;
+}
+
 /* Line through positions a..b of the run (from c->rel), whose coordinate
  * sums over a..from-1, added in order from 0, are sx, sy (from = a, sums 0:
  * all of them). Two passes: centring first keeps float sums exact enough
@@ -112,7 +140,7 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
 {
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
-    float half, diff, root, lmax, lmin, v1x, v1y, v2x, v2y, nrm, mx, my;
+    float half, diff, root, lmax, lmin, mx, my;
     size_t i;
     const size_t n = b + 1u - a;
     if (b < a + 1u) {
@@ -142,27 +170,7 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     lmax = half + root;
     lmin = half - root;
     l->rss = lmin > 0.0f ? lmin : 0.0f;
-    /* Eigenvector of the larger eigenvalue: of the two equivalent forms, the
-     * one with the larger norm is the better conditioned. */
-    v1x = sxy;
-    v1y = lmax - sxx;
-    v2x = lmax - syy;
-    v2y = sxy;
-    if (v1x * v1x + v1y * v1y >= v2x * v2x + v2y * v2y) {
-        nrm = sqrtf(v1x * v1x + v1y * v1y);
-        l->dx = v1x;
-        l->dy = v1y;
-    } else {
-        nrm = sqrtf(v2x * v2x + v2y * v2y);
-        l->dx = v2x;
-        l->dy = v2y;
-    }
-    if (!(nrm > 0.0f)) {
-        return 0; /* all points coincide */
-    }
-    l->dx /= nrm;
-    l->dy /= nrm;
-    return 1;
+    return major_axis(sxx, sxy, syy, lmax, &l->dx, &l->dy);
 }
 
 static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
@@ -474,7 +482,7 @@ static int side_dir_bound(const lc_ctx_t *c, size_t s, size_t e, lc_side_dir_t *
     const float n = (float)(e + 1u - s);
     float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f, ext2 = 0.0f;
     float terms = 0.0f;
-    float cxx, cxy, cyy, half, diff, root, lmax, gap, trace, v1x, v1y, v2x, v2y, nrm, mass;
+    float cxx, cxy, cyy, half, diff, root, lmax, gap, trace, mass;
     float eps_p, eps;
     size_t i = s;
     while (i <= e) {
@@ -513,24 +521,9 @@ static int side_dir_bound(const lc_ctx_t *c, size_t s, size_t e, lc_side_dir_t *
     lmax = half + root;
     gap = 2.0f * root;
     trace = fabsf(cxx + cyy);
-    v1x = cxy;
-    v1y = lmax - cxx;
-    v2x = lmax - cyy;
-    v2y = cxy;
-    if (v1x * v1x + v1y * v1y >= v2x * v2x + v2y * v2y) {
-        nrm = sqrtf(v1x * v1x + v1y * v1y);
-        d->dx = v1x;
-        d->dy = v1y;
-    } else {
-        nrm = sqrtf(v2x * v2x + v2y * v2y);
-        d->dx = v2x;
-        d->dy = v2y;
-    }
-    if (!(nrm > 0.0f)) {
+    if (!major_axis(cxx, cxy, cyy, lmax, &d->dx, &d->dy)) {
         return 0;
     }
-    d->dx /= nrm;
-    d->dy /= nrm;
     eps_p = (4.0f * terms + 512.0f) * LC_ROUNDOFF * mass;
     eps = eps_p + (4.0f * (n + 3.0f) + 16.0f) * LC_ROUNDOFF * (trace + 4.0f * eps_p) +
           2.0f * n * n * n * LC_ROUNDOFF * LC_ROUNDOFF * mass;

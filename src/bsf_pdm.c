@@ -10,6 +10,9 @@
 #include <string.h>
 
 #define NO_FRAGMENT 0xFFFFu
+#if BSF_PDM_MAX_FRAGMENTS > 32
+#error "bsf_pdm_fit_anchored keeps its settled fragments in a 32-bit mask"
+#endif
 /* A fragment whose RMS is above this multiple of target_rms is "far" from
  * the target: a solve stops after its first iteration (refinement follows
  * anyway), and refinement grows such fragments by several points at once
@@ -1072,7 +1075,7 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
     float t0[BSF_PDM_MAX_FRAGMENTS];
     float t1[BSF_PDM_MAX_FRAGMENTS];
     size_t max_ctrl;
-    uint32_t settled = 0u;
+    uint32_t settled = 0u; /* a bit per fragment (pick_fragment) */
     size_t f;
     size_t i;
     float length = 0.0f;

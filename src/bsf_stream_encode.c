@@ -968,6 +968,11 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                     ((uint32_t)f->kind << (m_len + 1u)) | (n_unique << 1) | (mask != 0u ? 1u : 0u),
                     m_len + 2u);
         }
+#else
+        field_u(w, &b, costing, f->kind, 1u);
+        field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
+        field_u(w, &b, costing, mask != 0u ? 1u : 0u, 1u);
+#endif
         if (mask != 0u) {
             uint32_t j = n_unique; /* bits left, the highest first */
             do {
@@ -976,21 +981,6 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                 field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
             } while (j > 0u);
         }
-#else
-        field_u(w, &b, costing, f->kind, 1u);
-        field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
-        if (mask == 0u) {
-            field_u(w, &b, costing, 0u, 1u);
-        } else {
-            uint32_t j = n_unique; /* bits left, the highest first */
-            field_u(w, &b, costing, 1u, 1u);
-            do {
-                const unsigned take = j > 16u ? 16u : j;
-                j -= take;
-                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
-            } while (j > 0u);
-        }
-#endif
         field_eg2(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
                   BSF_WIRE_K_GAP, span, BSF_WIRE_K_SPAN);
         /* E_curve rounded half up: the planning run checked 0 <= e_curve <=
