@@ -50,6 +50,18 @@ typedef struct {
 } bsf_point_t;
 
 /**
+ * A planar pose: where a frame (the laser, the robot) sits in a parent frame
+ * (the world, the map). A point p given in the child frame is at
+ * (x + cos(theta) p.x - sin(theta) p.y, y + sin(theta) p.x + cos(theta) p.y)
+ * in the parent frame. Metres and radians, counter-clockwise.
+ */
+typedef struct {
+    float x;     /**< metres */
+    float y;     /**< metres */
+    float theta; /**< radians, counter-clockwise from the parent's x axis */
+} bsf_pose_t;
+
+/**
  * An interest point (corner) found by a corner detector (FALKO or BID).
  * The beam index is what segmentation and fitting use; the other fields
  * describe the keypoint for users who want it as a landmark.
