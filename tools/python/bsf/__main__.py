@@ -37,9 +37,13 @@ def cmd_extract(a: argparse.Namespace) -> int:
             print("bsf: extract of a ROS bag needs --topic (e.g. --topic /scan)", file=sys.stderr)
             return 2
         from .rosbag import BagError, extract_bag
+        from .tf import MAX_GAP_NS_DEFAULT
 
+        if a.max_pose_gap is not None and not (a.max_pose_gap > 0 and a.max_pose_gap < 1e9):
+            print(f"bsf: --max-pose-gap must be a positive number of seconds, got {a.max_pose_gap}", file=sys.stderr)
+            return 2
         try:
-            n, failed, nbytes = extract_bag(
+            n, failed, nbytes, no_pose = extract_bag(
                 a.input,
                 a.topic,
                 a.output,
@@ -47,20 +51,30 @@ def cmd_extract(a: argparse.Namespace) -> int:
                 quant_step=a.quant,
                 range_max=a.range_max,
                 timing=not a.no_time,
+                pose_from=a.pose_from,
+                frame=a.frame,
+                max_gap_ns=round((a.max_pose_gap if a.max_pose_gap is not None else MAX_GAP_NS_DEFAULT / 1e9) * 1e9),
                 **params,
             )
         except (BagError, BsfError, TypeError, OSError) as e:
             print(f"bsf: {e}", file=sys.stderr)
             return 1
         print(
-            f"{a.input}: {n} scans of {a.topic} extracted with {a.method}, {nbytes} bytes, {failed} refused",
+            f"{a.input}: {n} scans of {a.topic} extracted with {a.method}, {nbytes} bytes, {failed} refused"
+            + (f", {no_pose} without a pose skipped" if a.pose_from else ""),
             file=sys.stderr,
         )
+        if n == 0 and no_pose:
+            print(f"bsf: {a.input}: no scan of {a.topic} has a pose from {a.pose_from}", file=sys.stderr)
+            return 1
         if n == 0 and failed == 0:
             print(f"bsf: {a.input}: no message on {a.topic}", file=sys.stderr)
             return 1
         return 1 if failed else 0
     # Anything else is read as a CARMEN log, as `bsf extract` does.
+    if a.pose_from or a.frame or a.max_pose_gap is not None:
+        print("bsf: --pose-from, --frame and --max-pose-gap are for ROS bags (a CARMEN log carries its poses)", file=sys.stderr)
+        return 2
     errors: List[str] = []
     n = nbytes = 0
     try:
@@ -142,6 +156,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     e.add_argument("--count", type=int, default=None, help="CARMEN: at most N scans")
     e.add_argument("--no-time", action="store_true", help="send 0 as extraction time (byte-reproducible output)")
     e.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", help="parameter override, e.g. pdm_target_rms=0.02")
+    e.add_argument("--pose-from", metavar="TOPIC", help="bags: poses from a tf topic (/tf, with /tf_static) or a nav_msgs/Odometry topic")
+    e.add_argument("--frame", help="bags: fixed frame of the poses (default: map if the transforms have it, else odom; odometry: its own frame)")
+    e.add_argument("--max-pose-gap", type=float, metavar="S", help="bags: longest gap between two pose samples to interpolate across, seconds (1)")
     e.set_defaults(func=cmd_extract)
     pl = sub.add_parser("plot", help="draw a bsf stream to an image (needs matplotlib)")
     pl.add_argument("input", metavar="IN", help="bsf stream ('-': stdin)")
