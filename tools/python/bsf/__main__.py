@@ -138,6 +138,22 @@ def cmd_plot(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_export(a: argparse.Namespace) -> int:
+    from .export import ExportError, export
+
+    if a.samples < 2:
+        print(f"bsf: --samples must be at least 2, got {a.samples}", file=sys.stderr)
+        return 2
+    try:
+        res = export(a.input, a.output, a.format, frame_id=a.frame_id, laser_frame=a.laser_frame, samples=a.samples, prefix=a.prefix)
+    except (ExportError, BsfError, OSError) as e:
+        print(f"bsf: {e}", file=sys.stderr)
+        return 1
+    counts = ", ".join(f"{n} on {t}" for t, n in sorted(res.messages.items()))
+    print(f"{a.output}: {res.frames} frames exported ({counts})", file=sys.stderr)
+    return 0
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     p = argparse.ArgumentParser(prog="python -m bsf", description="bsf from Python: ROS bags and CARMEN logs to bsf streams, plots.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -166,6 +182,19 @@ def main(argv: Optional[List[str]] = None) -> int:
     pl.add_argument("--sensor", action="store_true", help="sensor frame instead of the world frame")
     pl.add_argument("--dpi", type=int, default=150)
     pl.set_defaults(func=cmd_plot)
+    x = sub.add_parser(
+        "export",
+        help="write a bsf stream as ROS 2 markers (MCAP for Foxglove, or a ROS 2 bag for RViz 2; needs the rosbag extra)",
+        description="Features as visualization_msgs/MarkerArray (line strips, vertex spheres), the laser pose and path.",
+    )
+    x.add_argument("input", metavar="IN", help="bsf stream ('-': stdin)")
+    x.add_argument("-o", dest="output", required=True, help="OUT.mcap, or a new directory with --format ros2bag")
+    x.add_argument("--format", choices=("mcap", "ros2bag"), default=None, help="default: mcap for *.mcap")
+    x.add_argument("--frame-id", default="map", help="fixed frame of frames with a pose (map)")
+    x.add_argument("--laser-frame", default="laser", help="frame of frames without a pose (laser)")
+    x.add_argument("--samples", type=int, default=32, help="points per feature's line strip (32)")
+    x.add_argument("--prefix", default="/bsf", help="topic prefix (/bsf: /bsf/features, /bsf/pose, /bsf/path)")
+    x.set_defaults(func=cmd_export)
     a = p.parse_args(argv)
     try:
         return int(a.func(a))
