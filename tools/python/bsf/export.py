@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
@@ -324,10 +325,20 @@ def export(
             raise ExportError(f"{os.fspath(out)}: name an MCAP file *.mcap, or give the format (ros2bag for a bag directory)")
         fmt = "mcap"
     frames = read(source) if isinstance(source, (str, os.PathLike)) else source
-    with Exporter(out, fmt, **options) as ex:
-        for f in frames:
-            if isinstance(f, Frame):
-                ex.add_frame(f)
-    if ex.result.frames == 0:
-        raise ExportError(f"{os.fspath(source) if isinstance(source, (str, os.PathLike)) else 'the stream'} holds no scan frame")
+    ex = Exporter(out, fmt, **options)
+    try:
+        with ex:
+            for f in frames:
+                if isinstance(f, Frame):
+                    ex.add_frame(f)
+        if ex.result.frames == 0:
+            raise ExportError(f"{os.fspath(source) if isinstance(source, (str, os.PathLike)) else 'the stream'} holds no scan frame")
+    except BaseException:
+        # no half-written output is left behind for a viewer to open
+        target = Path(out)
+        if fmt == "mcap":
+            target.unlink(missing_ok=True)
+        else:
+            shutil.rmtree(target, ignore_errors=True)
+        raise
     return ex.result

@@ -201,3 +201,6 @@ def test_export_errors_are_clear(posed_stream, tmp_path):
     meta_only.write_bytes(bsf.encode(next(f for f in bsf.decode(stream.read_bytes()) if isinstance(f, bsf.Metadata))))
     r = run_py("export", meta_only, "-o", tmp_path / "m.mcap")
     assert r.returncode == 1 and "holds no scan frame" in r.stderr
+    assert not (tmp_path / "m.mcap").exists() and not (tmp_path / "j.mcap").exists()  # nothing half-written left
+    r = run_py("export", meta_only, "-o", tmp_path / "m_bag", "--format", "ros2bag")
+    assert r.returncode == 1 and not (tmp_path / "m_bag").exists()
