@@ -37,7 +37,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import BsfError, Frame, Metadata, read
+from . import Frame, Metadata, read
 
 FORMATS = ("mcap", "ros2bag")
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
