@@ -177,11 +177,20 @@ class PoseSource:
         return out
 
 
-def _add_tf(tree: TransformTree, msg: object, static: bool) -> None:
+def _add_tf(tree: TransformTree, msg: object, static: bool) -> int:
+    added = 0
     for ts in msg.transforms:  # type: ignore[attr-defined]
         tr, q = ts.transform.translation, ts.transform.rotation
         yaw = yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))
-        tree.add(str(ts.header.frame_id), str(ts.child_frame_id), _stamp_ns(ts), float(tr.x), float(tr.y), yaw, static)
+        added += tree.add(str(ts.header.frame_id), str(ts.child_frame_id), _stamp_ns(ts), float(tr.x), float(tr.y), yaw, static)
+    return added
+
+
+def _names(frames: "set[str]", most: int = 20) -> str:
+    """Frame names for a message, at most ``most`` of them (a bag may name thousands)."""
+    names = sorted(frames)
+    more = f", ... ({len(names)} frames)" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
 
 
 def load_poses(
@@ -220,6 +229,7 @@ def load_poses(
         tree = TransformTree(max_gap_ns)
         src = PoseSource(tree, "", kind)
         odom_frame = ""
+        usable = 0  # transforms taken from the pose topic itself
         static = [c for c in by_topic.get(TF_STATIC, []) if c.msgtype in TF_TYPES and pose_from != TF_STATIC]
         try:
             for conn, _, raw in reader.messages(connections=conns + static):
@@ -228,12 +238,13 @@ def load_poses(
                     if conn.topic == TF_STATIC and conn in static:
                         _add_tf(tree, m, True)
                     elif kind == "tf":
-                        _add_tf(tree, m, pose_from == TF_STATIC)
+                        usable += _add_tf(tree, m, pose_from == TF_STATIC)
                     else:
                         p, q = m.pose.pose.position, m.pose.pose.orientation
                         yaw = yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))
                         if tree.add(str(m.header.frame_id), str(m.child_frame_id), _stamp_ns(m), float(p.x), float(p.y), yaw):
                             odom_frame = odom_frame or str(m.header.frame_id).lstrip("/")
+                            usable += 1
                     src.messages += 1
                 except (GeneratorExit, KeyboardInterrupt):
                     raise
@@ -246,12 +257,12 @@ def load_poses(
     finally:
         reader.close()
     frames = tree.frames
-    if not frames:
+    if not usable:
         raise BagError(f"{path}: {pose_from} holds no usable transform ({src.messages} messages; " + "; ".join(src.notes() or ["empty"]) + ")")
     if frame is not None:
         fixed = frame.lstrip("/")
         if fixed not in frames:
-            raise BagError(f"{path}: the fixed frame {fixed} is not in the pose data; frames: {', '.join(sorted(frames))}")
+            raise BagError(f"{path}: the fixed frame {fixed} is not in the pose data; frames: {_names(frames)}")
     elif kind == "odometry":
         fixed = odom_frame
     elif "map" in frames:
@@ -259,7 +270,7 @@ def load_poses(
     elif "odom" in frames:
         fixed = "odom"
     else:
-        raise BagError(f"{path}: neither map nor odom is in the pose data; choose the fixed frame with --frame ({', '.join(sorted(frames))})")
+        raise BagError(f"{path}: neither map nor odom is in the pose data; choose the fixed frame with --frame ({_names(frames)})")
     src.fixed_frame = fixed
     return src
 

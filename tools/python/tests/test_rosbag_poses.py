@@ -217,3 +217,24 @@ def test_transform_tree_interpolation_and_limits():
     with pytest.raises(PoseError, match="after the last transform"):
         tr.lookup("odom", "laser", 10**8 + 1)
     assert not tr.add("a", "a", 0, 0.0, 0.0, 0.0) and not tr.add("a", "b", 0, 0.0, math.nan, 0.0) and tr.rejected == 2
+
+
+def test_ros1_style_frame_names_and_the_default_fixed_frame(tmp_path):
+    # tf1 wrote frame names with a leading '/'; neither map nor odom here
+    b = Bag()
+    for k in range(30):
+        t = 0.05 * k
+        b.tf([("/world", "/base_link", T0_NS + round(t * 1e9), base_in_odom(t))])
+    b.tf([("/base_link", "/laser", T0_NS, MOUNT)], topic="/tf_static")
+    b.scan(T0_NS + 500_000_000, "/laser", *raycast(laser_in("odom", 0.5, False)))
+    bag = b.write(tmp_path / "world.bag", "bag")
+    r = run_py("extract", bag, "--topic", "/scan", "--pose-from", "/tf", "-o", tmp_path / "w.bsf")
+    assert r.returncode == 1 and "neither map nor odom is in the pose data" in r.stderr and "world" in r.stderr
+    r = run_py("extract", bag, "--topic", "/scan", "--pose-from", "/tf", "--frame", "world", "-o", tmp_path / "w.bsf")
+    assert r.returncode == 0, r.stderr
+    _assert_poses(scan_frames(bsf.decode((tmp_path / "w.bsf").read_bytes())), [0.5], "odom", False)
+    # pose options on a CARMEN log are refused, not ignored
+    log = tmp_path / "x.log"
+    log.write_text("")
+    r = run_py("extract", log, "--pose-from", "/tf", "-o", tmp_path / "x.bsf")
+    assert r.returncode == 2 and "for ROS bags" in r.stderr
