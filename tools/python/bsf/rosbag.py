@@ -27,7 +27,7 @@ from typing import Dict, Iterator, List, NamedTuple, Optional, Union
 import numpy as np
 
 from . import BsfError
-from .tf import MAX_GAP_NS_DEFAULT, Pose, PoseError, TransformTree, yaw_of_quaternion
+from .tf import MAX_GAP_NS_DEFAULT, Pose, PoseError, TransformTree
 
 LASERSCAN = "sensor_msgs/msg/LaserScan"
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -172,6 +172,11 @@ class PoseSource:
         out = []
         if self.bad_messages:
             out.append(f"{self.bad_messages} pose messages could not be decoded and were ignored")
+        if self.tree.tilted:
+            out.append(
+                f"{self.tree.tilted} transforms turn their child frame upside down and were ignored "
+                "(a laser mounted upside down sees a mirrored scan, which a plane pose cannot express)"
+            )
         if self.tree.rejected:
             out.append(f"{self.tree.rejected} transforms with non-finite values or bad frame names were ignored")
         return out
@@ -181,8 +186,8 @@ def _add_tf(tree: TransformTree, msg: object, static: bool) -> int:
     added = 0
     for ts in msg.transforms:  # type: ignore[attr-defined]
         tr, q = ts.transform.translation, ts.transform.rotation
-        yaw = yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))
-        added += tree.add(str(ts.header.frame_id), str(ts.child_frame_id), _stamp_ns(ts), float(tr.x), float(tr.y), yaw, static)
+        quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+        added += tree.add_3d(str(ts.header.frame_id), str(ts.child_frame_id), _stamp_ns(ts), float(tr.x), float(tr.y), quat, static)
     return added
 
 
@@ -241,8 +246,8 @@ def load_poses(
                         usable += _add_tf(tree, m, pose_from == TF_STATIC)
                     else:
                         p, q = m.pose.pose.position, m.pose.pose.orientation
-                        yaw = yaw_of_quaternion(float(q.x), float(q.y), float(q.z), float(q.w))
-                        if tree.add(str(m.header.frame_id), str(m.child_frame_id), _stamp_ns(m), float(p.x), float(p.y), yaw):
+                        quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+                        if tree.add_3d(str(m.header.frame_id), str(m.child_frame_id), _stamp_ns(m), float(p.x), float(p.y), quat):
                             odom_frame = odom_frame or str(m.header.frame_id).lstrip("/")
                             usable += 1
                     src.messages += 1

@@ -6,7 +6,9 @@ A :class:`TransformTree` holds timed transforms parent -> child (as ROS
 each projected to the plane: x, y and the yaw of the rotation. Looking up a
 frame in another at a time composes the chain between them through their
 common ancestor, interpolating each timed transform at that time (linear in
-x and y, the shorter way round in yaw).
+x and y, the shorter way round in yaw). A 3D transform is projected: its
+translation's x and y, the heading of its rotation; one that turns its child
+upside down (a mirrored scan) is refused (:meth:`TransformTree.add_3d`).
 
 A lookup never extrapolates: a time before a transform's first sample, after
 its last, or between two samples further apart than ``max_gap_ns`` raises
@@ -64,6 +66,14 @@ def yaw_of_quaternion(x: float, y: float, z: float, w: float) -> Optional[float]
     return yaw if math.isfinite(yaw) else None
 
 
+def is_upright(x: float, y: float, z: float, w: float) -> bool:
+    """True when the rotation keeps the child's z axis pointing up (less than
+    90 degrees of roll and pitch combined). A laser mounted upside down sees a
+    mirrored scan, which a plane pose (x, y, yaw) cannot express."""
+    n = x * x + y * y + z * z + w * w
+    return math.isfinite(n) and n >= 1e-12 and 1.0 - 2.0 * (x * x + y * y) / n > 1e-9
+
+
 def strip_frame(name: str) -> str:
     """tf frame names as tf2 uses them: no leading '/' (ROS 1 tf wrote one)."""
     return name.lstrip("/")
@@ -81,6 +91,7 @@ class TransformTree:
         self._parents: Dict[str, Set[str]] = {}
         self._arrays: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
         self.rejected = 0  #: transforms not added: non-finite values, a frame its own parent, an empty name
+        self.tilted = 0  #: transforms not added: turned upside down (see :func:`is_upright`)
 
     def add(self, parent: str, child: str, stamp_ns: int, x: float, y: float, yaw: Optional[float], static: bool = False) -> bool:
         """Add parent -> child (the child's origin and heading in the parent).
@@ -114,9 +125,6 @@ class TransformTree:
         for ps in self._parents.values():
             out |= ps
         return out
-
-    def has_timed(self) -> bool:
-        return bool(self._samples)
 
     def _parent(self, child: str) -> Optional[str]:
         ps = self._parents.get(child)
@@ -180,6 +188,17 @@ class TransformTree:
                 math.remainder(float(a[2]) + f * dyaw, 2.0 * math.pi),
             )
         return self._static[child]
+
+    def add_3d(
+        self, parent: str, child: str, stamp_ns: int, x: float, y: float, q: Tuple[float, float, float, float], static: bool = False
+    ) -> bool:
+        """:meth:`add` for a translation's x, y and a quaternion (x, y, z, w):
+        the rotation's heading; refused (counted in :attr:`tilted`) when it
+        turns the child upside down."""
+        if all(math.isfinite(v) for v in q) and not is_upright(*q) and yaw_of_quaternion(*q) is not None:
+            self.tilted += 1
+            return False
+        return self.add(parent, child, stamp_ns, x, y, yaw_of_quaternion(*q), static)
 
     def lookup(self, target: str, source: str, stamp_ns: int) -> Pose:
         """The origin and heading of frame ``source`` in frame ``target`` at ``stamp_ns``.

@@ -238,3 +238,26 @@ def test_ros1_style_frame_names_and_the_default_fixed_frame(tmp_path):
     log.write_text("")
     r = run_py("extract", log, "--pose-from", "/tf", "-o", tmp_path / "x.bsf")
     assert r.returncode == 2 and "for ROS bags" in r.stderr
+
+
+def test_tilted_mountings_project_to_the_plane_and_upside_down_is_refused(tmp_path):
+    yaw, pitch = MOUNT[2], 0.3
+    cz, sz, cp, sp = math.cos(yaw / 2), math.sin(yaw / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+    pitched = MOUNT + (-sz * sp, cz * sp, sz * cp, cz * cp)  # yaw, then pitched 17 degrees down: heading is yaw
+    upside_down = MOUNT + (cz, sz, 0.0, 0.0)  # yaw, then rolled 180 degrees
+    times = [0.4, 0.8]
+    for name, mount, ok in (("pitched", pitched, True), ("flipped", upside_down, False)):
+        b = Bag()
+        for k in range(60):
+            t = 0.02 * k
+            b.tf([("odom", "base_link", T0_NS + round(t * 1e9), base_in_odom(t))])
+        b.tf([("base_link", "laser", T0_NS, mount)], topic="/tf_static")
+        for i, t in enumerate(times):
+            b.scan(T0_NS + round(t * 1e9), "laser", *raycast(laser_in("odom", t, False), seed=i))
+        out = tmp_path / (name + ".bsf")
+        r = run_py("extract", b.write(tmp_path / (name + ".bag"), "bag"), "--topic", "/scan", "--pose-from", "/tf", "-o", out)
+        if ok:
+            assert r.returncode == 0, r.stderr
+            _assert_poses(scan_frames(bsf.decode(out.read_bytes())), times, "odom", False)
+        else:
+            _assert_clean(r, "1 transforms turn their child frame upside down", "the frame laser is not in the transforms")
