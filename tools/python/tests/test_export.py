@@ -124,6 +124,14 @@ def test_mcap_export_reads_back(posed_stream, tmp_path):
     assert f"{len(frames)} frames exported" in r.stderr
     msgs = _read_mcap(out)
     _check_messages(msgs, frames)
+    # the summary and index a viewer seeks with: the ros2 profile, per-channel counts
+    with open(out, "rb") as f:
+        rd = make_reader(f)
+        assert rd.get_header().profile == "ros2"
+        summary = rd.get_summary()
+        counts = {summary.channels[c].topic: n for c, n in summary.statistics.channel_message_counts.items()}
+        assert counts == {"/bsf/features": len(frames), "/bsf/pose": len(frames), "/bsf/path": 1}
+        assert summary.chunk_indexes and summary.statistics.message_start_time == frame_stamp_ns(frames[0])
     # the CDR bytes are what rosbags' ROS 2 Humble definitions read too
     store = get_typestore(Stores.ROS2_HUMBLE)
     for topic, mtype, _, m, raw in msgs:
