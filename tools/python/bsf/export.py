@@ -111,6 +111,8 @@ class Exporter:
             raise ExportError(f"samples must be at least 2, got {samples}")
         if not frame_id or not laser_frame:
             raise ExportError("frame names must not be empty")
+        if not prefix.startswith("/") or any(c.isspace() for c in prefix):
+            raise ExportError(f"the topic prefix must start with '/' and hold no spaces, got {prefix!r}")
         self.fmt = fmt
         self.frame_id = frame_id
         self.laser_frame = laser_frame

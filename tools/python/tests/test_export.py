@@ -197,6 +197,7 @@ def test_export_errors_are_clear(posed_stream, tmp_path):
         ((stream, "-o", tmp_path / "x.bin"), "name an MCAP file"),
         ((tmp_path / "missing.bsf", "-o", tmp_path / "x.mcap"), "missing.bsf"),
         ((stream, "-o", tmp_path / "x.mcap", "--samples", "1"), "--samples must be at least 2"),
+        ((stream, "-o", tmp_path / "x.mcap", "--prefix", "bsf"), "must start with '/'"),
     ):
         r = run_py("export", *args)
         assert r.returncode != 0 and needle in r.stderr and "Traceback" not in r.stderr, r.stderr
