@@ -11,7 +11,10 @@
  * is returned); a plain input never yields more records than lines; the
  * scan the tool would build has a range_max in (0, 81.8] that makes the
  * no-return codes invalid (or exactly the --range-max given), and
- * bsf_scan_to_points accepts or cleanly refuses it.
+ * bsf_scan_to_points accepts or cleanly refuses it. Memory: the reader's
+ * line buffer never holds more than CARMEN_MAX_BUFFER bytes, whatever the
+ * input (a gzip input inflates to far longer lines than that), and every
+ * line over CARMEN_MAX_LINE is one of the malformed lines reported.
  *
  * Input starting with 0x1f (gzip data starts 1f 8b) is written to a file
  * named *.log.gz, so cut or corrupt gzip streams (and non-gzip data under a
@@ -92,6 +95,8 @@ static void carmen_close_and_check(carmen_reader_t *r, FILE *err, char **report,
                                    const char *path, int rc)
 {
     const unsigned long malformed = carmen_malformed_count(r);
+    FUZZ_CHECK(carmen_overlong_count(r) <= malformed);
+    FUZZ_CHECK(carmen_buffer_bytes(r) <= CARMEN_MAX_BUFFER);
     carmen_close(r);
     FUZZ_CHECK(fclose(err) == 0);
     check_reports(*report, *report_len, path, malformed, rc);
@@ -143,6 +148,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_CHECK(isfinite(s.angle_min) && isfinite(s.angle_increment));
         FUZZ_CHECK(s.angle_increment != 0.0f);
         FUZZ_CHECK(s.line > last_line);
+        FUZZ_CHECK(carmen_buffer_bytes(r) <= CARMEN_MAX_BUFFER);
         last_line = s.line;
         ++records;
 
