@@ -489,6 +489,81 @@ static void test_plain_file_named_gz_is_refused(void)
     remove(named);
 }
 
+/* ---- overlong lines ----------------------------------------------------------- */
+
+/* Writes n copies of byte c. */
+static void write_run(FILE *f, int c, size_t n)
+{
+    static char chunk[65536];
+    memset(chunk, c, sizeof chunk);
+    while (n > 0u) {
+        const size_t k = n < sizeof chunk ? n : sizeof chunk;
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)k, (uint32_t)fwrite(chunk, 1, k, f));
+        n -= k;
+    }
+}
+
+/* Lines 1 and 5 are scans; 2 (3 MiB) and 6 (1.5 MiB, no newline, the end)
+ * are longer than the cap; 3 is a comment of exactly the cap, 4 a scan line
+ * one byte over it. Memory never exceeds the cap, whatever the line. */
+static void test_overlong_lines_are_reported_and_skipped_in_bounded_memory(void)
+{
+    static const char scan[] = "FLASER 3 1 2 3 0 0 0 0 0 0 %d.0 h %d.0\n";
+    char path[300];
+    char report[4096];
+    FILE *f, *err;
+    carmen_reader_t *rd;
+    carmen_scan_t s;
+    size_t n_rep;
+    snprintf(path, sizeof path, "%s_long.log", path_tmp);
+    f = fopen(path, "wb");
+    TEST_ASSERT_NOT_NULL(f);
+    fprintf(f, scan, 1, 1);
+    write_run(f, 'a', 3u << 20);
+    fputc('\n', f);
+    fputc('#', f);
+    write_run(f, 'c', CARMEN_MAX_LINE - 1u);
+    fputc('\n', f);
+    fputs("FLASER 3 1 2 3 0 0 0 0 0 0 4.0 h 4.0 ", f);
+    write_run(f, ' ', CARMEN_MAX_LINE);
+    fputc('\n', f);
+    fprintf(f, scan, 5, 5);
+    write_run(f, 'b', 3u << 19);
+    TEST_ASSERT_EQUAL_INT(0, fclose(f));
+
+    err = tmpfile();
+    TEST_ASSERT_NOT_NULL(err);
+    rd = carmen_open(path, err);
+    TEST_ASSERT_NOT_NULL(rd);
+    TEST_ASSERT_EQUAL_INT(1, carmen_next(rd, &s));
+    TEST_ASSERT_EQUAL_UINT32(1u, (uint32_t)s.line);
+    TEST_ASSERT_EQUAL_INT(1, carmen_next(rd, &s));
+    TEST_ASSERT_EQUAL_UINT32(5u, (uint32_t)s.line);
+    EXPECT_DOUBLE(5.0, s.timestamp);
+    TEST_ASSERT_TRUE(carmen_buffer_bytes(rd) <= CARMEN_MAX_BUFFER);
+    TEST_ASSERT_EQUAL_INT(0, carmen_next(rd, &s));
+    TEST_ASSERT_TRUE(carmen_buffer_bytes(rd) <= CARMEN_MAX_BUFFER);
+    TEST_ASSERT_EQUAL_UINT32(3u, (uint32_t)carmen_overlong_count(rd));
+    TEST_ASSERT_EQUAL_UINT32(3u, (uint32_t)carmen_malformed_count(rd));
+    carmen_close(rd);
+    rewind(err);
+    n_rep = fread(report, 1, sizeof report - 1u, err);
+    report[n_rep] = '\0';
+    fclose(err);
+    {
+        static const int lines[] = {2, 4, 6};
+        char expect[400];
+        size_t i;
+        for (i = 0; i < 3u; ++i) {
+            snprintf(expect, sizeof expect, "%s:%d: line longer than 1048576 bytes", path,
+                     lines[i]);
+            TEST_ASSERT_NOT_NULL_MESSAGE(strstr(report, expect), report);
+        }
+        TEST_ASSERT_NULL_MESSAGE(strstr(report, ":3:"), report);
+    }
+    remove(path);
+}
+
 int main(void)
 {
     int rc;
@@ -501,6 +576,7 @@ int main(void)
     RUN_TEST(test_control_bytes_make_a_reported_malformed_line);
     RUN_TEST(test_every_cut_of_a_gzip_log_is_a_read_error);
     RUN_TEST(test_plain_file_named_gz_is_refused);
+    RUN_TEST(test_overlong_lines_are_reported_and_skipped_in_bounded_memory);
     rc = UNITY_END();
     remove(path_plain);
     remove(path_gz);

@@ -11,14 +11,17 @@
  * is returned); a plain input never yields more records than lines; the
  * scan the tool would build has a range_max in (0, 81.8] that makes the
  * no-return codes invalid (or exactly the --range-max given), and
- * bsf_scan_to_points accepts or cleanly refuses it.
+ * bsf_scan_to_points accepts or cleanly refuses it. Memory: the reader's
+ * line buffer never holds more than CARMEN_MAX_BUFFER bytes, whatever the
+ * input (a gzip input inflates to far longer lines than that), and every
+ * line over CARMEN_MAX_LINE is one of the malformed lines reported.
  *
  * Input starting with 0x1f (gzip data starts 1f 8b) is written to a file
  * named *.log.gz, so cut or corrupt gzip streams (and non-gzip data under a
  * .gz name) reach the reader's read-error paths; other input goes to a
  * plain *.log file.
  */
-#define _POSIX_C_SOURCE 200809L /* mkdtemp, unlink, rmdir, access, open_memstream */
+#define _GNU_SOURCE /* fopencookie; mkdtemp, unlink, rmdir, access */
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,53 +60,73 @@ static void remove_temp(void)
     rmdir(dir_path);
 }
 
-/* Checks the report text: one "PATH:N: " line per malformed line (N not
- * decreasing) plus one read-error line when rc < 0. */
-static void check_reports(const char *text, size_t len, const char *path, unsigned long malformed,
-                          int rc)
+/* The reader's reports, checked line by line as they are written (a gzip
+ * input can inflate to millions of reported lines: nothing is kept but the
+ * counts and the current line's start). Each line must be "PATH:N: ...",
+ * N not decreasing, one per malformed line plus one per read error. */
+typedef struct {
+    const char *path;
+    char head[512]; /* the line's first bytes: path, number and the message's start */
+    size_t len;     /* bytes of the current line so far */
+    unsigned long lines, read_errors, last;
+} report_check_t;
+
+static report_check_t reports;
+
+static void check_report_line(report_check_t *c)
 {
-    const size_t plen = strlen(path);
-    unsigned long lines = 0u, read_errors = 0u, last = 0u;
-    const char *p = text;
-    const char *end = text + len;
-    while (p < end) {
-        const char *nl = memchr(p, '\n', (size_t)(end - p));
-        char *after;
-        unsigned long n;
-        FUZZ_CHECK(nl != NULL);
-        FUZZ_CHECK((size_t)(nl - p) > plen + 2u && memcmp(p, path, plen) == 0 && p[plen] == ':');
-        n = strtoul(p + plen + 1u, &after, 10);
-        FUZZ_CHECK(after[0] == ':' && after[1] == ' ' && n >= 1u);
-        if (strncmp(after + 2, "read error", 10) == 0) {
-            ++read_errors;
-            FUZZ_CHECK(n >= last);
-        } else {
-            ++lines;
-            FUZZ_CHECK(n > last || (lines == 1u && n >= 1u));
-            last = n;
-        }
-        p = nl + 1;
+    const size_t plen = strlen(c->path);
+    const size_t kept = c->len < sizeof c->head ? c->len : sizeof c->head - 1u;
+    char *after;
+    unsigned long n;
+    c->head[kept] = '\0';
+    FUZZ_CHECK(kept > plen + 2u && memcmp(c->head, c->path, plen) == 0 && c->head[plen] == ':');
+    n = strtoul(c->head + plen + 1u, &after, 10);
+    FUZZ_CHECK(after[0] == ':' && after[1] == ' ' && n >= 1u);
+    if (strncmp(after + 2, "read error", 10) == 0) {
+        ++c->read_errors;
+        FUZZ_CHECK(n >= c->last);
+    } else {
+        ++c->lines;
+        FUZZ_CHECK(n > c->last || (c->lines == 1u && n >= 1u));
+        c->last = n;
     }
-    FUZZ_CHECK(lines == malformed);
-    FUZZ_CHECK(read_errors == (rc < 0 ? 1u : 0u));
 }
 
-static void carmen_close_and_check(carmen_reader_t *r, FILE *err, char **report, size_t *report_len,
-                                   const char *path, int rc)
+static ssize_t report_write(void *cookie, const char *buf, size_t size)
+{
+    report_check_t *c = cookie;
+    size_t i;
+    for (i = 0; i < size; ++i) {
+        if (buf[i] == '\n') {
+            check_report_line(c);
+            c->len = 0u;
+        } else {
+            if (c->len < sizeof c->head - 1u) {
+                c->head[c->len] = buf[i];
+            }
+            ++c->len;
+        }
+    }
+    return (ssize_t)size;
+}
+
+static void carmen_close_and_check(carmen_reader_t *r, FILE *err, int rc)
 {
     const unsigned long malformed = carmen_malformed_count(r);
+    FUZZ_CHECK(carmen_overlong_count(r) <= malformed);
+    FUZZ_CHECK(carmen_buffer_bytes(r) <= CARMEN_MAX_BUFFER);
     carmen_close(r);
     FUZZ_CHECK(fclose(err) == 0);
-    check_reports(*report, *report_len, path, malformed, rc);
-    free(*report);
+    FUZZ_CHECK(reports.len == 0u); /* every report ends with its newline */
+    FUZZ_CHECK(reports.lines == malformed);
+    FUZZ_CHECK(reports.read_errors == (rc < 0 ? 1u : 0u));
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     FILE *f;
     FILE *err;
-    char *report = NULL;
-    size_t report_len = 0u;
     carmen_reader_t *r;
     carmen_scan_t s;
     unsigned long last_line = 0u;
@@ -129,7 +152,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         newlines += data[i] == '\n';
     }
 
-    err = open_memstream(&report, &report_len);
+    memset(&reports, 0, sizeof reports);
+    reports.path = path;
+    {
+        static const cookie_io_functions_t io = {NULL, report_write, NULL, NULL};
+        err = fopencookie(&reports, "w", io);
+    }
     FUZZ_CHECK(err != NULL);
     r = carmen_open(path, err);
     FUZZ_CHECK(r != NULL);
@@ -143,6 +171,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_CHECK(isfinite(s.angle_min) && isfinite(s.angle_increment));
         FUZZ_CHECK(s.angle_increment != 0.0f);
         FUZZ_CHECK(s.line > last_line);
+        FUZZ_CHECK(carmen_buffer_bytes(r) <= CARMEN_MAX_BUFFER);
         last_line = s.line;
         ++records;
 
@@ -170,6 +199,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(rc == 0 || rc == -1);
     /* a gzip body can hold more lines than the raw input has newlines */
     FUZZ_CHECK(records <= newlines + 1u || is_gzip);
-    carmen_close_and_check(r, err, &report, &report_len, path, rc);
+    carmen_close_and_check(r, err, rc);
     return 0;
 }

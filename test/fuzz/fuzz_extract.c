@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * libFuzzer harness: the extractor (all three methods) fed arbitrary ranges,
- * geometry, parameters and a clock hook. Checks: bsf_extractor_init accepts
+ * libFuzzer harness: the extractor (all four methods; the default,
+ * LC-SVED-PDM, unless a flag picks another) fed arbitrary ranges, geometry,
+ * parameters (LC's included) and a clock hook. Checks: bsf_extractor_init accepts
  * exactly the parameters bsf_params_check accepts, the status is one the API
  * documents, an error leaves an empty result, a success gives a finite,
  * consistent result within the caps whose valid-point count matches the
@@ -9,7 +10,8 @@
  * frame (when the encoder can represent it) decodes to control points
  * within half a step.
  *
- * Input: byte 0 = flags, then geometry (2 bytes, or 16 with F_RAW_GEOM);
+ * Input: byte 0 = flags (F_RPOS and F_BID pick the method: neither LC,
+ * both FALKO), then geometry (2 bytes, or 16 with F_RAW_GEOM);
  * with F_PARAMS a count byte and that many edits of the method's defaults
  * (1 byte naming a field, 4 value bytes: a raw value when the field byte's
  * bit 7 is set, else a value near the default, so most edits stay in range
@@ -23,14 +25,14 @@
 #include "fuzz_check.h"
 
 enum {
-    F_RPOS = 0x01,        /* method RPOS-LSBA instead of FALKO-SVED-PDM */
+    F_RPOS = 0x01,        /* method RPOS-LSBA (with F_BID: FALKO-SVED-PDM) */
     F_RAW_RANGES = 0x02,  /* ranges are raw float bits (else uint16 millimetres) */
     F_RAW_GEOM = 0x04,    /* geometry is raw float bits (else small codes) */
-    F_PARAMS = 0x08,      /* segmentation and FALKO parameters follow */
+    F_PARAMS = 0x08,      /* parameter edits follow (any stage's) */
     F_OVER_CAP = 0x10,    /* a count at or just below/above BSF_MAX_POINTS */
     F_ENCODE = 0x20,      /* also encode and decode the result */
     F_FULL_CIRCLE = 0x40, /* the beams cover the whole circle (seam wrap paths) */
-    F_BID = 0x80          /* method BID-SVED-PDM (wins over F_RPOS) */
+    F_BID = 0x80          /* method BID-SVED-PDM (with F_RPOS: FALKO-SVED-PDM) */
 };
 
 static uint32_t clock_now;
@@ -189,7 +191,7 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
     uint32_t iv = raw ? v : (v & 0xFFu);
     memcpy(&fv, &v, sizeof fv);
 #define F(dst) (dst) = raw ? fv : near((dst), v)
-    switch ((field & 0x7Fu) % 37u) {
+    switch ((field & 0x7Fu) % 49u) {
     case 0: F(p->sved.a); break;
     case 1: F(p->sved.b); break;
     case 2: p->sved.min_segment_points = (uint16_t)iv; break;
@@ -236,6 +238,24 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
         p->clock_user = &clock_now;
         p->clock_hz = raw ? v : 1000000u;
         break;
+    case 37: F(p->lc.jump_a); break;
+    case 38: F(p->lc.jump_b); break;
+    case 39: F(p->lc.split_min); break;
+    case 40: F(p->lc.split_sigmas); break;
+    case 41:
+        /* in (0, pi/2): near the default, or raw */
+        p->lc.min_turn = raw ? fv : 0.01f + 0.006f * (float)(v & 0xFFu);
+        break;
+    case 42: F(p->lc.curve_ratio); break;
+    case 43: F(p->lc.floor); break;
+    case 44: F(p->lc.max_side); break;
+    case 45: F(p->lc.apex_slack); break;
+    case 46: F(p->lc.min_side_len); break;
+    case 47:
+        /* the default is FLT_MAX (no limit): a limit in metres, or raw */
+        p->lc.max_range = raw ? fv : 0.25f * (float)(v & 0xFFu);
+        break;
+    case 48: p->lc.min_side_points = (uint16_t)(raw ? v : iv % 70u); break;
     default:
         F(p->sved.a);
         F(p->sved.b);
@@ -264,9 +284,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     in.p = data;
     in.n = size;
     flags = (uint8_t)take_u32(&in, 1u);
-    params = bsf_params_default((flags & F_BID)    ? BSF_METHOD_BID_SVED_PDM
-                                : (flags & F_RPOS) ? BSF_METHOD_RPOS_LSBA
-                                                   : BSF_METHOD_FALKO_SVED_PDM);
+    {
+        static const bsf_method_t by_flags[4] = {BSF_METHOD_LC_SVED_PDM, BSF_METHOD_RPOS_LSBA,
+                                                 BSF_METHOD_BID_SVED_PDM,
+                                                 BSF_METHOD_FALKO_SVED_PDM};
+        const unsigned pick = ((flags & F_RPOS) ? 1u : 0u) | ((flags & F_BID) ? 2u : 0u);
+        params = bsf_params_default(by_flags[pick]);
+    }
     clock_now = 0u;
     clock_step = 0u;
     clock_calls = 0u;

@@ -6,7 +6,7 @@
  * COBS / frame-decode / encoder modes), the same scans as extractor inputs
  * (each method, parameter edits, a clock, a 1081-beam raw-float scan), and
  * synthetic CARMEN logs (FLASER 180/181/360/361, a line longer than the
- * reader's first buffer, gzip whole and cut).
+ * reader's first buffer, gzip whole and cut, a gzip line over the line cap).
  * Usage: make_corpus DIR   (DIR/stream, DIR/extract, DIR/carmen must exist)
  */
 #include <math.h>
@@ -202,14 +202,32 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
     memcpy(out + n, tmp + 3, len - 3u);
     err |= write_file(dir, "extract", "clock.bin", out, n + len - 3u);
 
+    n = 0u;
+    out[n++] = 0x28u; /* F_PARAMS | F_ENCODE, the default method (LC): four LC edits */
+    out[n++] = (uint8_t)(7u | (25u << 6));
+    out[n++] = (uint8_t)((25u >> 2) | 0x40u);
+    out[n++] = 4u;
+    out[n++] = 39u; /* lc.split_min x 0.625 */
+    n = put4(out, n, 4u);
+    out[n++] = 42u; /* lc.curve_ratio x 0.375 */
+    n = put4(out, n, 2u);
+    out[n++] = 47u; /* lc.max_range 8 m */
+    n = put4(out, n, 32u);
+    out[n++] = 48u; /* lc.min_side_points 2 */
+    n = put4(out, n, 2u);
+    len = extract_input(tmp, 361u, 0x28u);
+    memcpy(out + n, tmp + 3, len - 3u);
+    err |= write_file(dir, "extract", "lc_params.bin", out, n + len - 3u);
+
     /* extract: 1081 beams of 6-beam blocks alternating 2 m and 6 m (the
      * harness repeats one period up to the cap): more segments, keypoints
      * and control points than the caps hold, so the cut paths run */
     {
-        static const uint8_t methods[3] = {0x30u, 0x31u, 0xB0u}; /* FALKO, RPOS, BID */
-        static const char *const names[3] = {"cut_falko.bin", "cut_rpos.bin", "cut_bid.bin"};
+        static const uint8_t methods[4] = {0xB1u, 0x31u, 0xB0u, 0x30u}; /* FALKO, RPOS, BID, LC */
+        static const char *const names[4] = {"cut_falko.bin", "cut_rpos.bin", "cut_bid.bin",
+                                             "cut_lc.bin"};
         size_t m;
-        for (m = 0; m < 3u; ++m) {
+        for (m = 0; m < 4u; ++m) {
             n = 0u;
             out[n++] = methods[m];
             out[n++] = (uint8_t)(7u | (8u << 6)); /* angle_min -2.4, increment 0.0045 */
@@ -264,6 +282,39 @@ static int extra_seeds(const char *dir, const uint8_t *frame, size_t frame_len, 
         deflateEnd(&zs);
         err |= write_file(dir, "carmen", "two_scans_gzip.seed", gz, n);
         err |= write_file(dir, "carmen", "two_scans_gzip_cut.seed", gz, n / 2u);
+
+        /* a scan, then a line of 2 MiB (over the reader's line cap) in a few
+         * KiB of gzip, then a scan */
+        len = flaser_line(text, sizeof text, 180u, 1.0);
+        memset(&zs, 0, sizeof zs);
+        if (deflateInit2(&zs, 9, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+            return 1;
+        }
+        zs.next_out = gz;
+        zs.avail_out = (uInt)sizeof gz;
+        zs.next_in = (Bytef *)text;
+        zs.avail_in = (uInt)len;
+        if (deflate(&zs, Z_NO_FLUSH) != Z_OK) {
+            return 1;
+        }
+        memset(text, 'a', 65536u);
+        for (i = 0; i < 32u; ++i) {
+            zs.next_in = (Bytef *)text;
+            zs.avail_in = 65536u;
+            if (deflate(&zs, Z_NO_FLUSH) != Z_OK) {
+                return 1;
+            }
+        }
+        text[0] = '\n';
+        len = 1u + flaser_line(text + 1, sizeof text - 1u, 181u, 2.0);
+        zs.next_in = (Bytef *)text;
+        zs.avail_in = (uInt)len;
+        if (deflate(&zs, Z_FINISH) != Z_STREAM_END) {
+            return 1;
+        }
+        n = sizeof gz - zs.avail_out;
+        deflateEnd(&zs);
+        err |= write_file(dir, "carmen", "overlong_line_gzip.seed", gz, n);
     }
 #endif
     return err;

@@ -397,5 +397,62 @@ check(n_valid_of(["--no-return", "off", "--no-return", "50"]) == [180 - n_code] 
 r = run(["extract", "code50.log", "--no-return", "-3"], text=True)
 check(r.returncode != 0 and "--no-return" in r.stderr, "--no-return refuses a negative code")
 
+# 13. intact frames of an unknown type (a newer sender's): every command counts them.
+def crc32c(data):
+    crc = 0xFFFFFFFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = (crc >> 1) ^ (0x82F63B78 if crc & 1 else 0)
+    return crc ^ 0xFFFFFFFF
+
+
+def cobs_frame(payload):
+    """payload + its CRC-32C (little-endian), COBS-encoded, 0x00-terminated."""
+    body = payload + crc32c(payload).to_bytes(4, "little")
+    out, block = bytearray(), bytearray()
+    for b in body:
+        if b == 0:
+            out += bytes([len(block) + 1]) + block
+            block = bytearray()
+        else:
+            block.append(b)
+            if len(block) == 254:
+                out += b"\xff" + block
+                block = bytearray()
+    out += bytes([len(block) + 1]) + block
+    return bytes(out) + b"\0"
+
+
+raw = open(os.path.join(WORK, "synth.bsf"), "rb").read()
+cut = raw.index(b"\0", raw.index(b"\0") + 1) + 1  # the metadata and the first scan
+unknown = cobs_frame(b"\x2f\x01\x02\x03") + cobs_frame(b"\x2e" + bytes(range(40)))
+open(os.path.join(WORK, "unknown.bsf"), "wb").write(raw[:cut] + unknown + raw[cut:])
+r = run(["decode", "unknown.bsf", "--json"], text=True)
+check(r.returncode == 0 and json.loads(r.stdout.strip().splitlines()[-1])["counters"]["unknown_type"] == 2,
+      "decode counts 2 frames of an unknown type")
+r = run(["metrics", "unknown.bsf"], text=True)
+check(r.returncode == 0 and "unknown type      2 frames" in r.stdout and "frames dropped    0 " in r.stdout,
+      "metrics counts and prints them, apart from damage (%r)" % [l for l in r.stdout.splitlines() if "unknown" in l])
+r = run(["listen", "unknown.bsf"], text=True)
+check(r.returncode == 0 and "unknown type 2," in r.stdout, "listen counts them")
+
+# 14. a metadata source (the log's name) holding quotes, a backslash and a
+# right-to-left override: listen prints it escaped as decode --json does.
+hostile = 'a"b\\c\u202ed.log'
+shutil.copy(os.path.join(WORK, "synth.log"), os.path.join(WORK, hostile))
+r = run(["extract", hostile, "--count", "3", "-o", "hostile.bsf"], text=True)
+check(r.returncode == 0, "extract of a log named with quotes, backslash and U+202E")
+r = run(["decode", "hostile.bsf", "--json"], text=True)
+meta = [json.loads(l)["metadata"] for l in r.stdout.splitlines() if l.startswith('{"metadata"')]
+check(meta and meta[0]["source"] == hostile, "decode --json carries the name exactly (%r)" % (meta[:1],))
+escaped = '"a\\"b\\\\c\\u202ed.log"'
+json_text = r.stdout
+r = run(["listen", "hostile.bsf"], text=True)
+line = [l for l in r.stdout.splitlines() if l.startswith("metadata ")]
+check(r.returncode == 0 and line and (" source=%s " % escaped) in line[0] and "\u202e" not in r.stdout,
+      "listen prints the source escaped, no raw override (%r)" % line[:1])
+check(escaped in json_text and "\u202e" not in json_text, "decode --json writes the same escape, no raw override")
+
 print("%d checks failed" % len(failures) if failures else "all tool checks passed")
 sys.exit(1 if failures else 0)

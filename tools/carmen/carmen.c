@@ -31,6 +31,10 @@
  * input, so the same requests keep the same lines before a read error. */
 #define CARMEN_BLOCK 65536u
 
+#if CARMEN_MAX_BUFFER != CARMEN_MAX_LINE + CARMEN_BLOCK + 1u
+#error "CARMEN_MAX_BUFFER must be the longest line, a block and a NUL"
+#endif
+
 /* No position yet (of a control byte in the line). */
 #define CARMEN_NONE ((size_t)-1)
 
@@ -59,6 +63,7 @@ struct carmen_reader {
     unsigned char bad_value;
     unsigned long line_no;
     unsigned long malformed;
+    unsigned long overlong; /* lines longer than CARMEN_MAX_LINE */
     float ranges[CARMEN_MAX_BEAMS];
 };
 
@@ -178,6 +183,16 @@ unsigned long carmen_malformed_count(const carmen_reader_t *reader)
     return reader->malformed;
 }
 
+unsigned long carmen_overlong_count(const carmen_reader_t *reader)
+{
+    return reader->overlong;
+}
+
+size_t carmen_buffer_bytes(const carmen_reader_t *reader)
+{
+    return reader->buf_cap;
+}
+
 /* Reports a read error: where the data stopped and the last line that was
  * read whole (everything after it is lost). */
 static void report_read_error(carmen_reader_t *r, const char *what)
@@ -285,7 +300,10 @@ static int make_room(carmen_reader_t *r)
         r->buf_pos = 0;
     }
     if (r->buf_cap - r->buf_len < CARMEN_BLOCK + 1u) {
-        const size_t cap = 2u * r->buf_cap;
+        /* never beyond the longest line's room: read_line drops a longer
+         * line before asking for more */
+        const size_t cap =
+            r->buf_cap < CARMEN_MAX_BUFFER / 2u ? 2u * r->buf_cap : (size_t)CARMEN_MAX_BUFFER;
         char *bigger = cap > r->buf_cap ? realloc(r->buf, cap) : NULL;
         if (bigger == NULL) {
             if (r->err != NULL) {
@@ -352,11 +370,67 @@ static size_t find_line_end(const carmen_reader_t *r, size_t i, size_t from, siz
     return n;
 }
 
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void
+report(carmen_reader_t *r, const char *fmt, ...)
+{
+    va_list ap;
+    ++r->malformed;
+    if (r->err != NULL) {
+        fprintf(r->err, "%s:%lu: ", r->path, r->line_no);
+        va_start(ap, fmt);
+        vfprintf(r->err, fmt, ap);
+        va_end(ap);
+        fputc('\n', r->err);
+    }
+}
+
+/* Reads and drops the rest of an overlong line (its first bytes are
+ * already dropped), a block at a time in the buffer's fixed room, up to and
+ * including its newline. Returns 1 (the next line starts at buf_pos), 0 at
+ * the end of the data (the overlong line was the last), -1 on a (reported)
+ * read error. */
+static int skip_rest_of_line(carmen_reader_t *r)
+{
+    for (;;) {
+        const char *nl;
+        long got;
+        r->buf_pos = r->buf_len = 0;
+        got = refill(r);
+        if (got <= 0) {
+            if (got == 0) {
+                ++r->line_no; /* the last line, ended by the end of the data */
+            }
+            return (int)got;
+        }
+        nl = memchr(r->buf, '\n', r->buf_len);
+        if (nl != NULL) {
+            r->buf_pos = (size_t)(nl - r->buf) + 1u;
+            ++r->line_no;
+            return 1;
+        }
+    }
+}
+
+/* Reports the line being read as longer than CARMEN_MAX_LINE (it is line
+ * line_no + 1: line_no counts the lines read whole). */
+static void report_overlong(carmen_reader_t *r)
+{
+    ++r->line_no;
+    report(r, "line longer than %lu bytes (no CARMEN message is): skipped",
+           (unsigned long)CARMEN_MAX_LINE);
+    --r->line_no;
+    ++r->overlong;
+}
+
 /* Finds the next whole line (without its newline) in the buffer, reading
  * more as needed: reader->line, NUL-terminated. Every byte up to the
- * newline belongs to the line, NUL included. Returns 1, 0 at end of file,
- * -1 on error (the partial last line of a cut file is lost and reported,
- * never returned). */
+ * newline belongs to the line, NUL included. A line longer than
+ * CARMEN_MAX_LINE is reported and skipped without keeping more than that
+ * much of it. Returns 1, 0 at end of file, -1 on error (the partial last
+ * line of a cut file is lost and reported, never returned). */
 static int read_line(carmen_reader_t *r)
 {
     size_t seen = 0; /* bytes of the line looked at so far */
@@ -366,10 +440,30 @@ static int read_line(carmen_reader_t *r)
     for (;;) {
         end = find_line_end(r, r->buf_pos + seen, r->buf_pos, &first_ctrl, &ctrl_value, &first_cr);
         if (end < r->buf_len) {
+            if (end - r->buf_pos > CARMEN_MAX_LINE) {
+                report_overlong(r);
+                ++r->line_no;
+                r->buf_pos = end + 1u;
+                seen = 0;
+                first_ctrl = first_cr = CARMEN_NONE;
+                continue;
+            }
             next = end + 1u;
             break;
         }
         seen = r->buf_len - r->buf_pos;
+        if (seen > CARMEN_MAX_LINE) {
+            /* Condemned before its newline: never buffered further. */
+            int rc;
+            report_overlong(r);
+            rc = skip_rest_of_line(r);
+            if (rc <= 0) {
+                return rc;
+            }
+            seen = 0;
+            first_ctrl = first_cr = CARMEN_NONE;
+            continue;
+        }
         {
             long got;
             if (make_room(r) != 0) {
@@ -384,6 +478,11 @@ static int read_line(carmen_reader_t *r)
                     return 0;
                 }
                 end = next = r->buf_len; /* last line without a newline, end checked */
+                if (end - r->buf_pos > CARMEN_MAX_LINE) {
+                    report_overlong(r);
+                    ++r->line_no;
+                    return 0;
+                }
                 break;
             }
         }
@@ -528,23 +627,6 @@ static void skip_field(fields_t *f, const char *name)
     size_t len;
     if (f->what == NULL && next_token(f, &len) == NULL) {
         f->what = name;
-    }
-}
-
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((format(printf, 2, 3)))
-#endif
-static void
-report(carmen_reader_t *r, const char *fmt, ...)
-{
-    va_list ap;
-    ++r->malformed;
-    if (r->err != NULL) {
-        fprintf(r->err, "%s:%lu: ", r->path, r->line_no);
-        va_start(ap, fmt);
-        vfprintf(r->err, fmt, ap);
-        va_end(ap);
-        fputc('\n', r->err);
     }
 }
 

@@ -24,6 +24,14 @@
  *    *.gz that holds no gzip data (e.g. cut before its header) is a read
  *    error: carmen_next returns -1 after "file:N: read error: WHAT; the last
  *    complete line is M". The partial line at the cut is never returned.
+ *
+ * Memory is bounded whatever the input: a line longer than CARMEN_MAX_LINE
+ * (far more than the longest scan line needs) is reported as malformed the
+ * moment it passes that length ("file:line: line longer than ..."), counted
+ * apart (carmen_overlong_count), and the rest of it is read and dropped a
+ * block at a time; the line buffer never holds more than CARMEN_MAX_BUFFER
+ * bytes. A gzip bomb of one endless line costs its decompression time, not
+ * its size in memory.
  */
 #ifndef BSF_TOOLS_CARMEN_H
 #define BSF_TOOLS_CARMEN_H
@@ -33,6 +41,15 @@
 
 /** Largest beam count accepted on one line; more is reported as malformed. */
 #define CARMEN_MAX_BEAMS 8192
+
+/** Longest line read (bytes before its newline). A ROBOTLASER1 line of
+ *  CARMEN_MAX_BEAMS readings and as many remissions, 24 characters each,
+ *  is under 400 KiB. */
+#define CARMEN_MAX_LINE 1048576u
+
+/** Most bytes the reader's line buffer ever takes: the longest line, one
+ *  read block (64 KiB) and the terminating NUL. */
+#define CARMEN_MAX_BUFFER (CARMEN_MAX_LINE + 65536u + 1u)
 
 /** Kind of laser message a record came from. */
 typedef enum {
@@ -94,6 +111,13 @@ int carmen_next(carmen_reader_t *reader, carmen_scan_t *scan);
 
 /** Number of malformed laser lines skipped so far. */
 unsigned long carmen_malformed_count(const carmen_reader_t *reader);
+
+/** Number of those lines that were longer than CARMEN_MAX_LINE: not damage
+ *  a real log shows, so a caller may treat any as a failure of the run. */
+unsigned long carmen_overlong_count(const carmen_reader_t *reader);
+
+/** Bytes the reader's line buffer holds now (at most CARMEN_MAX_BUFFER). */
+size_t carmen_buffer_bytes(const carmen_reader_t *reader);
 
 /** Readings at or above this are no-return codes in the CARMEN logs we know
  *  (81.83, 81.91); genuine outdoor returns reach about 81.8 m. */

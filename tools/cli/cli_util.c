@@ -19,6 +19,47 @@ void fail_msg(const char *fmt, ...)
     fputc('\n', stderr);
 }
 
+/* The code point of the bidirectional formatting character UTF-8 encoded at
+ * p, or 0. All of them are three bytes long but U+061C (two). */
+static unsigned bidi_control_at(const unsigned char *p)
+{
+    if (p[0] == 0xD8u && p[1] == 0x9Cu) {
+        return 0x061Cu;
+    }
+    if (p[0] == 0xE2u && p[1] == 0x80u &&
+        ((p[2] >= 0x8Eu && p[2] <= 0x8Fu) || (p[2] >= 0xAAu && p[2] <= 0xAEu))) {
+        return 0x2000u + (p[2] - 0x80u);
+    }
+    if (p[0] == 0xE2u && p[1] == 0x81u && p[2] >= 0xA6u && p[2] <= 0xA9u) {
+        return 0x2040u + (p[2] - 0x80u);
+    }
+    return 0u;
+}
+
+void print_json_string(FILE *f, const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    fputc('"', f);
+    while (*p != '\0') {
+        const unsigned bidi = bidi_control_at(p);
+        if (bidi != 0u) {
+            fprintf(f, "\\u%04x", bidi);
+            p += bidi == 0x061Cu ? 2 : 3;
+            continue;
+        }
+        if (*p == '"' || *p == '\\') {
+            fputc('\\', f);
+            fputc(*p, f);
+        } else if (*p < 0x20u || *p == 0x7Fu) {
+            fprintf(f, "\\u%04x", (unsigned)*p);
+        } else {
+            fputc(*p, f);
+        }
+        ++p;
+    }
+    fputc('"', f);
+}
+
 int usage_error(const char *fmt, ...)
 {
     va_list ap;

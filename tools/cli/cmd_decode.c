@@ -38,19 +38,6 @@ static void format_utc(char *out, size_t cap, int64_t us)
     snprintf(out + strlen(out), cap - strlen(out), ".%06ldZ", frac);
 }
 
-/* A validated source name (UTF-8, no control characters) as a JSON string. */
-static void print_json_string(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s != '\0'; ++s) {
-        if (*s == '"' || *s == '\\') {
-            fputc('\\', f);
-        }
-        fputc(*s, f);
-    }
-    fputc('"', f);
-}
-
 static int print_metadata(decode_ctx_t *ctx, const bsf_frame_t *fr, size_t bytes)
 {
     const bsf_metadata_t *m = &fr->metadata;

@@ -35,8 +35,9 @@ static const char extract_help[] =
     "time is not finite, negative or beyond 1e11 s. A scan with more keypoints,\n"
     "segments or control points than the library's caps is kept with the features\n"
     "that fit and reported as cut (not failed). The summary goes to stderr; progress\n"
-    "too, when stderr is a terminal. Exits 1 when the log holds no laser line or any\n"
-    "scan was skipped.\n";
+    "too, when stderr is a terminal. A line longer than 1 MiB (no CARMEN message is)\n"
+    "is reported and skipped without reading it into memory. Exits 1 when the log\n"
+    "holds no laser line, any scan was skipped or any line was longer than 1 MiB.\n";
 
 /* Largest log time accepted, seconds since 1970 (year 5138): a larger one is
  * a corrupt field, and its microseconds would not fit the metadata frame. */
@@ -156,7 +157,7 @@ static int run_extract(const extract_opts_t *o)
     carmen_scan_t rec;
     FILE *out;
     progress_t prog;
-    unsigned long index = 0, done = 0, failed = 0, bad_time = 0, malformed;
+    unsigned long index = 0, done = 0, failed = 0, bad_time = 0, malformed, overlong;
     unsigned long own_geometry = 0;
     cut_totals_t cut;
     unsigned long long bytes = 0;
@@ -293,6 +294,7 @@ static int run_extract(const extract_opts_t *o)
     }
     progress_end(&prog);
     malformed = carmen_malformed_count(rd);
+    overlong = carmen_overlong_count(rd);
     carmen_close(rd);
     if (close_out(out, o->out) != 0 || r < 0 || write_failed) {
         return EXIT_FAIL;
@@ -315,7 +317,12 @@ static int run_extract(const extract_opts_t *o)
                 "(kept: what fits, largest first; see the README's memory section)\n",
                 o->log, cut.keypoints, cut.segments, cut.points, cut.scans);
     }
-    return failed || bad_time ? EXIT_FAIL : 0;
+    if (overlong > 0u) {
+        fail_msg("%s: %lu lines longer than %lu bytes (reported above): not a CARMEN log "
+                 "as written",
+                 o->log, overlong, (unsigned long)CARMEN_MAX_LINE);
+    }
+    return failed || bad_time || overlong ? EXIT_FAIL : 0;
 }
 
 int cmd_extract(int argc, char **argv)

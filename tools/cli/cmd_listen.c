@@ -178,13 +178,18 @@ static void print_metadata_line(const bsf_frame_t *fr, size_t bytes, const bsf_d
     const bsf_metadata_t *m = &fr->metadata;
     const char *method = bsf_method_name((bsf_method_t)m->method);
     printf("metadata library=%u.%u.%u method=%s beams=%lu angle_min=%.6f angle_increment=%.6f "
-           "range=%.3f..%.3f quant=%.4f source=%s%s%s bytes=%zu | ok=%lu dropped=%lu\n",
+           "range=%.3f..%.3f quant=%.4f source=",
            (unsigned)m->lib_version_major, (unsigned)m->lib_version_minor,
            (unsigned)m->lib_version_patch, method != NULL ? method : "unknown",
            (unsigned long)m->n_beams, (double)m->angle_min, (double)m->angle_increment,
-           (double)m->range_min, (double)m->range_max, (double)m->quant_step,
-           m->source_len ? "\"" : "", m->source_len ? m->source : "none", m->source_len ? "\"" : "",
-           bytes, (unsigned long)s->frames_ok, dropped(s));
+           (double)m->range_min, (double)m->range_max, (double)m->quant_step);
+    /* the sender's text, escaped as decode --json writes it */
+    if (m->source_len > 0u) {
+        print_json_string(stdout, m->source);
+    } else {
+        fputs("none", stdout);
+    }
+    printf(" bytes=%zu | ok=%lu dropped=%lu\n", bytes, (unsigned long)s->frames_ok, dropped(s));
 }
 
 static void note_seq(listen_state_t *ls, uint32_t seq)

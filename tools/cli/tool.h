@@ -50,6 +50,11 @@ extern const char *g_cmd;
 void fail_msg(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
 /** fail_msg plus a pointer to --help; returns EXIT_USAGE. */
 int usage_error(const char *fmt, ...) BSF_PRINTF_LIKE(1, 2);
+/** A UTF-8 string (a metadata source, a method name) as a JSON string, safe
+ *  on a terminal too: quote and backslash escaped, control characters and
+ *  the bidirectional formatting characters (U+061C, U+200E, U+200F,
+ *  U+202A..U+202E, U+2066..U+2069) written as \uXXXX. */
+void print_json_string(FILE *f, const char *s);
 /** Monotonic time, seconds. */
 double now_s(void);
 /** Whole decimal number in [lo, hi]: 0, or -1 when malformed or out of range. */

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import io
 import math
+import operator
 import os
 import stat
 import sys
@@ -332,7 +333,23 @@ def _finite(name: str, v: Any) -> float:
     return f
 
 
+# struct formats of float32 and float64 items, with or without a byte-order mark
+_FLOAT_FORMATS = {p + c for p in ("", "@", "=", "<", ">", "!") for c in "fd"}
+
+
 def _ranges_array(ranges: Any) -> np.ndarray:
+    if not isinstance(ranges, np.ndarray):
+        # A raw buffer (bytes, a memoryview of packed floats) would be read as
+        # one number per byte: only buffers that say they hold floats are readings.
+        try:
+            view = memoryview(ranges)
+        except TypeError:
+            view = None
+        if view is not None and view.format not in _FLOAT_FORMATS:
+            raise TypeError(
+                f"ranges as a buffer must hold float32 or float64 items (struct format 'f' or 'd'), "
+                f"got format {view.format!r}: use np.frombuffer(data, dtype=np.float32) for packed floats"
+            )
     arr = np.asarray(ranges)
     if arr.dtype.kind not in "fiu":
         raise TypeError(f"ranges must be real numbers (a float array), got dtype {arr.dtype}")
@@ -469,6 +486,8 @@ def encode(
     ``quant_step`` defaults to the frame's own (a decoded frame) or
     :data:`QUANT_STEP_DEFAULT`. ``no_time`` sends 0 as extraction time
     (reproducible bytes); ``seq`` and ``timestamp_ms`` override the frame's.
+    Raises OverflowError when seq is outside 0..2**32-1 or timestamp_ms
+    outside 0..2**64-1, TypeError when either is not an integer.
     A :class:`Metadata` is encoded as a metadata frame (format version 2).
     """
     if isinstance(frame, Metadata):
@@ -504,8 +523,9 @@ def encode(
         frame.stats.time_ns if frame.version == 0 else int(frame.time_us) * 1000
     )
     return _core.encode(
-        int(frame.seq if seq is None else seq),
-        int(frame.timestamp_ms if timestamp_ms is None else timestamp_ms),
+        # integers only (a float would be truncated); the range is checked in C
+        operator.index(frame.seq if seq is None else seq),
+        operator.index(frame.timestamp_ms if timestamp_ms is None else timestamp_ms),
         pose,
         step,
         (feats, ctrl_b, vert_b, stats),
@@ -674,11 +694,20 @@ def read_carmen(path: Union[str, "os.PathLike[str]"]) -> Iterator[CarmenScan]:
     """Laser scans (FLASER, ROBOTLASER1) of a CARMEN log, plain or gzip.
 
     Malformed lines are reported on stderr as FILE:LINE and skipped, as by
-    ``bsf extract``.
+    ``bsf extract``. A line longer than 1 MiB (no CARMEN message is, but a
+    gzip bomb is) is reported the same way and dropped in bounded memory.
+
+    Raises:
+        OSError: the log cannot be opened, or its data is cut or corrupt.
+        BsfError: once the log is read to its end, when it held a line longer
+            than 1 MiB, or no laser scan at all (``bsf extract`` exits 1 then too).
     """
-    rd = _core.CarmenReader(os.fspath(path))
+    name = os.fspath(path)
+    rd = _core.CarmenReader(name)
+    scans = 0
     try:
         for d in rd:
+            scans += 1
             yield CarmenScan(
                 ranges=np.frombuffer(d["ranges"], dtype=np.float32).copy(),
                 angle_min=d["angle_min"],
@@ -690,8 +719,15 @@ def read_carmen(path: Union[str, "os.PathLike[str]"]) -> Iterator[CarmenScan]:
                 timestamp=d["timestamp"],
                 line=d["line"],
             )
+        overlong, malformed = rd.overlong, rd.malformed
     finally:
         rd.close()
+    if overlong:
+        raise BsfError(f"{name}: {overlong} lines longer than 1048576 bytes (reported above): not a CARMEN log as written")
+    if scans == 0:
+        raise BsfError(
+            f"{name}: no laser line (FLASER or ROBOTLASER1) in the log" + (" that could be read" if malformed else "")
+        )
 
 
 def _round_ms(seconds: float) -> int:
@@ -699,6 +735,11 @@ def _round_ms(seconds: float) -> int:
     x = seconds * 1000.0
     i = math.floor(x)
     return int(i) + (1 if x - i >= 0.5 else 0)
+
+
+#: Largest log time accepted, seconds since 1970, as ``bsf extract`` has it: a
+#: larger one is a corrupt field, and its microseconds would not fit the stream.
+_LOG_TIME_MAX_S = 1e11
 
 
 def _log_frames(
@@ -719,6 +760,15 @@ def _log_frames(
             continue
         if count is not None and done >= count:
             break
+        if not (math.isfinite(s.timestamp) and 0.0 <= s.timestamp <= _LOG_TIME_MAX_S):
+            msg = (
+                f"{os.fspath(path)}:{s.line}: scan {index} skipped: its time {s.timestamp:g} s is not a time "
+                f"bsf can carry (finite, 0 .. {_LOG_TIME_MAX_S:g} s)"
+            )
+            if errors is None:
+                raise BsfError(msg)
+            errors.append(msg)
+            continue
         rmax = float(np.float32(range_max)) if range_max else s.range_max
         try:
             fr = ex.extract(s.ranges, s.angle_min, s.angle_increment, 0.0, rmax)
@@ -750,8 +800,9 @@ def extract_log(
     number = scan index, time in ms since the first extracted scan, the laser
     pose. (``python -m bsf extract LOG`` also writes the metadata frames.)
 
-    A scan the library refuses is skipped (its message is appended to
-    ``errors`` when given, else raised).
+    A scan the library refuses, or whose time is not finite, negative or
+    beyond 1e11 s, is skipped (its message is appended to ``errors`` when
+    given, else raised), as by ``bsf extract``.
     """
     for _, _, fr in _log_frames(path, method, first, count, range_max, timing, errors, params):
         yield fr

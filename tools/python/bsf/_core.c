@@ -14,6 +14,7 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -189,12 +190,15 @@ static int param_set(bsf_params_t *p, const param_desc_t *d, PyObject *value)
         if (v == -1.0 && PyErr_Occurred()) {
             return -1;
         }
-        if (!isfinite(v) || fabs(v) > 3.0e38) {
+        /* Every finite float is accepted, FLT_MAX included (the default of
+         * lc_max_range): a double rounds to FLT_MAX below FLT_MAX + half
+         * its ulp (2^128 - 2^103), and to infinity from there. */
+        if (!isfinite(v) || fabs(v) >= 0x1.ffffffp127) {
             PyErr_Format(g_bsf_error, "parameter %s must be a finite float, got %R", d->name,
                          value);
             return -1;
         }
-        f = (float)v;
+        f = fabs(v) > (double)FLT_MAX ? (v > 0.0 ? FLT_MAX : -FLT_MAX) : (float)v;
         memcpy(base, &f, sizeof f);
         return 0;
     }
@@ -604,6 +608,12 @@ static int Extractor_init(ExtractorObject *self, PyObject *args, PyObject *kwds)
     bsf_params_t p;
     bsf_status_t st;
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "U|Op", kwlist, &method, &params, &timing)) {
+        return -1;
+    }
+    if (self->busy) {
+        /* another thread is inside bsf_extract on this extractor (without
+         * the GIL): re-initialising it now would change its state mid-scan */
+        PyErr_SetString(PyExc_RuntimeError, "this Extractor is already running in another thread");
         return -1;
     }
     if (params_build(method, params, &p) != 0) {
@@ -1034,11 +1044,22 @@ static PyObject *Carmen_get_malformed(CarmenObject *self, void *closure)
     return PyLong_FromUnsignedLong(carmen_malformed_count(self->rd));
 }
 
+static PyObject *Carmen_get_overlong(CarmenObject *self, void *closure)
+{
+    (void)closure;
+    if (self->rd == NULL) {
+        return PyLong_FromLong(0);
+    }
+    return PyLong_FromUnsignedLong(carmen_overlong_count(self->rd));
+}
+
 static PyMethodDef Carmen_methods[] = {
     {"close", (PyCFunction)Carmen_close, METH_NOARGS, "close the log"}, {NULL, NULL, 0, NULL}};
 
 static PyGetSetDef Carmen_getset[] = {
     {"malformed", (getter)Carmen_get_malformed, NULL, "malformed laser lines skipped so far", NULL},
+    {"overlong", (getter)Carmen_get_overlong, NULL,
+     "lines longer than the reader's cap (1 MiB) skipped so far (also counted as malformed)", NULL},
     {NULL, NULL, NULL, NULL, NULL}};
 
 static PyTypeObject CarmenType = {
@@ -1057,10 +1078,36 @@ static PyTypeObject CarmenType = {
 
 /* ---- module functions -------------------------------------------------------------- */
 
+/* An integer in 0..max (PyArg_ParseTuple's "k" and "K" wrap silently):
+ * 0, or -1 with TypeError (not an integer) or OverflowError set. */
+static int unsigned_arg(PyObject *obj, const char *name, unsigned long long max,
+                        unsigned long long *out)
+{
+    PyObject *index = PyNumber_Index(obj);
+    PyObject *zero;
+    int negative;
+    if (index == NULL) {
+        return -1;
+    }
+    zero = PyLong_FromLong(0);
+    negative = zero != NULL ? PyObject_RichCompareBool(index, zero, Py_LT) : -1;
+    Py_XDECREF(zero);
+    *out = negative == 0 ? PyLong_AsUnsignedLongLong(index) : 0u;
+    Py_DECREF(index);
+    if (negative < 0) {
+        return -1;
+    }
+    if (negative == 1 || (*out == (unsigned long long)-1 && PyErr_Occurred()) || *out > max) {
+        PyErr_Clear();
+        PyErr_Format(PyExc_OverflowError, "%s = %R is outside 0..%llu", name, obj, max);
+        return -1;
+    }
+    return 0;
+}
+
 static PyObject *core_encode(PyObject *mod, PyObject *args)
 {
-    unsigned long seq;
-    unsigned long long ts;
+    unsigned long long seq, ts;
     PyObject *pose, *res_tup, *out;
     double quant;
     bsf_frame_info_t info;
@@ -1069,11 +1116,12 @@ static PyObject *core_encode(PyObject *mod, PyObject *args)
     size_t len = 0;
     (void)mod;
     PyObject *geometry = Py_None;
-    if (!PyArg_ParseTuple(args, "kKOdO|O", &seq, &ts, &pose, &quant, &res_tup, &geometry)) {
+    PyObject *seq_obj, *ts_obj;
+    if (!PyArg_ParseTuple(args, "OOOdO|O", &seq_obj, &ts_obj, &pose, &quant, &res_tup, &geometry)) {
         return NULL;
     }
-    if (seq > 0xFFFFFFFFul) {
-        PyErr_Format(g_bsf_error, "seq %lu does not fit in 32 bits", seq);
+    if (unsigned_arg(seq_obj, "seq", 0xFFFFFFFFull, &seq) != 0 ||
+        unsigned_arg(ts_obj, "timestamp_ms", 0xFFFFFFFFFFFFFFFFull, &ts) != 0) {
         return NULL;
     }
     bsf_frame_info_init(&info);
