@@ -107,6 +107,47 @@ BSF_NODISCARD bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts,
                                                        const bsf_no_return_params_t *p,
                                                        size_t *n_rejected);
 
+/** Candidate values bsf_no_return_learn keeps count of. */
+#define BSF_NO_RETURN_CANDIDATES 4u
+/** Scans of evidence after which bsf_no_return_learn takes a value as a code. */
+#define BSF_NO_RETURN_LEARN_SCANS 20u
+
+/**
+ * State of bsf_no_return_learn across the scans of one sensor. Caller-owned,
+ * fixed size; start it with bsf_no_return_learner_init. Fields are private.
+ */
+typedef struct {
+    float value[BSF_NO_RETURN_CANDIDATES];    /**< candidate codes (0: empty slot) */
+    uint32_t count[BSF_NO_RETURN_CANDIDATES]; /**< scans of evidence for each */
+    uint16_t beam[BSF_NO_RETURN_CANDIDATES];  /**< where each was last seen isolated */
+    uint32_t n_scans;                         /**< scans seen (saturates) */
+    float code;                               /**< the learned code; 0 until one is found */
+} bsf_no_return_learner_t;
+
+/** Start (or restart) a learner: no candidates, no code. Does nothing for NULL. */
+void bsf_no_return_learner_init(bsf_no_return_learner_t *l);
+
+/**
+ * Learn a no-return code that is not in runs (a driver writing "no return" as
+ * a fixed value, for example 50.0, on lone beams as well as in runs) from a
+ * stream of scans: a scan is evidence for its largest valid reading when some
+ * run of beams holding exactly that value (one beam is enough) reads more than
+ * 10 % above its valid neighbours on both sides, as in
+ * bsf_points_reject_no_return, and it stands on other beams than the last
+ * time (a sensor standing still sees a far surface through a gap on the
+ * same beam scan after scan). A value becomes the code once it has
+ * BSF_NO_RETURN_LEARN_SCANS scans of evidence and that is at least a quarter of
+ * the scans seen: a genuine surface far away does not repeat bit for bit as an
+ * isolated maximum scan after scan while the sensor moves. Once found, the
+ * code stays. Put it in bsf_no_return_params_t.code (and re-initialise the
+ * extractor) to drop it from later scans.
+ * @param code_out  the learned code after this scan, 0 when none (may be NULL)
+ * @return BSF_OK; BSF_ERR_ARG for NULL l or scan, or ranges NULL with count > 0;
+ *         BSF_ERR_CAPACITY when count exceeds BSF_MAX_POINTS.
+ */
+BSF_NODISCARD bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *scan,
+                                               float *code_out);
+
 BSF_END_DECLS
 
 #endif /* BSF_SCAN_H */
