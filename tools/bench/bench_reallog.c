@@ -4,7 +4,7 @@
  * logs, where no ground truth exists: for every feature of every scan, the
  * largest distance of one of its points to its curve, and its E_curve.
  *
- *   bench_reallog DATA_DIR [--method M] [--check]
+ *   bench_reallog DATA_DIR [--method M] [--check] [--verbose] [--what-if]
  *
  * reads DATA_DIR/{intel,mit-csail,fr079,fr-clinic}.log.gz whole, extracts as
  * `bsf extract` does (the log's own range limit), and prints per log: scans,
@@ -13,6 +13,9 @@
  * average, and how many features have E_curve above BSF_REALLOG_E_MAX and
  * above BSF_REALLOG_E_TARGET. --check exits 1 when a log misses the targets
  * (p99 <= BSF_REALLOG_E_TARGET, no feature above BSF_REALLOG_E_MAX).
+ * --verbose prints every feature over the target; --what-if what the p99
+ * would be, and how many points would leave features, were the features
+ * whose E_curve exceeds 0.2, 0.15, 0.1 or 0.075 m not sent as curves.
  */
 #include <math.h>
 #include <stdio.h>
@@ -46,6 +49,14 @@ static bsf_extractor_t ex;
 static bsf_result_t res;
 static hist_t h_all;
 static hist_t h_far;
+/* What-if: the p99 and the points lost were features with E_curve above
+ * each of these bounds not sent as curves (--what-if). */
+#define N_BOUNDS 4
+static const double e_bounds[N_BOUNDS] = {0.20, 0.15, 0.10, 0.075};
+static hist_t h_kept[N_BOUNDS];
+static unsigned long pts_lost[N_BOUNDS];
+static int verbose = 0;
+static int what_if = 0;
 
 static void hist_add(hist_t *h, double d)
 {
@@ -105,6 +116,7 @@ static double feature_max_dist(const bsf_feature_t *f, double *mean_range)
     double worst = 0.0;
     double sum_r = 0.0;
     size_t n_pts = 0;
+    size_t worst_at = 0;
     size_t j;
     size_t b;
     for (j = 0; j < ns; ++j) {
@@ -117,7 +129,10 @@ static double feature_max_dist(const bsf_feature_t *f, double *mean_range)
     for (b = f->first_beam;; b = b + 1u < ex.points.count ? b + 1u : 0u) {
         if (ex.points.valid[b] && ex.scratch.seg.label[b] == f->first_beam) {
             const double d = dist_to_polyline(ex.points.pt[b], samples, ns);
-            worst = d > worst ? d : worst;
+            if (d > worst) {
+                worst = d;
+                worst_at = n_pts;
+            }
             sum_r += (double)ex.points.range[b];
             ++n_pts;
         }
@@ -126,6 +141,16 @@ static double feature_max_dist(const bsf_feature_t *f, double *mean_range)
         }
     }
     *mean_range = n_pts > 0u ? sum_r / (double)n_pts : 0.0;
+    if (verbose && worst > BSF_REALLOG_E_TARGET) {
+        size_t nv = 0;
+        for (j = 0; j < f->n_ctrl; ++j) {
+            nv += res.ctrl_is_vertex[f->ctrl_first + j];
+        }
+        printf("far point %.3f m: point %lu of %lu, beams %u-%u, mean range %.1f m, %u ctrl "
+               "(%lu vertex slots), E_curve %.3f m\n",
+               worst, (unsigned long)worst_at, (unsigned long)n_pts, f->first_beam, f->last_beam,
+               *mean_range, f->n_ctrl, (unsigned long)nv, (double)f->e_curve);
+    }
     return worst;
 }
 
@@ -147,15 +172,21 @@ int main(int argc, char **argv)
             }
         } else if (strcmp(argv[a], "--check") == 0) {
             check = 1;
+        } else if (strcmp(argv[a], "--what-if") == 0) {
+            what_if = 1;
+        } else if (strcmp(argv[a], "--verbose") == 0) {
+            verbose = 1; /* every feature over the target */
         } else if (argv[a][0] != '-' && dir == NULL) {
             dir = argv[a];
         } else {
-            fprintf(stderr, "usage: %s DATA_DIR [--method M] [--check]\n", argv[0]);
+            fprintf(stderr, "usage: %s DATA_DIR [--method M] [--check] [--verbose] [--what-if]\n",
+                    argv[0]);
             return 2;
         }
     }
     if (dir == NULL) {
-        fprintf(stderr, "usage: %s DATA_DIR [--method M] [--check]\n", argv[0]);
+        fprintf(stderr, "usage: %s DATA_DIR [--method M] [--check] [--verbose] [--what-if]\n",
+                argv[0]);
         return 2;
     }
     printf("bench_reallog: %s, per feature the largest point-to-curve distance\n",
@@ -172,6 +203,7 @@ int main(int argc, char **argv)
         unsigned long scans = 0;
         unsigned long over_max = 0;
         unsigned long over_target = 0;
+        unsigned long n_in = 0;
         int r;
         snprintf(path, sizeof path, "%s/%s.log.gz", dir, logs[d]);
         rd = carmen_open(path, NULL);
@@ -186,6 +218,8 @@ int main(int argc, char **argv)
         }
         memset(&h_all, 0, sizeof h_all);
         memset(&h_far, 0, sizeof h_far);
+        memset(h_kept, 0, sizeof h_kept);
+        memset(pts_lost, 0, sizeof pts_lost);
         while ((r = carmen_next(rd, &rec)) > 0) {
             const bsf_scan_t sc = scan_of_record(&rec, 0.0);
             size_t f;
@@ -193,12 +227,20 @@ int main(int argc, char **argv)
             if (bsf_extract(&ex, &sc, &res) != BSF_OK) {
                 continue; /* counted by bsf extract; a failed scan sends nothing */
             }
+            n_in += res.stats.n_in_features;
             for (f = 0; f < res.n_features; ++f) {
                 double mean_r = 0.0;
                 const double md = feature_max_dist(&res.features[f], &mean_r);
                 hist_add(&h_all, md);
                 if (mean_r >= BSF_REALLOG_FAR) {
                     hist_add(&h_far, md);
+                }
+                for (a = 0; a < N_BOUNDS; ++a) {
+                    if ((double)res.features[f].e_curve > e_bounds[a]) {
+                        pts_lost[a] += res.features[f].n_points;
+                    } else {
+                        hist_add(&h_kept[a], md);
+                    }
                 }
                 over_max += (double)res.features[f].e_curve > BSF_REALLOG_E_MAX;
                 over_target += (double)res.features[f].e_curve > BSF_REALLOG_E_TARGET;
@@ -212,6 +254,14 @@ int main(int argc, char **argv)
         printf("| %s | %lu | %lu | %.3f / %.3f / %.3f | %lu | %.3f | %lu | %lu |\n", logs[d], scans,
                h_all.n, hist_q(&h_all, 0.5), hist_q(&h_all, 0.99), h_all.max, h_far.n,
                hist_q(&h_far, 0.99), over_max, over_target);
+        if (what_if) {
+            for (a = 0; a < N_BOUNDS; ++a) {
+                printf("  what if E_curve > %.3f m were not sent: p99 %.3f m, %lu points (%.2f %% "
+                       "of the points in features) out of features\n",
+                       e_bounds[a], hist_q(&h_kept[a], 0.99), pts_lost[a],
+                       n_in > 0u ? 100.0 * (double)pts_lost[a] / (double)n_in : 0.0);
+            }
+        }
         fflush(stdout);
         if (hist_q(&h_all, 0.99) > BSF_REALLOG_E_TARGET || over_max > 0u) {
             ++missed;
