@@ -336,6 +336,10 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
             if (hit) {
                 acc->found_sparse[band]++;
                 hist_add(&acc->vertex_err_sparse, best);
+            } else if (bsf_truth_verbose && !dense) {
+                printf("missed sparse-wall corner at world (%.3f, %.3f), range %.2f m, beam %d, "
+                       "angle %.0f deg, nearest vertex %.3f m\n",
+                       c->wx, c->wy, c->range, c->beam, c->angle * 57.29577951, best);
             }
             if (deg >= BSF_TRUTH_OBTUSE_MIN && deg <= BSF_TRUTH_OBTUSE_MAX) {
                 if (corner_convex(scene, c, lidar)) {
