@@ -115,6 +115,10 @@ class SdistWithLibrary(sdist):
     without the repository around it."""
 
     def make_release_tree(self, base_dir, files):
+        # setuptools lists the extension's sources as they are named
+        # (../../src/...), which would be copied outside the release tree:
+        # they go into csrc/ below instead.
+        files = [f for f in files if not os.path.normpath(f).startswith(os.pardir)]
         super().make_release_tree(base_dir, files)
         copied = 0
         for pattern in LIBRARY_FILES:
