@@ -189,7 +189,9 @@ static int param_set(bsf_params_t *p, const param_desc_t *d, PyObject *value)
         if (v == -1.0 && PyErr_Occurred()) {
             return -1;
         }
-        if (!isfinite(v) || fabs(v) > 3.0e38) {
+        /* 0x1.ffffffp+127 is the least double that rounds to float infinity:
+         * anything below is a float (FLT_MAX as Python prints it included). */
+        if (!isfinite(v) || fabs(v) >= 0x1.ffffffp+127) {
             PyErr_Format(g_bsf_error, "parameter %s must be a finite float, got %R", d->name,
                          value);
             return -1;
