@@ -14,7 +14,7 @@
 #              pip index): it must not need Unity or anything else
 #   python     sdist of the archive's tools/python, a wheel built from that
 #              sdist alone (copied out of any checkout), installed into a fresh
-#              venv; the package's tests run against the installed wheel and
+#              venv; the sdist's tests run against the installed wheel and
 #              the archive build's tool
 #   live       the README's live-link commands twice in a row (a FIFO made by
 #              mktemp each time), with build-m4's firmware and build's tool;
@@ -157,8 +157,10 @@ do_python() {
     python3 -m venv "$py/venv"
     "$py/venv/bin/pip" install -q --disable-pip-version-check \
         -c "$src/tools/python/tests/requirements-ci.txt" "$wheel[plot,rosbag,serial,test]"
-    # The tests, away from any source of the package: only the wheel can be imported.
-    cp -r "$src/tools/python/tests" "$py/tests"
+    # The sdist's own tests, away from any source of the package: only the
+    # installed wheel can be imported.
+    [ -f "$py/alone/$name/tests/conftest.py" ] || fail "the sdist carries no tests/conftest.py"
+    cp -r "$py/alone/$name/tests" "$py/tests"
     (cd "$py" && "$py/venv/bin/python" - "$version" "$py/venv" << 'EOF'
 import sys
 import bsf
