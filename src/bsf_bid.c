@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* BID: the B-spline interest point detector (design brief section 5). */
+/* BID: the B-spline interest point detector (docs/DESIGN.md, "Methods"). */
 #include "bsf/bsf_bid.h"
 #include "bsf_fit_internal.h"
 #include "bsf_math.h"

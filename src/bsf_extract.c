@@ -526,7 +526,9 @@ static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res)
             res->stats.n_cut_segments++;
             res->stats.n_cut_points += s->n_points;
         } else if (st != BSF_OK) {
-            res->stats.n_unfitted++; /* its points count as wasted (design 7) */
+            /* Not fitted: its points count as wasted (docs/DESIGN.md, "PDM and
+             * refinement"). */
+            res->stats.n_unfitted++;
         }
     }
     put_features_in_beam_order(res);
@@ -542,7 +544,8 @@ static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
             break;
         }
         if (st != BSF_OK) {
-            /* Not fitted: its points count as wasted (design 7). */
+            /* Not fitted: its points count as wasted (docs/DESIGN.md, "PDM and
+             * refinement"). */
             res->stats.n_unfitted++;
         }
     }

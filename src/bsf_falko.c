@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * FALKO keypoints, following FALKOLib's FALKOExtractor::extract step by step
- * (design brief section 4), in float and in caller-owned memory.
+ * (docs/DESIGN.md, "Methods"), in float and in caller-owned memory.
  *
  * Float versus the reference's double. The decisions that pick keypoints are
  * comparisons: neighbour distance <= r, the triangle base and height against

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* PDM: point distance minimisation with boundary, vertex and precision
- * control points, and error-driven refinement (design brief section 7). */
+ * control points, and error-driven refinement (docs/DESIGN.md, "PDM and
+ * refinement"). */
 #include "bsf/bsf_fit.h"
 #include "bsf/bsf_bspline.h"
 #include "bsf_fit_internal.h"
@@ -16,8 +17,8 @@
 /* A fragment whose RMS is above this multiple of target_rms is "far" from
  * the target: a solve stops after its first iteration (refinement follows
  * anyway), and refinement grows such fragments by several points at once
- * and restarts the fit from arc length (design brief section 7, measured on
- * the four datasets: fewer refits and no warm start stuck on a corner the
+ * and restarts the fit from arc length (docs/DESIGN.md, "PDM and refinement";
+ * measured on the four datasets: fewer refits and no warm start stuck on a corner the
  * vertices miss). */
 #define PDM_FAR_RATIO 2.0f
 /* Far growth aims at this multiple of target_rms (above 1, so the last
@@ -233,7 +234,7 @@ static inline size_t span_of(float t, float fs, size_t n_span, float *u)
 /* One span's control points written around the middle one: on the span,
  * C(u) = P1 + b0 (P0 - P1) + b2 (P2 - P1) with b0 = k0 (1 - u)^2 and
  * b2 = k2 u^2, k0 and k2 being 1 on a clamped end and 1/2 inside. This is the
- * closed form of the design's Appendix with b1 = 1 - b0 - b2. Points arrive in
+ * closed form of docs/DESIGN.md's appendix with b1 = 1 - b0 - b2. Points arrive in
  * scan order, so consecutive ones mostly share a span: the coefficients are
  * loaded once per span change. */
 typedef struct {

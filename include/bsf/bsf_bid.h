@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * bsf_bid.h - BID, the B-spline interest point detector (design brief
- * section 5): the paper's deliberately expensive baseline corner detector.
+ * bsf_bid.h - BID, the B-spline interest point detector (docs/DESIGN.md,
+ * "Methods"): the paper's deliberately expensive baseline corner detector.
  *
  * For every valid beam q, the points within r_q = neigh_a * exp(neigh_b *
  * range_q) (walking outwards in beam order) are fitted by PDM with a clamped
@@ -11,7 +11,7 @@
  * Interest points are the beams whose N_q is a local minimum below t_th,
  * after the same beam non-maxima suppression as FALKO.
  *
- * Deviation from design section 5: the design starts the curve with four
+ * Deviation from the paper's description: it starts the curve with four
  * control points evenly spaced along the neighbourhood's principal axis and
  * takes the first footpoints from that start curve. On a sharp corner the
  * principal axis can lie along the corner's bisector, where that projection

@@ -6,7 +6,7 @@
  * spans over the parameter t in [0, 1]; its knots are
  * {0, 0, 0, 1/(n-1), ..., (n-2)/(n-1), 1, 1, 1}. Span s covers
  * t in [s/(n-1), (s+1)/(n-1)] and is shaped by control points s, s+1, s+2.
- * Evaluation uses the closed form of each span (design brief, Appendix).
+ * Evaluation uses the closed form of each span (docs/DESIGN.md, appendix).
  * A control point stored twice in a row (a vertex) is passed through, with a
  * straight span on each side.
  */

@@ -3,7 +3,8 @@
  * bsf_fit.h - fit a clamped uniform quadratic B-spline (bsf_bspline.h) to
  * the points of one segment: LSBA (least squares, 4 control points, the
  * paper's baseline) and PDM (point distance minimisation with boundary,
- * vertex and precision control points, the default; design brief section 7).
+ * vertex and precision control points, the default; docs/DESIGN.md, "PDM and
+ * refinement").
  *
  * Inputs are compact arrays of a segment's valid points in scan order.
  * Coordinates must be finite with magnitude <= BSF_FIT_MAX_COORD; fits are
@@ -59,7 +60,7 @@ typedef struct {
      *  fragment's chord (at least one). Metres, > 0. Default 1.0. */
     float precision_spacing;
     /** Bending weight per metre of segment length: lambda = this * L, where L
-     *  is the polyline length. >= 0 and <= 1. Default 1e-6 (design 7). */
+     *  is the polyline length. >= 0 and <= 1. Default 1e-6 (docs/DESIGN.md). */
     float lambda_per_metre;
     /** Stop when the RMS improves by less than this fraction in one
      *  iteration. In (0, 1). Default 0.01. */
@@ -150,7 +151,7 @@ typedef struct {
 } bsf_pdm_info_t;
 
 /**
- * PDM fit of one segment (design brief section 7).
+ * PDM fit of one segment (docs/DESIGN.md, "PDM and refinement").
  *
  * The stored control polygon is: boundary point, the first fragment's
  * precision points, vertex (twice), the next fragment's precision points,

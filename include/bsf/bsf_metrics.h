@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * bsf_metrics.h - the paper's four quality metrics (section 6.1), per scan
- * and aggregated over a dataset, exactly as design section 8 defines them.
+ * and aggregated over a dataset, as docs/DESIGN.md ("Methods") defines them.
  *
  * Per scan:
  *   retrievability  Gamma = points in kept features / N valid readings   (ratio, x100 for %)

@@ -4,7 +4,7 @@
  * belong to one surface), drop the short ones as wasted, and classify the
  * kept ones as auxiliary (a corner inside) or bleak (smooth).
  *
- * Two methods (design section 6):
+ * Two methods (docs/DESIGN.md, "Methods"):
  *  - SVED (default): a point joins the current segment when its distance to
  *    the segment's last point is at most r(rho) = a * exp(b * rho), rho the
  *    range of the new point. Invalid beams never break a segment by

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * bench_scenes.h - the benchmark scenes of issue 15, shared by bench_extract
+ * bench_scenes.h - the benchmark scenes of docs/PERFORMANCE.md, shared by bench_extract
  * (host time), bench_count (x86 instructions under callgrind) and
  * bench_m4_icount (Cortex-M4F instructions under QEMU).
  *

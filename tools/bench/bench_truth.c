@@ -200,7 +200,7 @@ static void print_row(int which, const sensor_t *sen, const noise_t *nz,
         100.0 * s->gamma, s->eta, s->bytes_per_scan, s->us_per_scan, failed);
 }
 
-/* The issue-14 targets for office-like scenes (the demo office and the
+/* The targets of docs/GROUND_TRUTH.md for office-like scenes (the demo office and the
  * angles office; the curved room is judged on precision and curves only).
  * Returns the number of failed checks. The curve targets (p99 <= 3 cm, max
  * <= 8 cm at sigma <= 1 cm) are not met everywhere yet (docs/GROUND_TRUTH.md

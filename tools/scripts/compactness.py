@@ -10,8 +10,8 @@ For each CARMEN log (ROBOTLASER1 or FLASER lines) this prints, per scan:
 as median and 95th percentile, in the Markdown table of docs/FORMAT.md.
 
 Usage:
-  tools/compactness.py --bsf build/tools/bsf --data /work/shared/data
-  tools/compactness.py --bsf build/tools/bsf --data DIR --quant 0.001 0.002 0.005 0.01 --only intel
+  tools/scripts/compactness.py --bsf build/tools/bsf --data ../shared/data
+  tools/scripts/compactness.py --bsf build/tools/bsf --data DIR --quant 0.001 0.002 0.005 0.01 --only intel
 """
 import argparse
 import gzip

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""Every figure of issue 15's table in one command (docs/PERFORMANCE.md).
+"""Every figure of docs/PERFORMANCE.md's speed and size table in one command.
 
 x86-64: exact instruction counts under callgrind of tools/bench/bench_count
 (fixed workloads, no clock hook) and of the whole `bsf extract` process.
@@ -34,7 +34,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
-# budget, FALKOLib, floor per row key (issue 15); None: no such figure.
+# budget, FALKOLib, floor per row key (docs/PERFORMANCE.md); None: no such figure.
 FALKOLIB_X86 = 114_000  # FALKOLib's FALKO extractor alone, x86 -O2, per Intel scan
 FLOOR_X86 = 11_700  # points from a table plus one pass over them, per Intel scan
 FLOOR_M4 = 8_000
@@ -407,7 +407,7 @@ def main():
             shutil.rmtree(work, ignore_errors=True)
     commit = run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], check=False).strip()
     t = table(rows)
-    print(f"issue 15 figures, commit {commit}, {time.time() - t0:.0f} s")
+    print(f"performance figures, commit {commit}, {time.time() - t0:.0f} s")
     if args.markdown:
         print("\n| figure | today | budget | FALKOLib | floor | status | command |")
         print("|---|---|---|---|---|---|---|")

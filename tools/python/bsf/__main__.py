@@ -37,9 +37,13 @@ def cmd_extract(a: argparse.Namespace) -> int:
             print("bsf: extract of a ROS bag needs --topic (e.g. --topic /scan)", file=sys.stderr)
             return 2
         from .rosbag import BagError, extract_bag
+        from .tf import MAX_GAP_NS_DEFAULT
 
+        if a.max_pose_gap is not None and not (a.max_pose_gap > 0 and a.max_pose_gap < 1e9):
+            print(f"bsf: --max-pose-gap must be a positive number of seconds, got {a.max_pose_gap}", file=sys.stderr)
+            return 2
         try:
-            n, failed, nbytes = extract_bag(
+            n, failed, nbytes, no_pose = extract_bag(
                 a.input,
                 a.topic,
                 a.output,
@@ -47,20 +51,30 @@ def cmd_extract(a: argparse.Namespace) -> int:
                 quant_step=a.quant,
                 range_max=a.range_max,
                 timing=not a.no_time,
+                pose_from=a.pose_from,
+                frame=a.frame,
+                max_gap_ns=round((a.max_pose_gap if a.max_pose_gap is not None else MAX_GAP_NS_DEFAULT / 1e9) * 1e9),
                 **params,
             )
         except (BagError, BsfError, TypeError, OSError) as e:
             print(f"bsf: {e}", file=sys.stderr)
             return 1
         print(
-            f"{a.input}: {n} scans of {a.topic} extracted with {a.method}, {nbytes} bytes, {failed} refused",
+            f"{a.input}: {n} scans of {a.topic} extracted with {a.method}, {nbytes} bytes, {failed} refused"
+            + (f", {no_pose} without a pose skipped" if a.pose_from else ""),
             file=sys.stderr,
         )
+        if n == 0 and no_pose:
+            print(f"bsf: {a.input}: no scan of {a.topic} has a pose from {a.pose_from}", file=sys.stderr)
+            return 1
         if n == 0 and failed == 0:
             print(f"bsf: {a.input}: no message on {a.topic}", file=sys.stderr)
             return 1
         return 1 if failed else 0
     # Anything else is read as a CARMEN log, as `bsf extract` does.
+    if a.pose_from or a.frame or a.max_pose_gap is not None:
+        print("bsf: --pose-from, --frame and --max-pose-gap are for ROS bags (a CARMEN log carries its poses)", file=sys.stderr)
+        return 2
     errors: List[str] = []
     n = nbytes = 0
     try:
@@ -129,6 +143,22 @@ def cmd_plot(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_export(a: argparse.Namespace) -> int:
+    from .export import ExportError, export
+
+    if a.samples < 2:
+        print(f"bsf: --samples must be at least 2, got {a.samples}", file=sys.stderr)
+        return 2
+    try:
+        res = export(a.input, a.output, a.format, frame_id=a.frame_id, laser_frame=a.laser_frame, samples=a.samples, prefix=a.prefix)
+    except (ExportError, BsfError, OSError) as e:
+        print(f"bsf: {e}", file=sys.stderr)
+        return 1
+    counts = ", ".join(f"{n} on {t}" for t, n in sorted(res.messages.items()))
+    print(f"{a.output}: {res.frames} frames exported ({counts})", file=sys.stderr)
+    return 0
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     p = argparse.ArgumentParser(prog="python -m bsf", description="bsf from Python: ROS bags and CARMEN logs to bsf streams, plots.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -147,6 +177,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     e.add_argument("--count", type=int, default=None, help="CARMEN: at most N scans")
     e.add_argument("--no-time", action="store_true", help="send 0 as extraction time (byte-reproducible output)")
     e.add_argument("--param", action="append", type=_param, metavar="NAME=VALUE", help="parameter override, e.g. pdm_target_rms=0.02")
+    e.add_argument("--pose-from", metavar="TOPIC", help="bags: poses from a tf topic (/tf, with /tf_static) or a nav_msgs/Odometry topic")
+    e.add_argument("--frame", help="bags: fixed frame of the poses (default: map if the transforms have it, else odom; odometry: its own frame)")
+    e.add_argument("--max-pose-gap", type=float, metavar="S", help="bags: longest gap between two pose samples to interpolate across, seconds (1)")
     e.set_defaults(func=cmd_extract)
     pl = sub.add_parser("plot", help="draw a bsf stream to an image (needs matplotlib)")
     pl.add_argument("input", metavar="IN", help="bsf stream ('-': stdin)")
@@ -154,6 +187,19 @@ def main(argv: Optional[List[str]] = None) -> int:
     pl.add_argument("--sensor", action="store_true", help="sensor frame instead of the world frame")
     pl.add_argument("--dpi", type=int, default=150)
     pl.set_defaults(func=cmd_plot)
+    x = sub.add_parser(
+        "export",
+        help="write a bsf stream as ROS 2 markers (MCAP for Foxglove, or a ROS 2 bag for RViz 2; needs the rosbag extra)",
+        description="Features as visualization_msgs/MarkerArray (line strips, vertex spheres), the laser pose and path.",
+    )
+    x.add_argument("input", metavar="IN", help="bsf stream ('-': stdin)")
+    x.add_argument("-o", dest="output", required=True, help="OUT.mcap, or a new directory with --format ros2bag")
+    x.add_argument("--format", choices=("mcap", "ros2bag"), default=None, help="default: mcap for *.mcap")
+    x.add_argument("--frame-id", default="map", help="fixed frame of frames with a pose (map)")
+    x.add_argument("--laser-frame", default="laser", help="frame of frames without a pose (laser)")
+    x.add_argument("--samples", type=int, default=32, help="points per feature's line strip (32)")
+    x.add_argument("--prefix", default="/bsf", help="topic prefix (/bsf: /bsf/features, /bsf/pose, /bsf/path)")
+    x.set_defaults(func=cmd_export)
     a = p.parse_args(argv)
     try:
         return int(a.func(a))
