@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 # Install rules (BSF_INSTALL): the library, its headers, the port clock hooks
 # (bsf::port, plus their sources for firmware builds), the CMake package
-# (find_package(bsf CONFIG)) and a relocatable pkg-config file.
+# (find_package(bsf CONFIG)), a relocatable pkg-config file, the licence and
+# the documentation.
 include(CMakePackageConfigHelpers)
 
 install(TARGETS bsf bsf_port EXPORT bsfTargets
@@ -60,3 +61,8 @@ foreach(_cap IN LISTS BSF_CAPS)
 endforeach()
 configure_file(cmake/bsf.pc.in ${PROJECT_BINARY_DIR}/bsf.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/bsf.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# The licence and the documentation, where packagers and users look for them
+# (share/doc/bsf): README.md links docs/ relatively, so docs/ keeps its name.
+install(FILES LICENSE README.md CHANGELOG.md CITATION.cff DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs)

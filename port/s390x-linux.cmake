@@ -6,6 +6,11 @@
 #   cmake -S . -B build-s390x -DCMAKE_TOOLCHAIN_FILE=port/s390x-linux.cmake
 #   cmake --build build-s390x && ctest --test-dir build-s390x
 #
+# Every test that needs an operating system runs here too (the tool, the
+# CARMEN reader, the fuzz corpus replays): BSF_BUILD_TOOLS is ON by default on
+# a hosted target. Without an s390x zlib the reader reads .gz logs through the
+# system's `gzip -dc` (qemu-user starts the host's gzip), so no more packages.
+#
 # Needs: gcc-s390x-linux-gnu libc6-dev-s390x-cross qemu-user (the first two
 # conflict with gcc-multilib). GCC on s390x evaluates float in double in ISO C
 # mode; cmake/BsfFloatEval.cmake adds -fexcess-precision=fast for that.

@@ -22,7 +22,7 @@
  *    (relative) of its boundary, and 3 of 91 864 sector values within 1e-5
  *    sector of a boundary (none exactly on it). None of them changes a
  *    keypoint: the port gives the reference's keypoint beam indices on
- *    100 % of the scans (test/test_falko_ref.c).
+ *    100 % of the scans (test/system/test_falko_ref.c).
  * Where the reference reads one point past the end of the scan (its window
  * runs to i + alpha + 1 <= numBeams inclusive), this port clamps to the scan.
  *

@@ -13,10 +13,10 @@
 #include "bsf_abi.h"
 
 #define BSF_VERSION_MAJOR 0
-#define BSF_VERSION_MINOR 1
+#define BSF_VERSION_MINOR 2
 #define BSF_VERSION_PATCH 0
 /** "MAJOR.MINOR.PATCH" of these headers. */
-#define BSF_VERSION_STRING "0.1.0"
+#define BSF_VERSION_STRING "0.2.0"
 /** The version as one comparable number: MAJOR * 10000 + MINOR * 100 + PATCH. */
 #define BSF_VERSION_NUMBER (BSF_VERSION_MAJOR * 10000 + BSF_VERSION_MINOR * 100 + BSF_VERSION_PATCH)
 

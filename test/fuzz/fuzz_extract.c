@@ -367,7 +367,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         check_error_result();
         return 0;
     }
-    /* BSF_OK_CUT: a cap cut the output, and the stats say so (issue 18) */
+    /* BSF_OK_CUT: a cap cut the output, and the stats say so (docs/DESIGN.md, Cut policy) */
     FUZZ_CHECK(st == BSF_OK || st == BSF_OK_CUT);
     FUZZ_CHECK((st == BSF_OK_CUT) == (res.stats.cut != 0u));
     check_times(&params);

@@ -6,7 +6,7 @@
  * `bsf extract | bsf metrics` reproduces them from the stream alone.
  * Usage: synth_log OUT.log N_SCANS [clutter]
  * With `clutter`, the scans are 1081-beam views of a room of zig-zag shelves
- * whose corners exceed the keypoint cap in some scans (issue 18), and the
+ * whose corners exceed the keypoint cap in some scans (docs/DESIGN.md, Cut policy), and the
  * cut scans are counted too (cut_scans=).
  */
 #include <stdio.h>

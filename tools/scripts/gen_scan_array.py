@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
 """Turn the ROBOTLASER1 scans of a CARMEN log (plain or .gz) into a C file
-for test/bench_log_scans.h, so a bare-metal benchmark can run real scans.
+for test/bench/bench_log_scans.h, so a bare-metal benchmark can run real scans.
 
     gen_scan_array.py [--stride K] [--max-scans N] LOG OUT.c
 

@@ -4,7 +4,7 @@
 
 x86-64: exact instruction counts under callgrind of tools/bench/bench_count
 (fixed workloads, no clock hook) and of the whole `bsf extract` process.
-Cortex-M4F: QEMU -icount runs of test/bench_m4_icount (all Intel scans with
+Cortex-M4F: QEMU -icount runs of test/bench/bench_m4_icount (all Intel scans with
 the default method and FALKO-SVED-PDM, the office scans, the adversarial
 scans) and of bench_m4_icount_big (3200-beam office, 4000-beam long wall).
 Size: the extract + encode firmware's link map (size_report.py), stack

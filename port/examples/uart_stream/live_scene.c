@@ -28,7 +28,7 @@ static bsf_lidar_t live_lidar(double x, double y, double theta)
 
 bsf_status_t live_scene_start(void)
 {
-    const bsf_params_t params = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
+    const bsf_params_t params = bsf_params_default(BSF_METHOD_DEFAULT);
     bsf_scene_demo_office(&g_scene);
     bsf_scene_rng_seed(&g_rng, 2026u);
     return bsf_extractor_init(&g_extractor, &params);

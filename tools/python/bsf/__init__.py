@@ -38,6 +38,7 @@ from . import _core
 from ._core import BsfError
 
 __all__ = [
+    "__version__",
     "BsfError",
     "Feature",
     "ScanStats",
@@ -59,6 +60,10 @@ __all__ = [
     "plot",
     "METHODS",
 ]
+
+#: Version of the compiled C library, "MAJOR.MINOR.PATCH"; the package's own
+#: version is the same (setup.py reads it from include/bsf/bsf_version.h).
+__version__: str = _core.version()
 
 #: Compile-time caps of this build (beams per scan, keypoints, segments,
 #: control points) and the wire format version it writes.
@@ -86,7 +91,14 @@ def default_params(method: str = "lc-sved-pdm") -> Dict[str, Union[int, float]]:
     ``pdm_target_rms``, ``sved_a``, ``falko_min_score_th``); pass any of them
     as keyword arguments to :func:`extract` or :class:`Extractor`.
     """
-    return dict(_core.default_params(method))
+    return _readable_params(_core.default_params(method))
+
+
+def _readable_params(params: Dict[str, Union[int, float]]) -> Dict[str, Union[int, float]]:
+    """Parameters as the library holds them (float32), each float written as
+    the shortest decimal that is the same float32: 0.2, not 0.20000000298023224.
+    Passed back to :func:`extract`, each gives the same float32 again."""
+    return {k: float(str(np.float32(v))) if isinstance(v, float) else v for k, v in params.items()}
 
 
 # ---- data model -------------------------------------------------------------------
@@ -351,7 +363,14 @@ def _ranges_array(ranges: Any) -> np.ndarray:
                 f"got format {view.format!r}: use np.frombuffer(data, dtype=np.float32) for packed floats"
             )
     arr = np.asarray(ranges)
-    if arr.dtype.kind not in "fiu":
+    if arr.dtype.kind in "iub":
+        # Integer readings are usually a driver's millimetres: read as metres,
+        # every one would be out of range and the scan silently empty.
+        raise TypeError(
+            f"ranges must be floating-point metres, got an integer array (dtype {arr.dtype}); "
+            "for millimetres pass ranges / 1000.0, for whole metres ranges.astype(float)"
+        )
+    if arr.dtype.kind != "f":
         raise TypeError(f"ranges must be real numbers (a float array), got dtype {arr.dtype}")
     if arr.ndim != 1:
         raise BsfError(f"ranges must be one-dimensional, got shape {arr.shape}")
@@ -379,7 +398,7 @@ class Extractor:
     @property
     def params(self) -> Dict[str, Union[int, float]]:
         """The effective parameters (defaults and overrides)."""
-        return dict(self._ex.params)
+        return _readable_params(self._ex.params)
 
     def extract(
         self,
@@ -439,8 +458,8 @@ def extract(
     """Extract the B-spline features of one scan.
 
     Args:
-        ranges: 1-D array of readings in metres (any real dtype; used as
-            float32). Beam i points at ``angle_min + i * angle_increment``.
+        ranges: 1-D float array of readings in metres (used as float32;
+            an integer array, such as a driver's millimetres, is a TypeError). Beam i points at ``angle_min + i * angle_increment``.
             A reading is valid when finite and ``range_min <= r < range_max``;
             invalid ones keep their index but are never points.
         angle_min, angle_increment: radians, counter-clockwise.
@@ -456,7 +475,7 @@ def extract(
         flags, beam runs and E_curve, and whose ``stats`` are the scan's.
 
     Raises:
-        TypeError: ranges not real numbers, unknown parameter name.
+        TypeError: ranges not floating-point numbers, unknown parameter name.
         BsfError (a ValueError): bad shape or geometry, more beams than
             :data:`caps`, a parameter out of range.
     """

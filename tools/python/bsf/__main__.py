@@ -109,6 +109,11 @@ def cmd_extract(a: argparse.Namespace) -> int:
     for e in errors:
         print(e, file=sys.stderr)
     print(f"{a.input}: {n} scans extracted with {a.method}, {nbytes} bytes, {len(errors)} failed", file=sys.stderr)
+    if n == 0 and not errors and not a.first:
+        # As `bsf extract`: a file without a laser line is not a log (a typo,
+        # a script, a bag without its suffix), and an empty stream is no result.
+        print(f"bsf: {a.input}: no laser line (FLASER or ROBOTLASER1) in the log", file=sys.stderr)
+        return 1
     return 1 if errors else 0
 
 

@@ -1369,7 +1369,16 @@ static PyObject *core_default_params(PyObject *mod, PyObject *args)
     return params_to_dict(&p);
 }
 
+/* version() -> "MAJOR.MINOR.PATCH" of the compiled library (bsf.__version__). */
+static PyObject *core_version(PyObject *mod, PyObject *unused)
+{
+    (void)mod;
+    (void)unused;
+    return PyUnicode_FromString(bsf_version());
+}
+
 static PyMethodDef core_methods[] = {
+    {"version", core_version, METH_NOARGS, "version() -> the C library's version string"},
     {"encode", core_encode, METH_VARARGS,
      "encode(seq, timestamp_ms, pose|None, quant_step, result) -> frame bytes"},
     {"bspline_eval", core_bspline_eval, METH_VARARGS,

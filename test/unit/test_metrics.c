@@ -161,7 +161,7 @@ static void test_counts_of_a_result_sum_its_features(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_metrics_counts(&r, NULL));
 }
 
-/* Issue 17 item 6: 32-bit sums wrapped (ctrl_per_scan 34.8 instead of 512
+/* Sums once kept in 32 bits wrapped (ctrl_per_scan 34.8 instead of 512
  * after 9 M full scans). The accumulator is brought to 8 388 607 full scans
  * (512 control points each: 2^32 - 512 in total, the last value a 32-bit sum
  * holds) as 9 M adds would leave it, then more full scans are added. */

@@ -188,7 +188,7 @@ static void test_intel_corrected_flaser_matches_falkolib_on_every_scan(void)
  * triangle-height test is within float rounding of the boundary when the
  * area comes from absolute coordinates (about 1e-5 relative lost to
  * cancellation): the port dropped it until the area was computed relative to
- * the apex (issue 14). Skipped without the log. */
+ * the apex. Skipped without the log. */
 static void test_fr_clinic_scan_5434_keeps_keypoint_175(void)
 {
     char path[4096];

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Caps past the input cut a cluttered scan's output instead of failing it
- * (issue 18): synthetic clutter scans that exceed the keypoint, segment and
+ * (docs/DESIGN.md, "Cut policy"): synthetic clutter scans that exceed the keypoint, segment and
  * control-point caps in turn keep the features that fit by the documented
  * rule, report the cut in their stats, still encode within
  * BSF_FRAME_MAX_SIZE and decode to the same features. Built twice: against

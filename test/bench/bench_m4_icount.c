@@ -356,7 +356,7 @@ static int make_synthetic(size_t *n_out)
     return 0;
 }
 
-/* ---- cluttered room, 1081 beams (issue 18): keypoint-cap cuts ------------- */
+/* ---- cluttered room, 1081 beams: keypoint-cap cuts (docs/DESIGN.md) ------- */
 
 #define N_CLUTTER_SCANS 4
 

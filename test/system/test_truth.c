@@ -4,10 +4,11 @@
  * office: 14 m x 10 m, corners up to 8 m away) with the default method:
  * corner recall by range, vertex precision and position error, and the
  * largest distance of any curve from the true walls. The bounds are the
- * issue-14 targets; the FALKO-SVED-PDM of before (FALKOLib's corners, free
+ * ground-truth targets (docs/GROUND_TRUTH.md, which has the full benchmark,
+ * bench_truth); the FALKO-SVED-PDM of before (FALKOLib's corners, free
  * vertices) fails every one of them (recall 2-12 %, vertex error median
  * 5 cm, curves up to 20 cm off the walls), so each test would catch a return
- * to it. docs/GROUND_TRUTH.md has the full benchmark (bench_truth).
+ * to it.
  */
 #include <math.h>
 #include <stdio.h>

@@ -1,12 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Segmentation that survives real logs (issue 13), on synthetic scans with
+ * Segmentation that survives real logs, on synthetic scans with
  * ground truth: no-return codes that the log does not declare, far ranges,
  * mixed pixels at depth jumps, an outdoor-like scene with ranges up to 80 m,
  * and full-circle scans whose seam crosses a wall or a corner.
  *
- * Built twice: against the default library, and (host only) against bsf_big,
- * whose 4096-beam caps also run the 3200-beam full-circle case.
+ * Built twice: against the default library, and (host and s390x, not bare
+ * metal) against bsf_big, whose 4096-beam caps also run the 3200-beam
+ * full-circle case.
  */
 #include <math.h>
 #include <stdio.h>
