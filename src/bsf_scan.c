@@ -356,8 +356,13 @@ bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *s
     if (l->code > 0.0f) {
         return BSF_OK;
     }
-    if (l->n_scans < UINT32_MAX) {
-        l->n_scans++;
+    l->n_scans = (l->n_scans + 1u) % BSF_NO_RETURN_AGE_SCANS;
+    if (l->n_scans == 0u) {
+        /* Old evidence fades: a value must keep recurring to become a code,
+         * and a value that recurred once for a while frees its slot. */
+        for (i = 0; i < BSF_NO_RETURN_CANDIDATES; ++i) {
+            l->count[i] /= 2u;
+        }
     }
     for (i = 0; i < scan->count; ++i) {
         const float r = scan->ranges[i];
@@ -366,9 +371,8 @@ bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *s
         }
     }
     if (top > 0.0f && isolated_top(scan, top, &at)) {
-        /* Count it: its own slot, else an empty one, else replace the
-         * weakest candidate (which then starts from the weakest count, so a
-         * frequent value cannot be pushed out by a stream of rare ones). */
+        /* Count it: its own slot, else the weakest one (an empty slot has
+         * count 0), whose value it replaces with no evidence of its own. */
         size_t slot = BSF_NO_RETURN_CANDIDATES;
         size_t weakest = 0;
         for (i = 0; i < BSF_NO_RETURN_CANDIDATES; ++i) {
@@ -383,6 +387,7 @@ bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *s
         if (slot == BSF_NO_RETURN_CANDIDATES) {
             slot = weakest;
             l->value[slot] = top;
+            l->count[slot] = 0u;
             l->beam[slot] = (uint16_t)(at + 3u); /* never "the same beam" */
         }
         /* The same beam or its neighbour as last time is no new evidence. */
@@ -391,8 +396,7 @@ bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *s
             l->count[slot]++;
         }
         l->beam[slot] = (uint16_t)at;
-        if (l->count[slot] >= BSF_NO_RETURN_LEARN_SCANS &&
-            (uint64_t)l->count[slot] * 4u >= (uint64_t)l->n_scans) {
+        if (l->count[slot] >= BSF_NO_RETURN_LEARN_SCANS) {
             l->code = top;
         }
     }

@@ -111,6 +111,8 @@ BSF_NODISCARD bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts,
 #define BSF_NO_RETURN_CANDIDATES 4u
 /** Scans of evidence after which bsf_no_return_learn takes a value as a code. */
 #define BSF_NO_RETURN_LEARN_SCANS 20u
+/** Every this many scans bsf_no_return_learn halves all evidence. */
+#define BSF_NO_RETURN_AGE_SCANS 64u
 
 /**
  * State of bsf_no_return_learn across the scans of one sensor. Caller-owned,
@@ -120,7 +122,7 @@ typedef struct {
     float value[BSF_NO_RETURN_CANDIDATES];    /**< candidate codes (0: empty slot) */
     uint32_t count[BSF_NO_RETURN_CANDIDATES]; /**< scans of evidence for each */
     uint16_t beam[BSF_NO_RETURN_CANDIDATES];  /**< where each was last seen isolated */
-    uint32_t n_scans;                         /**< scans seen (saturates) */
+    uint32_t n_scans;                         /**< scans since evidence was last halved */
     float code;                               /**< the learned code; 0 until one is found */
 } bsf_no_return_learner_t;
 
@@ -135,10 +137,13 @@ void bsf_no_return_learner_init(bsf_no_return_learner_t *l);
  * 10 % above its valid neighbours on both sides, as in
  * bsf_points_reject_no_return, and it stands on other beams than the last
  * time (a sensor standing still sees a far surface through a gap on the
- * same beam scan after scan). A value becomes the code once it has
- * BSF_NO_RETURN_LEARN_SCANS scans of evidence and that is at least a quarter of
- * the scans seen: a genuine surface far away does not repeat bit for bit as an
- * isolated maximum scan after scan while the sensor moves. Once found, the
+ * same beam scan after scan). Evidence is halved every
+ * BSF_NO_RETURN_AGE_SCANS scans, and a value becomes the code once it has
+ * BSF_NO_RETURN_LEARN_SCANS scans of evidence: it must recur in about one scan
+ * in six or more (a code written in half the scans is found within about 40),
+ * and a genuine surface far away does not repeat bit for bit as an isolated
+ * maximum that often while the sensor moves. BSF_NO_RETURN_CANDIDATES values
+ * are counted at once; a new one takes the slot of the least evidence. Once found, the
  * code stays. Put it in bsf_no_return_params_t.code (and re-initialise the
  * extractor) to drop it from later scans.
  * @param code_out  the learned code after this scan, 0 when none (may be NULL)

@@ -222,9 +222,10 @@ static void test_an_isolated_code_needs_the_user_given_value(void)
 }
 
 /* Scan k of a sensor walking through a closed room (1 cm quantised ranges);
- * with lone_code > 0, most scans get one to three short runs (1..4 beams)
- * of exactly that value at varying beams, as a real log writes no return. */
-static bsf_scan_t walking_scan(int k, float lone_code, bsf_scene_rng_t *rng)
+ * with lone_code > 0, scans get one to three short runs (1..4 beams) of
+ * exactly that value at varying beams, as a real log writes no return: 3 in
+ * 4 scans when every is 0, else one in `every`. */
+static bsf_scan_t walking_scan(int k, float lone_code, int every, bsf_scene_rng_t *rng)
 {
     bsf_lidar_t l =
         bsf_lidar_default(1.0 + 0.05 * (double)k, 2.0, 0.03 * (double)k, 181u, 3.14159265358979);
@@ -237,7 +238,7 @@ static bsf_scan_t walking_scan(int k, float lone_code, bsf_scene_rng_t *rng)
     for (i = 0; i < l.n_beams; ++i) {
         ranges[i] = (float)((double)(long)((double)ranges[i] * 100.0 + 0.5) / 100.0);
     }
-    if (lone_code > 0.0f && k % 4 != 3) {
+    if (lone_code > 0.0f && (every == 0 ? k % 4 != 3 : k % every == 0)) {
         const int runs = 1 + (int)(bsf_scene_rng_next(rng) % 3u);
         int r;
         for (r = 0; r < runs; ++r) {
@@ -264,7 +265,7 @@ static void test_a_lone_code_recurring_as_the_maximum_is_learnt(void)
     bsf_scene_rng_seed(&rng, 27u);
     bsf_no_return_learner_init(&learner);
     for (k = 0; k < 60; ++k) {
-        const bsf_scan_t s = walking_scan(k, 50.0f, &rng);
+        const bsf_scan_t s = walking_scan(k, 50.0f, 0, &rng);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
         if (code > 0.0f && learnt_at < 0) {
             learnt_at = k;
@@ -275,7 +276,7 @@ static void test_a_lone_code_recurring_as_the_maximum_is_learnt(void)
     TEST_ASSERT_TRUE(learnt_at >= 19 && learnt_at < 40);
     /* The code stays; with it the extractor drops exactly those readings. */
     {
-        const bsf_scan_t s = walking_scan(61, 50.0f, &rng);
+        const bsf_scan_t s = walking_scan(61, 50.0f, 0, &rng);
         size_t i;
         size_t n_code = 0;
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
@@ -302,7 +303,15 @@ static void test_no_code_is_learnt_from_genuine_scans(void)
     bsf_scene_rng_seed(&rng, 28u);
     bsf_no_return_learner_init(&learner);
     for (k = 0; k < 100; ++k) {
-        s = walking_scan(k, 0.0f, &rng);
+        s = walking_scan(k, 0.0f, 0, &rng);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
+    }
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, code);
+    /* A value written in one scan in ten: its evidence fades faster than it
+     * grows (halved every BSF_NO_RETURN_AGE_SCANS scans). */
+    bsf_no_return_learner_init(&learner);
+    for (k = 0; k < 300; ++k) {
+        s = walking_scan(k % 100, 50.0f, 10, &rng);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
     }
     TEST_ASSERT_EQUAL_FLOAT(0.0f, code);
@@ -311,7 +320,7 @@ static void test_no_code_is_learnt_from_genuine_scans(void)
     bsf_no_return_learner_init(&learner);
     for (k = 0; k < 100; ++k) {
         bsf_scene_rng_seed(&rng, 29u); /* the very same scan each time */
-        s = walking_scan(0, 0.0f, &rng);
+        s = walking_scan(0, 0.0f, 0, &rng);
         ranges[90] = 12.34f;
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
     }
