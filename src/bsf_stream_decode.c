@@ -396,9 +396,9 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
             out->seq = 0u;
             out->timestamp_ms = 0u;
             out->has_pose = 0u;
-            out->pose_x = 0.0f;
-            out->pose_y = 0.0f;
-            out->pose_theta = 0.0f;
+            out->pose.x = 0.0f;
+            out->pose.y = 0.0f;
+            out->pose.theta = 0.0f;
             out->quant_step = out->metadata.quant_step;
             out->time_us = 0u;
             out->has_geometry = 0u;
@@ -541,9 +541,9 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
         out->seq = seq;
         out->timestamp_ms = timestamp;
         out->has_pose = (uint8_t)has_pose;
-        out->pose_x = (float)pose[0] / 1000.0f;
-        out->pose_y = (float)pose[1] / 1000.0f;
-        out->pose_theta = (float)theta_signed * BSF_WIRE_RAD_PER_THETA;
+        out->pose.x = (float)pose[0] / 1000.0f;
+        out->pose.y = (float)pose[1] / 1000.0f;
+        out->pose.theta = (float)theta_signed * BSF_WIRE_RAD_PER_THETA;
         out->quant_step = step;
         out->time_us = time_us;
         out->has_geometry = (uint8_t)ext.has_geometry;

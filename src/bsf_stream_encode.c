@@ -727,8 +727,8 @@ static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code
         return BSF_ERR_ARG;
     }
     if (info->has_pose != 0u &&
-        (!(fabsf(info->pose_x) <= BSF_POSE_XY_MAX) || !(fabsf(info->pose_y) <= BSF_POSE_XY_MAX) ||
-         !(fabsf(info->pose_theta) <= BSF_POSE_THETA_MAX))) {
+        (!(fabsf(info->pose.x) <= BSF_POSE_XY_MAX) || !(fabsf(info->pose.y) <= BSF_POSE_XY_MAX) ||
+         !(fabsf(info->pose.theta) <= BSF_POSE_THETA_MAX))) {
         return BSF_ERR_ARG;
     }
     return BSF_OK;
@@ -903,10 +903,10 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     field_eg64(w, &b, costing, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
         const uint32_t theta =
-            (uint32_t)round_to_int(info->pose_theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
-        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose_x * 1000.0f)),
+            (uint32_t)round_to_int(info->pose.theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
+        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose.x * 1000.0f)),
                    BSF_WIRE_K_POSE);
-        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose_y * 1000.0f)),
+        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose.y * 1000.0f)),
                    BSF_WIRE_K_POSE);
         field_u(w, &b, costing, theta, 16u);
     }
@@ -1289,9 +1289,9 @@ void bsf_frame_info_init(bsf_frame_info_t *info)
         info->seq = 0u;
         info->timestamp_ms = 0u;
         info->has_pose = 0u;
-        info->pose_x = 0.0f;
-        info->pose_y = 0.0f;
-        info->pose_theta = 0.0f;
+        info->pose.x = 0.0f;
+        info->pose.y = 0.0f;
+        info->pose.theta = 0.0f;
         info->quant_step = BSF_QUANT_STEP_DEFAULT;
         info->has_geometry = 0u;
         info->angle_min = 0.0f;

@@ -140,10 +140,10 @@ typedef struct {
     uint32_t seq;          /**< sequence number (wraps), for loss detection */
     uint64_t timestamp_ms; /**< scan time, milliseconds since the stream's time origin
                                 (bsf_metadata_t.time_origin_us) */
-    uint8_t has_pose;      /**< 1: pose_* are sent (laser pose in the world frame) */
-    float pose_x;          /**< metres, |x| <= BSF_POSE_XY_MAX, sent in 1 mm units */
-    float pose_y;          /**< metres, |y| <= BSF_POSE_XY_MAX, sent in 1 mm units */
-    float pose_theta;      /**< radians, |theta| <= BSF_POSE_THETA_MAX, sent in 2*pi/65536 units */
+    uint8_t has_pose;      /**< 1: pose is sent (laser pose in the world frame) */
+    /** |x|, |y| <= BSF_POSE_XY_MAX metres, sent in 1 mm units; |theta| <=
+     * BSF_POSE_THETA_MAX radians, sent in 2*pi/65536 units */
+    bsf_pose_t pose;
     float quant_step;      /**< control point step, metres, [BSF_QUANT_STEP_MIN, _MAX],
                                 rounded to 0.1 mm */
     uint8_t has_geometry;  /**< 1: this scan's geometry travels in the frame (with
@@ -301,14 +301,14 @@ BSF_NODISCARD bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const b
  * and stats 0; its arrays are not touched).
  */
 typedef struct {
-    uint8_t version;         /**< format version of the frame (1 or 2) */
-    uint8_t type;            /**< BSF_FRAME_TYPE_FEATURES or BSF_FRAME_TYPE_METADATA */
-    uint32_t seq;            /**< sequence number */
-    uint64_t timestamp_ms;   /**< milliseconds since the stream's time origin (metadata) */
-    uint8_t has_pose;        /**< 1 when pose_* are valid */
-    float pose_x;            /**< metres (1 mm resolution) */
-    float pose_y;            /**< metres (1 mm resolution) */
-    float pose_theta;        /**< radians in [-pi, pi) (2*pi/65536 resolution) */
+    uint8_t version;       /**< format version of the frame (1 or 2) */
+    uint8_t type;          /**< BSF_FRAME_TYPE_FEATURES or BSF_FRAME_TYPE_METADATA */
+    uint32_t seq;          /**< sequence number */
+    uint64_t timestamp_ms; /**< milliseconds since the stream's time origin (metadata) */
+    uint8_t has_pose;      /**< 1 when pose is valid */
+    /** x, y in metres (1 mm resolution); theta in radians in [-pi, pi)
+     * (2*pi/65536 resolution) */
+    bsf_pose_t pose;
     float quant_step;        /**< metres */
     uint32_t time_us;        /**< extraction time, microseconds (<= 4 294 967) */
     uint8_t has_geometry;    /**< 1: the frame carries its scan's geometry (below, and
