@@ -8,11 +8,10 @@
  *   at a time (GCC and Clang; BSF_CRC32C_PORTABLE turns it off);
  * - by default, one byte per step from a 256-entry table (1 KiB of read-only
  *   data), about half the instructions of two nibble steps;
- * - in size-optimised builds (-Os), or with BSF_CRC32C_NIBBLE_TABLE, two
+ * - in the compact variant (BSF_CONFIG_COMPACT), or with BSF_CRC32C_NIBBLE_TABLE, two
  *   steps of a 16-entry table (64 bytes), for flash-bound microcontrollers.
  */
-#if defined(__OPTIMIZE_SIZE__) && !defined(BSF_CRC32C_NIBBLE_TABLE) &&                             \
-    !defined(BSF_CRC32C_BYTE_TABLE)
+#if BSF_CONFIG_COMPACT && !defined(BSF_CRC32C_NIBBLE_TABLE) && !defined(BSF_CRC32C_BYTE_TABLE)
 #define BSF_CRC32C_NIBBLE_TABLE
 #endif
 

@@ -87,7 +87,13 @@ static inline size_t fill_points(const bsf_scan_t *scan, bsf_points_t *out, int 
     return n_valid;
 }
 
-#if !defined(__OPTIMIZE_SIZE__) && (defined(__SSE2__) || defined(__ARM_NEON))
+#if BSF_CONFIG_SIMD && (defined(__SSE2__) || defined(__ARM_NEON))
+#define SCAN_BRANCH_FREE 1
+#else
+#define SCAN_BRANCH_FREE 0
+#endif
+
+#if SCAN_BRANCH_FREE
 /* fill_points(scan, out, 1) without branches, which compilers turn into
  * vector code (4 beams per step with SSE2 or NEON): every beam's sine and
  * cosine as bsf_sincosf_bounded computes them (the same expressions, its
@@ -154,9 +160,9 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
     /* every beam angle within bsf_sincosf_bounded's domain (a margin of
      * 384 rad covers the rounding of this bound and of the angles): one loop
      * without the checks only huge angles need, chosen once per scan */
-#if !defined(__OPTIMIZE_SIZE__)
+#if !BSF_CONFIG_COMPACT
     if (fabsf(scan->angle_min) + (float)scan->count * fabsf(scan->angle_increment) <= 16000.0f) {
-#if defined(__SSE2__) || defined(__ARM_NEON)
+#if SCAN_BRANCH_FREE
         n_valid = fill_points_branch_free(scan, out);
 #else
         n_valid = fill_points(scan, out, 1);
@@ -165,7 +171,7 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
         n_valid = fill_points(scan, out, 0);
     }
 #else
-    /* -Os: the out-of-line functions for every angle (the same bits) */
+    /* compact: the out-of-line functions for every angle (the same bits) */
     n_valid = fill_points(scan, out, 0);
 #endif
     out->count = scan->count;

@@ -1,19 +1,12 @@
 /* SPDX-License-Identifier: MIT */
-#include "bsf/bsf_stream.h"
-
-#include <math.h>
-#include <string.h>
-
-#include "bsf_math.h"
-#include "bsf_wire.h"
-
-#if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
-    !defined(BSF_ENC_PORTABLE)
-#include <emmintrin.h>
-#endif
-
 /*
- * How a features frame is made (two runs over the result, docs/PERFORMANCE.md):
+ * bsf_features_encode.c - the features frame's encoder (bsf_frame_encode,
+ * bsf_frame_encode_sink; docs/FORMAT.md, "Features frame"): its checks, the
+ * quantisation of the control points into wire values, the choice of each
+ * value class's Exp-Golomb order and the payload's fields. The bytes
+ * (bit writer, CRC, COBS) are bsf_stream_writer.h's.
+ *
+ * How a features frame is made (two runs over the result):
  *
  * 1. Planning: validates the whole input, sums the bits of every field but
  *    the control point values, quantises each control point once into a
@@ -26,407 +19,31 @@
  *    (a feature beyond the table is quantised again); then CRC-32C over the
  *    payload and COBS in place.
  *
- * Sinks, metadata frames and buffers smaller than the bound take the
- * streaming path: the same bit writer fills a small chunk whose bytes go
- * through CRC and COBS to a counter, the buffer or the sink.
+ * Sinks and buffers smaller than the bound take the streaming path: the
+ * same bit writer fills a small chunk whose bytes go through CRC and COBS
+ * to a counter, the buffer or the sink.
  */
+#include "bsf/bsf_stream.h"
 
-/* ---- Streaming output: COBS blocks to a counter, a buffer or a sink ---- */
+#include <math.h>
+#include <string.h>
 
-typedef struct {
-    uint8_t *buf;    /* buffer mode, else NULL */
-    size_t cap;      /* size of buf */
-    size_t pos;      /* bytes of the frame produced so far */
-    size_t code_pos; /* buffer mode: where the current block's code byte goes */
-    uint8_t code;    /* 1 + data bytes in the current block */
-    uint32_t crc;    /* CRC-32C of the payload so far */
-    bsf_encoder_t *work;
-    bsf_sink_fn sink; /* sink mode: a block is collected in work->block, its code byte first */
-    void *ctx;
-    int failed; /* the sink refused bytes */
-} stream_t;
+#include "bsf_math.h"
+#include "bsf_stream_writer.h"
+#include "bsf_wire.h"
 
-static void emit(stream_t *s, const uint8_t *data, size_t len)
-{
-    if (!s->failed) {
-        if (s->sink(s->ctx, data, len) != 0) {
-            s->failed = 1;
-        } else {
-            s->pos += len;
-        }
-    }
-}
-
-static void block_start(stream_t *s)
-{
-    s->code = 1u;
-    if (s->sink == NULL) {
-        s->code_pos = s->pos++;
-    }
-}
-
-static void block_end(stream_t *s)
-{
-    if (s->sink != NULL) {
-        s->work->block[0] = s->code;
-        emit(s, s->work->block, s->code);
-    } else if (s->buf != NULL && s->code_pos < s->cap) {
-        s->buf[s->code_pos] = s->code;
-    }
-}
-
-static void stream_init(stream_t *s)
-{
-    memset(s, 0, sizeof *s);
-    block_start(s);
-}
-
-/* One body byte (payload or CRC) through COBS. */
-static void stream_byte(stream_t *s, uint8_t b)
-{
-    if (b == 0u) {
-        block_end(s);
-        block_start(s);
-        return;
-    }
-    if (s->sink != NULL) {
-        s->work->block[s->code] = b;
-    } else {
-        if (s->buf != NULL && s->pos < s->cap) {
-            s->buf[s->pos] = b;
-        }
-        ++s->pos;
-    }
-    if (++s->code == 0xFFu) {
-        block_end(s);
-        block_start(s);
-    }
-}
-
-static void stream_payload(stream_t *s, const uint8_t *data, size_t len)
-{
-    size_t i;
-    s->crc = bsf_crc32c(s->crc, data, len);
-    for (i = 0; i < len; ++i) {
-        stream_byte(s, data[i]);
-    }
-}
-
-/* The CRC (not itself checksummed), the last block and the 0x00. */
-static void stream_finish(stream_t *s)
-{
-    unsigned i;
-    const uint32_t crc = s->crc;
-    for (i = 0; i < 4u; ++i) {
-        stream_byte(s, (uint8_t)(crc >> (8u * i)));
-    }
-    if (s->sink != NULL) {
-        s->work->block[0] = s->code;
-        s->work->block[s->code] = 0u;
-        emit(s, s->work->block, (size_t)s->code + 1u);
-    } else {
-        block_end(s);
-        if (s->buf != NULL && s->pos < s->cap) {
-            s->buf[s->pos] = 0u;
-        }
-        ++s->pos;
-    }
-}
-
-/* ---- Bit writer ---------------------------------------------------------- */
-
-/* The hot paths inline their helpers so that the writer's state lives in
- * registers; a size-optimised build (-Os) leaves that to the compiler. */
-#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
-#define ENC_INLINE static inline __attribute__((always_inline))
+/* Both coordinates of a point quantised at once with SSE2 (x86-64; the
+ * BSF_CONFIG_SIMD variant, BSF_ENC_PORTABLE turns it off alone). */
+#if BSF_CONFIG_SIMD && defined(__SSE2__) && defined(__x86_64__) && !defined(BSF_ENC_PORTABLE)
+#define FEATURES_SSE2 1
+#include <emmintrin.h>
 #else
-#define ENC_INLINE static inline
+#define FEATURES_SSE2 0
 #endif
 
-#if defined(__GNUC__) || defined(__clang__)
-#define ENC_NOINLINE static __attribute__((noinline))
-#else
-#define ENC_NOINLINE static
-#endif
+/* ---- Quantisation -------------------------------------------------------- */
 
-#define CHUNK_BYTES 32u /* streaming path: payload bytes handed on at a time */
-
-/*
- * The payload's bits, most significant first, gather in acc and leave as
- * whole big-endian 32-bit words. A run copies this into a local, so that it
- * stays in registers. In a costing run nothing is written: bits sums the
- * fields' lengths.
- */
-#if UINTPTR_MAX > 0xFFFFFFFFu && !defined(__OPTIMIZE_SIZE__)
-/* 64-bit hosts: a field that completes a word stays whole in acc, and the
- * word is the 32 bits above the field's rest (fewer shifts per word). */
-#define ENC_ACC64 1
-typedef uint64_t acc_t;
-#else
-typedef uint32_t acc_t;
-#endif
-
-typedef struct {
-    uint8_t *p;    /* the next word goes here */
-    uint8_t *end;  /* words must end at or before this */
-    acc_t acc;     /* pending bits in the low 32 - room bits (higher bits: leftovers) */
-    unsigned room; /* free bits in acc, 1..32 */
-    uint32_t bits; /* costing run: payload bits so far */
-} bits_t;
-
-/* Where the words go. */
-typedef struct {
-    bits_t b;
-    stream_t *out; /* streaming path; NULL when writing straight into a buffer */
-    uint8_t *end;  /* the end after a spill */
-    int overflow;  /* direct writing reached its end (a planning bug: never written) */
-    uint8_t chunk[CHUNK_BYTES];
-} writer_t;
-
-static void writer_init(writer_t *w, stream_t *out, uint8_t *start, uint8_t *end)
-{
-    w->out = out;
-    w->overflow = 0;
-    w->b.acc = 0u;
-    w->b.room = 32u;
-    w->b.bits = 0u;
-    if (start != NULL) {
-        w->b.p = start;
-        w->b.end = end;
-    } else {
-        w->b.p = w->chunk;
-        w->b.end = w->chunk + CHUNK_BYTES;
-    }
-}
-
-ENC_INLINE void store_be32(uint8_t *p, uint32_t v)
-{
-#if defined(__BYTE_ORDER__) && defined(__ORDER_BIG_ENDIAN__) &&                                    \
-    __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
-    memcpy(p, &v, 4u);
-#elif defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                               \
-    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__ && (defined(__GNUC__) || defined(__clang__))
-    v = __builtin_bswap32(v);
-    memcpy(p, &v, 4u);
-#else
-    p[0] = (uint8_t)(v >> 24);
-    p[1] = (uint8_t)(v >> 16);
-    p[2] = (uint8_t)(v >> 8);
-    p[3] = (uint8_t)v;
-#endif
-}
-
-/* No room for a word at p: hand the chunk on (streaming), or stop writing
- * (direct). Returns where the next word goes; w->end is its end. */
-static uint8_t *writer_spill(writer_t *w, uint8_t *p)
-{
-    if (w->out != NULL) {
-        stream_payload(w->out, w->chunk, (size_t)(p - w->chunk));
-    } else {
-        w->overflow = 1;
-    }
-    w->end = w->chunk + CHUNK_BYTES;
-    return w->chunk;
-}
-
-ENC_INLINE void put_word(writer_t *w, bits_t *b, uint32_t word)
-{
-    if ((size_t)(b->end - b->p) < 4u) {
-        b->p = writer_spill(w, b->p);
-        b->end = w->end;
-    }
-    store_be32(b->p, word);
-    b->p += 4;
-}
-
-/* The n (0..31) bits of v (v < 2^n). */
-ENC_INLINE void put_bits(writer_t *w, bits_t *b, uint32_t v, unsigned n)
-{
-#ifdef ENC_ACC64
-    b->acc = (b->acc << n) | v;
-    if (n < b->room) {
-        b->room -= n;
-    } else {
-        const unsigned rest = n - b->room; /* bits of v for the next word; room <= n <= 31 */
-        put_word(w, b, (uint32_t)(b->acc >> rest));
-        b->room = 32u - rest;
-    }
-#else
-    if (n < b->room) {
-        b->acc = (b->acc << n) | v;
-        b->room -= n;
-    } else {
-        const unsigned rest = n - b->room; /* bits of v for the next word; room <= n <= 31 */
-        put_word(w, b, (b->acc << b->room) | (v >> rest));
-        b->acc = v; /* the bits of v above rest leave with the next word's shifts */
-        b->room = 32u - rest;
-    }
-#endif
-}
-
-/* floor(log2(c)) for 1 <= c < 2^31 (x86 BSR). */
-ENC_INLINE unsigned log2_nz(uint32_t c)
-{
-#if defined(__GNUC__) || defined(__clang__)
-    return 31u ^ (unsigned)__builtin_clz(c);
-#else
-    return bsf_wire_bitlen31(c) - 1u;
-#endif
-}
-
-/* Exp-Golomb code of order k (<= 25) of v < 2^30: v + 2^k in 2 b - 1 - k
- * bits, b its bit length (b - 1 - k leading zeros, then v + 2^k). */
-ENC_INLINE void put_eg(writer_t *w, bits_t *b, uint32_t v, unsigned k)
-{
-    const uint32_t c = v + ((uint32_t)1 << k);
-    const unsigned lg = log2_nz(c);
-    const unsigned len = 2u * lg + 1u - k;
-    if (len < 32u) {
-        put_bits(w, b, c, len);
-    } else {
-        put_bits(w, b, 0u, lg - k);
-        put_bits(w, b, c, lg + 1u);
-    }
-}
-
-ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
-{
-    return 2u * log2_nz(v + ((uint32_t)1 << k)) + 1u - k;
-}
-
-/* Fields, written or (costing) counted: u(n) with n <= 31. */
-ENC_INLINE void field_u(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned n)
-{
-    if (costing) {
-        b->bits += n;
-    } else {
-        put_bits(w, b, v, n);
-    }
-}
-
-/* EGk of v < 2^30, k <= 25. */
-ENC_INLINE void field_eg(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned k)
-{
-    if (costing) {
-        b->bits += eg_len(v, k);
-    } else {
-        put_eg(w, b, v, k);
-    }
-}
-
-/* Two EG fields, v0 (order k0) then v1 (order k1), each v < 2^30 and k <= 25:
- * one field when both codes fit in 31 bits together (feature fields). */
-#if !defined(__OPTIMIZE_SIZE__)
-ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsigned k0,
-                          uint32_t v1, unsigned k1)
-{
-    const uint32_t c0 = v0 + ((uint32_t)1 << k0);
-    const uint32_t c1 = v1 + ((uint32_t)1 << k1);
-    const unsigned len0 = 2u * log2_nz(c0) + 1u - k0;
-    const unsigned len1 = 2u * log2_nz(c1) + 1u - k1;
-    if (costing) {
-        b->bits += len0 + len1;
-    } else if (len0 + len1 < 32u) {
-        put_bits(w, b, (c0 << len1) | c1, len0 + len1);
-    } else {
-        put_eg(w, b, v0, k0);
-        put_eg(w, b, v1, k1);
-    }
-}
-#else
-/* -Os: the two fields one after the other (a macro: no function of its own) */
-#define field_eg2(w, b, costing, v0, k0, v1, k1)                                                   \
-    do {                                                                                           \
-        field_eg(w, b, costing, v0, k0);                                                           \
-        field_eg(w, b, costing, v1, k1);                                                           \
-    } while (0)
-#endif
-
-/* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
- * wide fields. State in and out by value, so that the caller's stays in
- * registers. */
-static bits_t put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k)
-{
-    const uint64_t u = (v >> k) + 1u;
-    const unsigned n = bsf_wire_bitlen(u);
-    unsigned i;
-    if (costing) {
-        b.bits += 2u * n - 1u + k;
-        return b;
-    }
-    for (i = 1u; i < n; ++i) {
-        put_bits(w, &b, 0u, 1u); /* the n - 1 zeros */
-    }
-    for (i = n; i > 0u;) { /* u, then the k low bits of v: 16 bits at a time */
-        const unsigned take = i > 16u ? 16u : i;
-        i -= take;
-        put_bits(w, &b, (uint32_t)(u >> i) & ((1u << take) - 1u), take);
-    }
-    for (i = k; i > 0u;) {
-        const unsigned take = i > 16u ? 16u : i;
-        i -= take;
-        put_bits(w, &b, (uint32_t)(v >> i) & ((1u << take) - 1u), take);
-    }
-    return b;
-}
-
-ENC_INLINE void field_eg64(writer_t *w, bits_t *b, int costing, uint64_t v, unsigned k)
-{
-    if (v < ((uint64_t)1 << 30) && k <= 25u) {
-        field_eg(w, b, costing, (uint32_t)v, k);
-    } else {
-        *b = put_eg_wide(w, *b, costing, v, k);
-    }
-}
-
-ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
-{
-    const uint32_t u = bsf_float_bits(v);
-    field_u(w, b, costing, u >> 16, 16u);
-    field_u(w, b, costing, u & 0xFFFFu, 16u);
-}
-
-#if !defined(__OPTIMIZE_SIZE__) /* the direct writer only (job_direct) */
-/* Bits written so far. */
-static size_t writer_bits(const writer_t *w, const uint8_t *start)
-{
-    return (size_t)(w->b.p - start) * 8u + (32u - w->b.room);
-}
-
-/* Pads the payload to whole bytes and pushes out its last, partial word
- * (its unused bytes are overwritten by what follows). */
-static void writer_flush(writer_t *w)
-{
-    if (w->b.room < 32u) {
-        put_word(w, &w->b, (uint32_t)(w->b.acc << w->b.room));
-    }
-}
-#endif
-
-/* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
-static void writer_end_stream(writer_t *w)
-{
-    size_t n;
-    if (w->b.room < 32u) {
-        const unsigned tail = (32u - w->b.room + 7u) / 8u; /* bytes of the partial word */
-        put_word(w, &w->b, (uint32_t)(w->b.acc << w->b.room));
-        n = (size_t)(w->b.p - w->chunk) - (4u - tail);
-    } else {
-        n = (size_t)(w->b.p - w->chunk);
-    }
-    stream_payload(w->out, w->chunk, n);
-    stream_finish(w->out);
-}
-
-/* ---- Quantisation and checks ------------------------------------------- */
-
-static int is_finite_f(float v)
-{
-    return bsf_finite_bits(v);
-}
-
-#if defined(__SSE2__) && defined(__x86_64__) && !defined(__OPTIMIZE_SIZE__) &&                     \
-    !defined(BSF_ENC_PORTABLE)
+#if FEATURES_SSE2
 /* Both coordinates at once with the same IEEE single operations as
  * quantise (divide, add, truncate, compare), so the same q and verdict. */
 ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
@@ -636,7 +253,7 @@ ENC_INLINE void put_value_code(writer_t *w, bits_t *b, uint32_t c, unsigned lg, 
 }
 
 /* The values' codes at the frame's orders: the hot loop of the writing run. */
-#if !defined(__OPTIMIZE_SIZE__)
+#if !BSF_CONFIG_COMPACT
 /* Values come in pairs of one class (x, then y of a point): the two codes
  * go out as one field when they fit in 31 bits together (the usual case),
  * which saves a class lookup and a field per point. */
@@ -687,6 +304,26 @@ ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *
 #endif
 
 /* ---- Features frame ------------------------------------------------------ */
+
+/* A feature's kind, its distinct control points m (>= 2, as m - 2 in EG1)
+ * and the mask flag. */
+ENC_INLINE void field_kind_m_mask(writer_t *w, bits_t *b, int costing, uint32_t kind, uint32_t m,
+                                  int has_mask)
+{
+#if !BSF_CONFIG_COMPACT
+#if BSF_WIRE_K_M != 1u
+#error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
+#endif
+    /* one field of at most 14 bits: the EG1 code of m - 2 is m in
+     * 2 floor(log2 m) bits */
+    const unsigned m_len = 2u * log2_nz(m);
+    field_u(w, b, costing, (kind << (m_len + 1u)) | (m << 1) | (has_mask ? 1u : 0u), m_len + 2u);
+#else
+    field_u(w, b, costing, kind, 1u);
+    field_eg(w, b, costing, m - 2u, BSF_WIRE_K_M);
+    field_u(w, b, costing, has_mask ? 1u : 0u, 1u);
+#endif
+}
 
 /* Beams minus one of a feature's run: last - first, or through the seam of
  * a full-circle scan of n_beams beams when first > last. */
@@ -956,23 +593,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
                                       table, NULL, &mask) /
                        2u;
         }
-#if !defined(__OPTIMIZE_SIZE__)
-#if BSF_WIRE_K_M != 1u
-#error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
-#endif
-        {
-            /* kind, m - 2 (EG1: the code is m in 2 floor(log2 m) bits) and the
-             * mask flag as one field of at most 14 bits */
-            const unsigned m_len = 2u * log2_nz(n_unique);
-            field_u(w, &b, costing,
-                    ((uint32_t)f->kind << (m_len + 1u)) | (n_unique << 1) | (mask != 0u ? 1u : 0u),
-                    m_len + 2u);
-        }
-#else
-        field_u(w, &b, costing, f->kind, 1u);
-        field_eg(w, &b, costing, n_unique - 2u, BSF_WIRE_K_M);
-        field_u(w, &b, costing, mask != 0u ? 1u : 0u, 1u);
-#endif
+        field_kind_m_mask(w, &b, costing, f->kind, n_unique, mask != 0u);
         if (mask != 0u) {
             uint32_t j = n_unique; /* bits left, the highest first */
             do {
@@ -999,56 +620,6 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     w->b = b;
 }
 
-/* ---- Metadata frame ------------------------------------------------------ */
-
-void bsf_metadata_init(bsf_metadata_t *m)
-{
-    if (m != NULL) {
-        memset(m, 0, sizeof *m);
-        m->lib_version_major = (uint16_t)BSF_VERSION_MAJOR;
-        m->lib_version_minor = (uint16_t)BSF_VERSION_MINOR;
-        m->lib_version_patch = (uint16_t)BSF_VERSION_PATCH;
-        m->quant_step = BSF_QUANT_STEP_DEFAULT;
-        m->max_points = (uint32_t)BSF_MAX_POINTS;
-        m->max_keypoints = (uint32_t)BSF_MAX_KEYPOINTS;
-        m->max_segments = (uint32_t)BSF_MAX_SEGMENTS;
-        m->max_ctrl_per_feature = (uint32_t)BSF_MAX_CTRL_PER_FEATURE;
-        m->max_ctrl_points = (uint32_t)BSF_MAX_CTRL_POINTS;
-    }
-}
-
-static int cap_ok(uint32_t v)
-{
-    return v >= 1u && v <= BSF_WIRE_META_U16_MAX;
-}
-
-static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
-{
-    float code;
-    if (!is_finite_f(m->quant_step)) {
-        return BSF_ERR_ARG;
-    }
-    code = bsf_floorf(m->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
-    if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
-        return BSF_ERR_ARG;
-    }
-    *step_code = (uint32_t)code;
-    if (!is_finite_f(m->target_rms) || !(m->target_rms >= 0.0f) || !cap_ok(m->max_points) ||
-        !cap_ok(m->max_keypoints) || !cap_ok(m->max_segments) || !cap_ok(m->max_ctrl_per_feature) ||
-        !cap_ok(m->max_ctrl_points) || m->n_beams > BSF_WIRE_META_U16_MAX ||
-        !is_finite_f(m->angle_min) || !is_finite_f(m->angle_increment) ||
-        !is_finite_f(m->range_min) || !is_finite_f(m->range_max) || !(m->range_min >= 0.0f) ||
-        !(m->range_max >= m->range_min) || m->has_time_origin > 1u ||
-        (m->has_time_origin != 0u && (m->time_origin_us > BSF_METADATA_TIME_ORIGIN_MAX ||
-                                      m->time_origin_us < -BSF_METADATA_TIME_ORIGIN_MAX)) ||
-        m->source_len > BSF_METADATA_SOURCE_MAX ||
-        !bsf_wire_source_ok((const uint8_t *)m->source, m->source_len)) {
-        return BSF_ERR_ARG;
-    }
-    return BSF_OK;
-}
-
-/* The two runs as functions of their own, each compiled for its mode. */
 static void frame_payload_write(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
                                 const bsf_result_t *res, uint32_t *table)
 {
@@ -1061,226 +632,37 @@ static void frame_payload_cost(writer_t *w, plan_t *pl, const bsf_frame_info_t *
     frame_payload_run(w, 1, pl, info, res, table);
 }
 
-/* The metadata payload through w (FORMAT.md section 3.6); m was checked. */
-static void metadata_payload(writer_t *w, int costing, const bsf_metadata_t *m, uint32_t step_code)
-{
-    bits_t *b = &w->b;
-    unsigned i;
-    field_u(w, b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA, 8u);
-    field_eg(w, b, costing, m->lib_version_major, BSF_WIRE_K_LIB_VERSION);
-    field_eg(w, b, costing, m->lib_version_minor, BSF_WIRE_K_LIB_VERSION);
-    field_eg(w, b, costing, m->lib_version_patch, BSF_WIRE_K_LIB_VERSION);
-    field_eg(w, b, costing, m->method, BSF_WIRE_K_METHOD);
-    field_float(w, b, costing, m->target_rms);
-    field_eg(w, b, costing, step_code, BSF_WIRE_K_STEP);
-    field_eg(w, b, costing, m->max_points, BSF_WIRE_K_CAP_POINTS);
-    field_eg(w, b, costing, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
-    field_eg(w, b, costing, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
-    field_eg(w, b, costing, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
-    field_eg(w, b, costing, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
-    field_eg(w, b, costing, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
-    field_float(w, b, costing, m->angle_min);
-    field_float(w, b, costing, m->angle_increment);
-    field_float(w, b, costing, m->range_min);
-    field_float(w, b, costing, m->range_max);
-    field_u(w, b, costing, m->has_time_origin != 0u ? 1u : 0u, 1u);
-    if (m->has_time_origin != 0u) {
-        field_eg64(w, b, costing, bsf_wire_zigzag(m->time_origin_us), BSF_WIRE_K_TIME_ORIGIN);
-    }
-    field_eg(w, b, costing, m->source_len, BSF_WIRE_K_SOURCE_LEN);
-    for (i = 0; i < m->source_len; ++i) {
-        field_u(w, b, costing, (uint8_t)m->source[i], 8u);
-    }
-}
+/* ---- The features frame as a job of bsf_stream_writer.h ----------------- */
 
-/* ---- Both frame types: plan, then write to a buffer or a sink ------------ */
-
-typedef struct job job_t;
-
-/* What differs between the frame types, as functions that the job calls:
- * a firmware that encodes only features frames links no metadata code. */
-typedef bsf_status_t (*job_plan_fn)(job_t *job);
-typedef void (*job_payload_fn)(writer_t *w, int costing, job_t *job);
-
-struct job {
-    const bsf_frame_info_t *info; /* features frame: info and res */
+typedef struct {
+    bsf_enc_job_t job; /* first: the writer's view */
+    const bsf_frame_info_t *info;
     const bsf_result_t *res;
-    const bsf_metadata_t *meta; /* or a metadata frame */
-    uint32_t *table;            /* features frame: VALUE_TABLE entries */
-    job_plan_fn plan_fn;        /* checks the input, bounds the payload (and chooses the orders) */
-    job_payload_fn payload_fn;  /* the payload through w, written or counted */
+    uint32_t *table; /* VALUE_TABLE entries */
     plan_t plan;
-};
+} features_job_t;
 
-/* The payload through w, written or counted (the plan checked the input). */
-static void job_payload(writer_t *w, int costing, job_t *job)
+static void features_job_payload(writer_t *w, int costing, bsf_enc_job_t *job)
 {
-    job->payload_fn(w, costing, job);
-}
-
-static void frame_job_payload(writer_t *w, int costing, job_t *job)
-{
+    features_job_t *fj = (features_job_t *)job;
     if (costing) {
-        frame_payload_cost(w, &job->plan, job->info, job->res, job->table);
+        frame_payload_cost(w, &fj->plan, fj->info, fj->res, fj->table);
     } else {
-        frame_payload_write(w, &job->plan, job->info, job->res, job->table);
+        frame_payload_write(w, &fj->plan, fj->info, fj->res, fj->table);
     }
 }
 
-static void metadata_job_payload(writer_t *w, int costing, job_t *job)
+static bsf_status_t features_job_plan(bsf_enc_job_t *job)
 {
-    metadata_payload(w, costing, job->meta, job->plan.step_code);
-}
-
-/* The exact payload bits: a costing run (a call of its own, so that its
- * writer is not on the planning run's stack). */
-ENC_NOINLINE uint32_t job_bits(job_t *job)
-{
-    writer_t w;
-    writer_init(&w, NULL, NULL, NULL);
-    job_payload(&w, 1, job);
-    return w.b.bits;
-}
-
-static bsf_status_t frame_job_plan(job_t *job)
-{
-    const bsf_status_t st = check_frame(job->info, job->res, &job->plan);
-    return st != BSF_OK ? st : plan_frame(job->info, job->res, job->table, &job->plan);
-}
-
-static bsf_status_t metadata_job_plan(job_t *job)
-{
-    const bsf_status_t st = check_metadata(job->meta, &job->plan.step_code);
+    features_job_t *fj = (features_job_t *)job;
+    bsf_status_t st;
+    memset(&fj->plan, 0, sizeof fj->plan);
+    st = check_frame(fj->info, fj->res, &fj->plan);
     if (st == BSF_OK) {
-        job->plan.max_bits = job_bits(job); /* exact */
+        st = plan_frame(fj->info, fj->res, fj->table, &fj->plan);
     }
+    job->max_bits = fj->plan.max_bits;
     return st;
-}
-
-/* Checks the input and bounds the payload's size (and chooses the orders). */
-static bsf_status_t job_plan(job_t *job)
-{
-    memset(&job->plan, 0, sizeof job->plan);
-    return job->plan_fn(job);
-}
-
-static void job_stream(job_t *job, stream_t *s)
-{
-    writer_t w;
-    writer_init(&w, s, NULL, NULL);
-    job_payload(&w, 0, job);
-    writer_end_stream(&w);
-}
-
-#if !defined(__OPTIMIZE_SIZE__)
-/* COBS bound of a body of n bytes, with the delimiter. */
-static size_t frame_bound(size_t body)
-{
-    return body + body / 254u + 2u;
-}
-
-/*
- * The frame straight into buf, which holds the frame_bound of max_bits: the
- * payload goes to buf + 1 (behind the first code byte) and gets its CRC; a
- * body with full COBS blocks moves up by their number (a code byte each),
- * and COBS turns it into its code in place. Nothing is written beyond the
- * frame.
- */
-static bsf_status_t job_direct(job_t *job, uint8_t *buf, size_t *out_len)
-{
-    const size_t max_payload = ((size_t)job->plan.max_bits + 7u) / 8u;
-    uint8_t *const start = buf + 1;
-    writer_t w;
-    size_t payload;
-    size_t body;
-    uint32_t crc;
-    size_t full = 0;
-    size_t len;
-    unsigned i;
-    /* the last word may reach 3 bytes beyond the payload, into the CRC's place */
-    writer_init(&w, NULL, start, start + max_payload + BSF_FRAME_CRC_SIZE);
-    job_payload(&w, 0, job);
-    payload = (writer_bits(&w, start) + 7u) / 8u;
-    writer_flush(&w);
-    if (w.overflow || payload > max_payload) {
-        *out_len = 0u;
-        return BSF_ERR_BUFFER; /* beyond the planned bound: never happens */
-    }
-    crc = bsf_crc32c(0u, start, payload);
-    for (i = 0; i < 4u; ++i) {
-        start[payload + i] = (uint8_t)(crc >> (8u * i));
-    }
-    body = payload + BSF_FRAME_CRC_SIZE;
-    if (body >= 254u) {
-        full = bsf_cobs_full_blocks(start, body);
-        if (full > 0u) {
-            memmove(start + full, start, body);
-        }
-    }
-    len = bsf_cobs_encode_in_place(buf, 1u + full, body);
-    buf[len] = 0u;
-    *out_len = len + 1u;
-    return BSF_OK;
-}
-#endif
-
-static bsf_status_t job_encode(job_t *job, uint8_t *buf, size_t cap, size_t *out_len)
-{
-    const bsf_status_t st = job_plan(job);
-    size_t body;
-    stream_t s;
-    if (st != BSF_OK) {
-        *out_len = 0u;
-        return st;
-    }
-#if !defined(__OPTIMIZE_SIZE__)
-    /* The direct writer is for speed only: a size-optimised build (-Os)
-     * leaves it out and always streams, which gives the same frame. */
-    if (buf != NULL &&
-        cap >= frame_bound(((size_t)job->plan.max_bits + 7u) / 8u + BSF_FRAME_CRC_SIZE)) {
-        return job_direct(job, buf, out_len);
-    }
-#endif
-    body = ((size_t)job_bits(job) + 7u) / 8u + BSF_FRAME_CRC_SIZE;
-    if (body < 254u) {
-        *out_len = body + 2u; /* exact: no block reaches 254 bytes */
-    } else {
-        stream_init(&s); /* count */
-        job_stream(job, &s);
-        *out_len = s.pos;
-    }
-    if (buf == NULL) {
-        return BSF_OK;
-    }
-    if (*out_len > cap) {
-        return BSF_ERR_BUFFER;
-    }
-    stream_init(&s);
-    s.buf = buf;
-    s.cap = cap;
-    job_stream(job, &s);
-    *out_len = s.pos;
-    return BSF_OK;
-}
-
-static bsf_status_t job_encode_sink(job_t *job, bsf_encoder_t *work, bsf_sink_fn sink, void *ctx,
-                                    size_t *written)
-{
-    stream_t s;
-    const bsf_status_t st = job_plan(job);
-    if (st != BSF_OK) {
-        return st;
-    }
-    memset(&s, 0, sizeof s);
-    s.work = work;
-    s.sink = sink;
-    s.ctx = ctx;
-    block_start(&s);
-    job_stream(job, &s);
-    if (written != NULL) {
-        *written = s.pos;
-    }
-    return s.failed ? BSF_ERR_BUFFER : BSF_OK;
 }
 
 void bsf_frame_info_init(bsf_frame_info_t *info)
@@ -1300,27 +682,27 @@ void bsf_frame_info_init(bsf_frame_info_t *info)
 }
 
 /* A features-frame job over result, quantising into table. */
-static void frame_job_init(job_t *job, const bsf_frame_info_t *info, const bsf_result_t *result,
-                           uint32_t *table)
+static void features_job_init(features_job_t *fj, const bsf_frame_info_t *info,
+                              const bsf_result_t *result, uint32_t *table)
 {
-    memset(job, 0, sizeof *job);
-    job->info = info;
-    job->res = result;
-    job->table = table;
-    job->plan_fn = frame_job_plan;
-    job->payload_fn = frame_job_payload;
+    memset(fj, 0, sizeof *fj);
+    fj->info = info;
+    fj->res = result;
+    fj->table = table;
+    fj->job.plan = features_job_plan;
+    fj->job.payload = features_job_payload;
 }
 
 bsf_status_t bsf_frame_encode(const bsf_frame_info_t *info, const bsf_result_t *result,
                               uint8_t *buf, size_t cap, size_t *out_len)
 {
     uint32_t table[VALUE_TABLE];
-    job_t job;
+    features_job_t fj;
     if (info == NULL || result == NULL || out_len == NULL) {
         return BSF_ERR_ARG;
     }
-    frame_job_init(&job, info, result, table);
-    return job_encode(&job, buf, cap, out_len);
+    features_job_init(&fj, info, result, table);
+    return bsf_enc_job_encode(&fj.job, buf, cap, out_len);
 }
 
 bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *info,
@@ -1328,43 +710,13 @@ bsf_status_t bsf_frame_encode_sink(bsf_encoder_t *work, const bsf_frame_info_t *
                                    size_t *written)
 {
     uint32_t table[VALUE_TABLE];
-    job_t job;
+    features_job_t fj;
     if (written != NULL) {
         *written = 0u;
     }
     if (work == NULL || info == NULL || result == NULL || sink == NULL) {
         return BSF_ERR_ARG;
     }
-    frame_job_init(&job, info, result, table);
-    return job_encode_sink(&job, work, sink, ctx, written);
-}
-
-bsf_status_t bsf_metadata_encode(const bsf_metadata_t *m, uint8_t *buf, size_t cap, size_t *out_len)
-{
-    job_t job;
-    if (m == NULL || out_len == NULL) {
-        return BSF_ERR_ARG;
-    }
-    memset(&job, 0, sizeof job);
-    job.meta = m;
-    job.plan_fn = metadata_job_plan;
-    job.payload_fn = metadata_job_payload;
-    return job_encode(&job, buf, cap, out_len);
-}
-
-bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const bsf_metadata_t *m,
-                                      bsf_sink_fn sink, void *ctx, size_t *written)
-{
-    job_t job;
-    if (written != NULL) {
-        *written = 0u;
-    }
-    if (work == NULL || m == NULL || sink == NULL) {
-        return BSF_ERR_ARG;
-    }
-    memset(&job, 0, sizeof job);
-    job.meta = m;
-    job.plan_fn = metadata_job_plan;
-    job.payload_fn = metadata_job_payload;
-    return job_encode_sink(&job, work, sink, ctx, written);
+    features_job_init(&fj, info, result, table);
+    return bsf_enc_job_encode_sink(&fj.job, work, sink, ctx, written);
 }
