@@ -397,6 +397,17 @@ static int32_t round_to_int(float v)
     return (int32_t)bsf_floorf(v + 0.5f);
 }
 
+/* The pose (checked): x and y in millimetres, theta in 2 pi / 65536 units
+ * (FORMAT.md section 3.1). */
+static void field_pose(writer_t *w, bits_t *b, int costing, const bsf_pose_t *pose)
+{
+    const uint32_t theta = (uint32_t)round_to_int(pose->theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
+    /* |x|, |y| <= BSF_POSE_XY_MAX: at most 2e9 mm, whose zigzag fits 32 bits */
+    field_eg64(w, b, costing, zigzag32(round_to_int(pose->x * 1000.0f)), BSF_WIRE_K_POSE);
+    field_eg64(w, b, costing, zigzag32(round_to_int(pose->y * 1000.0f)), BSF_WIRE_K_POSE);
+    field_u(w, b, costing, theta, 16u);
+}
+
 /* Header bits at most, and per feature bits at most outside the control
  * point values (FORMAT.md section 7). */
 #define HEADER_MAX_BITS 619u
@@ -410,7 +421,6 @@ typedef struct {
     int has_ext;
     uint32_t n_cached;      /* leading features whose values are all in the table */
     int32_t prev_resume[2]; /* the last anchor before feature n_cached */
-    uint32_t max_bits;      /* payload bits at most (exact for a metadata frame) */
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
 } plan_t;
 
@@ -446,8 +456,8 @@ static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t
  * bounds the payload's size: the values' exact bits plus the most the
  * header and feature fields can take.
  */
-static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t *res,
-                               uint32_t *table, plan_t *pl)
+static bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table, plan_t *pl,
+                               uint32_t *max_bits)
 {
     bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     const float step = pl->step;
@@ -499,13 +509,12 @@ static bsf_status_t plan_frame(const bsf_frame_info_t *info, const bsf_result_t 
         res->stats.n_cut_points > res->stats.n_valid - sum_points) {
         return BSF_ERR_ARG;
     }
-    pl->max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * n_features;
+    *max_bits = HEADER_MAX_BITS + FEATURE_MAX_BITS * n_features;
     for (cls = 0; cls < BSF_WIRE_N_CLASSES; ++cls) {
         uint32_t bits;
         pl->k_ctrl[cls] = (uint8_t)bsf_wire_eg_tally_best(&tally[cls], &bits);
-        pl->max_bits += bits;
+        *max_bits += bits;
     }
-    (void)info;
     return BSF_OK;
 }
 
@@ -539,13 +548,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     field_eg64(w, &b, costing, info->seq, BSF_WIRE_K_SEQ);
     field_eg64(w, &b, costing, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
-        const uint32_t theta =
-            (uint32_t)round_to_int(info->pose.theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
-        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose.x * 1000.0f)),
-                   BSF_WIRE_K_POSE);
-        field_eg64(w, &b, costing, bsf_wire_zigzag(round_to_int(info->pose.y * 1000.0f)),
-                   BSF_WIRE_K_POSE);
-        field_u(w, &b, costing, theta, 16u);
+        field_pose(w, &b, costing, &info->pose);
     }
     field_eg(w, &b, costing, pl->step_code, BSF_WIRE_K_STEP);
     field_eg(w, &b, costing, res->stats.n_valid, BSF_WIRE_K_N);
@@ -654,15 +657,10 @@ static void features_job_payload(writer_t *w, int costing, bsf_enc_job_t *job)
 
 static bsf_status_t features_job_plan(bsf_enc_job_t *job)
 {
+    /* planned once, from the zeros of features_job_init */
     features_job_t *fj = (features_job_t *)job;
-    bsf_status_t st;
-    memset(&fj->plan, 0, sizeof fj->plan);
-    st = check_frame(fj->info, fj->res, &fj->plan);
-    if (st == BSF_OK) {
-        st = plan_frame(fj->info, fj->res, fj->table, &fj->plan);
-    }
-    job->max_bits = fj->plan.max_bits;
-    return st;
+    const bsf_status_t st = check_frame(fj->info, fj->res, &fj->plan);
+    return st != BSF_OK ? st : plan_frame(fj->res, fj->table, &fj->plan, &job->max_bits);
 }
 
 void bsf_frame_info_init(bsf_frame_info_t *info)

@@ -111,44 +111,6 @@ static void stream_finish(stream_t *s)
     }
 }
 
-/* ---- Bit writer: the rare paths ------------------------------------------ */
-
-uint8_t *bsf_writer_spill(writer_t *w, uint8_t *p)
-{
-    if (w->out != NULL) {
-        stream_payload(w->out, w->chunk, (size_t)(p - w->chunk));
-    } else {
-        w->overflow = 1;
-    }
-    w->end = w->chunk + CHUNK_BYTES;
-    return w->chunk;
-}
-
-bits_t bsf_writer_put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k)
-{
-    const uint64_t u = (v >> k) + 1u;
-    const unsigned n = bsf_wire_bitlen(u);
-    unsigned i;
-    if (costing) {
-        b.bits += 2u * n - 1u + k;
-        return b;
-    }
-    for (i = 1u; i < n; ++i) {
-        put_bits(w, &b, 0u, 1u); /* the n - 1 zeros */
-    }
-    for (i = n; i > 0u;) { /* u, then the k low bits of v: 16 bits at a time */
-        const unsigned take = i > 16u ? 16u : i;
-        i -= take;
-        put_bits(w, &b, (uint32_t)(u >> i) & ((1u << take) - 1u), take);
-    }
-    for (i = k; i > 0u;) {
-        const unsigned take = i > 16u ? 16u : i;
-        i -= take;
-        put_bits(w, &b, (uint32_t)(v >> i) & ((1u << take) - 1u), take);
-    }
-    return b;
-}
-
 #if !BSF_CONFIG_COMPACT /* the direct writer only (job_direct) */
 /* Bits written so far. */
 static size_t writer_bits(const writer_t *w, const uint8_t *start)
@@ -165,6 +127,19 @@ static void writer_flush(writer_t *w)
     }
 }
 #endif
+
+/* ---- Bit writer: the rare paths ------------------------------------------ */
+
+uint8_t *bsf_writer_spill(writer_t *w, uint8_t *p)
+{
+    if (w->out != NULL) {
+        stream_payload(w->out, w->chunk, (size_t)(p - w->chunk));
+    } else {
+        w->overflow = 1;
+    }
+    w->end = w->chunk + CHUNK_BYTES;
+    return w->chunk;
+}
 
 /* Streaming path: the payload's last bytes, then CRC, last block and 0x00. */
 static void writer_end_stream(writer_t *w)

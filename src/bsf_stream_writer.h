@@ -233,14 +233,37 @@ ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsi
 /* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
  * wide fields. State in and out by value, so that the caller's stays in
  * registers. */
-bits_t bsf_writer_put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k);
+static inline bits_t put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k)
+{
+    const uint64_t u = (v >> k) + 1u;
+    const unsigned n = bsf_wire_bitlen(u);
+    unsigned i;
+    if (costing) {
+        b.bits += 2u * n - 1u + k;
+        return b;
+    }
+    for (i = 1u; i < n; ++i) {
+        put_bits(w, &b, 0u, 1u); /* the n - 1 zeros */
+    }
+    for (i = n; i > 0u;) { /* u, then the k low bits of v: 16 bits at a time */
+        const unsigned take = i > 16u ? 16u : i;
+        i -= take;
+        put_bits(w, &b, (uint32_t)(u >> i) & ((1u << take) - 1u), take);
+    }
+    for (i = k; i > 0u;) {
+        const unsigned take = i > 16u ? 16u : i;
+        i -= take;
+        put_bits(w, &b, (uint32_t)(v >> i) & ((1u << take) - 1u), take);
+    }
+    return b;
+}
 
 ENC_INLINE void field_eg64(writer_t *w, bits_t *b, int costing, uint64_t v, unsigned k)
 {
     if (v < ((uint64_t)1 << 30) && k <= 25u) {
         field_eg(w, b, costing, (uint32_t)v, k);
     } else {
-        *b = bsf_writer_put_eg_wide(w, *b, costing, v, k);
+        *b = put_eg_wide(w, *b, costing, v, k);
     }
 }
 
