@@ -13,6 +13,14 @@ static int get_cap(reader_t *r, unsigned k, uint32_t *v)
     return get_u32(r, k, BSF_WIRE_META_U16_MAX, v) && *v >= 1u;
 }
 
+/* Every cap the frame carries, in wire order. */
+static int get_caps(reader_t *r, bsf_metadata_t *m)
+{
+#define META_CAP_GET(field, cap, k) get_cap(r, k, &m->field) &&
+    return BSF_WIRE_META_CAPS(META_CAP_GET) 1;
+#undef META_CAP_GET
+}
+
 /* Metadata payload after byte 0 (see metadata_payload in the encoder). */
 static bsf_status_t parse_metadata(reader_t *r, bsf_metadata_t *out)
 {
@@ -34,11 +42,7 @@ static bsf_status_t parse_metadata(reader_t *r, bsf_metadata_t *out)
     if (!get_u32(r, BSF_WIRE_K_METHOD, BSF_WIRE_METHOD_MAX, &method) ||
         !get_float(r, &m.target_rms) || !(m.target_rms >= 0.0f) ||
         !get_u32(r, BSF_WIRE_K_STEP, BSF_WIRE_STEP_CODE_MAX, &step_code) || step_code == 0u ||
-        !get_cap(r, BSF_WIRE_K_CAP_POINTS, &m.max_points) ||
-        !get_cap(r, BSF_WIRE_K_CAP_KEYPOINTS, &m.max_keypoints) ||
-        !get_cap(r, BSF_WIRE_K_CAP_SEGMENTS, &m.max_segments) ||
-        !get_cap(r, BSF_WIRE_K_CAP_CTRL_PER_FEATURE, &m.max_ctrl_per_feature) ||
-        !get_cap(r, BSF_WIRE_K_CAP_CTRL_POINTS, &m.max_ctrl_points) ||
+        !get_caps(r, &m) ||
         !get_u32(r, BSF_WIRE_K_META_N_BEAMS, BSF_WIRE_META_U16_MAX, &m.n_beams) ||
         !get_float(r, &m.angle_min) || !get_float(r, &m.angle_increment) ||
         !get_float(r, &m.range_min) || !get_float(r, &m.range_max) || !(m.range_min >= 0.0f) ||

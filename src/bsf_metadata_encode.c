@@ -21,17 +21,23 @@ void bsf_metadata_init(bsf_metadata_t *m)
         m->lib_version_minor = (uint16_t)BSF_VERSION_MINOR;
         m->lib_version_patch = (uint16_t)BSF_VERSION_PATCH;
         m->quant_step = BSF_QUANT_STEP_DEFAULT;
-        m->max_points = (uint32_t)BSF_MAX_POINTS;
-        m->max_keypoints = (uint32_t)BSF_MAX_KEYPOINTS;
-        m->max_segments = (uint32_t)BSF_MAX_SEGMENTS;
-        m->max_ctrl_per_feature = (uint32_t)BSF_MAX_CTRL_PER_FEATURE;
-        m->max_ctrl_points = (uint32_t)BSF_MAX_CTRL_POINTS;
+#define META_CAP_INIT(field, cap, k) m->field = (uint32_t)(cap);
+        BSF_WIRE_META_CAPS(META_CAP_INIT)
+#undef META_CAP_INIT
     }
 }
 
 static int cap_ok(uint32_t v)
 {
     return v >= 1u && v <= BSF_WIRE_META_U16_MAX;
+}
+
+/* Every cap the frame carries within 1..65535. */
+static int caps_ok(const bsf_metadata_t *m)
+{
+#define META_CAP_OK(field, cap, k) cap_ok(m->field) &&
+    return BSF_WIRE_META_CAPS(META_CAP_OK) 1;
+#undef META_CAP_OK
 }
 
 static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
@@ -45,12 +51,11 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
         return BSF_ERR_ARG;
     }
     *step_code = (uint32_t)code;
-    if (!is_finite_f(m->target_rms) || !(m->target_rms >= 0.0f) || !cap_ok(m->max_points) ||
-        !cap_ok(m->max_keypoints) || !cap_ok(m->max_segments) || !cap_ok(m->max_ctrl_per_feature) ||
-        !cap_ok(m->max_ctrl_points) || m->n_beams > BSF_WIRE_META_U16_MAX ||
-        !is_finite_f(m->angle_min) || !is_finite_f(m->angle_increment) ||
-        !is_finite_f(m->range_min) || !is_finite_f(m->range_max) || !(m->range_min >= 0.0f) ||
-        !(m->range_max >= m->range_min) || m->has_time_origin > 1u ||
+    if (!is_finite_f(m->target_rms) || !(m->target_rms >= 0.0f) || !caps_ok(m) ||
+        m->n_beams > BSF_WIRE_META_U16_MAX || !is_finite_f(m->angle_min) ||
+        !is_finite_f(m->angle_increment) || !is_finite_f(m->range_min) ||
+        !is_finite_f(m->range_max) || !(m->range_min >= 0.0f) || !(m->range_max >= m->range_min) ||
+        m->has_time_origin > 1u ||
         (m->has_time_origin != 0u && (m->time_origin_us > BSF_METADATA_TIME_ORIGIN_MAX ||
                                       m->time_origin_us < -BSF_METADATA_TIME_ORIGIN_MAX)) ||
         m->source_len > BSF_METADATA_SOURCE_MAX ||
@@ -71,11 +76,9 @@ static void metadata_payload(writer_t *w, int costing, const bsf_metadata_t *m, 
     field_eg(w, b, costing, m->method, BSF_WIRE_K_METHOD);
     field_float(w, b, costing, m->target_rms);
     field_eg(w, b, costing, step_code, BSF_WIRE_K_STEP);
-    field_eg(w, b, costing, m->max_points, BSF_WIRE_K_CAP_POINTS);
-    field_eg(w, b, costing, m->max_keypoints, BSF_WIRE_K_CAP_KEYPOINTS);
-    field_eg(w, b, costing, m->max_segments, BSF_WIRE_K_CAP_SEGMENTS);
-    field_eg(w, b, costing, m->max_ctrl_per_feature, BSF_WIRE_K_CAP_CTRL_PER_FEATURE);
-    field_eg(w, b, costing, m->max_ctrl_points, BSF_WIRE_K_CAP_CTRL_POINTS);
+#define META_CAP_FIELD(field, cap, k) field_eg(w, b, costing, m->field, k);
+    BSF_WIRE_META_CAPS(META_CAP_FIELD)
+#undef META_CAP_FIELD
     field_eg(w, b, costing, m->n_beams, BSF_WIRE_K_META_N_BEAMS);
     field_float(w, b, costing, m->angle_min);
     field_float(w, b, costing, m->angle_increment);

@@ -139,16 +139,28 @@
 #error "BSF_CONFIG_METHODS must name at least one method and only BSF_CONFIG_METHOD_* bits"
 #endif
 
+/**
+ * Every cap that sizes a caller-owned object, one X(tag, cap) each: the caps
+ * guard (bsf_abi.h) puts each tag and value into the symbols, in this order
+ * (P1081K64S128F32C512 with the defaults), and the check below holds them
+ * to plain decimal spelling. A module's caps join by a line here (a tag of
+ * its own, one capital letter; at most 15 caps in all); nothing else needs
+ * to change for the guard (docs/DESIGN.md, Caps guard).
+ */
+#define BSF_CONFIG_CAPS(X)                                                                         \
+    X(P, BSF_MAX_POINTS)                                                                           \
+    X(K, BSF_MAX_KEYPOINTS)                                                                        \
+    X(S, BSF_MAX_SEGMENTS)                                                                         \
+    X(F, BSF_MAX_CTRL_PER_FEATURE)                                                                 \
+    X(C, BSF_MAX_CTRL_POINTS)
+
 /* Plain decimal spelling: the caps become part of symbol names (see above).
  * Appending a 0 to a decimal literal multiplies it by ten; for any other
  * spelling this comparison fails or does not compile. */
 #define BSF_CONFIG_CAT_(a, b) a##b
 #define BSF_CONFIG_APPEND0_(x) BSF_CONFIG_CAT_(x, 0)
-#if BSF_CONFIG_APPEND0_(BSF_MAX_POINTS) != BSF_MAX_POINTS * 10 ||                                  \
-    BSF_CONFIG_APPEND0_(BSF_MAX_KEYPOINTS) != BSF_MAX_KEYPOINTS * 10 ||                            \
-    BSF_CONFIG_APPEND0_(BSF_MAX_SEGMENTS) != BSF_MAX_SEGMENTS * 10 ||                              \
-    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_PER_FEATURE) != BSF_MAX_CTRL_PER_FEATURE * 10 ||              \
-    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_POINTS) != BSF_MAX_CTRL_POINTS * 10
+#define BSF_CONFIG_NOT_DECIMAL_(tag, cap) BSF_CONFIG_APPEND0_(cap) != (cap)*10 ||
+#if BSF_CONFIG_CAPS(BSF_CONFIG_NOT_DECIMAL_) 0
 #error "bsf caps must be plain decimal integers such as 361 (they become part of symbol names)"
 #endif
 
