@@ -12,6 +12,49 @@
  *
  * Every byte from the link is untrusted: the decoder checks every field
  * before a frame is delivered and never writes beyond its fixed buffers.
+ *
+ * Example usage: a scan's features as one frame in a buffer (link_write
+ * stands for your UART or socket).
+ *
+ *     static uint8_t frame[BSF_FRAME_MAX_SIZE];
+ *
+ *     int send_scan(const bsf_result_t *result, uint32_t seq, uint64_t time_ms)
+ *     {
+ *         bsf_frame_info_t info;
+ *         size_t len = 0;
+ *         bsf_frame_info_init(&info);
+ *         info.seq = seq;
+ *         info.timestamp_ms = time_ms;
+ *         if (bsf_frame_encode(&info, result, frame, sizeof frame, &len) != BSF_OK) {
+ *             return -1;
+ *         }
+ *         return link_write(frame, len); // len bytes, the 0x00 delimiter last
+ *     }
+ *
+ * Example usage: received bytes, in chunks of any size, back into frames
+ * (call bsf_decoder_init(&decoder) once first; use_features stands for
+ * your code).
+ *
+ *     static bsf_decoder_t decoder;
+ *     static bsf_frame_t received;
+ *
+ *     void on_bytes(const uint8_t *data, size_t len)
+ *     {
+ *         while (len > 0u) {
+ *             size_t used = 0;
+ *             const int type = bsf_decoder_feed(&decoder, data, len, &used, &received);
+ *             if (type < 0) {
+ *                 return; // only for NULL arguments
+ *             }
+ *             if (type == (int)BSF_FRAME_TYPE_FEATURES) {
+ *                 use_features(&received.result, received.has_pose ? &received.pose : NULL);
+ *             }
+ *             data += used;
+ *             len -= used;
+ *         }
+ *     }
+ *
+ * CI compiles and runs both (test/test_stream_header_examples.c).
  */
 #ifndef BSF_STREAM_H
 #define BSF_STREAM_H
