@@ -310,6 +310,7 @@ ENC_INLINE void put_values(writer_t *w, bits_t *b, int costing, const uint32_t *
 ENC_INLINE void field_kind_m_mask(writer_t *w, bits_t *b, int costing, uint32_t kind, uint32_t m,
                                   int has_mask)
 {
+    (void)costing; /* unused in the compact variant (ENC_COSTING) */
 #if !BSF_CONFIG_COMPACT
 #if BSF_WIRE_K_M != 1u
 #error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
@@ -401,6 +402,7 @@ static int32_t round_to_int(float v)
  * (FORMAT.md section 3.1). */
 static void field_pose(writer_t *w, bits_t *b, int costing, const bsf_pose_t *pose)
 {
+    (void)costing; /* unused in the compact variant (ENC_COSTING) */
     const uint32_t theta = (uint32_t)round_to_int(pose->theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
     /* |x|, |y| <= BSF_POSE_XY_MAX: at most 2e9 mm, whose zigzag fits 32 bits */
     field_eg64(w, b, costing, zigzag32(round_to_int(pose->x * 1000.0f)), BSF_WIRE_K_POSE);

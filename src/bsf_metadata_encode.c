@@ -67,6 +67,7 @@ static bsf_status_t check_metadata(const bsf_metadata_t *m, uint32_t *step_code)
 
 static void metadata_payload(writer_t *w, int costing, const bsf_metadata_t *m, uint32_t step_code)
 {
+    (void)costing; /* unused in the compact variant (ENC_COSTING) */
     bits_t *b = &w->b;
     unsigned i;
     field_u(w, b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_METADATA, 8u);

@@ -167,7 +167,7 @@ uint32_t
 bsf_enc_job_bits(bsf_enc_job_t *job)
 {
     writer_t w;
-    writer_init(&w, NULL, NULL, NULL);
+    writer_init(&w, 1, NULL, NULL, NULL);
     job->payload(&w, 1, job);
     return w.b.bits;
 }
@@ -182,7 +182,7 @@ static bsf_status_t job_plan(bsf_enc_job_t *job)
 static void job_stream(bsf_enc_job_t *job, stream_t *s)
 {
     writer_t w;
-    writer_init(&w, s, NULL, NULL);
+    writer_init(&w, 0, s, NULL, NULL);
     job->payload(&w, 0, job);
     writer_end_stream(&w);
 }
@@ -213,7 +213,7 @@ static bsf_status_t job_direct(bsf_enc_job_t *job, uint8_t *buf, size_t *out_len
     size_t len;
     unsigned i;
     /* the last word may reach 3 bytes beyond the payload, into the CRC's place */
-    writer_init(&w, NULL, start, start + max_payload + BSF_FRAME_CRC_SIZE);
+    writer_init(&w, 0, NULL, start, start + max_payload + BSF_FRAME_CRC_SIZE);
     job->payload(&w, 0, job);
     payload = (writer_bits(&w, start) + 7u) / 8u;
     writer_flush(&w);

@@ -69,6 +69,9 @@ typedef struct {
     acc_t acc;     /* pending bits in the low 32 - room bits (higher bits: leftovers) */
     unsigned room; /* free bits in acc, 1..32 */
     uint32_t bits; /* costing run: payload bits so far */
+#if BSF_CONFIG_COMPACT
+    int costing; /* a costing run (see ENC_COSTING) */
+#endif
 } bits_t;
 
 /* Where the words go. */
@@ -80,8 +83,16 @@ typedef struct {
     uint8_t chunk[CHUNK_BYTES];
 } writer_t;
 
-static inline void writer_init(writer_t *w, struct bsf_cobs_out *out, uint8_t *start, uint8_t *end)
+/* A writer for a costing run (only counting), or for writing to out
+ * (streaming) or straight to start .. end. */
+static inline void writer_init(writer_t *w, int costing, struct bsf_cobs_out *out, uint8_t *start,
+                               uint8_t *end)
 {
+#if BSF_CONFIG_COMPACT
+    w->b.costing = costing;
+#else
+    (void)costing;
+#endif
     w->out = out;
     w->overflow = 0;
     w->b.acc = 0u;
@@ -182,10 +193,33 @@ ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
     return 2u * log2_nz(v + ((uint32_t)1 << k)) + 1u - k;
 }
 
+/*
+ * Whether a run only counts: the callers' costing argument, a constant once
+ * the field functions are inlined into a run of either kind. The compact
+ * variant keeps one copy of each field function instead, and takes the
+ * kind from the bits (set by writer_init), so that they take four arguments,
+ * all in registers; the costing argument is then left out.
+ */
+#if BSF_CONFIG_COMPACT
+#define ENC_COSTING_PARAM
+#define ENC_COSTING(b) ((b)->costing)
+#define field_u(w, b, costing, v, n) field_u_(w, b, v, n)
+#define field_eg(w, b, costing, v, k) field_eg_(w, b, v, k)
+#define field_eg64(w, b, costing, v, k) field_eg64_(w, b, v, k)
+#define field_float(w, b, costing, v) field_float_(w, b, v)
+#else
+#define ENC_COSTING_PARAM int costing,
+#define ENC_COSTING(b) costing
+#define field_u(w, b, costing, v, n) field_u_(w, b, costing, v, n)
+#define field_eg(w, b, costing, v, k) field_eg_(w, b, costing, v, k)
+#define field_eg64(w, b, costing, v, k) field_eg64_(w, b, costing, v, k)
+#define field_float(w, b, costing, v) field_float_(w, b, costing, v)
+#endif
+
 /* Fields, written or (costing) counted: u(n) with n <= 31. */
-ENC_INLINE void field_u(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned n)
+ENC_INLINE void field_u_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint32_t v, unsigned n)
 {
-    if (costing) {
+    if (ENC_COSTING(b)) {
         b->bits += n;
     } else {
         put_bits(w, b, v, n);
@@ -193,9 +227,9 @@ ENC_INLINE void field_u(writer_t *w, bits_t *b, int costing, uint32_t v, unsigne
 }
 
 /* EGk of v < 2^30, k <= 25. */
-ENC_INLINE void field_eg(writer_t *w, bits_t *b, int costing, uint32_t v, unsigned k)
+ENC_INLINE void field_eg_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint32_t v, unsigned k)
 {
-    if (costing) {
+    if (ENC_COSTING(b)) {
         b->bits += eg_len(v, k);
     } else {
         put_eg(w, b, v, k);
@@ -233,12 +267,12 @@ ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsi
 /* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
  * wide fields. State in and out by value, so that the caller's stays in
  * registers. */
-static inline bits_t put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v, unsigned k)
+static inline bits_t put_eg_wide(writer_t *w, bits_t b, ENC_COSTING_PARAM uint64_t v, unsigned k)
 {
     const uint64_t u = (v >> k) + 1u;
     const unsigned n = bsf_wire_bitlen(u);
     unsigned i;
-    if (costing) {
+    if (ENC_COSTING(&b)) {
         b.bits += 2u * n - 1u + k;
         return b;
     }
@@ -258,16 +292,20 @@ static inline bits_t put_eg_wide(writer_t *w, bits_t b, int costing, uint64_t v,
     return b;
 }
 
-ENC_INLINE void field_eg64(writer_t *w, bits_t *b, int costing, uint64_t v, unsigned k)
+ENC_INLINE void field_eg64_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint64_t v, unsigned k)
 {
     if (v < ((uint64_t)1 << 30) && k <= 25u) {
         field_eg(w, b, costing, (uint32_t)v, k);
     } else {
+#if BSF_CONFIG_COMPACT
+        *b = put_eg_wide(w, *b, v, k);
+#else
         *b = put_eg_wide(w, *b, costing, v, k);
+#endif
     }
 }
 
-ENC_INLINE void field_float(writer_t *w, bits_t *b, int costing, float v)
+ENC_INLINE void field_float_(writer_t *w, bits_t *b, ENC_COSTING_PARAM float v)
 {
     const uint32_t u = bsf_float_bits(v);
     field_u(w, b, costing, u >> 16, 16u);
