@@ -2,10 +2,10 @@
 /*
  * bsf_stream_writer.c - the byte machinery of the frame encoders: the
  * streaming output (payload bytes through CRC-32C and COBS to a counter, a
- * buffer or a sink), the bit writer's rare paths, and the frame job that
- * plans a frame and writes it (bsf_stream_writer.h). Nothing here knows what
- * a frame holds; the frame types live in bsf_features_encode.c and
- * bsf_metadata_encode.c.
+ * buffer or a sink), the bit writer's spill of a full chunk, and the frame
+ * job that plans a frame and writes it (bsf_stream_writer.h). Nothing here
+ * knows what a frame holds; the frame types live in bsf_features_encode.c
+ * and bsf_metadata_encode.c.
  */
 #include "bsf_stream_writer.h"
 

@@ -38,12 +38,6 @@
 #define ENC_INLINE static inline
 #endif
 
-#if defined(__GNUC__) || defined(__clang__)
-#define ENC_NOINLINE static __attribute__((noinline))
-#else
-#define ENC_NOINLINE static
-#endif
-
 #define CHUNK_BYTES 32u /* streaming path: payload bytes handed on at a time */
 
 /*
