@@ -1,4 +1,10 @@
 /* SPDX-License-Identifier: MIT */
+/*
+ * bsf_cobs.c - byte machinery: Consistent Overhead Byte Stuffing, the
+ * framing of every frame (docs/FORMAT.md). The public one-shot coder
+ * (bsf_cobs_encode, bsf_cobs_decode) and, for the frame writer, the count
+ * of full blocks and the in-place encoder (bsf_wire.h).
+ */
 #include "bsf/bsf_stream.h"
 
 #include <string.h>
