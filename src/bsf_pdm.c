@@ -267,17 +267,6 @@ static inline void load_span(const bsf_point_t *ctrl, size_t n_span, size_t span
 /* Sums of one span's basis products and basis-weighted coordinates over the
  * points that fall on it, added to the normal equations once per span
  * change instead of once per point. */
-/* The curve at u of the span with coefficients e, minus (qx, qy), and the
- * basis weights b0, b2 it used. */
-static inline void span_residual(const span_coef_t *e, float u, float qx, float qy, float *b0,
-                                 float *b2, float *ex, float *ey)
-{
-    *b0 = e->k0 * (1.0f - u) * (1.0f - u);
-    *b2 = e->k2 * u * u;
-    *ex = e->p1x + *b0 * e->ax + *b2 * e->bx - qx;
-    *ey = e->p1y + *b0 * e->ay + *b2 * e->by - qy;
-}
-
 typedef struct {
     size_t span;
     float s[6]; /* products b0 b0, b1 b0, b1 b1, b2 b0, b2 b1, b2 b2 */
@@ -713,13 +702,22 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                         load_span(w->ctrl, n_span, span_new, &cn);
                         e = &cn;
                     }
-                    span_residual(e, u_new, qx, qy, &nb0, &nb2, &nex, &ney);
+                    nb0 = e->k0 * (1.0f - u_new) * (1.0f - u_new);
+                    nb2 = e->k2 * u_new * u_new;
+                    nex = e->p1x + nb0 * e->ax + nb2 * e->bx - qx;
+                    ney = e->p1y + nb0 * e->ay + nb2 * e->by - qy;
 #else
                     if ((span_new = span_of(t_new, fs, n_span, &u_new)) == c.span) {
-                        span_residual(&c, u_new, qx, qy, &nb0, &nb2, &nex, &ney);
+                        nb0 = c.k0 * (1.0f - u_new) * (1.0f - u_new);
+                        nb2 = c.k2 * u_new * u_new;
+                        nex = c.p1x + nb0 * c.ax + nb2 * c.bx - qx;
+                        ney = c.p1y + nb0 * c.ay + nb2 * c.by - qy;
                     } else {
                         load_span(w->ctrl, n_span, span_new, &cn);
-                        span_residual(&cn, u_new, qx, qy, &nb0, &nb2, &nex, &ney);
+                        nb0 = cn.k0 * (1.0f - u_new) * (1.0f - u_new);
+                        nb2 = cn.k2 * u_new * u_new;
+                        nex = cn.p1x + nb0 * cn.ax + nb2 * cn.bx - qx;
+                        ney = cn.p1y + nb0 * cn.ay + nb2 * cn.by - qy;
                     }
 #endif
                 }
