@@ -400,7 +400,7 @@ static int32_t round_to_int(float v)
 
 /* The pose (checked): x and y in millimetres, theta in 2 pi / 65536 units
  * (FORMAT.md section 3.1). */
-static void field_pose(writer_t *w, bits_t *b, int costing, const bsf_pose_t *pose)
+ENC_INLINE void field_pose(writer_t *w, bits_t *b, int costing, const bsf_pose_t *pose)
 {
     (void)costing; /* unused in the compact variant (ENC_COSTING) */
     const uint32_t theta = (uint32_t)round_to_int(pose->theta * BSF_WIRE_THETA_PER_RAD) & 0xFFFFu;
