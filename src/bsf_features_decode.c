@@ -8,7 +8,7 @@
  */
 #include <string.h>
 
-#include "bsf_stream_reader.h"
+#include "bsf_frame_parsers.h"
 
 static int in_quant_range(int64_t q)
 {

@@ -6,7 +6,7 @@
  */
 #include <string.h>
 
-#include "bsf_stream_reader.h"
+#include "bsf_frame_parsers.h"
 
 static int get_cap(reader_t *r, unsigned k, uint32_t *v)
 {

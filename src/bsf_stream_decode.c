@@ -3,14 +3,15 @@
  * bsf_stream_decode.c - frame decoding apart from what a frame holds:
  * bsf_frame_decode checks a body's CRC-32C, reads its version and type byte
  * and hands the payload to that type's parser (the table below: a new frame
- * type joins by one entry); bsf_decoder_feed undoes COBS byte by byte,
+ * type joins by one entry, its parser declared in bsf_frame_parsers.h);
+ * bsf_decoder_feed undoes COBS byte by byte,
  * finds the 0x00 delimiters and counts what it could not deliver.
  */
 #include "bsf/bsf_stream.h"
 
 #include <string.h>
 
-#include "bsf_stream_reader.h"
+#include "bsf_frame_parsers.h"
 #include "bsf_wire.h"
 
 /* The frame types this decoder reads, from the format version each

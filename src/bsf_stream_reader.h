@@ -3,9 +3,10 @@
  * bsf_stream_reader.h - internal: the byte machinery every frame decoder
  * shares: a bit reader over a payload whose CRC has been checked, reading
  * fields (u(n), Exp-Golomb, zigzag, floats) most significant bit first with
- * every value bounded, and the frame parser's interface that
- * bsf_stream_decode.c dispatches to by frame type (docs/DESIGN.md, Stream
- * design; docs/FORMAT.md for the fields).
+ * every value bounded, and the type of a frame parser, which
+ * bsf_stream_decode.c dispatches to by frame type (the parsers are listed in
+ * bsf_frame_parsers.h; docs/DESIGN.md, Stream design; docs/FORMAT.md for
+ * the fields).
  */
 #ifndef BSF_STREAM_READER_H
 #define BSF_STREAM_READER_H
@@ -152,9 +153,5 @@ static inline int padding_ok(reader_t *r)
  * BSF_ERR_FORMAT or BSF_ERR_CAPACITY.
  */
 typedef bsf_status_t (*bsf_frame_parse_fn)(reader_t *r, unsigned version, bsf_frame_t *out);
-
-/* The frame types' parsers (bsf_features_decode.c, bsf_metadata_decode.c). */
-bsf_status_t bsf_features_parse(reader_t *r, unsigned version, bsf_frame_t *out);
-bsf_status_t bsf_metadata_parse(reader_t *r, unsigned version, bsf_frame_t *out);
 
 #endif /* BSF_STREAM_READER_H */
