@@ -4,8 +4,8 @@
  * bsf_frame_decode checks a body's CRC-32C, reads its version and type byte
  * and hands the payload to that type's parser (the table below: a new frame
  * type joins by one entry, its parser declared in bsf_frame_parsers.h);
- * bsf_decoder_feed undoes COBS byte by byte,
- * finds the 0x00 delimiters and counts what it could not deliver.
+ * bsf_decoder_feed undoes COBS byte by byte, finds the 0x00 delimiters and
+ * counts what it could not deliver.
  */
 #include "bsf/bsf_stream.h"
 
