@@ -1,4 +1,10 @@
 /* SPDX-License-Identifier: MIT */
+/*
+ * bsf_cobs.c - byte machinery: Consistent Overhead Byte Stuffing, the
+ * framing of every frame (docs/FORMAT.md). The public one-shot coder
+ * (bsf_cobs_encode, bsf_cobs_decode) and, for the frame writer, the count
+ * of full blocks and the in-place encoder (bsf_wire.h).
+ */
 #include "bsf/bsf_stream.h"
 
 #include <string.h>
@@ -93,7 +99,7 @@ size_t bsf_cobs_full_blocks(const uint8_t *body, size_t n)
     }
 }
 
-#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
+#if (defined(__GNUC__) || defined(__clang__)) && !BSF_CONFIG_COMPACT
 /* A body of fewer than 254 bytes right behind its first code byte: no block
  * is full and no byte moves, so each zero byte becomes the distance to the
  * next zero (or to the end), and buf[0] the distance to the first. Zero
@@ -149,7 +155,7 @@ size_t bsf_cobs_encode_in_place(uint8_t *buf, size_t offset, size_t n)
     const uint8_t *const src_end = src + n;
     uint8_t *code_at = buf;
     uint8_t *out = buf + 1;
-#if (defined(__GNUC__) || defined(__clang__)) && !defined(__OPTIMIZE_SIZE__)
+#if (defined(__GNUC__) || defined(__clang__)) && !BSF_CONFIG_COMPACT
     if (offset == 1u && n < 254u) {
         return cobs_short_in_place(buf, n);
     }

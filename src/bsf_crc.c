@@ -2,17 +2,18 @@
 #include "bsf/bsf_stream.h"
 
 /*
- * CRC-32C (Castagnoli), reflected; the encoder and the stream decoder run
+ * bsf_crc.c - byte machinery: CRC-32C (Castagnoli), reflected, the frame
+ * check of every frame (bsf_crc32c). The encoder and the stream decoder run
  * every byte of every frame through it. Three ways to the same CRC:
  * - x86-64 with SSE4.2 (checked at run time): the CRC32 instruction, 8 bytes
  *   at a time (GCC and Clang; BSF_CRC32C_PORTABLE turns it off);
  * - by default, one byte per step from a 256-entry table (1 KiB of read-only
  *   data), about half the instructions of two nibble steps;
- * - in size-optimised builds (-Os), or with BSF_CRC32C_NIBBLE_TABLE, two
- *   steps of a 16-entry table (64 bytes), for flash-bound microcontrollers.
+ * - in the compact variant (BSF_CONFIG_COMPACT), or with
+ *   BSF_CRC32C_NIBBLE_TABLE, two steps of a 16-entry table (64 bytes), for
+ *   flash-bound microcontrollers.
  */
-#if defined(__OPTIMIZE_SIZE__) && !defined(BSF_CRC32C_NIBBLE_TABLE) &&                             \
-    !defined(BSF_CRC32C_BYTE_TABLE)
+#if BSF_CONFIG_COMPACT && !defined(BSF_CRC32C_NIBBLE_TABLE) && !defined(BSF_CRC32C_BYTE_TABLE)
 #define BSF_CRC32C_NIBBLE_TABLE
 #endif
 

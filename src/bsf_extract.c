@@ -172,9 +172,10 @@ static void clock_stage(stage_clock_t *c, bsf_stats_t *stats, bsf_stage_t stage)
     c->last = now;
 }
 
-/* Over BSF_MAX_KEYPOINTS the detector keeps the strongest (bsf_falko_detect,
- * bsf_bid_detect) and reports how many it found: keep those and count the
- * rest as cut. Any other error stands. */
+/* Over BSF_MAX_KEYPOINTS the detector keeps what fits (bsf_falko_detect and
+ * bsf_bid_detect the strongest, bsf_lc_detect the first in beam order) and
+ * reports how many it found: keep those and count the rest as cut. Any other
+ * error stands. */
 static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex,
                                             bsf_stats_t *stats)
 {

@@ -44,7 +44,7 @@
 #include "bsf_math.h"
 #include "bsf_nms.h"
 
-#if !defined(__OPTIMIZE_SIZE__) && defined(__SSE2__)
+#if BSF_CONFIG_SIMD && defined(__SSE2__)
 #include <emmintrin.h>
 #define FALKO_SSE2_WALKS 1
 /* Windows this wide (at least 3: see certainly_rejected_inside) walk four
@@ -719,6 +719,23 @@ static size_t walk_down4(const bsf_point_t *pt, bsf_point_t c, float out2, size_
 }
 #endif
 
+/* Whether beam i's window of half-width w lies inside the scan, so that
+ * certainly_rejected_inside may judge it. The compact variant
+ * (BSF_CONFIG_COMPACT) always answers no: certainly_rejected alone, the same
+ * results with less code. The markers FALKO_WIN_NONE and FALKO_WIN_EXACT
+ * exceed any i. */
+static inline int window_inside(size_t w, size_t i, size_t count)
+{
+#if !BSF_CONFIG_COMPACT
+    return w <= i && i + w < count;
+#else
+    (void)w;
+    (void)i;
+    (void)count;
+    return 0;
+#endif
+}
+
 /* certainly_rejected for a window [i - w, i + w] inside the scan (no
  * clamping, no wrapping: nearly every apex), in fewer instructions. The end
  * searches skip the validity test: an invalid beam is (0, 0) (bsf_points_t),
@@ -869,13 +886,7 @@ bsf_status_t bsf_falko_detect(const bsf_points_t *pts, const bsf_falko_params_t 
 
     for (i = 0; i < pts->count; ++i) {
         const size_t w = work->win_hi[i];
-        /* -Os: certainly_rejected alone (same results, less code). The
-         * markers FALKO_WIN_NONE and FALKO_WIN_EXACT exceed any i. */
-#if !defined(__OPTIMIZE_SIZE__)
-        const int inside = w <= i && i + w < pts->count;
-#else
-        const int inside = 0;
-#endif
+        const int inside = window_inside(w, i, pts->count);
         int verdict;
         neigh_t ends;
         work->score[i] = FALKO_REJECTED;

@@ -77,7 +77,7 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
-#if !defined(__OPTIMIZE_SIZE__)
+#if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
     bsf_lc_block_t *blk;
@@ -310,7 +310,7 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
     return pos;
 }
 
-#if !defined(__OPTIMIZE_SIZE__)
+#if !BSF_CONFIG_COMPACT
 /* Speed only, same answers: on long runs (dense scans) the side walks step
  * over whole blocks of points that are provably within the side radius, and
  * a bound from the blocks' coordinate sums rejects most splits of a straight
@@ -569,11 +569,62 @@ static int dense_at(const lc_ctx_t *c, size_t apex, size_t m, float side2)
 }
 #endif
 
+/* The block shortcuts as judge and detect_run see them: in the compact
+ * variant (BSF_CONFIG_COMPACT) there are none, and these do nothing. */
+
+/* Lets the runs of detect_run use block summaries when long enough. */
+static inline void blocks_attach(lc_ctx_t *c, bsf_lc_work_t *w, size_t m)
+{
+#if !BSF_CONFIG_COMPACT
+    c->blk = NULL;
+    c->blk_built = 0;
+    if (m >= LC_BLOCK_MIN_RUN) {
+        c->blk = w->block;
+    }
+#else
+    (void)c;
+    (void)w;
+    (void)m;
+#endif
+}
+
+/* No block summaries (before the first run). */
+static inline void blocks_detach(lc_ctx_t *c)
+{
+#if !BSF_CONFIG_COMPACT
+    c->blk = NULL;
+    c->blk_built = 0;
+#else
+    (void)c;
+#endif
+}
+
+/* 1 when judge should walk by blocks at apex (the summaries are built on
+ * first use), else 0. */
+static inline int blocks_use(lc_ctx_t *c, size_t apex, size_t m, float side2)
+{
+#if !BSF_CONFIG_COMPACT
+    if (c->blk != NULL && dense_at(c, apex, m, side2)) {
+        if (!c->blk_built) {
+            build_blocks(c->pts, c->run, m, c->blk);
+            c->blk_built = 1;
+        }
+        return 1;
+    }
+#else
+    (void)c;
+    (void)apex;
+    (void)m;
+    (void)side2;
+#endif
+    return 0;
+}
+
 /* walk_side, by blocks when the judge uses them. */
 static inline size_t walk(const lc_ctx_t *c, int blocks, size_t pos, size_t stop, int step,
                           float side2)
 {
-#if !defined(__OPTIMIZE_SIZE__)
+#if !BSF_CONFIG_COMPACT
     if (blocks) {
         return walk_side_blocks(c, pos, stop, step, side2);
     }
@@ -581,6 +632,29 @@ static inline size_t walk(const lc_ctx_t *c, int blocks, size_t pos, size_t stop
     (void)blocks;
 #endif
     return walk_side(c, pos, stop, step, side2);
+}
+
+/* With blocks: 1 when the turn bound proves that the sides a0..apex and
+ * apex..b1 make no corner, else 0 after storing the window's relative
+ * points for the exact fits. Without blocks: 0. */
+static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t apex, size_t b1)
+{
+#if !BSF_CONFIG_COMPACT
+    if (blocks) {
+        /* every path from here to the turn test ends in "no corner" */
+        if (surely_no_turn(c, a0, apex, b1)) {
+            return 1;
+        }
+        fill_rel(c, a0, b1);
+    }
+#else
+    (void)c;
+    (void)blocks;
+    (void)a0;
+    (void)apex;
+    (void)b1;
+#endif
+    return 0;
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -611,15 +685,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
-#if !defined(__OPTIMIZE_SIZE__)
-    if (c->blk != NULL && dense_at(c, apex, m, side2)) {
-        if (!c->blk_built) {
-            build_blocks(c->pts, c->run, m, c->blk);
-            c->blk_built = 1;
-        }
-        blocks = 1;
-    }
-#endif
+    blocks = blocks_use(c, apex, m, side2);
     a0 = walk(c, blocks, apex, lo, -1, side2);
     b1 = walk(c, blocks, apex, hi, 1, side2);
     /* A side cut short by a neighbouring split reaches past it: noise often
@@ -641,15 +707,9 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
         return 0;
     }
-#if !defined(__OPTIMIZE_SIZE__)
-    if (blocks) {
-        /* every path from here to the turn test ends in "no corner" */
-        if (surely_no_turn(c, a0, apex, b1)) {
-            return 0;
-        }
-        fill_rel(c, a0, b1);
+    if (blocks_rule_out(c, blocks, a0, apex, b1)) {
+        return 0;
     }
-#endif
     if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
         return 0;
     }
@@ -871,13 +931,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
-#if !defined(__OPTIMIZE_SIZE__)
-    c->blk = NULL;
-    c->blk_built = 0;
-    if (m >= LC_BLOCK_MIN_RUN) {
-        c->blk = w->block;
-    }
-#endif
+    blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
     memset(&last, 0, sizeof last);
@@ -958,7 +1012,7 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
     if (d2 <= p->jump_a * p->jump_a) {
         return 1;
     }
-#if !defined(__OPTIMIZE_SIZE__) /* -Os: expf every time (the bounds only decide early) */
+#if !BSF_CONFIG_COMPACT /* compact: expf every time (the bounds only decide early) */
     if (x >= 0.0f && x <= 1.0f) {
         /* lo <= bsf_expf(x) <= hi, and rounding is monotonic: r * r lies
          * between the squares of jump_a * lo and jump_a * hi, so expf only
@@ -1039,10 +1093,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.y = 0.0f;
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
-#if !defined(__OPTIMIZE_SIZE__)
-    c.blk = NULL;
-    c.blk_built = 0;
-#endif
+    blocks_detach(&c);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
         if (!close_run && !pts->valid[i]) {

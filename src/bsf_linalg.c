@@ -11,10 +11,10 @@ static int finite_f(float v)
 
 /* In-place banded Cholesky of factor (holding A + loading * I). Returns 0 on
  * a bad pivot. */
-/* The written-out half-bandwidth-2 paths below are for speed only: a
- * size-optimised build (-Os) leaves them out and runs the general loops,
- * which do the same arithmetic in the same order (same results). */
-#if !defined(__OPTIMIZE_SIZE__)
+/* The written-out half-bandwidth-2 paths below are for speed only: the
+ * compact variant (BSF_CONFIG_COMPACT) leaves them out and runs the general
+ * loops, which do the same arithmetic in the same order (same results). */
+#if !BSF_CONFIG_COMPACT
 #define BSF_LINALG_BW2 1
 #else
 #define BSF_LINALG_BW2 0

@@ -309,8 +309,8 @@ static void sums_flush(bsf_pdm_work_t *w, const span_sums_t *a)
     const size_t u1 = unk[1];
     const size_t u2 = unk[2];
     float *band = w->band;
-#if defined(__OPTIMIZE_SIZE__)
-    /* -Os: the same additions in the same order, from tables (the three
+#if BSF_CONFIG_COMPACT
+    /* compact: the same additions in the same order, from tables (the three
      * diagonal products, then the three below it). */
     static const uint8_t row[6] = {0u, 1u, 2u, 1u, 2u, 2u};
     static const uint8_t col[6] = {0u, 1u, 2u, 0u, 0u, 1u};
@@ -696,8 +696,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                     nex = ex + du_try * (ux + 0.5f * du_try * c.uux);
                     ney = ey + du_try * (uy + 0.5f * du_try * c.uuy);
                 } else {
-#if defined(__OPTIMIZE_SIZE__)
-                    /* -Os: one copy of the evaluation, on span c or the new span */
+#if BSF_CONFIG_COMPACT
+                    /* compact: one copy of the evaluation, on span c or the new span */
                     const span_coef_t *e = &c;
                     if ((span_new = span_of(t_new, fs, n_span, &u_new)) != c.span) {
                         load_span(w->ctrl, n_span, span_new, &cn);

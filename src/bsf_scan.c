@@ -87,7 +87,13 @@ static inline size_t fill_points(const bsf_scan_t *scan, bsf_points_t *out, int 
     return n_valid;
 }
 
-#if !defined(__OPTIMIZE_SIZE__) && (defined(__SSE2__) || defined(__ARM_NEON))
+#if BSF_CONFIG_SIMD && (defined(__SSE2__) || defined(__ARM_NEON))
+#define SCAN_BRANCH_FREE 1
+#else
+#define SCAN_BRANCH_FREE 0
+#endif
+
+#if SCAN_BRANCH_FREE
 /* fill_points(scan, out, 1) without branches, which compilers turn into
  * vector code (4 beams per step with SSE2 or NEON): every beam's sine and
  * cosine as bsf_sincosf_bounded computes them (the same expressions, its
@@ -133,6 +139,26 @@ static size_t fill_points_branch_free(const bsf_scan_t *scan, bsf_points_t *out)
 }
 #endif
 
+/* Every beam's point, the fastest way this build has (the same bits every
+ * way). With every beam angle within bsf_sincosf_bounded's domain (a margin
+ * of 384 rad covers the rounding of this bound and of the angles): one loop
+ * without the checks only huge angles need, chosen once per scan, or the
+ * branch-free loop (BSF_CONFIG_SIMD). The compact variant without SIMD
+ * calls the out-of-line functions for every angle. */
+static size_t fill_all_points(const bsf_scan_t *scan, bsf_points_t *out)
+{
+#if SCAN_BRANCH_FREE || !BSF_CONFIG_COMPACT
+    if (fabsf(scan->angle_min) + (float)scan->count * fabsf(scan->angle_increment) <= 16000.0f) {
+#if SCAN_BRANCH_FREE
+        return fill_points_branch_free(scan, out);
+#else
+        return fill_points(scan, out, 1);
+#endif
+    }
+#endif
+    return fill_points(scan, out, 0);
+}
+
 bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
 {
     size_t n_valid;
@@ -151,23 +177,7 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
         return BSF_ERR_ARG;
     }
 
-    /* every beam angle within bsf_sincosf_bounded's domain (a margin of
-     * 384 rad covers the rounding of this bound and of the angles): one loop
-     * without the checks only huge angles need, chosen once per scan */
-#if !defined(__OPTIMIZE_SIZE__)
-    if (fabsf(scan->angle_min) + (float)scan->count * fabsf(scan->angle_increment) <= 16000.0f) {
-#if defined(__SSE2__) || defined(__ARM_NEON)
-        n_valid = fill_points_branch_free(scan, out);
-#else
-        n_valid = fill_points(scan, out, 1);
-#endif
-    } else {
-        n_valid = fill_points(scan, out, 0);
-    }
-#else
-    /* -Os: the out-of-line functions for every angle (the same bits) */
-    n_valid = fill_points(scan, out, 0);
-#endif
+    n_valid = fill_all_points(scan, out);
     out->count = scan->count;
     out->n_valid = n_valid;
     out->angle_min = scan->angle_min;

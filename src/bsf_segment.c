@@ -188,8 +188,8 @@ static void beam_radius_start(beam_radius_t *r, float rho)
 static int beam_within_slow(beam_radius_t *r, float d2)
 {
     const float x = r->two_b * r->rho;
-#if defined(__OPTIMIZE_SIZE__)
-    /* -Os: the threshold itself, without the bounds that spare expf (same
+#if BSF_CONFIG_COMPACT
+    /* compact: the threshold itself, without the bounds that spare expf (same
      * answers: the bounds only decide early) */
     {
         const float lower = r->a2 * bsf_exp_taylor4(x);

@@ -39,6 +39,15 @@
 #define BSF_WIRE_K_CAP_SEGMENTS 4u
 #define BSF_WIRE_K_CAP_CTRL_PER_FEATURE 2u
 #define BSF_WIRE_K_CAP_CTRL_POINTS 6u
+/* The caps a metadata frame carries, in wire order: X(field of
+ * bsf_metadata_t, this build's cap, Exp-Golomb order). A cap joins the
+ * frame by a line here, a field and a format version (FORMAT.md). */
+#define BSF_WIRE_META_CAPS(X)                                                                      \
+    X(max_points, BSF_MAX_POINTS, BSF_WIRE_K_CAP_POINTS)                                           \
+    X(max_keypoints, BSF_MAX_KEYPOINTS, BSF_WIRE_K_CAP_KEYPOINTS)                                  \
+    X(max_segments, BSF_MAX_SEGMENTS, BSF_WIRE_K_CAP_SEGMENTS)                                     \
+    X(max_ctrl_per_feature, BSF_MAX_CTRL_PER_FEATURE, BSF_WIRE_K_CAP_CTRL_PER_FEATURE)             \
+    X(max_ctrl_points, BSF_MAX_CTRL_POINTS, BSF_WIRE_K_CAP_CTRL_POINTS)
 #define BSF_WIRE_K_META_N_BEAMS 8u
 #define BSF_WIRE_K_TIME_ORIGIN 40u
 #define BSF_WIRE_K_SOURCE_LEN 3u

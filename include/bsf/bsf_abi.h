@@ -20,10 +20,12 @@
  *     undefined reference to `bsf_extract_capsP361K64S128F32C512'
  * which names the caps the program was compiled with (P: BSF_MAX_POINTS,
  * K: BSF_MAX_KEYPOINTS, S: BSF_MAX_SEGMENTS, F: BSF_MAX_CTRL_PER_FEATURE,
- * C: BSF_MAX_CTRL_POINTS); `nm libbsf.a | grep _caps` shows the library's.
- * Source code keeps calling bsf_extract(); only the symbol differs. This is
- * why the caps must be written as plain decimal numbers (bsf_config.h checks
- * it). A new public function taking a caps-sized object must be added below.
+ * C: BSF_MAX_CTRL_POINTS: the tags of BSF_CONFIG_CAPS in bsf_config.h, where
+ * a new module's caps join the guard); `nm libbsf.a | grep _caps` shows the
+ * library's. Source code keeps calling bsf_extract(); only the symbol
+ * differs. This is why the caps must be written as plain decimal numbers
+ * (bsf_config.h checks it). A new public function taking a caps-sized object
+ * must be added below (docs/DESIGN.md, Caps guard).
  */
 #ifndef BSF_ABI_H
 #define BSF_ABI_H
@@ -58,12 +60,16 @@
 
 /* ---- Caps guard ----------------------------------------------------------- */
 
-#define BSF_CAPS_PASTE_(fn, p, k, s, f, c) fn##_capsP##p##K##k##S##s##F##f##C##c
-#define BSF_CAPS_EXPAND_(fn, p, k, s, f, c) BSF_CAPS_PASTE_(fn, p, k, s, f, c)
+/* Each cap of BSF_CONFIG_CAPS as ", tag value" (P1081), then all of them
+ * pasted behind fn_caps: up to 15 caps, the slots left over empty. */
+#define BSF_CAPS_CAT_(a, b) BSF_CAPS_CAT2_(a, b)
+#define BSF_CAPS_CAT2_(a, b) a##b
+#define BSF_CAPS_ITEM_(tag, cap) , BSF_CAPS_CAT_(tag, cap)
+#define BSF_CAPS_JOIN_(...) BSF_CAPS_JOIN16_(__VA_ARGS__, , , , , , , , , , , , , , , , )
+#define BSF_CAPS_JOIN16_(a, b, c, d, e, f, g, h, i, j, k, l, m, n, o, p, ...)                      \
+    a##b##c##d##e##f##g##h##i##j##k##l##m##n##o##p
 /** The symbol of function fn for the caps of this translation unit. */
-#define BSF_CAPS_NAME(fn)                                                                          \
-    BSF_CAPS_EXPAND_(fn, BSF_MAX_POINTS, BSF_MAX_KEYPOINTS, BSF_MAX_SEGMENTS,                      \
-                     BSF_MAX_CTRL_PER_FEATURE, BSF_MAX_CTRL_POINTS)
+#define BSF_CAPS_NAME(fn) BSF_CAPS_JOIN_(fn##_caps BSF_CONFIG_CAPS(BSF_CAPS_ITEM_))
 
 /* Every public function whose arguments include a caps-sized object. */
 #define bsf_scan_to_points BSF_CAPS_NAME(bsf_scan_to_points)

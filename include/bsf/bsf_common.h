@@ -62,16 +62,19 @@ typedef struct {
 } bsf_pose_t;
 
 /**
- * An interest point (corner) found by a corner detector (FALKO or BID).
+ * An interest point (corner) found by a corner detector (LC, FALKO or BID).
  * The beam index is what segmentation and fitting use; the other fields
- * describe the keypoint for users who want it as a landmark.
+ * describe the keypoint for users who want it as a landmark (LC: the two
+ * walls' intersection).
  */
 typedef struct {
     uint16_t index;    /**< beam index of the keypoint */
     bsf_point_t point; /**< position, sensor frame, metres (sub-beam refined when enabled) */
-    float orientation; /**< FALKO orientation, radians (0 for BID) */
-    float radius;      /**< neighbourhood radius used, metres */
-    float score;       /**< FALKO: raw integer score (lower = more corner-like); BID: N_q */
+    float orientation; /**< FALKO orientation; LC: the corner's bisector; radians (0 for BID) */
+    float radius;      /**< neighbourhood radius used (LC: the longer side), metres */
+    /** FALKO: raw integer score (lower = more corner-like); BID: N_q; LC: the
+     *  curve-to-lines residual ratio (higher = sharper) */
+    float score;
 } bsf_keypoint_t;
 
 /** Short English name of a status code ("ok", "bad argument", ...); never NULL. */

@@ -19,6 +19,28 @@
  * the library's). For that reason each cap must be a plain decimal integer
  * (361, not 361u, 0x169 or (360 + 1)); a cap may also be a macro that
  * expands to one.
+ *
+ * Switches (each may be set on the command line or in BSF_CONFIG_HEADER):
+ *
+ *   BSF_MAX_POINTS, BSF_MAX_KEYPOINTS, BSF_MAX_SEGMENTS,
+ *   BSF_MAX_CTRL_PER_FEATURE, BSF_MAX_CTRL_POINTS
+ *       the caps: sizes of the caller-owned objects (below; BSF_CONFIG_CAPS
+ *       lists them for the caps guard).
+ *   BSF_CONFIG_METHODS
+ *       the extraction methods compiled in (below).
+ *   BSF_CONFIG_COMPACT (0 or 1)
+ *       1: code kept only for speed is compiled in its short form (one
+ *       general loop instead of written-out special cases, no fast paths
+ *       that a general path also covers, nibble-table CRC). Default: 1 when
+ *       the compiler optimises for size (-Os, -Oz: __OPTIMIZE_SIZE__), else 0.
+ *   BSF_CONFIG_SIMD (0 or 1)
+ *       1: the SSE2 (x86) and NEON (Arm) paths where the target has them.
+ *       Default: 1 unless BSF_CONFIG_COMPACT is 1.
+ *
+ * The build variants (BSF_CONFIG_COMPACT, BSF_CONFIG_SIMD) change speed and
+ * code size only: every combination computes the same features and writes
+ * the same bytes, and none changes an object's size, so a program need not
+ * see the library's values (docs/DESIGN.md, Build variants).
  */
 #ifndef BSF_CONFIG_H
 #define BSF_CONFIG_H
@@ -70,6 +92,24 @@
 #define BSF_CONFIG_METHODS 15
 #endif
 
+/** 1: speed-only code in its short form (see the switches above). */
+#ifndef BSF_CONFIG_COMPACT
+#if defined(__OPTIMIZE_SIZE__)
+#define BSF_CONFIG_COMPACT 1
+#else
+#define BSF_CONFIG_COMPACT 0
+#endif
+#endif
+
+/** 1: SSE2 / NEON paths where the target has them (see the switches above). */
+#ifndef BSF_CONFIG_SIMD
+#if BSF_CONFIG_COMPACT
+#define BSF_CONFIG_SIMD 0
+#else
+#define BSF_CONFIG_SIMD 1
+#endif
+#endif
+
 /* Range checks: a bad value stops the build here rather than corrupting
  * memory at run time. Beam indices are stored as uint16_t. */
 #if BSF_MAX_POINTS < 8 || BSF_MAX_POINTS > 65535
@@ -88,20 +128,39 @@
 #error "BSF_MAX_CTRL_POINTS must be in [BSF_MAX_CTRL_PER_FEATURE, 65535]"
 #endif
 
+#if (BSF_CONFIG_COMPACT) != 0 && (BSF_CONFIG_COMPACT) != 1
+#error "BSF_CONFIG_COMPACT must be 0 or 1"
+#endif
+#if (BSF_CONFIG_SIMD) != 0 && (BSF_CONFIG_SIMD) != 1
+#error "BSF_CONFIG_SIMD must be 0 or 1"
+#endif
+
 #if (BSF_CONFIG_METHODS) < 1 || (BSF_CONFIG_METHODS) > 15
 #error "BSF_CONFIG_METHODS must name at least one method and only BSF_CONFIG_METHOD_* bits"
 #endif
+
+/**
+ * Every cap that sizes a caller-owned object, one X(tag, cap) each: the caps
+ * guard (bsf_abi.h) puts each tag and value into the symbols, in this order
+ * (P1081K64S128F32C512 with the defaults), and the check below holds them
+ * to plain decimal spelling. A module's caps join by a line here (a tag of
+ * its own, one capital letter; at most 15 caps in all); nothing else needs
+ * to change for the guard (docs/DESIGN.md, Caps guard).
+ */
+#define BSF_CONFIG_CAPS(X)                                                                         \
+    X(P, BSF_MAX_POINTS)                                                                           \
+    X(K, BSF_MAX_KEYPOINTS)                                                                        \
+    X(S, BSF_MAX_SEGMENTS)                                                                         \
+    X(F, BSF_MAX_CTRL_PER_FEATURE)                                                                 \
+    X(C, BSF_MAX_CTRL_POINTS)
 
 /* Plain decimal spelling: the caps become part of symbol names (see above).
  * Appending a 0 to a decimal literal multiplies it by ten; for any other
  * spelling this comparison fails or does not compile. */
 #define BSF_CONFIG_CAT_(a, b) a##b
 #define BSF_CONFIG_APPEND0_(x) BSF_CONFIG_CAT_(x, 0)
-#if BSF_CONFIG_APPEND0_(BSF_MAX_POINTS) != BSF_MAX_POINTS * 10 ||                                  \
-    BSF_CONFIG_APPEND0_(BSF_MAX_KEYPOINTS) != BSF_MAX_KEYPOINTS * 10 ||                            \
-    BSF_CONFIG_APPEND0_(BSF_MAX_SEGMENTS) != BSF_MAX_SEGMENTS * 10 ||                              \
-    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_PER_FEATURE) != BSF_MAX_CTRL_PER_FEATURE * 10 ||              \
-    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_POINTS) != BSF_MAX_CTRL_POINTS * 10
+#define BSF_CONFIG_NOT_DECIMAL_(tag, cap) BSF_CONFIG_APPEND0_(cap) != (cap)*10 ||
+#if BSF_CONFIG_CAPS(BSF_CONFIG_NOT_DECIMAL_) 0
 #error "bsf caps must be plain decimal integers such as 361 (they become part of symbol names)"
 #endif
 

@@ -1,16 +1,17 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * bsf_extract.h - the whole pipeline in one call: scan -> points -> corners
- * -> segments -> B-spline features, for the three methods of the paper.
+ * -> segments -> B-spline features, for each of the four methods (bsf's
+ * default LC-SVED-PDM and the paper's three; docs/DESIGN.md, Methods).
  *
  *   static bsf_extractor_t ex;               // all working memory, no heap
  *   static bsf_result_t res;
- *   bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
+ *   bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
  *   if (bsf_extractor_init(&ex, &p) != BSF_OK) { ... }
  *   if (bsf_extract(&ex, &scan, &res) >= 0) { ... res.features ... }  // BSF_OK or BSF_OK_CUT
  *
- * Each stage is also callable on its own (bsf_scan.h, bsf_falko.h,
- * bsf_bid.h, bsf_segment.h, bsf_fit.h).
+ * Each stage is also callable on its own (bsf_scan.h, bsf_lc.h,
+ * bsf_falko.h, bsf_bid.h, bsf_segment.h, bsf_fit.h).
  */
 #ifndef BSF_EXTRACT_H
 #define BSF_EXTRACT_H
@@ -33,7 +34,8 @@ BSF_BEGIN_DECLS
  * line-corner detector (bsf_lc.h), and holds each PDM vertex at LC's two-line
  * intersection: it finds the corners FALKO misses (FALKO's neighbourhood and
  * its per-scan relative score hide most corners beyond 3 m and lone corners)
- * and places them where the walls meet (docs/GROUND_TRUTH.md has the numbers).
+ * and places them where the walls meet (docs/DESIGN.md, Why LC is the default;
+ * docs/GROUND_TRUTH.md has the numbers).
  */
 typedef enum {
     BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM */
@@ -147,10 +149,12 @@ BSF_NODISCARD bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_par
  *
  * Caps past the input (bsf_config.h) degrade gracefully and visibly: what
  * fits is kept, BSF_OK_CUT is returned and result->stats says what was cut.
- *  - More keypoints than BSF_MAX_KEYPOINTS: the strongest are kept (FALKO:
- *    highest strength; BID: lowest N_q; ties to the lower beam). A dropped
- *    keypoint loses a vertex, not points. stats.n_keypoints counts the kept
- *    ones, stats.n_cut_keypoints the others (BSF_CUT_KEYPOINTS).
+ *  - More keypoints than BSF_MAX_KEYPOINTS: LC keeps the first ones in beam
+ *    order (it has no strength to rank by); FALKO and BID keep the
+ *    strongest (FALKO: highest strength; BID: lowest N_q; ties to the lower
+ *    beam). A dropped keypoint loses a vertex, not points. stats.n_keypoints
+ *    counts the kept ones, stats.n_cut_keypoints the others
+ *    (BSF_CUT_KEYPOINTS; docs/DESIGN.md, Cut policy).
  *  - More kept segments than BSF_MAX_SEGMENTS: the segments covering the most
  *    points are kept (ties: the earlier in beam order), in beam order
  *    (BSF_CUT_SEGMENTS).

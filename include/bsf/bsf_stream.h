@@ -12,6 +12,49 @@
  *
  * Every byte from the link is untrusted: the decoder checks every field
  * before a frame is delivered and never writes beyond its fixed buffers.
+ *
+ * Example usage: a scan's features as one frame in a buffer (link_write
+ * stands for your UART or socket).
+ *
+ *     static uint8_t frame[BSF_FRAME_MAX_SIZE];
+ *
+ *     int send_scan(const bsf_result_t *result, uint32_t seq, uint64_t time_ms)
+ *     {
+ *         bsf_frame_info_t info;
+ *         size_t len = 0;
+ *         bsf_frame_info_init(&info);
+ *         info.seq = seq;
+ *         info.timestamp_ms = time_ms;
+ *         if (bsf_frame_encode(&info, result, frame, sizeof frame, &len) != BSF_OK) {
+ *             return -1;
+ *         }
+ *         return link_write(frame, len); // len bytes, the 0x00 delimiter last
+ *     }
+ *
+ * Example usage: received bytes, in chunks of any size, back into frames
+ * (call bsf_decoder_init(&decoder) once first; use_features stands for
+ * your code).
+ *
+ *     static bsf_decoder_t decoder;
+ *     static bsf_frame_t received;
+ *
+ *     void on_bytes(const uint8_t *data, size_t len)
+ *     {
+ *         while (len > 0u) {
+ *             size_t used = 0;
+ *             const int type = bsf_decoder_feed(&decoder, data, len, &used, &received);
+ *             if (type < 0) {
+ *                 return; // only for NULL arguments
+ *             }
+ *             if (type == (int)BSF_FRAME_TYPE_FEATURES) {
+ *                 use_features(&received.result, received.has_pose ? &received.pose : NULL);
+ *             }
+ *             data += used;
+ *             len -= used;
+ *         }
+ *     }
+ *
+ * CI compiles and runs both (test/contract/test_stream_header_examples.c).
  */
 #ifndef BSF_STREAM_H
 #define BSF_STREAM_H
@@ -140,10 +183,10 @@ typedef struct {
     uint32_t seq;          /**< sequence number (wraps), for loss detection */
     uint64_t timestamp_ms; /**< scan time, milliseconds since the stream's time origin
                                 (bsf_metadata_t.time_origin_us) */
-    uint8_t has_pose;      /**< 1: pose_* are sent (laser pose in the world frame) */
-    float pose_x;          /**< metres, |x| <= BSF_POSE_XY_MAX, sent in 1 mm units */
-    float pose_y;          /**< metres, |y| <= BSF_POSE_XY_MAX, sent in 1 mm units */
-    float pose_theta;      /**< radians, |theta| <= BSF_POSE_THETA_MAX, sent in 2*pi/65536 units */
+    uint8_t has_pose;      /**< 1: pose is sent (laser pose in the world frame) */
+    /** |x|, |y| <= BSF_POSE_XY_MAX metres, sent in 1 mm units; |theta| <=
+     * BSF_POSE_THETA_MAX radians, sent in 2*pi/65536 units */
+    bsf_pose_t pose;
     float quant_step;      /**< control point step, metres, [BSF_QUANT_STEP_MIN, _MAX],
                                 rounded to 0.1 mm */
     uint8_t has_geometry;  /**< 1: this scan's geometry travels in the frame (with
@@ -301,14 +344,14 @@ BSF_NODISCARD bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const b
  * and stats 0; its arrays are not touched).
  */
 typedef struct {
-    uint8_t version;         /**< format version of the frame (1 or 2) */
-    uint8_t type;            /**< BSF_FRAME_TYPE_FEATURES or BSF_FRAME_TYPE_METADATA */
-    uint32_t seq;            /**< sequence number */
-    uint64_t timestamp_ms;   /**< milliseconds since the stream's time origin (metadata) */
-    uint8_t has_pose;        /**< 1 when pose_* are valid */
-    float pose_x;            /**< metres (1 mm resolution) */
-    float pose_y;            /**< metres (1 mm resolution) */
-    float pose_theta;        /**< radians in [-pi, pi) (2*pi/65536 resolution) */
+    uint8_t version;       /**< format version of the frame (1 or 2) */
+    uint8_t type;          /**< BSF_FRAME_TYPE_FEATURES or BSF_FRAME_TYPE_METADATA */
+    uint32_t seq;          /**< sequence number */
+    uint64_t timestamp_ms; /**< milliseconds since the stream's time origin (metadata) */
+    uint8_t has_pose;      /**< 1 when pose is valid */
+    /** x, y in metres (1 mm resolution); theta in radians in [-pi, pi)
+     * (2*pi/65536 resolution) */
+    bsf_pose_t pose;
     float quant_step;        /**< metres */
     uint32_t time_us;        /**< extraction time, microseconds (<= 4 294 967) */
     uint8_t has_geometry;    /**< 1: the frame carries its scan's geometry (below, and

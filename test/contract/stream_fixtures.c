@@ -134,9 +134,9 @@ void fx_example_typical(bsf_frame_info_t *info, bsf_result_t *res)
     info->seq = 1234u;
     info->timestamp_ms = 700430u;
     info->has_pose = 1u;
-    info->pose_x = 4.774f;
-    info->pose_y = -5.846f;
-    info->pose_theta = -1.408f;
+    info->pose.x = 4.774f;
+    info->pose.y = -5.846f;
+    info->pose.theta = -1.408f;
     build(res, defs, 6, 176, 912345u);
 }
 
@@ -260,9 +260,9 @@ void fx_random_result(fx_rng_t *rng, uint32_t max_features, bsf_frame_info_t *in
     info->timestamp_ms = ((uint64_t)fx_rng_next(rng) << 8) | fx_rng_range(rng, 0u, 255u);
     info->has_pose = (uint8_t)fx_rng_range(rng, 0u, 1u);
     if (info->has_pose) {
-        info->pose_x = fx_rng_float(rng, -100.0f, 100.0f);
-        info->pose_y = fx_rng_float(rng, -100.0f, 100.0f);
-        info->pose_theta = fx_rng_float(rng, -3.14159f, 3.14159f);
+        info->pose.x = fx_rng_float(rng, -100.0f, 100.0f);
+        info->pose.y = fx_rng_float(rng, -100.0f, 100.0f);
+        info->pose.theta = fx_rng_float(rng, -3.14159f, 3.14159f);
     }
     info->quant_step = (float)fx_rng_range(rng, 1u, 100u) * 0.0001f;
 

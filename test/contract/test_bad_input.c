@@ -1354,9 +1354,9 @@ static void test_frame_encode_refuses_unrepresentable_input_without_writing(void
     BAD_ENCODE(BSF_ERR_ARG, info.quant_step = 0.0f);
     BAD_ENCODE(BSF_ERR_ARG, info.quant_step = NAN);
     BAD_ENCODE(BSF_ERR_ARG, info.quant_step = 2.0f);
-    BAD_ENCODE(BSF_ERR_ARG, (info.has_pose = 1u, info.pose_x = NAN));
-    BAD_ENCODE(BSF_ERR_ARG, (info.has_pose = 1u, info.pose_y = 3.0e6f));
-    BAD_ENCODE(BSF_ERR_ARG, (info.has_pose = 1u, info.pose_theta = 30.0f));
+    BAD_ENCODE(BSF_ERR_ARG, (info.has_pose = 1u, info.pose.x = NAN));
+    BAD_ENCODE(BSF_ERR_ARG, (info.has_pose = 1u, info.pose.y = 3.0e6f));
+    BAD_ENCODE(BSF_ERR_ARG, (info.has_pose = 1u, info.pose.theta = 30.0f));
     BAD_ENCODE(BSF_ERR_ARG, result.features[0].e_curve = NAN);
     BAD_ENCODE(BSF_ERR_ARG, result.features[0].e_curve = 2000.0f);
     BAD_ENCODE(BSF_ERR_ARG, result.features[0].n_ctrl = 2u);

@@ -23,6 +23,7 @@ static bsf_scene_t scene;
 static float ranges[BSF_MAX_POINTS];
 static bsf_keypoint_t all_keypoints[BSF_MAX_POINTS];
 static bsf_falko_work_t falko_work;
+static bsf_lc_work_t lc_work;
 static uint8_t frame[BSF_FRAME_MAX_SIZE];
 static uint8_t body[BSF_FRAME_MAX_SIZE];
 static bsf_frame_t decoded;
@@ -195,6 +196,65 @@ static void test_1081_beams_keypoint_cap_keeps_the_strongest(void)
     run_keypoint_case(&k1081);
 }
 
+/* A gear around the sensor: a star polygon of n_vertices corners
+ * alternating between r_in and r_out, seen by 1081 beams over 270 degrees
+ * (each beam's range from its ray's crossing with the edge it meets). */
+static bsf_scan_t gear_scan(unsigned n_vertices, double r_in, double r_out)
+{
+    const double step = 2.0 * PI_D / (double)n_vertices;
+    bsf_scan_t s;
+    size_t i;
+    memset(&s, 0, sizeof s);
+    s.ranges = ranges;
+    s.count = 1081u;
+    s.angle_min = (float)(-0.75 * PI_D);
+    s.angle_increment = (float)(1.5 * PI_D / 1080.0);
+    s.range_min = 0.1f;
+    s.range_max = 30.0f;
+    for (i = 0; i < s.count; ++i) {
+        const double a = (double)s.angle_min + (double)i * (double)s.angle_increment;
+        const unsigned k = (unsigned)(fmod(a + 4.0 * PI_D, 2.0 * PI_D) / step) % n_vertices;
+        const double r0 = k % 2u == 0u ? r_in : r_out;
+        const double r1 = k % 2u == 0u ? r_out : r_in;
+        const double x0 = r0 * cos(k * step);
+        const double y0 = r0 * sin(k * step);
+        const double ex_ = r1 * cos((k + 1u) * step) - x0;
+        const double ey = r1 * sin((k + 1u) * step) - y0;
+        ranges[i] = (float)((x0 * ey - y0 * ex_) / (cos(a) * ey - sin(a) * ex_));
+    }
+    return s;
+}
+
+/* LC has no strength order: over the keypoint cap it keeps the first
+ * BSF_MAX_KEYPOINTS corners in beam order, exactly those LC finds first
+ * with room for all, and counts the others as cut. (The gear's edges are
+ * too short for features: this pins the keypoint rule alone.) */
+static void test_lc_keypoint_cap_keeps_the_first_in_beam_order(void)
+{
+    const bsf_scan_t scan = gear_scan(120u, 3.0, 4.0);
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    size_t n_all = 0u;
+    size_t i;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_EQUAL_INT(BSF_OK_CUT, bsf_extract(&ex, &scan, &res));
+    printf("LC keypoint cap, gear of 120 corners: kept %u keypoints, cut %u\n",
+           (unsigned)res.stats.n_keypoints, (unsigned)res.stats.n_cut_keypoints);
+    TEST_ASSERT_EQUAL_UINT32(BSF_CUT_KEYPOINTS, res.stats.cut);
+    TEST_ASSERT_EQUAL_UINT32(BSF_MAX_KEYPOINTS, res.stats.n_keypoints);
+    TEST_ASSERT_TRUE(res.stats.n_cut_keypoints > 0u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_lc_detect(&ex.points, &ex.params.lc, &lc_work, all_keypoints,
+                                                BSF_MAX_POINTS, &n_all));
+    TEST_ASSERT_TRUE(n_all > (size_t)BSF_MAX_KEYPOINTS);
+    TEST_ASSERT_EQUAL_UINT32(n_all, res.stats.n_keypoints + res.stats.n_cut_keypoints);
+    TEST_ASSERT_EQUAL_UINT32(BSF_MAX_KEYPOINTS, ex.n_keypoints);
+    for (i = 0; i < ex.n_keypoints; ++i) {
+        TEST_ASSERT_EQUAL_UINT16(all_keypoints[i].index, ex.keypoints[i].index);
+        TEST_ASSERT_EQUAL_FLOAT(all_keypoints[i].point.x, ex.keypoints[i].point.x);
+        TEST_ASSERT_EQUAL_FLOAT(all_keypoints[i].point.y, ex.keypoints[i].point.y);
+    }
+    assert_frame_carries_the_result();
+}
+
 #if BSF_MAX_POINTS >= 3200
 /* The segments kept are those covering the most points: every cut segment
  * has at most as many points as the smallest kept one, and at least the
@@ -335,6 +395,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_1081_beams_keypoint_cap_keeps_the_strongest);
+    RUN_TEST(test_lc_keypoint_cap_keeps_the_first_in_beam_order);
 #if BSF_MAX_POINTS >= 3200
     RUN_TEST(test_3200_beams_keypoint_cap_keeps_the_strongest);
     RUN_TEST(test_3200_beams_segment_cap_keeps_the_largest);

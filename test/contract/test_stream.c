@@ -121,10 +121,10 @@ static void assert_round_trip(const bsf_frame_info_t *info, const bsf_result_t *
     TEST_ASSERT_TRUE(info->timestamp_ms == out->timestamp_ms);
     TEST_ASSERT_EQUAL_UINT8(info->has_pose, out->has_pose);
     if (info->has_pose) {
-        float dtheta = out->pose_theta - info->pose_theta;
+        float dtheta = out->pose.theta - info->pose.theta;
         dtheta -= 6.2831853f * floorf(dtheta / 6.2831853f + 0.5f);
-        TEST_ASSERT_FLOAT_WITHIN(0.0005f + 1e-5f * fabsf(info->pose_x), info->pose_x, out->pose_x);
-        TEST_ASSERT_FLOAT_WITHIN(0.0005f + 1e-5f * fabsf(info->pose_y), info->pose_y, out->pose_y);
+        TEST_ASSERT_FLOAT_WITHIN(0.0005f + 1e-5f * fabsf(info->pose.x), info->pose.x, out->pose.x);
+        TEST_ASSERT_FLOAT_WITHIN(0.0005f + 1e-5f * fabsf(info->pose.y), info->pose.y, out->pose.y);
         TEST_ASSERT_FLOAT_WITHIN(0.5f * 9.5874e-5f + 1e-6f, 0.0f, dtheta);
     }
     TEST_ASSERT_EQUAL_UINT32(in->stats.n_valid, out->result.stats.n_valid);
@@ -424,8 +424,8 @@ static void test_encoder_rejects_values_it_cannot_represent(void)
         case 3: info.quant_step = 0.0f; break;
         case 4: info.quant_step = 2.0f; break;
         case 5: info.quant_step = NAN; break;
-        case 6: info.pose_theta = NAN; break;
-        case 7: info.pose_x = 3e6f; break;
+        case 6: info.pose.theta = NAN; break;
+        case 7: info.pose.x = 3e6f; break;
         case 8: res.ctrl_is_vertex[6] = 0u; break; /* vertex without its copy */
         case 9: res.ctrl[6].x += 0.01f; break;     /* copies differ */
         case 10: res.features[2].n_ctrl = 2u; break;
@@ -498,9 +498,9 @@ static void test_worst_case_frame_fits_the_max_size_macro(void)
     info.seq = UINT32_MAX;
     info.timestamp_ms = UINT64_MAX;
     info.has_pose = 1u;
-    info.pose_x = -BSF_POSE_XY_MAX;
-    info.pose_y = BSF_POSE_XY_MAX;
-    info.pose_theta = 3.0f;
+    info.pose.x = -BSF_POSE_XY_MAX;
+    info.pose.y = BSF_POSE_XY_MAX;
+    info.pose.theta = 3.0f;
     info.quant_step = 0.0001f;
     memset(&res, 0, sizeof res);
     res.n_features = BSF_MAX_SEGMENTS;

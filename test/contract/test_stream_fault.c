@@ -74,9 +74,9 @@ static void judge(tally_t *t)
     info.seq = frame.seq;
     info.timestamp_ms = frame.timestamp_ms;
     info.has_pose = frame.has_pose;
-    info.pose_x = frame.pose_x;
-    info.pose_y = frame.pose_y;
-    info.pose_theta = frame.pose_theta;
+    info.pose.x = frame.pose.x;
+    info.pose.y = frame.pose.y;
+    info.pose.theta = frame.pose.theta;
     info.quant_step = frame.quant_step;
     if (bsf_frame_encode(&info, &frame.result, check, sizeof check, &n_back) != BSF_OK ||
         n_back != n_sent || memcmp(check, sent, n_sent) != 0) {
@@ -239,9 +239,9 @@ static void test_crc_valid_mutations_are_rejected_or_consistent(void)
         info.seq = frame.seq;
         info.timestamp_ms = frame.timestamp_ms;
         info.has_pose = frame.has_pose;
-        info.pose_x = frame.pose_x;
-        info.pose_y = frame.pose_y;
-        info.pose_theta = frame.pose_theta;
+        info.pose.x = frame.pose.x;
+        info.pose.y = frame.pose.y;
+        info.pose.theta = frame.pose.theta;
         info.quant_step = frame.quant_step;
         TEST_ASSERT_EQUAL_INT(BSF_OK,
                               bsf_frame_encode(&info, &frame.result, check, sizeof check, &n_back));

@@ -59,9 +59,9 @@ static uint32_t hash_frame(uint32_t h, const bsf_frame_t *f)
     h = det_hash_u32(h, (uint32_t)(f->timestamp_ms & 0xffffffffu));
     h = det_hash_u32(h, (uint32_t)(f->timestamp_ms >> 32));
     h = det_hash_u32(h, f->has_pose);
-    h = det_hash_floats(h, &f->pose_x, 1u);
-    h = det_hash_floats(h, &f->pose_y, 1u);
-    h = det_hash_floats(h, &f->pose_theta, 1u);
+    h = det_hash_floats(h, &f->pose.x, 1u);
+    h = det_hash_floats(h, &f->pose.y, 1u);
+    h = det_hash_floats(h, &f->pose.theta, 1u);
     h = det_hash_floats(h, &f->quant_step, 1u);
     h = det_hash_u32(h, f->result.n_features);
     h = det_hash_u32(h, f->result.n_ctrl);
@@ -213,9 +213,9 @@ bsf_status_t det_run_log(const det_log_scan_t *scans, size_t n, const uint32_t *
             info.seq = (uint32_t)(k * DET_METHODS + m);
             info.timestamp_ms = s->timestamp_ms;
             info.has_pose = 1u;
-            info.pose_x = float_of_bits(s->pose_x);
-            info.pose_y = float_of_bits(s->pose_y);
-            info.pose_theta = float_of_bits(s->pose_theta);
+            info.pose.x = float_of_bits(s->pose_x);
+            info.pose.y = float_of_bits(s->pose_y);
+            info.pose.theta = float_of_bits(s->pose_theta);
             st = det_frame(&scan, &info, det_methods[m], out, NULL, NULL);
             if (st != BSF_OK) {
                 return st;

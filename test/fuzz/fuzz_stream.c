@@ -81,9 +81,9 @@ static void check_frame(const bsf_frame_t *fr)
     FUZZ_CHECK(fr->version == 1u || fr->version == BSF_FORMAT_VERSION);
     FUZZ_CHECK(fr->type == BSF_FRAME_TYPE_FEATURES);
     FUZZ_CHECK(fr->has_pose <= 1u);
-    FUZZ_CHECK(fuzz_finite(fr->pose_x) && fabsf(fr->pose_x) <= BSF_POSE_XY_MAX);
-    FUZZ_CHECK(fuzz_finite(fr->pose_y) && fabsf(fr->pose_y) <= BSF_POSE_XY_MAX);
-    FUZZ_CHECK(fuzz_finite(fr->pose_theta) && fabsf(fr->pose_theta) <= 3.1416f);
+    FUZZ_CHECK(fuzz_finite(fr->pose.x) && fabsf(fr->pose.x) <= BSF_POSE_XY_MAX);
+    FUZZ_CHECK(fuzz_finite(fr->pose.y) && fabsf(fr->pose.y) <= BSF_POSE_XY_MAX);
+    FUZZ_CHECK(fuzz_finite(fr->pose.theta) && fabsf(fr->pose.theta) <= 3.1416f);
     FUZZ_CHECK(fr->quant_step >= BSF_QUANT_STEP_MIN * 0.999f &&
                fr->quant_step <= BSF_QUANT_STEP_MAX * 1.001f);
     fuzz_check_result(&fr->result, 0);
@@ -120,12 +120,12 @@ static void check_equal(const bsf_frame_t *a, const bsf_frame_t *b)
     FUZZ_CHECK(a->has_pose == b->has_pose);
     /* Beyond 8192 m a float's step exceeds the 1 mm wire unit, so decode and
      * re-encode may move the pose by one float step there (reported). */
-    if (!(same_pose(a->pose_x, b->pose_x) && same_pose(a->pose_y, b->pose_y))) {
-        fprintf(stderr, "pose %.9g %.9g -> %.9g %.9g\n", (double)a->pose_x, (double)a->pose_y,
-                (double)b->pose_x, (double)b->pose_y);
+    if (!(same_pose(a->pose.x, b->pose.x) && same_pose(a->pose.y, b->pose.y))) {
+        fprintf(stderr, "pose %.9g %.9g -> %.9g %.9g\n", (double)a->pose.x, (double)a->pose.y,
+                (double)b->pose.x, (double)b->pose.y);
     }
-    FUZZ_CHECK(same_pose(a->pose_x, b->pose_x) && same_pose(a->pose_y, b->pose_y));
-    FUZZ_CHECK(a->pose_theta == b->pose_theta);
+    FUZZ_CHECK(same_pose(a->pose.x, b->pose.x) && same_pose(a->pose.y, b->pose.y));
+    FUZZ_CHECK(a->pose.theta == b->pose.theta);
     FUZZ_CHECK(a->quant_step == b->quant_step);
     /* The decoder refuses a time_us that stats.time_ns cannot hold, so every
      * delivered frame's time and stats re-encode exactly. */
@@ -174,9 +174,9 @@ static void reencode(const bsf_frame_t *fr)
     info.seq = fr->seq;
     info.timestamp_ms = fr->timestamp_ms;
     info.has_pose = fr->has_pose;
-    info.pose_x = fr->pose_x;
-    info.pose_y = fr->pose_y;
-    info.pose_theta = fr->pose_theta;
+    info.pose.x = fr->pose.x;
+    info.pose.y = fr->pose.y;
+    info.pose.theta = fr->pose.theta;
     info.quant_step = fr->quant_step;
     info.has_geometry = fr->has_geometry;
     info.angle_min = fr->angle_min;
@@ -231,9 +231,9 @@ static void make_reference(void)
     base_info.seq = 4242u;
     base_info.timestamp_ms = 123456u;
     base_info.has_pose = 1u;
-    base_info.pose_x = 1.5f;
-    base_info.pose_y = -2.25f;
-    base_info.pose_theta = 0.5f;
+    base_info.pose.x = 1.5f;
+    base_info.pose.y = -2.25f;
+    base_info.pose.theta = 0.5f;
     /* With its geometry the frame carries its beam count, so a metadata
      * frame in the garbage before it cannot change what it decodes to. */
     base.stats.n_beams = 40u;
@@ -369,9 +369,9 @@ static void fuzz_encoder(const uint8_t *p, size_t n, uint8_t sel)
         const size_t f = (size_t)(p[0] >> 4) % BSF_MAX_SEGMENTS;
         const size_t c = (size_t)(v >> 16) % BSF_MAX_CTRL_POINTS;
         switch (p[0] & 0x0Fu) {
-        case 0: info.pose_x = as_float(v); break;
-        case 1: info.pose_y = as_float(v); break;
-        case 2: info.pose_theta = as_float(v); break;
+        case 0: info.pose.x = as_float(v); break;
+        case 1: info.pose.y = as_float(v); break;
+        case 2: info.pose.theta = as_float(v); break;
         case 3: info.quant_step = as_float(v); break;
         case 4: edited.ctrl[p[0] >> 4].x = as_float(v); break;
         case 5: edited.ctrl[p[0] >> 4].y = as_float(v); break;

@@ -392,9 +392,9 @@ int main(int argc, char **argv)
             res.stats.n_beams = (uint32_t)sc.count;
         }
         info.has_pose = (uint8_t)(k != 1u);
-        info.pose_x = (float)x;
-        info.pose_y = (float)y;
-        info.pose_theta = (float)th;
+        info.pose.x = (float)x;
+        info.pose.y = (float)y;
+        info.pose.theta = (float)th;
         if (bsf_frame_encode(&info, &res, wire, sizeof wire, &len) != BSF_OK) {
             return 1;
         }

@@ -127,8 +127,8 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
         fprintf(ctx->out, "seq=%lu t=%.3f pose=", (unsigned long)fr->seq,
                 1e-3 * (double)fr->timestamp_ms);
         if (fr->has_pose) {
-            fprintf(ctx->out, "(%.3f,%.3f,%.4f)", (double)fr->pose_x, (double)fr->pose_y,
-                    (double)fr->pose_theta);
+            fprintf(ctx->out, "(%.3f,%.3f,%.4f)", (double)fr->pose.x, (double)fr->pose.y,
+                    (double)fr->pose.theta);
         } else {
             fputs("none", ctx->out);
         }
@@ -167,11 +167,11 @@ static void print_json_features(decode_ctx_t *ctx, const bsf_frame_t *fr, size_t
             (unsigned)fr->version);
     if (fr->has_pose) {
         fputs("\"pose\":[", ctx->out);
-        print_json_float(ctx->out, fr->pose_x);
+        print_json_float(ctx->out, fr->pose.x);
         fputc(',', ctx->out);
-        print_json_float(ctx->out, fr->pose_y);
+        print_json_float(ctx->out, fr->pose.y);
         fputc(',', ctx->out);
-        print_json_float(ctx->out, fr->pose_theta);
+        print_json_float(ctx->out, fr->pose.theta);
         fputs("],", ctx->out);
     } else {
         fputs("\"pose\":null,", ctx->out);

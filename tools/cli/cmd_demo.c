@@ -103,9 +103,9 @@ int cmd_demo(int argc, char **argv)
             info.seq = (uint32_t)k;
             info.timestamp_ms = (uint64_t)(100 * k);
             info.has_pose = 1u;
-            info.pose_x = (float)x;
-            info.pose_y = (float)y;
-            info.pose_theta = (float)remainder(th, 2.0 * M_PI);
+            info.pose.x = (float)x;
+            info.pose.y = (float)y;
+            info.pose.theta = (float)remainder(th, 2.0 * M_PI);
             st = bsf_frame_encode(&info, &g_res, g_frame_buf, sizeof g_frame_buf, &len);
         }
         if (st != BSF_OK) {

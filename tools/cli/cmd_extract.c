@@ -295,9 +295,9 @@ static int run_extract(const extract_opts_t *o)
          * fewer bytes; the metadata frame carries the absolute origin. */
         info.timestamp_ms = (uint64_t)((t_us - ms.meta.time_origin_us + 500) / 1000);
         info.has_pose = 1u;
-        info.pose_x = (float)rec.laser_pose.x;
-        info.pose_y = (float)rec.laser_pose.y;
-        info.pose_theta = (float)remainder(rec.laser_pose.theta, 2.0 * M_PI);
+        info.pose.x = (float)rec.laser_pose.x;
+        info.pose.y = (float)rec.laser_pose.y;
+        info.pose.theta = (float)remainder(rec.laser_pose.theta, 2.0 * M_PI);
         st = bsf_frame_encode(&info, &g_res, g_frame_buf, sizeof g_frame_buf, &len);
         if (st != BSF_OK) {
             fprintf(stderr, "%s:%lu: scan %lu not encoded: %s\n", o->log, rec.line, index,

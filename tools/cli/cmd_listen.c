@@ -147,7 +147,7 @@ static void print_frame_line(listen_state_t *ls, const bsf_frame_t *fr, size_t b
     }
     printf("frame seq=%lu t=%.3f pose=", (unsigned long)fr->seq, 1e-3 * (double)fr->timestamp_ms);
     if (fr->has_pose) {
-        printf("(%.3f,%.3f,%.4f)", (double)fr->pose_x, (double)fr->pose_y, (double)fr->pose_theta);
+        printf("(%.3f,%.3f,%.4f)", (double)fr->pose.x, (double)fr->pose.y, (double)fr->pose.theta);
     } else {
         fputs("none", stdout);
     }

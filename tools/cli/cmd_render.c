@@ -30,9 +30,9 @@ typedef struct {
 static pose2_t pose_of(const bsf_frame_t *f)
 {
     pose2_t p;
-    const double th = f->has_pose ? (double)f->pose_theta : 0.0;
-    p.x = f->has_pose ? (double)f->pose_x : 0.0;
-    p.y = f->has_pose ? (double)f->pose_y : 0.0;
+    const double th = f->has_pose ? (double)f->pose.theta : 0.0;
+    p.x = f->has_pose ? (double)f->pose.x : 0.0;
+    p.y = f->has_pose ? (double)f->pose.y : 0.0;
     p.c = cos(th);
     p.s = sin(th);
     return p;
@@ -255,7 +255,7 @@ typedef struct {
 
 static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
 {
-    const double x = (double)fr->pose_x, y = (double)fr->pose_y;
+    const double x = (double)fr->pose.x, y = (double)fr->pose.y;
     if (!fr->has_pose) {
         return;
     }
@@ -266,7 +266,7 @@ static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
     bsf_svg_path_point(svg, x, y);
     p->x = x;
     p->y = y;
-    p->theta = (double)fr->pose_theta;
+    p->theta = (double)fr->pose.theta;
     ++p->n;
 }
 
@@ -417,7 +417,7 @@ static int render_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
     case PASS_HISTOGRAM:
         for_each_curve_sample(fr, bounds_sample, rc->b);
         if (fr->has_pose) { /* the robot's positions belong in the picture */
-            bounds_sample(rc->b, 0, (double)fr->pose_x, (double)fr->pose_y);
+            bounds_sample(rc->b, 0, (double)fr->pose.x, (double)fr->pose.y);
         }
         break;
     case PASS_CURVES: draw_features(rc->svg, fr); break;

@@ -57,9 +57,9 @@ bsf_status_t live_scene_scan(uint32_t k, bsf_frame_info_t *info, const bsf_resul
     info->seq = k;
     info->timestamp_ms = (uint64_t)k * LIVE_SCENE_PERIOD_MS;
     info->has_pose = 1u;
-    info->pose_x = (float)x;
-    info->pose_y = (float)y;
-    info->pose_theta = (float)theta;
+    info->pose.x = (float)x;
+    info->pose.y = (float)y;
+    info->pose.theta = (float)theta;
     *result = &g_result;
     return BSF_OK;
 }

@@ -822,7 +822,7 @@ static PyObject *frame_to_tuple(const bsf_frame_t *f)
         Py_INCREF(geometry);
     }
     if (f->has_pose) {
-        pose = Py_BuildValue("(ddd)", (double)f->pose_x, (double)f->pose_y, (double)f->pose_theta);
+        pose = Py_BuildValue("(ddd)", (double)f->pose.x, (double)f->pose.y, (double)f->pose.theta);
     } else {
         pose = Py_None;
         Py_INCREF(pose);
@@ -1134,9 +1134,9 @@ static PyObject *core_encode(PyObject *mod, PyObject *args)
             return NULL;
         }
         info.has_pose = 1u;
-        info.pose_x = (float)x;
-        info.pose_y = (float)y;
-        info.pose_theta = (float)th;
+        info.pose.x = (float)x;
+        info.pose.y = (float)y;
+        info.pose.theta = (float)th;
     }
     if (geometry != Py_None) {
 #ifdef BSF_FRAME_TYPE_METADATA
