@@ -297,3 +297,121 @@ bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_
     }
     return BSF_OK;
 }
+
+void bsf_no_return_learner_init(bsf_no_return_learner_t *l)
+{
+    if (l != NULL) {
+        memset(l, 0, sizeof *l);
+    }
+}
+
+/* Is some run of beams reading exactly top, in the raw scan, more than 10 %
+ * above the valid readings next to it on both sides (each side having one)?
+ * Returns 1 and its first beam in *at, else 0. */
+static int isolated_top(const bsf_scan_t *scan, float top, size_t *at)
+{
+    const float jump = 0.1f * top;
+    size_t i = 0;
+    while (i < scan->count) {
+        size_t last = i;
+        size_t j;
+        int left = 0;
+        int right = 0;
+        if (scan->ranges[i] != top ||
+            !bsf_range_is_valid(scan->ranges[i], scan->range_min, scan->range_max)) {
+            ++i;
+            continue;
+        }
+        while (last + 1u < scan->count && scan->ranges[last + 1u] == top) {
+            ++last;
+        }
+        for (j = i; j > 0u; --j) {
+            const float r = scan->ranges[j - 1u];
+            if (bsf_range_is_valid(r, scan->range_min, scan->range_max)) {
+                left = top - r > jump;
+                break;
+            }
+        }
+        for (j = last + 1u; j < scan->count; ++j) {
+            const float r = scan->ranges[j];
+            if (bsf_range_is_valid(r, scan->range_min, scan->range_max)) {
+                right = top - r > jump;
+                break;
+            }
+        }
+        if (left && right) {
+            *at = i;
+            return 1;
+        }
+        i = last + 1u;
+    }
+    return 0;
+}
+
+bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *scan,
+                                 float *code_out)
+{
+    float top = 0.0f;
+    size_t at = 0;
+    size_t i;
+    if (code_out != NULL) {
+        *code_out = l != NULL ? l->code : 0.0f;
+    }
+    if (l == NULL || scan == NULL || (scan->count > 0u && scan->ranges == NULL)) {
+        return BSF_ERR_ARG;
+    }
+    if (scan->count > (size_t)BSF_MAX_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    if (l->code > 0.0f) {
+        return BSF_OK;
+    }
+    l->n_scans = (l->n_scans + 1u) % BSF_NO_RETURN_AGE_SCANS;
+    if (l->n_scans == 0u) {
+        /* Old evidence fades: a value must keep recurring to become a code,
+         * and a value that recurred once for a while frees its slot. */
+        for (i = 0; i < BSF_NO_RETURN_CANDIDATES; ++i) {
+            l->count[i] /= 2u;
+        }
+    }
+    for (i = 0; i < scan->count; ++i) {
+        const float r = scan->ranges[i];
+        if (bsf_range_is_valid(r, scan->range_min, scan->range_max) && r > top) {
+            top = r;
+        }
+    }
+    if (top > 0.0f && isolated_top(scan, top, &at)) {
+        /* Count it: its own slot, else the weakest one (an empty slot has
+         * count 0), whose value it replaces with no evidence of its own. */
+        size_t slot = BSF_NO_RETURN_CANDIDATES;
+        size_t weakest = 0;
+        for (i = 0; i < BSF_NO_RETURN_CANDIDATES; ++i) {
+            if (l->value[i] == top) {
+                slot = i;
+                break;
+            }
+            if (l->count[i] < l->count[weakest]) {
+                weakest = i;
+            }
+        }
+        if (slot == BSF_NO_RETURN_CANDIDATES) {
+            slot = weakest;
+            l->value[slot] = top;
+            l->count[slot] = 0u;
+            l->beam[slot] = (uint16_t)(at + 3u); /* never "the same beam" */
+        }
+        /* The same beam or its neighbour as last time is no new evidence. */
+        if ((at > (size_t)l->beam[slot] ? at - l->beam[slot] : l->beam[slot] - at) > 1u &&
+            l->count[slot] < UINT32_MAX) {
+            l->count[slot]++;
+        }
+        l->beam[slot] = (uint16_t)at;
+        if (l->count[slot] >= BSF_NO_RETURN_LEARN_SCANS) {
+            l->code = top;
+        }
+    }
+    if (code_out != NULL) {
+        *code_out = l->code;
+    }
+    return BSF_OK;
+}

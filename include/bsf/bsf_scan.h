@@ -107,6 +107,52 @@ BSF_NODISCARD bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts,
                                                        const bsf_no_return_params_t *p,
                                                        size_t *n_rejected);
 
+/** Candidate values bsf_no_return_learn keeps count of. */
+#define BSF_NO_RETURN_CANDIDATES 4u
+/** Scans of evidence after which bsf_no_return_learn takes a value as a code. */
+#define BSF_NO_RETURN_LEARN_SCANS 20u
+/** Every this many scans bsf_no_return_learn halves all evidence. */
+#define BSF_NO_RETURN_AGE_SCANS 64u
+
+/**
+ * State of bsf_no_return_learn across the scans of one sensor. Caller-owned,
+ * fixed size; start it with bsf_no_return_learner_init. Fields are private.
+ */
+typedef struct {
+    float value[BSF_NO_RETURN_CANDIDATES];    /**< candidate codes (0: empty slot) */
+    uint32_t count[BSF_NO_RETURN_CANDIDATES]; /**< scans of evidence for each */
+    uint16_t beam[BSF_NO_RETURN_CANDIDATES];  /**< where each was last seen isolated */
+    uint32_t n_scans;                         /**< scans since evidence was last halved */
+    float code;                               /**< the learned code; 0 until one is found */
+} bsf_no_return_learner_t;
+
+/** Start (or restart) a learner: no candidates, no code. Does nothing for NULL. */
+void bsf_no_return_learner_init(bsf_no_return_learner_t *l);
+
+/**
+ * Learn a no-return code that is not in runs (a driver writing "no return" as
+ * a fixed value, for example 50.0, on lone beams as well as in runs) from a
+ * stream of scans: a scan is evidence for its largest valid reading when some
+ * run of beams holding exactly that value (one beam is enough) reads more than
+ * 10 % above its valid neighbours on both sides, as in
+ * bsf_points_reject_no_return, and it stands on other beams than the last
+ * time (a sensor standing still sees a far surface through a gap on the
+ * same beam scan after scan). Evidence is halved every
+ * BSF_NO_RETURN_AGE_SCANS scans, and a value becomes the code once it has
+ * BSF_NO_RETURN_LEARN_SCANS scans of evidence: it must recur in about one scan
+ * in six or more (a code written in half the scans is found within about 40),
+ * and a genuine surface far away does not repeat bit for bit as an isolated
+ * maximum that often while the sensor moves. BSF_NO_RETURN_CANDIDATES values
+ * are counted at once; a new one takes the slot of the least evidence. Once found, the
+ * code stays. Put it in bsf_no_return_params_t.code (and re-initialise the
+ * extractor) to drop it from later scans.
+ * @param code_out  the learned code after this scan, 0 when none (may be NULL)
+ * @return BSF_OK; BSF_ERR_ARG for NULL l or scan, or ranges NULL with count > 0;
+ *         BSF_ERR_CAPACITY when count exceeds BSF_MAX_POINTS.
+ */
+BSF_NODISCARD bsf_status_t bsf_no_return_learn(bsf_no_return_learner_t *l, const bsf_scan_t *scan,
+                                               float *code_out);
+
 BSF_END_DECLS
 
 #endif /* BSF_SCAN_H */

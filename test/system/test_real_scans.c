@@ -221,6 +221,120 @@ static void test_an_isolated_code_needs_the_user_given_value(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_extractor_init(&ex, &p));
 }
 
+/* Scan k of a sensor walking through a closed room (1 cm quantised ranges);
+ * with lone_code > 0, scans get one to three short runs (1..4 beams) of
+ * exactly that value at varying beams, as a real log writes no return: 3 in
+ * 4 scans when every is 0, else one in `every`. */
+static bsf_scan_t walking_scan(int k, float lone_code, int every, bsf_scene_rng_t *rng)
+{
+    bsf_lidar_t l =
+        bsf_lidar_default(1.0 + 0.05 * (double)k, 2.0, 0.03 * (double)k, 181u, 3.14159265358979);
+    bsf_scan_t s;
+    size_t i;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_rect_room(&scene, -1.0, 0.0, 7.0, 5.0));
+    l.noise_sigma = 0.01;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, rng, ranges, NULL, BSF_MAX_POINTS));
+    for (i = 0; i < l.n_beams; ++i) {
+        ranges[i] = (float)((double)(long)((double)ranges[i] * 100.0 + 0.5) / 100.0);
+    }
+    if (lone_code > 0.0f && (every == 0 ? k % 4 != 3 : k % every == 0)) {
+        const int runs = 1 + (int)(bsf_scene_rng_next(rng) % 3u);
+        int r;
+        for (r = 0; r < runs; ++r) {
+            const size_t b = 2u + (size_t)(bsf_scene_rng_next(rng) % 170u);
+            const size_t n = 1u + (size_t)(bsf_scene_rng_next(rng) % 4u);
+            for (i = b; i < b + n; ++i) {
+                ranges[i] = lone_code;
+            }
+        }
+    }
+    s = bsf_scene_lidar_scan(&l, ranges);
+    s.range_max = 81.8f;
+    return s;
+}
+
+static void test_a_lone_code_recurring_as_the_maximum_is_learnt(void)
+{
+    bsf_no_return_learner_t learner;
+    bsf_scene_rng_t rng;
+    bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
+    float code = -1.0f;
+    int k;
+    int learnt_at = -1;
+    bsf_scene_rng_seed(&rng, 27u);
+    bsf_no_return_learner_init(&learner);
+    for (k = 0; k < 60; ++k) {
+        const bsf_scan_t s = walking_scan(k, 50.0f, 0, &rng);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
+        if (code > 0.0f && learnt_at < 0) {
+            learnt_at = k;
+        }
+    }
+    TEST_ASSERT_EQUAL_FLOAT(50.0f, code);
+    /* 20 scans of evidence, 3 in 4 scans have the code: about scan 26. */
+    TEST_ASSERT_TRUE(learnt_at >= 19 && learnt_at < 40);
+    /* The code stays; with it the extractor drops exactly those readings. */
+    {
+        const bsf_scan_t s = walking_scan(61, 50.0f, 0, &rng);
+        size_t i;
+        size_t n_code = 0;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
+        TEST_ASSERT_EQUAL_FLOAT(50.0f, code);
+        for (i = 0; i < s.count; ++i) {
+            n_code += s.ranges[i] == 50.0f;
+        }
+        TEST_ASSERT_TRUE(n_code >= 1u);
+        p.no_return.code = code;
+        extract(&p, &s);
+        TEST_ASSERT_EQUAL_UINT32(181u - n_code, res.stats.n_valid);
+        TEST_ASSERT_TRUE(farthest_feature_point() < 9.0);
+    }
+}
+
+static void test_no_code_is_learnt_from_genuine_scans(void)
+{
+    bsf_no_return_learner_t learner;
+    bsf_scene_rng_t rng;
+    bsf_scan_t s;
+    float code = -1.0f;
+    int k;
+    /* A walk without codes: the maxima are the room's far corners. */
+    bsf_scene_rng_seed(&rng, 28u);
+    bsf_no_return_learner_init(&learner);
+    for (k = 0; k < 100; ++k) {
+        s = walking_scan(k, 0.0f, 0, &rng);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
+    }
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, code);
+    /* A value written in one scan in ten: its evidence fades faster than it
+     * grows (halved every BSF_NO_RETURN_AGE_SCANS scans). */
+    bsf_no_return_learner_init(&learner);
+    for (k = 0; k < 300; ++k) {
+        s = walking_scan(k % 100, 50.0f, 10, &rng);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
+    }
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, code);
+    /* A sensor standing still, a far surface seen through a one-beam gap:
+     * the same isolated maximum on the same beam in every scan is no code. */
+    bsf_no_return_learner_init(&learner);
+    for (k = 0; k < 100; ++k) {
+        bsf_scene_rng_seed(&rng, 29u); /* the very same scan each time */
+        s = walking_scan(0, 0.0f, 0, &rng);
+        ranges[90] = 12.34f;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_no_return_learn(&learner, &s, &code));
+    }
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, code);
+    /* Bad input. */
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_no_return_learn(NULL, &s, &code));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_no_return_learn(&learner, NULL, &code));
+    s.ranges = NULL;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_no_return_learn(&learner, &s, &code));
+    s.ranges = ranges;
+    s.count = (size_t)BSF_MAX_POINTS + 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_CAPACITY, bsf_no_return_learn(&learner, &s, &code));
+}
+
 static void test_a_genuine_maximum_seen_by_two_beams_stays_valid(void)
 {
     /* The far corner of a square room straight ahead, between two beams: both
@@ -759,6 +873,8 @@ int main(void)
     RUN_TEST(test_undeclared_no_return_code_in_runs_is_never_a_point);
     RUN_TEST(test_an_isolated_code_needs_the_user_given_value);
     RUN_TEST(test_a_genuine_maximum_seen_by_two_beams_stays_valid);
+    RUN_TEST(test_a_lone_code_recurring_as_the_maximum_is_learnt);
+    RUN_TEST(test_no_code_is_learnt_from_genuine_scans);
     RUN_TEST(test_a_run_of_equal_maxima_next_to_close_readings_is_a_surface);
     RUN_TEST(test_far_sparse_points_are_not_chained_metres_apart);
     RUN_TEST(test_a_mixed_pixel_at_a_depth_jump_bends_no_feature);

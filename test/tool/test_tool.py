@@ -397,6 +397,59 @@ check(n_valid_of(["--no-return", "off", "--no-return", "50"]) == [180 - n_code] 
 r = run(["extract", "code50.log", "--no-return", "-3"], text=True)
 check(r.returncode != 0 and "--no-return" in r.stderr, "--no-return refuses a negative code")
 
+# 9b. a no-return code that is not in runs: lone beams and short runs (1 to 4)
+#     of exactly 50.0 in most scans of a moving sensor, as a real log writes
+#     them. Runs that short are no run code, but the value recurs as the
+#     scan's isolated maximum scan after scan: learnt, then dropped.
+import random
+
+rng = random.Random(27)
+code_scans = []
+with open(os.path.join(WORK, "lone50.log"), "w") as f:
+    for k in range(60):
+        x0 = 2.0 + 0.05 * k
+        rs = [room_range(-math.pi / 2 + i * math.pi / 180.0 + 0.02 * k, x0=x0, y0=2.5)
+              for i in range(180)]
+        codes = set()
+        if k % 4 != 3:
+            for _ in range(rng.randint(1, 3)):
+                b, n = rng.randrange(2, 170), rng.randint(1, 4)
+                codes.update(range(b, b + n))
+        for b in codes:
+            rs[b] = 50.0
+        code_scans.append(len(codes))
+        f.write("FLASER 180 %s 0 0 0 0 0 0 %d.0 nohost %d.0\n" % (" ".join("%.2f" % v for v in rs), k, k))
+r = run(["extract", "lone50.log", "--reproducible", "-o", "lone50.bsf"], text=True)
+learnt_at = None
+for line in r.stderr.splitlines():
+    if "50 m is a no-return code" in line:
+        learnt_at = int(line.split("from scan ")[1].split()[0])
+d = run(["decode", "lone50.bsf", "--json"], text=True)
+nv = [int(line.split('"n_valid":')[1].split(",")[0]) for line in d.stdout.splitlines()
+      if '"n_valid":' in line]
+check(r.returncode == 0 and learnt_at is not None and learnt_at < 40,
+      "a lone no-return code 50.0 is learnt across scans (from scan %s)" % learnt_at)
+check(learnt_at is not None and len(nv) == 60 and
+      all(nv[k] == 180 - code_scans[k] for k in range(learnt_at, 60)) and
+      all(nv[k] == 180 for k in range(learnt_at) if code_scans[k] and code_scans[k] < 5),
+      "after it is learnt, every 50.0 reading is dropped, and no other (n_valid %s)" % nv[:8])
+r = run(["extract", "lone50.log", "--no-return", "off", "-o", "lone50off.bsf"], text=True)
+check(r.returncode == 0 and "no-return code" not in r.stderr, "--no-return off learns no code")
+
+# 9c. a genuine far return through a narrow gap, the sensor standing still:
+#     the same isolated maximum on the same beam, scan after scan, is no code.
+with open(os.path.join(WORK, "gap.log"), "w") as f:
+    for k in range(60):
+        rs = [room_range(-math.pi / 2 + i * math.pi / 180.0) for i in range(180)]
+        rs[90] = 12.34
+        f.write("FLASER 180 %s 0 0 0 0 0 0 %d.0 nohost %d.0\n" % (" ".join("%.2f" % v for v in rs), k, k))
+r = run(["extract", "gap.log", "--reproducible", "-o", "gap.bsf"], text=True)
+d = run(["decode", "gap.bsf", "--json"], text=True)
+nv = [int(line.split('"n_valid":')[1].split(",")[0]) for line in d.stdout.splitlines()
+      if '"n_valid":' in line]
+check(r.returncode == 0 and "no-return code" not in r.stderr and nv == [180] * 60,
+      "a far surface seen through a gap from a standing sensor is no code (n_valid %s)" % nv[:4])
+
 # 13. intact frames of an unknown type (a newer sender's): every command counts them.
 def crc32c(data):
     crc = 0xFFFFFFFF

@@ -138,3 +138,87 @@ bsf_status_t bench_adv_scan(int kind, size_t k, float *ranges, size_t cap, bsf_s
     *scan = bsf_scene_lidar_scan(&l, ranges);
     return BSF_OK;
 }
+
+bsf_status_t bench_truth_corridor(bsf_scene_t *scene)
+{
+    /* One closed outline: the bottom wall left to right, then the top wall
+     * right to left, each with six recesses. */
+    double xy[2 * 52];
+    size_t n = 0;
+    int r;
+    const double len = 24.0;
+    const double half = 1.0;
+    const double depth = 0.5;
+    const double door = 1.2;
+    xy[2u * n] = 0.0;
+    xy[2u * n++ + 1u] = -half;
+    for (r = 0; r < 6; ++r) {
+        const double x0 = 1.5 + 3.5 * (double)r;
+        xy[2u * n] = x0;
+        xy[2u * n++ + 1u] = -half;
+        xy[2u * n] = x0;
+        xy[2u * n++ + 1u] = -half - depth;
+        xy[2u * n] = x0 + door;
+        xy[2u * n++ + 1u] = -half - depth;
+        xy[2u * n] = x0 + door;
+        xy[2u * n++ + 1u] = -half;
+    }
+    xy[2u * n] = len;
+    xy[2u * n++ + 1u] = -half;
+    xy[2u * n] = len;
+    xy[2u * n++ + 1u] = half;
+    for (r = 5; r >= 0; --r) {
+        const double x0 = 3.2 + 3.5 * (double)r;
+        xy[2u * n] = x0 + door;
+        xy[2u * n++ + 1u] = half;
+        xy[2u * n] = x0 + door;
+        xy[2u * n++ + 1u] = half + depth;
+        xy[2u * n] = x0;
+        xy[2u * n++ + 1u] = half + depth;
+        xy[2u * n] = x0;
+        xy[2u * n++ + 1u] = half;
+    }
+    xy[2u * n] = 0.0;
+    xy[2u * n++ + 1u] = half;
+    bsf_scene_init(scene);
+    return bsf_scene_add_polyline(scene, xy, n, 1) == BSF_OK ? BSF_OK : BSF_ERR_CAPACITY;
+}
+
+bsf_scene_pose_t bench_truth_corridor_pose(long k, long n)
+{
+    bsf_scene_pose_t p;
+    const double s = n > 0 ? (double)k / (double)n : 0.0;
+    const int back = s >= 0.5;
+    const double u = back ? 2.0 * (s - 0.5) : 2.0 * s;
+    p.x = back ? 22.0 - 20.0 * u : 2.0 + 20.0 * u;
+    p.y = 0.3 * sin(7.0 * BENCH_PI * u);
+    p.theta = (back ? BENCH_PI : 0.0) + 0.4 * sin(5.0 * BENCH_PI * u);
+    p.theta = atan2(sin(p.theta), cos(p.theta));
+    return p;
+}
+
+bsf_status_t bench_truth_clutter(bsf_scene_t *scene)
+{
+    bsf_scene_clutter_t c;
+    bsf_scene_rng_t rng;
+    c.half_w = 5.0;
+    c.half_h = 3.5;
+    c.n_teeth = 4;
+    c.tooth_depth = 0.4;
+    c.n_posts = 6;
+    c.n_boxes = 5;
+    c.clear = 1.5;
+    bsf_scene_rng_seed(&rng, 2718u);
+    bsf_scene_init(scene);
+    return bsf_scene_add_clutter_room(scene, &c, &rng);
+}
+
+bsf_scene_pose_t bench_truth_clutter_pose(long k, long n)
+{
+    bsf_scene_pose_t p;
+    const double a = n > 0 ? 2.0 * BENCH_PI * (double)k / (double)n : 0.0;
+    p.x = 0.8 * cos(a);
+    p.y = 0.8 * sin(a);
+    p.theta = atan2(sin(1.5 * a), cos(1.5 * a));
+    return p;
+}

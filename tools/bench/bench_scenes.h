@@ -78,4 +78,28 @@ size_t bench_adv_beams(int kind);
  */
 bsf_status_t bench_adv_scan(int kind, size_t k, float *ranges, size_t cap, bsf_scan_t *scan);
 
+/**
+ * A long corridor for bench_truth: 24 m x 2 m, its two walls broken by
+ * door recesses (1.2 m wide, 0.5 m deep, every 3.5 m, staggered between the
+ * sides), so that most corners are seen at grazing incidence.
+ * @return BSF_OK, or BSF_ERR_CAPACITY when the scene cannot hold it.
+ */
+bsf_status_t bench_truth_corridor(bsf_scene_t *scene);
+
+/** Pose k of n in the corridor: down the centre line and back, heading along
+ *  it with a wobble of +-0.4 rad. */
+bsf_scene_pose_t bench_truth_corridor_pose(long k, long n);
+
+/**
+ * A cluttered room for bench_truth: bsf_scene_add_clutter_room, 10 m x 7 m,
+ * zig-zag shelving along both long walls, 6 posts and 5 boxes, kept 1.5 m
+ * clear of the origin, drawn from a fixed seed.
+ * @return BSF_OK, or the error of bsf_scene_add_clutter_room.
+ */
+bsf_status_t bench_truth_clutter(bsf_scene_t *scene);
+
+/** Pose k of n in the cluttered room: on a 0.8 m circle round the origin,
+ *  headings turning once and a half round the circle. */
+bsf_scene_pose_t bench_truth_clutter_pose(long k, long n);
+
 #endif /* BENCH_SCENES_H */

@@ -20,6 +20,7 @@
 #include <time.h>
 
 #include "bsf/bsf.h"
+#include "bench_scenes.h"
 #include "bsf_scene.h"
 #include "bsf_truth.h"
 #include "carmen.h"
@@ -51,7 +52,11 @@ static const noise_t noises[] = {
 };
 #define N_NOISES (sizeof noises / sizeof noises[0])
 
-static const char *const scene_names[3] = {"office", "angles", "curved"};
+static const char *const scene_names[5] = {"office", "angles", "curved", "corridor", "clutter"};
+#define N_SCENES 5
+/* Scenes the targets are checked on (--check); the corridor and the
+ * cluttered room are reported only. */
+#define N_CHECKED_SCENES 3
 
 static bsf_extractor_t ex;
 static bsf_result_t res;
@@ -74,14 +79,32 @@ static double now_ns(void)
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
 
-static void make_scene(int which, bsf_scene_t *sc)
+static int make_scene(int which, bsf_scene_t *sc)
 {
     if (which == 0) {
         bsf_scene_demo_office(sc);
     } else if (which == 1) {
         bsf_scene_truth_angles(sc);
-    } else {
+    } else if (which == 2) {
         bsf_scene_truth_curved(sc);
+    } else if (which == 3) {
+        return bench_truth_corridor(sc) == BSF_OK ? 0 : -1;
+    } else {
+        return bench_truth_clutter(sc) == BSF_OK ? 0 : -1;
+    }
+    return 0;
+}
+
+static void scene_pose(int which, long k, long n, double *x, double *y, double *th)
+{
+    if (which >= 3) {
+        const bsf_scene_pose_t p =
+            which == 3 ? bench_truth_corridor_pose(k, n) : bench_truth_clutter_pose(k, n);
+        *x = p.x;
+        *y = p.y;
+        *th = p.theta;
+    } else {
+        bsf_scene_truth_pose(which, k, n, x, y, th);
     }
 }
 
@@ -93,7 +116,10 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
     bsf_scene_rng_t rng;
     bsf_params_t p = make_params();
     long k;
-    make_scene(which, &sc);
+    if (make_scene(which, &sc) != 0) {
+        fprintf(stderr, "bench_truth: scene %s does not fit\n", scene_names[which]);
+        return -1;
+    }
     bsf_scene_rng_seed(&rng, 1234u + (uint64_t)which * 7u + (uint64_t)sen->beams);
     if (bsf_extractor_init(&ex, &p) != BSF_OK) {
         fprintf(stderr, "bench_truth: extractor init failed\n");
@@ -110,7 +136,14 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
         double t0;
         double t1;
         size_t i;
-        bsf_scene_truth_pose(which, k, n_poses, &x, &y, &th);
+        scene_pose(which, k, n_poses, &x, &y, &th);
+        if (which >= 3) {
+            const bsf_scene_pose_t pz = {x, y, th};
+            if (bench_poses_check(&sc, &pz, 1u, 0.3, NULL) >= 0) {
+                fprintf(stderr, "bench_truth: %s pose %ld is not free\n", scene_names[which], k);
+                return -1;
+            }
+        }
         lid = bsf_lidar_default(x, y, th, sen->beams,
                                 (double)(sen->beams - 1u) * sen->increment_deg * PI / 180.0);
         if (sen->full_circle) {
@@ -183,8 +216,13 @@ static void print_header(void)
     printf(
         "| scene | sensor | noise | visible | recall | <3m | 3-6m | 6-8m | precision | verr "
         "med/p90/max "
-        "cm | curve rms/p99/max cm | stray>5cm | Gamma | eta | bytes/scan | us/scan | failed |\n");
-    printf("|---|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|\n");
+        "cm | curve rms/p99/max cm | stray>5cm | Gamma | eta | bytes/scan | us/scan | failed "
+        "| sparse: visible | recall | 3-6m | verr med/p90 cm | obtuse cvx (n) | obtuse ccv (n) | "
+        "seam behind (n) "
+        "| ahead (n) |\n");
+    printf(
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:"
+        "|---:|---|---|---|---|---|\n");
 }
 
 static void print_row(int which, const sensor_t *sen, const noise_t *nz,
@@ -192,12 +230,19 @@ static void print_row(int which, const sensor_t *sen, const noise_t *nz,
 {
     printf(
         "| %s | %s | %s | %lu | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f / %.2f | "
-        "%.2f / %.2f / %.2f | %.1f%% | %.1f%% | %.3f | %.0f | %.0f | %ld |\n",
+        "%.2f / %.2f / %.2f | %.1f%% | %.1f%% | %.3f | %.0f | %.0f | %ld | %lu | %.1f%% | %.1f%% "
+        "| %.2f / %.2f | %.0f%% (%lu) | %.0f%% (%lu) | %.0f%% (%lu) | %.0f%% (%lu) |\n",
         scene_names[which], sen->name, nz->name, (unsigned long)s->visible, 100.0 * s->recall,
         100.0 * s->recall_band[0], 100.0 * s->recall_band[1], 100.0 * s->recall_band[2],
         100.0 * s->precision, 100.0 * s->verr_median, 100.0 * s->verr_p90, 100.0 * s->verr_max,
         100.0 * s->curve_rms, 100.0 * s->curve_p99, 100.0 * s->curve_max, 100.0 * s->stray_share,
-        100.0 * s->gamma, s->eta, s->bytes_per_scan, s->us_per_scan, failed);
+        100.0 * s->gamma, s->eta, s->bytes_per_scan, s->us_per_scan, failed,
+        (unsigned long)s->visible_sparse, 100.0 * s->recall_sparse,
+        100.0 * s->recall_sparse_band[1], 100.0 * s->verr_sparse_median, 100.0 * s->verr_sparse_p90,
+        100.0 * s->recall_obtuse, (unsigned long)s->obtuse_visible,
+        100.0 * s->recall_obtuse_concave, (unsigned long)s->obtuse_concave_visible,
+        100.0 * s->recall_behind, (unsigned long)s->behind_visible, 100.0 * s->recall_ahead,
+        (unsigned long)s->ahead_visible);
 }
 
 /* The targets of docs/GROUND_TRUTH.md for office-like scenes (the demo office and the
@@ -209,6 +254,7 @@ static void print_row(int which, const sensor_t *sen, const noise_t *nz,
  * code before LC fails. */
 #define CURVE_P99_BOUND 0.045
 #define CURVE_MAX_BOUND 0.12
+#define SPARSE_RECALL_BOUND 0.70
 static int check_targets(int which, const sensor_t *sen, const noise_t *nz,
                          const bsf_truth_summary_t *s)
 {
@@ -232,6 +278,22 @@ static int check_targets(int which, const sensor_t *sen, const noise_t *nz,
         MISS(s->recall < want_recall, "vertex recall (>= 90 % at 361+ beams, >= 70 % at 181)");
     }
     MISS(s->precision < 0.95, "vertex precision >= 95 %");
+    if (which != 2 && s->visible_sparse > 0u) {
+        /* Sparse-wall rule: the same recall targets, not met yet; a miss
+         * fails only below SPARSE_RECALL_BOUND, under the code of its
+         * introduction (74-100 % on the office-like rows). */
+        GOAL(s->recall_sparse < want_recall,
+             "sparse-wall recall (>= 90 % at 361+ beams, >= 70 % at 181)");
+        MISS(s->recall_sparse < SPARSE_RECALL_BOUND,
+             "sparse-wall recall >= 70 % (regression bound)");
+    }
+    if (s->obtuse_visible > 0u) {
+        GOAL(s->recall_obtuse < 0.85, "recall on obtuse convex corners >= 85 %");
+    }
+    if (s->behind_visible > 0u && s->ahead_visible > 0u) {
+        GOAL(s->recall_behind + 0.05 < s->recall_ahead,
+             "a corner behind a full-circle sensor found as often as ahead");
+    }
     if (nz->sigma <= 0.01 && !nz->mixed) {
         MISS(s->verr_median > 0.01, "vertex error median <= 1 cm");
         MISS(s->verr_p90 > 0.03, "vertex error p90 <= 3 cm");
@@ -356,8 +418,11 @@ int main(int argc, char **argv)
     printf("bench_truth: %s configuration, %ld poses per row\n",
            paper_mode ? "paper-faithful" : "default", n_poses);
     print_header();
-    for (w = 0; w < 3; ++w) {
+    for (w = 0; w < N_SCENES; ++w) {
         if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {
+            continue;
+        }
+        if (quick && only_scene == NULL && w >= N_CHECKED_SCENES) {
             continue;
         }
         for (si = 0; si < N_SENSORS; ++si) {
@@ -382,7 +447,7 @@ int main(int argc, char **argv)
                 }
                 print_row(w, &sensors[si], &noises[ni], &s, failed);
                 fflush(stdout);
-                if (check) {
+                if (check && w < N_CHECKED_SCENES) {
                     missed += check_targets(w, &sensors[si], &noises[ni], &s);
                     if (failed > 0) {
                         printf("TARGET MISSED: %s %s %s: %ld scans failed\n", scene_names[w],

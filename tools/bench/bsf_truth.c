@@ -186,6 +186,100 @@ static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, con
     return 1;
 }
 
+/* Sparse-wall rule (see bsf_truth.h): from the hit on each wall nearest the
+ * vertex, the run of consecutive beams on that wall (through the seam of a
+ * full-circle scan) holds at least BSF_TRUTH_MIN_HITS returns and reaches at
+ * least BSF_TRUTH_SPARSE_REACH from the vertex. */
+static int walls_seen_sparse(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                             const float *ranges, const int16_t *hit_shape)
+{
+    const size_t n = lidar->n_beams;
+    const int ring = fabs(fabs(lidar->angle_increment) * (double)n - 2.0 * 3.14159265358979) <=
+                     fabs(lidar->angle_increment);
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const int wall = side == 0 ? c->shape_a : c->shape_b;
+        double dmin = 1e300;
+        size_t start = n;
+        size_t i;
+        int dir;
+        int run = 1;
+        double reach = 0.0;
+        for (i = 0; i < n; ++i) {
+            if (hit_shape[i] == wall) {
+                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
+                const double d =
+                    hypot((double)ranges[i] * cos(a) - c->x, (double)ranges[i] * sin(a) - c->y);
+                if (d < dmin) {
+                    dmin = d;
+                    start = i;
+                }
+            }
+        }
+        if (start == n) {
+            return 0;
+        }
+        reach = dmin;
+        for (dir = -1; dir <= 1; dir += 2) {
+            size_t b = start;
+            size_t steps;
+            for (steps = 1; steps < n; ++steps) {
+                double a;
+                double d;
+                if (dir < 0) {
+                    if (b == 0u && !ring) {
+                        break;
+                    }
+                    b = b == 0u ? n - 1u : b - 1u;
+                } else {
+                    if (b + 1u == n && !ring) {
+                        break;
+                    }
+                    b = b + 1u == n ? 0u : b + 1u;
+                }
+                if (hit_shape[b] != wall || b == start) {
+                    break;
+                }
+                a = lidar->angle_min + (double)b * lidar->angle_increment;
+                d = hypot((double)ranges[b] * cos(a) - c->x, (double)ranges[b] * sin(a) - c->y);
+                reach = d > reach ? d : reach;
+                ++run;
+            }
+        }
+        if (run < BSF_TRUTH_MIN_HITS || reach < BSF_TRUTH_SPARSE_REACH) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* A convex corner: the sensor (origin of the sensor frame) stands outside
+ * the wedge between the corner's two walls. */
+static int corner_convex(const bsf_scene_t *scene, const bsf_scene_corner_t *c,
+                         const bsf_lidar_t *lidar)
+{
+    double dir[2][2];
+    double sx;
+    double sy;
+    double cab;
+    double cas;
+    double csb;
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const bsf_shape_t *w = &scene->shape[side == 0 ? c->shape_a : c->shape_b];
+        const double d0 = hypot(w->x0 - c->wx, w->y0 - c->wy);
+        const double d1 = hypot(w->x1 - c->wx, w->y1 - c->wy);
+        dir[side][0] = d0 > d1 ? w->x0 - c->wx : w->x1 - c->wx;
+        dir[side][1] = d0 > d1 ? w->y0 - c->wy : w->y1 - c->wy;
+    }
+    sx = lidar->pose.x - c->wx;
+    sy = lidar->pose.y - c->wy;
+    cab = dir[0][0] * dir[1][1] - dir[0][1] * dir[1][0];
+    cas = dir[0][0] * sy - dir[0][1] * sx;
+    csb = sx * dir[1][1] - sy * dir[1][0];
+    return !(cas * cab > 0.0 && csb * cab > 0.0);
+}
+
 int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                   const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
                   size_t bytes, double time_ns)
@@ -215,13 +309,16 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
     for (k = 0; k < n_corners; ++k) {
         const bsf_scene_corner_t *c = &corners[k];
         int band;
+        int dense;
         double best = 1e300;
-        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX ||
-            !walls_seen(c, lidar, ranges, hit_shape)) {
+        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX) {
+            continue;
+        }
+        dense = walls_seen(c, lidar, ranges, hit_shape);
+        if (!dense && !walls_seen_sparse(c, lidar, ranges, hit_shape)) {
             continue;
         }
         band = c->range < 3.0 ? 0 : (c->range < 6.0 ? 1 : 2);
-        acc->visible[band]++;
         for (j = 0; j < res->n_ctrl; ++j) {
             if (res->ctrl_is_vertex[j]) {
                 const double d =
@@ -229,6 +326,47 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
                 best = d < best ? d : best;
             }
         }
+        if (walls_seen_sparse(c, lidar, ranges, hit_shape)) {
+            const double deg = c->angle * 57.29577951308232;
+            const double off_seam = fabs(c->bearing - lidar->angle_min);
+            const int ring = fabs(fabs(lidar->angle_increment) * (double)lidar->n_beams -
+                                  6.283185307179586) <= fabs(lidar->angle_increment);
+            const int hit = best <= BSF_TRUTH_MATCH;
+            acc->visible_sparse[band]++;
+            if (hit) {
+                acc->found_sparse[band]++;
+                hist_add(&acc->vertex_err_sparse, best);
+            } else if (bsf_truth_verbose && !dense) {
+                printf("missed sparse-wall corner at world (%.3f, %.3f), range %.2f m, beam %d, "
+                       "angle %.0f deg, nearest vertex %.3f m\n",
+                       c->wx, c->wy, c->range, c->beam, c->angle * 57.29577951, best);
+            }
+            if (deg >= BSF_TRUTH_OBTUSE_MIN && deg <= BSF_TRUTH_OBTUSE_MAX) {
+                if (corner_convex(scene, c, lidar)) {
+                    acc->obtuse_visible++;
+                    acc->obtuse_found += (uint64_t)hit;
+                } else {
+                    acc->obtuse_concave_visible++;
+                    acc->obtuse_concave_found += (uint64_t)hit;
+                }
+            }
+            if (ring) {
+                /* beam 0 is the seam; its distance in angle, either way round */
+                const double seam = fmin(fmod(off_seam, 6.283185307179586),
+                                         6.283185307179586 - fmod(off_seam, 6.283185307179586));
+                if (seam * 57.29577951308232 <= BSF_TRUTH_SEAM_DEG) {
+                    acc->behind_visible++;
+                    acc->behind_found += (uint64_t)hit;
+                } else if (seam * 57.29577951308232 >= 180.0 - BSF_TRUTH_SEAM_DEG) {
+                    acc->ahead_visible++;
+                    acc->ahead_found += (uint64_t)hit;
+                }
+            }
+        }
+        if (!dense) {
+            continue;
+        }
+        acc->visible[band]++;
         if (best <= BSF_TRUTH_MATCH) {
             acc->found[band]++;
             hist_add(&acc->vertex_err, best);
@@ -359,6 +497,25 @@ void bsf_truth_summary(const bsf_truth_acc_t *acc, bsf_truth_summary_t *s)
     }
     s->visible = vis;
     s->recall = ratio(found, vis);
+    vis = 0;
+    found = 0;
+    for (b = 0; b < BSF_TRUTH_BANDS; ++b) {
+        vis += acc->visible_sparse[b];
+        found += acc->found_sparse[b];
+        s->recall_sparse_band[b] = ratio(acc->found_sparse[b], acc->visible_sparse[b]);
+    }
+    s->visible_sparse = vis;
+    s->recall_sparse = ratio(found, vis);
+    s->verr_sparse_median = bsf_truth_quantile(&acc->vertex_err_sparse, 0.5);
+    s->verr_sparse_p90 = bsf_truth_quantile(&acc->vertex_err_sparse, 0.9);
+    s->obtuse_visible = acc->obtuse_visible;
+    s->recall_obtuse = ratio(acc->obtuse_found, acc->obtuse_visible);
+    s->obtuse_concave_visible = acc->obtuse_concave_visible;
+    s->recall_obtuse_concave = ratio(acc->obtuse_concave_found, acc->obtuse_concave_visible);
+    s->behind_visible = acc->behind_visible;
+    s->recall_behind = ratio(acc->behind_found, acc->behind_visible);
+    s->ahead_visible = acc->ahead_visible;
+    s->recall_ahead = ratio(acc->ahead_found, acc->ahead_visible);
     s->precision = acc->vertices > 0u ? ratio(acc->vertices_correct, acc->vertices) : 1.0;
     s->verr_median = bsf_truth_quantile(&acc->vertex_err, 0.5);
     s->verr_p90 = bsf_truth_quantile(&acc->vertex_err, 0.9);

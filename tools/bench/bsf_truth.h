@@ -15,6 +15,11 @@
  *    surface: no gap above BSF_TRUTH_MAX_GAP from the vertex to the first or
  *    between them (a wall seen at grazing incidence, one return every half
  *    metre, is not seen as a wall by any segmentation).
+ *  - Sparse-wall rule (reported beside the first): a visible corner within
+ *    BSF_TRUTH_RANGE_MAX counts when each of its two walls has at least
+ *    BSF_TRUTH_MIN_HITS consecutive beams hitting it, starting with the hit
+ *    nearest the vertex and reaching at least BSF_TRUTH_SPARSE_REACH from it,
+ *    however far apart the returns are (3 returns on a line fix it).
  *  - A vertex (a control point stored twice) "finds" a visible corner when it
  *    lies within BSF_TRUTH_MATCH of it; recall = found / visible.
  *  - Precision = vertices within BSF_TRUTH_MATCH of any true corner (visible or
@@ -42,6 +47,12 @@
 #define BSF_TRUTH_MAX_GAP 0.25
 #define BSF_TRUTH_SAMPLES_PER_SPAN 8
 #define BSF_TRUTH_STRAY 0.05
+/** Sparse-wall rule: a wall needs BSF_TRUTH_MIN_HITS consecutive returns from
+ *  the one next to the vertex, reaching at least this far from it, metres. */
+#define BSF_TRUTH_SPARSE_REACH 0.3
+#define BSF_TRUTH_OBTUSE_MIN 120.0
+#define BSF_TRUTH_OBTUSE_MAX 150.0
+#define BSF_TRUTH_SEAM_DEG 30.0
 /** Range bands of the recall report: [0,3), [3,6), [6,8] metres. */
 #define BSF_TRUTH_BANDS 3
 /** Histogram resolution and extent of the distance quantiles. */
@@ -58,6 +69,18 @@ typedef struct {
 typedef struct {
     uint64_t visible[BSF_TRUTH_BANDS];
     uint64_t found[BSF_TRUTH_BANDS];
+    /* The same under the sparse-wall rule (bsf_truth_walls_sparse). */
+    uint64_t visible_sparse[BSF_TRUTH_BANDS];
+    uint64_t found_sparse[BSF_TRUTH_BANDS];
+    bsf_truth_hist_t vertex_err_sparse;
+    /* Classes, all under the sparse-wall rule: obtuse convex corners
+     * (BSF_TRUTH_OBTUSE_MIN..MAX degrees, the sensor outside the walls'
+     * wedge), and on a full-circle scan the corners behind the sensor
+     * (within BSF_TRUTH_SEAM_DEG of the seam at beam 0) and ahead. */
+    uint64_t obtuse_visible, obtuse_found;
+    uint64_t obtuse_concave_visible, obtuse_concave_found; /* the sensor inside the wedge */
+    uint64_t behind_visible, behind_found;
+    uint64_t ahead_visible, ahead_found;
     uint64_t vertices;         /* vertices judged */
     uint64_t vertices_correct; /* within BSF_TRUTH_MATCH of a true corner */
     uint64_t vertices_creases; /* at a wall-curve crease: not judged */
@@ -91,6 +114,11 @@ double bsf_truth_quantile(const bsf_truth_hist_t *h, double q);
 typedef struct {
     double recall; /* all bands */
     double recall_band[BSF_TRUTH_BANDS];
+    double recall_sparse; /* the same, sparse-wall rule */
+    double recall_sparse_band[BSF_TRUTH_BANDS];
+    double verr_sparse_median, verr_sparse_p90;
+    double recall_obtuse, recall_obtuse_concave, recall_behind, recall_ahead;
+    uint64_t visible_sparse, obtuse_visible, obtuse_concave_visible, behind_visible, ahead_visible;
     double precision;
     double verr_median, verr_p90, verr_max;
     double curve_rms, curve_p99, curve_max;

@@ -18,7 +18,10 @@ static const char extract_help[] =
     "  --no-return V    the sensor's no-return code: a reading of exactly V metres is\n"
     "                   never a point; 'off' stops recognising undeclared codes (by\n"
     "                   default, a run of 5 or more identical readings at the scan's\n"
-    "                   maximum, 10 % above its neighbours, is one); may be repeated\n"
+    "                   maximum, 10 % above its neighbours, is one, and so is a value\n"
+    "                   that keeps recurring as the scan's isolated maximum (20 scans\n"
+    "                   of evidence, halved every 64): dropped from then on); may be\n"
+    "                   repeated\n"
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
     "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
@@ -153,6 +156,9 @@ static int write_metadata(meta_state_t *ms, FILE *out, const char *out_name,
 static int run_extract(const extract_opts_t *o)
 {
     static meta_state_t ms;
+    /* An undeclared code that is not in runs is learnt across scans. */
+    static bsf_no_return_learner_t learner;
+    const int learn = !(o->no_return > 0.0) && !o->no_return_off;
     carmen_reader_t *rd;
     carmen_scan_t rec;
     FILE *out;
@@ -186,6 +192,7 @@ static int run_extract(const extract_opts_t *o)
     }
     memset(&ms, 0, sizeof ms);
     memset(&cut, 0, sizeof cut);
+    bsf_no_return_learner_init(&learner);
     bsf_frame_info_init(&info);
     info.quant_step = (float)o->quant;
     progress_init(&prog);
@@ -213,6 +220,25 @@ static int run_extract(const extract_opts_t *o)
         }
         t_us = llround(rec.timestamp * 1e6);
         sc = scan_of_record(&rec, o->range_max);
+        if (learn) {
+            float code = 0.0f;
+            if (bsf_no_return_learn(&learner, &sc, &code) == BSF_OK && code > 0.0f &&
+                g_ex.params.no_return.code != code) {
+                bsf_params_t p = g_ex.params;
+                p.no_return.code = code;
+                if (init_extractor_params(&p, !o->reproducible) != 0) {
+                    carmen_close(rd);
+                    (void)close_out(out, o->out);
+                    return EXIT_FAIL;
+                }
+                fprintf(
+                    stderr,
+                    "%s:%lu: %g m is a no-return code (the scan's isolated maximum in %u or more "
+                    "scans): readings of exactly %g m are no points from scan %lu on\n",
+                    o->log, rec.line, (double)code, (unsigned)BSF_NO_RETURN_LEARN_SCANS,
+                    (double)code, index);
+            }
+        }
         st = bsf_extract(&g_ex, &sc, &g_res);
         if (st == BSF_OK_CUT) {
             note_cut_scan(&cut, o->log, rec.line, index, &g_res.stats);
