@@ -191,10 +191,12 @@ def test_every_default_parameter_is_accepted_back(method):
 
 
 def test_float_parameters_accept_every_finite_float32():
-    assert bsf.default_params()["lc_max_range"] == float(np.finfo(np.float32).max)
+    # Parameters read back in their shortest float32 form (3.4028235e38 for
+    # FLT_MAX): the same float32, compared as one.
+    assert np.float32(bsf.default_params()["lc_max_range"]) == np.finfo(np.float32).max
     for v in (float(np.finfo(np.float32).max), 3.4028235e38, 1e38):
         ex = bsf.Extractor("lc-sved-pdm", lc_max_range=v)
-        assert ex.params["lc_max_range"] == float(np.float32(v))
+        assert np.float32(ex.params["lc_max_range"]) == np.float32(v)
     for v in (3.5e38, math.inf, math.nan, 1e300):
         with pytest.raises(bsf.BsfError, match="lc_max_range"):
             bsf.Extractor("lc-sved-pdm", lc_max_range=v)
