@@ -60,7 +60,7 @@ void bsf_map_params_default(bsf_map_params_t *p)
     p->match_angle = 0.5f;
     p->vertex_dist = 0.05f;
     p->ctrl_spacing = 0.25f;
-    p->send_tol = 0.015f;
+    p->send_tol = 0.02f;
     p->quant_step = BSF_QUANT_STEP_DEFAULT;
     p->weight_cap = 32u;
     p->forget_after = 50u;
@@ -410,7 +410,8 @@ static size_t sample_curve(const bsf_point_t *w, const uint8_t *vtx, size_t n, s
 
 static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, label_t *lab)
 {
-    const float d2max = m->params.match_dist * m->params.match_dist;
+    const float md = m->params.match_dist;
+    const float d2max = md * md;
     const float cmin = cosf(m->params.match_angle);
     size_t k;
     uint16_t g;
@@ -423,11 +424,20 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
             const bsf_map_seg_t *sg = &m->segs[g];
             const float ux = sg->bx - sg->ax;
             const float uy = sg->by - sg->ay;
-            const float l2 = ux * ux + uy * uy;
+            float l2;
             float t = 0.0f;
             float ex;
             float ey;
             float d2;
+            /* cheap rejection: the sample is beyond the chord's box grown by
+             * the match distance */
+            if ((s[k].x < sg->ax - md && s[k].x < sg->bx - md) ||
+                (s[k].x > sg->ax + md && s[k].x > sg->bx + md) ||
+                (s[k].y < sg->ay - md && s[k].y < sg->by - md) ||
+                (s[k].y > sg->ay + md && s[k].y > sg->by + md)) {
+                continue;
+            }
+            l2 = ux * ux + uy * uy;
             if (l2 > 1e-10f) {
                 t = ((s[k].x - sg->ax) * ux + (s[k].y - sg->ay) * uy) / l2;
                 t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);

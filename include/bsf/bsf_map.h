@@ -58,7 +58,7 @@ typedef struct {
                                    map feature (default 0.25) */
     float send_tol;           /**< metres, [0, 1]: a control point is re-sent when its fused
                                    position is farther than this from the value the receiver
-                                   holds (default 0.015) */
+                                   holds (default 0.02) */
     float quant_step;         /**< metres, [BSF_QUANT_STEP_MIN, BSF_QUANT_STEP_MAX], rounded
                                    to 0.1 mm: the wire's unit of control points (default 0.005) */
     uint16_t weight_cap;      /**< 1..255: observation weight at which a control point's
