@@ -13,8 +13,9 @@
 #include "bsf/bsf_stream.h"
 #include "bsf_map_internal.h"
 
-/* Scan curve samples per metre of control polygon, and their bounds. */
-#define SAMPLE_STEP 0.05f
+/* Spacing of scan curve samples along the control polygon, metres, and the
+ * bounds of their count. */
+#define SAMPLE_STEP 0.07f
 #define MIN_SAMPLES 4u
 #define MAX_SAMPLES 64u
 /* Control points one scan feature may refine at once. */
