@@ -55,6 +55,32 @@ typedef struct {
     uint8_t vertex;
 } newpt_t;
 
+/* Map features near the whole scan, gathered once per scan (and again
+ * after a merge or a forgotten feature moved slots). */
+typedef struct {
+    float box[4]; /* the scan's control points' box grown by match_dist */
+    uint16_t slot[BSF_MAP_MAX_FEATURES];
+    uint16_t n;
+    uint32_t removed; /* n_merged + n_forgotten when gathered */
+    int valid;
+} near_t;
+
+static void gather_near(const bsf_map_t *m, near_t *nr)
+{
+    uint16_t fs;
+    nr->n = 0u;
+    for (fs = 0; fs < m->n_features; ++fs) {
+        const bsf_map_feature_t *f = &m->features[fs];
+        if (f->max_x < nr->box[0] || f->min_x > nr->box[2] || f->max_y < nr->box[1] ||
+            f->min_y > nr->box[3]) {
+            continue;
+        }
+        nr->slot[nr->n++] = fs;
+    }
+    nr->removed = m->stats.n_merged + m->stats.n_forgotten;
+    nr->valid = 1;
+}
+
 void bsf_map_params_default(bsf_map_params_t *p)
 {
     p->match_dist = 0.10f;
@@ -950,14 +976,15 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
     }
 }
 
-static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n)
+static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
+                         near_t *nr)
 {
     sample_t s[MAX_SAMPLES];
     label_t lab[MAX_SAMPLES];
     float box[4];
     size_t ns;
     size_t k;
-    uint16_t fs;
+    size_t j;
     long first = -1;
     long last = -1;
 
@@ -982,7 +1009,11 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     box[2] += m->params.match_dist;
     box[3] += m->params.match_dist;
     m->n_segs = 0u;
-    for (fs = 0; fs < m->n_features; ++fs) {
+    if (!nr->valid || nr->removed != m->stats.n_merged + m->stats.n_forgotten) {
+        gather_near(m, nr);
+    }
+    for (j = 0; j < nr->n; ++j) {
+        const uint16_t fs = nr->slot[j];
         const bsf_map_feature_t *f = &m->features[fs];
         if ((f->flags & BSF_MAP_FF_FRESH) || f->max_x < box[0] || f->min_x > box[2] ||
             f->max_y < box[1] || f->min_y > box[3]) {
@@ -1021,7 +1052,6 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     /* refine every feature the samples matched, once each */
     for (k = 0; k < ns; ++k) {
         const uint16_t f = lab[k].feature;
-        size_t j;
         int seen = 0;
         if (f == BSF_MAP_NONE) {
             continue;
@@ -1112,6 +1142,7 @@ static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
 
 int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pose)
 {
+    near_t nr;
     float c;
     float sn;
     size_t i;
@@ -1130,6 +1161,28 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     }
     c = cosf(pose->theta);
     sn = sinf(pose->theta);
+    nr.valid = 0;
+    nr.n = 0u;
+    nr.removed = 0u;
+    nr.box[0] = nr.box[1] = 3.0e38f;
+    nr.box[2] = nr.box[3] = -3.0e38f;
+    for (i = 0; i < scan->n_features; ++i) {
+        const bsf_feature_t *f = &scan->features[i];
+        size_t j;
+        for (j = f->ctrl_first; j < (size_t)f->ctrl_first + f->n_ctrl; ++j) {
+            const bsf_point_t *p = &scan->ctrl[j];
+            const float x = pose->x + c * p->x - sn * p->y;
+            const float y = pose->y + sn * p->x + c * p->y;
+            nr.box[0] = x < nr.box[0] ? x : nr.box[0];
+            nr.box[1] = y < nr.box[1] ? y : nr.box[1];
+            nr.box[2] = x > nr.box[2] ? x : nr.box[2];
+            nr.box[3] = y > nr.box[3] ? y : nr.box[3];
+        }
+    }
+    nr.box[0] -= map->params.match_dist;
+    nr.box[1] -= map->params.match_dist;
+    nr.box[2] += map->params.match_dist;
+    nr.box[3] += map->params.match_dist;
     for (i = 0; i < scan->n_features; ++i) {
         const bsf_feature_t *f = &scan->features[i];
         bsf_point_t w[BSF_MAX_CTRL_PER_FEATURE];
@@ -1139,7 +1192,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
             w[j].x = pose->x + c * p->x - sn * p->y;
             w[j].y = pose->y + sn * p->x + c * p->y;
         }
-        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl);
+        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, &nr);
     }
     return (int)scan->n_features;
 }
