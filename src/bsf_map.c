@@ -9,7 +9,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "bsf/bsf_bspline.h"
 #include "bsf/bsf_stream.h"
 #include "bsf_map_internal.h"
 
@@ -324,6 +323,29 @@ static void span_basis(uint8_t ends, float u, float b[3])
     }
 }
 
+/* Derivatives of span_basis with respect to u (a tangent direction). */
+static void span_deriv(uint8_t ends, float u, float d[3])
+{
+    const float v = 1.0f - u;
+    if (ends == 3u) {
+        d[0] = -2.0f * v;
+        d[1] = 2.0f * (v - u);
+        d[2] = 2.0f * u;
+    } else if (ends & 1u) {
+        d[0] = -2.0f * v;
+        d[1] = 2.0f - 3.0f * u;
+        d[2] = u;
+    } else if (ends & 2u) {
+        d[0] = -v;
+        d[1] = 3.0f * v - 2.0f;
+        d[2] = 2.0f * u;
+    } else {
+        d[0] = -v;
+        d[1] = 1.0f - 2.0f * u;
+        d[2] = u;
+    }
+}
+
 /* Spans of feature slot fs whose chord box meets box[] (min x, min y, max x,
  * max y), appended to m->segs. */
 static void build_segs(bsf_map_t *m, uint16_t fs, const float box[4])
@@ -414,18 +436,32 @@ static size_t sample_curve(const bsf_point_t *w, const uint8_t *vtx, size_t n, s
     ns = (size_t)(len / SAMPLE_STEP) + 1u;
     ns = ns < MIN_SAMPLES ? MIN_SAMPLES : (ns > MAX_SAMPLES ? MAX_SAMPLES : ns);
     for (k = 0; k < ns; ++k) {
-        const float t = (float)k / (float)(ns - 1u);
-        bsf_point_t p;
-        bsf_point_t d;
+        /* span and local parameter of t = k / (ns - 1), the last sample at
+         * the end of the last span */
+        const float ts = (float)k * (float)(n - 2u) / (float)(ns - 1u);
+        size_t span = (size_t)ts;
+        float u;
+        float b[3];
+        float d[3];
+        float dx;
+        float dy;
         float dl;
-        if (bsf_bspline_eval(w, n, t, &p, &d, NULL) != BSF_OK) {
-            return 0;
+        uint8_t ends;
+        if (span > n - 3u) {
+            span = n - 3u;
         }
-        dl = sqrtf(d.x * d.x + d.y * d.y);
-        out[k].x = p.x;
-        out[k].y = p.y;
-        out[k].dx = dl > 0.0f ? d.x / dl : 0.0f;
-        out[k].dy = dl > 0.0f ? d.y / dl : 0.0f;
+        u = ts - (float)span;
+        u = u > 1.0f ? 1.0f : u;
+        ends = (uint8_t)((span == 0u ? 1u : 0u) | (span + 3u == n ? 2u : 0u));
+        span_basis(ends, u, b);
+        span_deriv(ends, u, d);
+        out[k].x = b[0] * w[span].x + b[1] * w[span + 1u].x + b[2] * w[span + 2u].x;
+        out[k].y = b[0] * w[span].y + b[1] * w[span + 1u].y + b[2] * w[span + 2u].y;
+        dx = d[0] * w[span].x + d[1] * w[span + 1u].x + d[2] * w[span + 2u].x;
+        dy = d[0] * w[span].y + d[1] * w[span + 1u].y + d[2] * w[span + 2u].y;
+        dl = sqrtf(dx * dx + dy * dy);
+        out[k].dx = dl > 0.0f ? dx / dl : 0.0f;
+        out[k].dy = dl > 0.0f ? dy / dl : 0.0f;
         out[k].vertex = 0u;
     }
     /* a vertex (slots i, i + 1 flagged) sits on the curve at t = i / (n - 2) */
