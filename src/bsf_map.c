@@ -232,7 +232,6 @@ static size_t chain_expanded(const bsf_map_t *m, const bsf_map_feature_t *f)
 /* 1 when every point is sent and within the tolerance of its sent value. */
 int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f)
 {
-    const float step = m->params.quant_step;
     const float tol = m->params.send_tol;
     uint16_t i = f->head;
     if (!(f->flags & BSF_MAP_FF_SENT)) {
@@ -240,14 +239,8 @@ int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f)
     }
     while (i != BSF_MAP_NONE) {
         const bsf_map_ctrl_t *c = &m->ctrl[i];
-        float ex;
-        float ey;
-        if (!(c->flags & BSF_MAP_CF_SENT)) {
-            return 0;
-        }
-        ex = c->x - (float)c->qx * step;
-        ey = c->y - (float)c->qy * step;
-        if (ex * ex + ey * ey > tol * tol) {
+        if (!(c->flags & BSF_MAP_CF_SENT) ||
+            bsf_map_ctrl_moved(c, m->params.quant_step, tol * tol)) {
             return 0;
         }
         i = c->next;
@@ -1012,6 +1005,39 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
     }
 }
 
+/* A scan vertex that matched a map curve where the map has no vertex (the
+ * curve was first seen without its corner): the span's control point nearest
+ * to it, if not a chain end and within ctrl_spacing, becomes a vertex there.
+ * The receiver gets it as a move with a vertex toggle; later observations of
+ * the corner merge into it. */
+static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
+{
+    const bsf_map_seg_t *sg = &m->segs[l->seg];
+    const float sp = m->params.ctrl_spacing;
+    float best = sp * sp;
+    uint16_t pick = BSF_MAP_NONE;
+    unsigned j;
+    for (j = 0; j < 3u; ++j) {
+        const bsf_map_ctrl_t *c = &m->ctrl[sg->p[j]];
+        const float d2 = (c->x - q->x) * (c->x - q->x) + (c->y - q->y) * (c->y - q->y);
+        if ((c->flags & BSF_MAP_CF_VERTEX) != 0u) {
+            return; /* the span already has its corner */
+        }
+        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && d2 < best) {
+            best = d2;
+            pick = sg->p[j];
+        }
+    }
+    if (pick != BSF_MAP_NONE) {
+        bsf_map_ctrl_t *c = &m->ctrl[pick];
+        c->x = q->x;
+        c->y = q->y;
+        c->flags |= BSF_MAP_CF_VERTEX;
+        c->weight = 1u;
+        ++m->stats.n_vertex_made;
+    }
+}
+
 static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
                          near_t *nr)
 {
@@ -1084,6 +1110,12 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
         }
         (void)feature_new(m, p, np);
         return;
+    }
+    /* corners the map has not got yet */
+    for (k = 0; k < ns; ++k) {
+        if (s[k].vertex && lab[k].feature != BSF_MAP_NONE) {
+            make_vertex(m, &lab[k], &s[k]);
+        }
     }
     /* refine every feature the samples matched, once each */
     for (k = 0; k < ns; ++k) {
@@ -1255,7 +1287,8 @@ int bsf_map_feature_ctrl(const bsf_map_t *map, size_t index, int sent, bsf_point
     }
     for (i = f->head; i != BSF_MAP_NONE; i = map->ctrl[i].next) {
         const bsf_map_ctrl_t *c = &map->ctrl[i];
-        const unsigned reps = (c->flags & BSF_MAP_CF_VERTEX) ? 2u : 1u;
+        const unsigned reps =
+            (c->flags & (sent ? BSF_MAP_CF_SENT_VTX : BSF_MAP_CF_VERTEX)) != 0u ? 2u : 1u;
         unsigned r;
         if (sent && !(c->flags & BSF_MAP_CF_SENT)) {
             continue;
@@ -1299,7 +1332,7 @@ int bsf_map_feature_q(const bsf_map_t *map, size_t index, int32_t *q, uint8_t *i
                 q[2u * n + 1u] = c->qy;
             }
             if (is_vertex != NULL) {
-                is_vertex[n] = (uint8_t)(c->flags & BSF_MAP_CF_VERTEX);
+                is_vertex[n] = (c->flags & BSF_MAP_CF_SENT_VTX) ? 1u : 0u;
             }
         }
         ++n;
