@@ -14,7 +14,7 @@
 
 /* Spacing of scan curve samples along the control polygon, metres, and the
  * bounds of their count. */
-#define SAMPLE_STEP 0.07f
+#define SAMPLE_STEP 0.08f
 #define MIN_SAMPLES 4u
 #define MAX_SAMPLES 64u
 /* Control points one scan feature may refine at once. */

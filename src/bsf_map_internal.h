@@ -16,8 +16,8 @@
 #define BSF_MAP_NONE 0xFFFFu
 
 /* bsf_map_ctrl_t.flags */
-#define BSF_MAP_CF_VERTEX 1u /* a vertex (multiplicity 2) */
-#define BSF_MAP_CF_SENT 2u   /* qx, qy hold what the receiver has */
+#define BSF_MAP_CF_VERTEX 1u   /* a vertex (multiplicity 2) */
+#define BSF_MAP_CF_SENT 2u     /* qx, qy hold what the receiver has */
 #define BSF_MAP_CF_SENT_VTX 4u /* the receiver's vertex flag of the point */
 
 /* bsf_map_feature_t.flags */
