@@ -23,5 +23,6 @@
 #include "bsf_extract.h"
 #include "bsf_stream.h"
 #include "bsf_map.h"
+#include "bsf_align.h"
 
 #endif /* BSF_H */

@@ -107,4 +107,17 @@
 #define bsf_map_rx_feature_ctrl BSF_MAP_CAPS_NAME(bsf_map_rx_feature_ctrl)
 #define bsf_map_rx_feature_q BSF_MAP_CAPS_NAME(bsf_map_rx_feature_q)
 
+/* Alignment's work area also follows the alignment caps (A: BSF_ALIGN_MAX_POINTS,
+ * V: BSF_ALIGN_MAX_VERTICES, S: BSF_ALIGN_MAX_SEGS, G: BSF_ALIGN_GRID, E:
+ * BSF_ALIGN_MAX_ENTRIES) and takes the map, so its symbols carry all three sets. */
+#define BSF_ALIGN_CAPS_PASTE_(fn, a, v, s, g, e) fn##_A##a##V##v##S##s##G##g##E##e
+#define BSF_ALIGN_CAPS_EXPAND_(fn, a, v, s, g, e) BSF_ALIGN_CAPS_PASTE_(fn, a, v, s, g, e)
+/** The symbol of alignment function fn for the caps of this translation unit. */
+#define BSF_ALIGN_CAPS_NAME(fn)                                                                    \
+    BSF_ALIGN_CAPS_EXPAND_(BSF_MAP_CAPS_NAME(fn), BSF_ALIGN_MAX_POINTS, BSF_ALIGN_MAX_VERTICES,    \
+                           BSF_ALIGN_MAX_SEGS, BSF_ALIGN_GRID, BSF_ALIGN_MAX_ENTRIES)
+
+#define bsf_align_points BSF_ALIGN_CAPS_NAME(bsf_align_points)
+#define bsf_align_features BSF_ALIGN_CAPS_NAME(bsf_align_features)
+
 #endif /* BSF_ABI_H */

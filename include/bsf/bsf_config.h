@@ -78,6 +78,32 @@
 #define BSF_MAP_RX_MAX_CTRL 32768
 #endif
 
+/* Alignment of a scan to the map (bsf_align.h): */
+/** Largest number of scan points one alignment uses (the rest are subsampled away). */
+#ifndef BSF_ALIGN_MAX_POINTS
+#define BSF_ALIGN_MAX_POINTS 128
+#endif
+
+/** Largest number of scan vertices, and of map vertices near the prior, one alignment uses. */
+#ifndef BSF_ALIGN_MAX_VERTICES
+#define BSF_ALIGN_MAX_VERTICES 64
+#endif
+
+/** Largest number of map chords (two per map span) near the prior one alignment holds. */
+#ifndef BSF_ALIGN_MAX_SEGS
+#define BSF_ALIGN_MAX_SEGS 1024
+#endif
+
+/** Cells per side of the correspondence grid of one alignment. */
+#ifndef BSF_ALIGN_GRID
+#define BSF_ALIGN_GRID 48
+#endif
+
+/** Entries (chord, cell) of that grid. */
+#ifndef BSF_ALIGN_MAX_ENTRIES
+#define BSF_ALIGN_MAX_ENTRIES 4096
+#endif
+
 /* Extraction methods compiled into the library: bit m of BSF_CONFIG_METHODS
  * stands for bsf_method_t m. Firmware that only ever runs one method sets
  * just its bit, so the link leaves the other detectors and fitters out (with
@@ -130,6 +156,21 @@
 #if BSF_MAP_RX_MAX_CTRL < 64 || BSF_MAP_RX_MAX_CTRL > 65535
 #error "BSF_MAP_RX_MAX_CTRL must be in [64, 65535]"
 #endif
+#if BSF_ALIGN_MAX_POINTS < 8 || BSF_ALIGN_MAX_POINTS > 4096
+#error "BSF_ALIGN_MAX_POINTS must be in [8, 4096]"
+#endif
+#if BSF_ALIGN_MAX_VERTICES < 1 || BSF_ALIGN_MAX_VERTICES > 4096
+#error "BSF_ALIGN_MAX_VERTICES must be in [1, 4096]"
+#endif
+#if BSF_ALIGN_MAX_SEGS < 16 || BSF_ALIGN_MAX_SEGS > 65535
+#error "BSF_ALIGN_MAX_SEGS must be in [16, 65535]"
+#endif
+#if BSF_ALIGN_GRID < 4 || BSF_ALIGN_GRID > 255
+#error "BSF_ALIGN_GRID must be in [4, 255]"
+#endif
+#if BSF_ALIGN_MAX_ENTRIES < 16 || BSF_ALIGN_MAX_ENTRIES > 65535
+#error "BSF_ALIGN_MAX_ENTRIES must be in [16, 65535]"
+#endif
 
 #if (BSF_CONFIG_METHODS) < 1 || (BSF_CONFIG_METHODS) > 15
 #error "BSF_CONFIG_METHODS must name at least one method and only BSF_CONFIG_METHOD_* bits"
@@ -149,7 +190,12 @@
     BSF_CONFIG_APPEND0_(BSF_MAP_MAX_CTRL) != BSF_MAP_MAX_CTRL * 10 ||                              \
     BSF_CONFIG_APPEND0_(BSF_MAP_MAX_OPS) != BSF_MAP_MAX_OPS * 10 ||                                \
     BSF_CONFIG_APPEND0_(BSF_MAP_RX_MAX_FEATURES) != BSF_MAP_RX_MAX_FEATURES * 10 ||                \
-    BSF_CONFIG_APPEND0_(BSF_MAP_RX_MAX_CTRL) != BSF_MAP_RX_MAX_CTRL * 10
+    BSF_CONFIG_APPEND0_(BSF_MAP_RX_MAX_CTRL) != BSF_MAP_RX_MAX_CTRL * 10 ||                        \
+    BSF_CONFIG_APPEND0_(BSF_ALIGN_MAX_POINTS) != BSF_ALIGN_MAX_POINTS * 10 ||                      \
+    BSF_CONFIG_APPEND0_(BSF_ALIGN_MAX_VERTICES) != BSF_ALIGN_MAX_VERTICES * 10 ||                  \
+    BSF_CONFIG_APPEND0_(BSF_ALIGN_MAX_SEGS) != BSF_ALIGN_MAX_SEGS * 10 ||                          \
+    BSF_CONFIG_APPEND0_(BSF_ALIGN_GRID) != BSF_ALIGN_GRID * 10 ||                                  \
+    BSF_CONFIG_APPEND0_(BSF_ALIGN_MAX_ENTRIES) != BSF_ALIGN_MAX_ENTRIES * 10
 #error "bsf caps must be plain decimal integers such as 361 (they become part of symbol names)"
 #endif
 
