@@ -40,8 +40,9 @@ BSF_BEGIN_DECLS
 #define BSF_FRAME_TYPE_MAP 3u
 /** Smallest frame buffer bsf_map_encode() accepts, bytes. */
 #define BSF_MAP_FRAME_MIN_SIZE 64u
-/** Largest map-update frame on the wire (COBS body + delimiter), bytes; the
- *  receiver's decoder buffer holds any frame up to BSF_FRAME_BODY_MAX_SIZE. */
+/** Largest map-update frame on the wire (COBS body + delimiter), bytes;
+ *  bsf_map_encode also keeps frames within BSF_FRAME_MAX_SIZE, what a stream
+ *  decoder of the same caps holds. */
 #define BSF_MAP_FRAME_MAX_SIZE 4096u
 
 /* ---- Parameters ------------------------------------------------------------ */
