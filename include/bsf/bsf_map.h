@@ -92,6 +92,7 @@ typedef struct {
     uint32_t n_forgotten;      /**< features dropped from RAM (the receiver keeps them) */
     uint32_t n_forgotten_ctrl; /**< their control points */
     uint32_t n_dropped_obs;    /**< scan features left out: caps full, nothing to forget */
+    uint32_t n_transient;      /**< features seen in one scan only, never sent, dropped */
     uint32_t n_frames;         /**< frames written by bsf_map_encode */
     uint32_t map_bytes;        /**< bytes of those frames, pose records excluded */
     uint32_t pose_bytes;       /**< bytes of pose records (and of pose-only frames) */
