@@ -1174,6 +1174,35 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     }
 }
 
+/* A feature never seen again (every point observed once) and never sent,
+ * unseen for TRANSIENT_CALLS calls: a passer-by or noise; it is dropped
+ * before it costs bytes. */
+#define TRANSIENT_CALLS 5u
+
+static void drop_transients(bsf_map_t *m)
+{
+    uint16_t fs = 0;
+    while (fs < m->n_features) {
+        const bsf_map_feature_t *f = &m->features[fs];
+        int once = 1;
+        uint16_t i;
+        if ((f->flags & BSF_MAP_FF_SENT) || m->stats.n_fused - f->last_seen < TRANSIENT_CALLS) {
+            ++fs;
+            continue;
+        }
+        for (i = f->head; i != BSF_MAP_NONE && once; i = m->ctrl[i].next) {
+            once = m->ctrl[i].weight <= 1u;
+        }
+        if (!once) {
+            ++fs;
+            continue;
+        }
+        chain_free(m, f->head);
+        feature_remove_slot(m, fs);
+        ++m->stats.n_transient;
+    }
+}
+
 static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
 {
     size_t i;
@@ -1227,6 +1256,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     for (fs = 0; fs < map->n_features; ++fs) {
         map->features[fs].flags &= (uint8_t)~BSF_MAP_FF_FRESH;
     }
+    drop_transients(map);
     c = cosf(pose->theta);
     sn = sinf(pose->theta);
     nr.valid = 0;

@@ -813,8 +813,12 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
     if (cap < BSF_MAP_FRAME_MIN_SIZE) {
         return BSF_ERR_BUFFER;
     }
+    /* no frame longer than a decoder of the same caps can hold */
     if (cap > BSF_MAP_FRAME_MAX_SIZE) {
         cap = BSF_MAP_FRAME_MAX_SIZE;
+    }
+    if (cap > BSF_FRAME_MAX_SIZE) {
+        cap = BSF_FRAME_MAX_SIZE;
     }
     /* payload written after room for the COBS overhead, encoded in place */
     offset = 2u + cap / 254u;
@@ -1156,7 +1160,8 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
     case BSF_MAP_REC_MERGE: {
         bsf_map_rx_feature_t *b = &rx->features[rec->id_b];
         int ok = f->state == RX_PRESENT && b->state == RX_PRESENT && f->upd == rec->upd &&
-                 b->upd == rec->upd_b && f->head != BSF_MAP_NONE && b->head != BSF_MAP_NONE;
+                 b->upd == rec->upd_b && f->head != BSF_MAP_NONE && b->head != BSF_MAP_NONE &&
+                 (uint32_t)f->n_ctrl + rec->n + b->n_ctrl <= BSF_MAP_REC_MAX_POINTS;
         if (ok) {
             if (rec->high) {
                 rx_reverse(rx, f);
