@@ -22,5 +22,6 @@
 #include "bsf_bid.h"
 #include "bsf_extract.h"
 #include "bsf_stream.h"
+#include "bsf_map.h"
 
 #endif /* BSF_H */

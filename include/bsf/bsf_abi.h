@@ -84,4 +84,27 @@
 #define bsf_decoder_init BSF_CAPS_NAME(bsf_decoder_init)
 #define bsf_decoder_feed BSF_CAPS_NAME(bsf_decoder_feed)
 
+/* The map's objects also follow the map caps (M: BSF_MAP_MAX_FEATURES, Q:
+ * BSF_MAP_MAX_CTRL, O: BSF_MAP_MAX_OPS, R: BSF_MAP_RX_MAX_FEATURES, Z:
+ * BSF_MAP_RX_MAX_CTRL), so their symbols carry those too. */
+#define BSF_MAP_CAPS_PASTE_(fn, m, q, o, r, z) fn##_M##m##Q##q##O##o##R##r##Z##z
+#define BSF_MAP_CAPS_EXPAND_(fn, m, q, o, r, z) BSF_MAP_CAPS_PASTE_(fn, m, q, o, r, z)
+/** The symbol of map function fn for the caps of this translation unit. */
+#define BSF_MAP_CAPS_NAME(fn)                                                                      \
+    BSF_MAP_CAPS_EXPAND_(BSF_CAPS_NAME(fn), BSF_MAP_MAX_FEATURES, BSF_MAP_MAX_CTRL,                \
+                         BSF_MAP_MAX_OPS, BSF_MAP_RX_MAX_FEATURES, BSF_MAP_RX_MAX_CTRL)
+
+#define bsf_map_init BSF_MAP_CAPS_NAME(bsf_map_init)
+#define bsf_map_fuse BSF_MAP_CAPS_NAME(bsf_map_fuse)
+#define bsf_map_encode BSF_MAP_CAPS_NAME(bsf_map_encode)
+#define bsf_map_pending BSF_MAP_CAPS_NAME(bsf_map_pending)
+#define bsf_map_feature_count BSF_MAP_CAPS_NAME(bsf_map_feature_count)
+#define bsf_map_feature_ctrl BSF_MAP_CAPS_NAME(bsf_map_feature_ctrl)
+#define bsf_map_feature_q BSF_MAP_CAPS_NAME(bsf_map_feature_q)
+#define bsf_map_rx_init BSF_MAP_CAPS_NAME(bsf_map_rx_init)
+#define bsf_map_rx_apply BSF_MAP_CAPS_NAME(bsf_map_rx_apply)
+#define bsf_map_rx_id_limit BSF_MAP_CAPS_NAME(bsf_map_rx_id_limit)
+#define bsf_map_rx_feature_ctrl BSF_MAP_CAPS_NAME(bsf_map_rx_feature_ctrl)
+#define bsf_map_rx_feature_q BSF_MAP_CAPS_NAME(bsf_map_rx_feature_q)
+
 #endif /* BSF_ABI_H */

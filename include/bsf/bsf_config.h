@@ -52,6 +52,32 @@
 #define BSF_MAX_CTRL_POINTS 512
 #endif
 
+/* Fused map (bsf_map.h). The robot's map: */
+/** Largest number of features of the robot's map held in RAM. */
+#ifndef BSF_MAP_MAX_FEATURES
+#define BSF_MAP_MAX_FEATURES 256
+#endif
+
+/** Pool of control points shared by the robot map's features (a vertex counts once). */
+#ifndef BSF_MAP_MAX_CTRL
+#define BSF_MAP_MAX_CTRL 2048
+#endif
+
+/** Largest number of merges queued between two map frames. */
+#ifndef BSF_MAP_MAX_OPS
+#define BSF_MAP_MAX_OPS 16
+#endif
+
+/** Largest feature id + 1 the receiver's map holds (features ever sent). */
+#ifndef BSF_MAP_RX_MAX_FEATURES
+#define BSF_MAP_RX_MAX_FEATURES 8192
+#endif
+
+/** Pool of control points of the receiver's map. */
+#ifndef BSF_MAP_RX_MAX_CTRL
+#define BSF_MAP_RX_MAX_CTRL 32768
+#endif
+
 /* Extraction methods compiled into the library: bit m of BSF_CONFIG_METHODS
  * stands for bsf_method_t m. Firmware that only ever runs one method sets
  * just its bit, so the link leaves the other detectors and fitters out (with
@@ -88,6 +114,23 @@
 #error "BSF_MAX_CTRL_POINTS must be in [BSF_MAX_CTRL_PER_FEATURE, 65535]"
 #endif
 
+/* Map pools are indexed by uint16_t with 0xFFFF as "none". */
+#if BSF_MAP_MAX_FEATURES < 1 || BSF_MAP_MAX_FEATURES > 65535
+#error "BSF_MAP_MAX_FEATURES must be in [1, 65535]"
+#endif
+#if BSF_MAP_MAX_CTRL < 64 || BSF_MAP_MAX_CTRL > 65535
+#error "BSF_MAP_MAX_CTRL must be in [64, 65535]"
+#endif
+#if BSF_MAP_MAX_OPS < 1 || BSF_MAP_MAX_OPS > 255
+#error "BSF_MAP_MAX_OPS must be in [1, 255]"
+#endif
+#if BSF_MAP_RX_MAX_FEATURES < 1 || BSF_MAP_RX_MAX_FEATURES > 16777216
+#error "BSF_MAP_RX_MAX_FEATURES must be in [1, 16777216]"
+#endif
+#if BSF_MAP_RX_MAX_CTRL < 64 || BSF_MAP_RX_MAX_CTRL > 65535
+#error "BSF_MAP_RX_MAX_CTRL must be in [64, 65535]"
+#endif
+
 #if (BSF_CONFIG_METHODS) < 1 || (BSF_CONFIG_METHODS) > 15
 #error "BSF_CONFIG_METHODS must name at least one method and only BSF_CONFIG_METHOD_* bits"
 #endif
@@ -101,7 +144,12 @@
     BSF_CONFIG_APPEND0_(BSF_MAX_KEYPOINTS) != BSF_MAX_KEYPOINTS * 10 ||                            \
     BSF_CONFIG_APPEND0_(BSF_MAX_SEGMENTS) != BSF_MAX_SEGMENTS * 10 ||                              \
     BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_PER_FEATURE) != BSF_MAX_CTRL_PER_FEATURE * 10 ||              \
-    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_POINTS) != BSF_MAX_CTRL_POINTS * 10
+    BSF_CONFIG_APPEND0_(BSF_MAX_CTRL_POINTS) != BSF_MAX_CTRL_POINTS * 10 ||                        \
+    BSF_CONFIG_APPEND0_(BSF_MAP_MAX_FEATURES) != BSF_MAP_MAX_FEATURES * 10 ||                      \
+    BSF_CONFIG_APPEND0_(BSF_MAP_MAX_CTRL) != BSF_MAP_MAX_CTRL * 10 ||                              \
+    BSF_CONFIG_APPEND0_(BSF_MAP_MAX_OPS) != BSF_MAP_MAX_OPS * 10 ||                                \
+    BSF_CONFIG_APPEND0_(BSF_MAP_RX_MAX_FEATURES) != BSF_MAP_RX_MAX_FEATURES * 10 ||                \
+    BSF_CONFIG_APPEND0_(BSF_MAP_RX_MAX_CTRL) != BSF_MAP_RX_MAX_CTRL * 10
 #error "bsf caps must be plain decimal integers such as 361 (they become part of symbol names)"
 #endif
 

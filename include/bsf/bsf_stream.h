@@ -299,6 +299,10 @@ BSF_NODISCARD bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const b
  * geometry are 0,
  * quant_step is metadata.quant_step, and result holds no features (counts
  * and stats 0; its arrays are not touched).
+ *
+ * Map update (BSF_FRAME_TYPE_MAP, bsf_map.h): the payload has been checked
+ * for well-formedness; seq is the map frame's sequence number, the other
+ * fields are 0 as for metadata; apply payload with bsf_map_rx_apply().
  */
 typedef struct {
     uint8_t version;         /**< format version of the frame (1 or 2) */
@@ -317,6 +321,11 @@ typedef struct {
     float angle_increment;   /**< radians (with has_geometry) */
     bsf_result_t result;     /**< features, control points, vertex flags, stats */
     bsf_metadata_t metadata; /**< only for type BSF_FRAME_TYPE_METADATA */
+    const uint8_t *payload;  /**< the frame's checked payload (CRC excluded), inside the
+                                  decoder's buffer (bsf_decoder_feed: valid until the next
+                                  call) or the caller's body (bsf_frame_decode); for a map
+                                  frame (BSF_FRAME_TYPE_MAP) hand it to bsf_map_rx_apply() */
+    size_t payload_len;      /**< bytes at payload */
 } bsf_frame_t;
 
 /**
