@@ -17,11 +17,6 @@ static const char render_help[] =
     "several times (a pipe is spooled to a temporary file), so memory does not grow\n"
     "with its length. Exits 1 when a non-empty input holds no valid frame.\n";
 
-#define RENDER_CURVE_COLOUR "#1f5fbf"
-#define RENDER_VERTEX_COLOUR "#d62728"
-#define RENDER_PATH_COLOUR "#2ca02c"
-#define RENDER_POINT_COLOUR "#9a9a9a"
-#define RENDER_WALL_COLOUR "#c8c8c8"
 
 typedef struct {
     double x, y, c, s;
@@ -245,20 +240,11 @@ static int draw_log_points(bsf_svg_points_t *pts, const char *log, long lo, long
     return r < 0 ? -1 : 0;
 }
 
-/* The robot's path: the poses of the frames drawn, fed in order to
- * path_add(), one polyline; a jump of more than 5 m (a new log segment, a
- * relocalisation) starts a new line. path_end() marks the last pose. */
-typedef struct {
-    unsigned long n;
-    double x, y, theta;
-} path_t;
-
-static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
+/* The robot's path: poses fed in order to render_path_point(), one
+ * polyline; a jump of more than 5 m (a new log segment, a relocalisation)
+ * starts a new line. render_path_end() marks the last pose. */
+void render_path_point(bsf_svg_t *svg, render_path_t *p, double x, double y, double theta)
 {
-    const double x = (double)fr->pose_x, y = (double)fr->pose_y;
-    if (!fr->has_pose) {
-        return;
-    }
     if (p->n == 0 || hypot(x - p->x, y - p->y) > 5.0) {
         bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
         bsf_svg_path_begin(svg);
@@ -266,11 +252,18 @@ static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
     bsf_svg_path_point(svg, x, y);
     p->x = x;
     p->y = y;
-    p->theta = (double)fr->pose_theta;
+    p->theta = theta;
     ++p->n;
 }
 
-static void path_end(bsf_svg_t *svg, const path_t *p)
+static void path_add(bsf_svg_t *svg, render_path_t *p, const bsf_frame_t *fr)
+{
+    if (fr->has_pose) {
+        render_path_point(svg, p, (double)fr->pose_x, (double)fr->pose_y, (double)fr->pose_theta);
+    }
+}
+
+void render_path_end(bsf_svg_t *svg, const render_path_t *p)
 {
     bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
     if (p->n > 0) {
@@ -298,7 +291,7 @@ static unsigned long draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
 }
 
 /* The legend row: the layers that are in the picture. */
-static void draw_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
+void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
 {
     bsf_svg_legend_item_t key[5];
     size_t n = 0;
@@ -391,7 +384,7 @@ typedef struct {
     render_pass_t pass;
     bounds_ctx_t *b;
     bsf_svg_t *svg;
-    path_t path;
+    render_path_t path;
     unsigned long vertices;
 } render_ctx_t;
 
@@ -527,13 +520,13 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     bsf_svg_curves_end(&svg);
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_PATH) != 0;
-        path_end(&svg, &rc.path);
+        render_path_end(&svg, &rc.path);
     }
     /* vertices on top */
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_VERTICES) != 0;
     }
-    draw_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL);
+    render_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL);
     snprintf(caption, sizeof caption, "%lu scans, %lu vertices", bc.frames, rc.vertices);
     if (points_log != NULL) {
         size_t len = strlen(caption);
