@@ -107,14 +107,27 @@ typedef struct {
 
 /** One feature of the robot's map (internal layout). */
 typedef struct {
+    float min_x, min_y; /**< bounding box of the control points, metres */
+    float max_x, max_y;
     uint32_t id;        /**< feature id on the wire, unique for the stream */
     uint32_t last_seen; /**< n_fused when last observed */
     uint16_t head;      /**< pool index of the first control point */
     uint16_t tail;      /**< pool index of the last control point */
     uint16_t n_ctrl;    /**< distinct control points (a vertex counts once) */
-    uint8_t flags;      /**< used, sent, ... */
+    uint8_t flags;      /**< sent, in a queued merge, made by this scan */
     uint8_t upd;        /**< update count mod 16, as the receiver holds it */
 } bsf_map_feature_t;
+
+/** Segments of map curves near one scan feature, searched by bsf_map_fuse. */
+#define BSF_MAP_SEG_WINDOW 192
+
+/** One span of a map curve as a chord between its knot points (internal). */
+typedef struct {
+    float ax, ay, bx, by; /**< chord from the span's start knot point to its end */
+    uint16_t feature;     /**< slot in features[] */
+    uint16_t p[3];        /**< pool indices of the span's three control points */
+    uint8_t ends;         /**< 1: the chain's first span, 2: its last span */
+} bsf_map_seg_t;
 
 /** A merge queued for the next frame (internal). */
 typedef struct {
@@ -132,14 +145,15 @@ typedef struct {
     bsf_map_ctrl_t ctrl[BSF_MAP_MAX_CTRL];
     bsf_map_op_t ops[BSF_MAP_MAX_OPS];
     uint16_t n_ops;
-    uint16_t n_features;                   /**< used slots of features[] (packed) */
-    uint16_t free_ctrl;                    /**< head of the free list of ctrl[] */
-    uint16_t n_free_ctrl;                  /**< points on that list */
-    uint32_t next_id;                      /**< id of the next new feature */
-    uint32_t frame_seq;                    /**< sequence number of the next frame */
-    uint32_t snapshot_next;                /**< round-robin position of snapshots (feature id) */
-    int32_t step_code;                     /**< quant_step in 0.1 mm */
-    bsf_point_t work[BSF_MAX_CTRL_POINTS]; /**< one scan's control points, world frame */
+    uint16_t n_features;                    /**< used slots of features[] (packed) */
+    uint16_t free_ctrl;                     /**< head of the free list of ctrl[] */
+    uint16_t n_free_ctrl;                   /**< points on that list */
+    uint32_t next_id;                       /**< id of the next new feature */
+    uint32_t frame_seq;                     /**< sequence number of the next frame */
+    uint32_t snapshot_next;                 /**< round-robin position of snapshots (feature id) */
+    int32_t step_code;                      /**< quant_step in 0.1 mm */
+    bsf_map_seg_t segs[BSF_MAP_SEG_WINDOW]; /**< work area of bsf_map_fuse */
+    uint16_t n_segs;
     bsf_map_stats_t stats;
 } bsf_map_t;
 
