@@ -37,6 +37,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
@@ -70,14 +71,29 @@ typedef struct {
     /* grid */
     mg_grid_result_t grid;
     int grid_ok;
-    /* synthetic truth of the map */
+    /* the map */
+    size_t map_update_bytes, map_pose_bytes, map_once_bytes;
+    unsigned long map_frames, map_once_missing; /* forgotten features not in the snapshot */
+    unsigned long map_features, map_vertices, map_forgotten, map_dropped;
+    unsigned long rx_mismatch, rx_compared, fuse_failed;
+    double map_length;
+    mg_hist_t map_dist;  /* raw point to the final map */
+    mg_hist_t map_truth; /* map curve samples to the true surface */
+    double *fuse_us;     /* host time per fuse call */
+    size_t n_fuse_us;
+    /* synthetic truth */
     double seen_m;
-    unsigned long corners_5, corners_one;
+    unsigned long corners_5, corners_one, corners_many;
 } column_t;
 
 static bsf_extractor_t g_ex;
+static bsf_map_t g_map;
+static bsf_map_t g_map_copy;
+static bsf_map_rx_t g_rx;
+static bsf_decoder_t g_dec;
+static bsf_frame_t g_frame;
 static bsf_result_t g_res;
-static uint8_t g_buf[BSF_FRAME_MAX_SIZE];
+static uint8_t g_buf[BSF_FRAME_MAX_SIZE + BSF_MAP_FRAME_MAX_SIZE];
 static const char *g_grid_out = NULL;
 
 /* The growing per-scan stream (for its gzip'd size). */
@@ -210,6 +226,8 @@ static void own_scan_distances(const mg_points_t *pts, size_t first, const mg_cu
     }
 }
 
+static int fuse_scan(column_t *col, double px, double py, double pth);
+
 /* Everything a scan contributes once extracted: stream bytes, raw points,
  * own-scan coverage. ranges/geometry in sc; pose of the sensor in the world. */
 static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t t_us, double px,
@@ -242,6 +260,203 @@ static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t 
         return -1;
     }
     own_scan_distances(pts, first, scratch, &col->own_dist);
+    return fuse_scan(col, px, py, pth);
+}
+
+static double now_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e6 + 1e-3 * (double)ts.tv_nsec;
+}
+
+/* A map frame through the decoder into the receiver, as a link delivers it. */
+static int to_receiver(const uint8_t *buf, size_t len)
+{
+    size_t off = 0;
+    while (off < len) {
+        size_t used = 0;
+        const int r = bsf_decoder_feed(&g_dec, buf + off, len - off, &used, &g_frame);
+        if (r < 0) {
+            return -1;
+        }
+        off += used;
+        if (r > 0) {
+            if (g_frame.type != BSF_FRAME_TYPE_MAP ||
+                bsf_map_rx_apply(&g_rx, g_frame.payload, g_frame.payload_len) < 0) {
+                return -1;
+            }
+        } else if (used == 0u) {
+            break;
+        }
+    }
+    return 0;
+}
+
+/* Write (and deliver) every waiting map change; pose may be NULL. */
+static int map_flush(column_t *col, const bsf_pose_t *pose)
+{
+    int first = 1;
+    while (first || bsf_map_pending(&g_map)) {
+        size_t len = 0;
+        if (bsf_map_encode(&g_map, first ? pose : NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) !=
+            BSF_OK) {
+            return -1;
+        }
+        if (len == 0u) {
+            break;
+        }
+        ++col->map_frames;
+        if (to_receiver(g_buf, len) != 0) {
+            fprintf(stderr, "bench_map: %s: the receiver refused a map frame\n", col->name);
+            return -1;
+        }
+        first = 0;
+    }
+    return 0;
+}
+
+/* Fuse g_res (the scan just extracted) at the sensor pose and send the changes. */
+static int fuse_scan(column_t *col, double px, double py, double pth)
+{
+    bsf_pose_t pose;
+    double t0;
+    int r;
+    pose.x = (float)px;
+    pose.y = (float)py;
+    pose.theta = (float)remainder(pth, 2.0 * PI);
+    t0 = now_us();
+    r = bsf_map_fuse(&g_map, &g_res, &pose);
+    if (col->fuse_us != NULL) {
+        col->fuse_us[col->n_fuse_us++] = now_us() - t0;
+    }
+    if (r < 0) {
+        ++col->fuse_failed;
+        return 0;
+    }
+    return map_flush(col, &pose);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+/* The bytes of the final map sent once: snapshot records of every feature
+ * the robot still holds, on a copy of the map (the library has no call that
+ * writes the whole map at once). */
+static int map_once_bytes(column_t *col)
+{
+    const size_t n = bsf_map_feature_count(&g_map);
+    uint32_t bytes0, snaps0;
+    int guard = 0;
+    memcpy(&g_map_copy, &g_map, sizeof g_map);
+    g_map_copy.params.snapshot_budget = 3000u;
+    bytes0 = g_map_copy.stats.map_bytes;
+    snaps0 = g_map_copy.stats.n_snapshots;
+    while ((size_t)(g_map_copy.stats.n_snapshots - snaps0) < n && guard++ < 100000) {
+        size_t len = 0;
+        if (bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
+            return -1;
+        }
+        if (len == 0u) {
+            break;
+        }
+    }
+    col->map_once_bytes = (size_t)(g_map_copy.stats.map_bytes - bytes0);
+    col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
+    return (size_t)(g_map_copy.stats.n_snapshots - snaps0) >= n ? 0 : -1;
+}
+
+/* The receiver's final map as curves; robot and receiver compared value for value. */
+static int final_map(column_t *col, mg_curves_t *map)
+{
+    static bsf_point_t ctrl[BSF_MAP_RX_MAX_CTRL];
+    static uint8_t vtx[BSF_MAP_RX_MAX_CTRL];
+    static double xy[2u * BSF_MAP_RX_MAX_CTRL];
+    static int32_t qa[2u * BSF_MAP_RX_MAX_CTRL], qb[2u * BSF_MAP_RX_MAX_CTRL];
+    static uint8_t va[BSF_MAP_RX_MAX_CTRL], vb[BSF_MAP_RX_MAX_CTRL];
+    const uint32_t limit = bsf_map_rx_id_limit(&g_rx);
+    size_t i;
+    uint32_t id;
+    mg_curves_clear(map);
+    for (id = 0; id < limit; ++id) {
+        const int n = bsf_map_rx_feature_ctrl(&g_rx, id, ctrl, vtx, BSF_MAP_RX_MAX_CTRL, NULL);
+        int k;
+        if (n < 3) {
+            continue;
+        }
+        for (k = 0; k < n; ++k) {
+            xy[2 * k] = (double)ctrl[k].x;
+            xy[2 * k + 1] = (double)ctrl[k].y;
+        }
+        if (mg_curves_add_bspline(map, xy, (size_t)n, vtx) != 0) {
+            return -1;
+        }
+    }
+    col->map_features = (unsigned long)map->n_curves;
+    col->map_vertices = (unsigned long)map->n_vtx;
+    col->map_length = map->length;
+    for (i = 0; i < bsf_map_feature_count(&g_map); ++i) {
+        uint32_t rid = 0;
+        const int na = bsf_map_feature_q(&g_map, i, qa, va, BSF_MAP_RX_MAX_CTRL, &rid);
+        const int nb = bsf_map_rx_feature_q(&g_rx, rid, qb, vb, BSF_MAP_RX_MAX_CTRL);
+        ++col->rx_compared;
+        if (na != nb || na < 0 ||
+            memcmp(qa, qb, 2u * (size_t)(na > 0 ? na : 0) * sizeof(int32_t)) != 0 ||
+            memcmp(va, vb, (size_t)(na > 0 ? na : 0)) != 0) {
+            ++col->rx_mismatch;
+        }
+    }
+    return 0;
+}
+
+/* Every raw point's distance to the final map. */
+static int map_coverage(column_t *col, const mg_points_t *pts, const mg_curves_t *map)
+{
+    mg_index_t ix;
+    size_t i;
+    if (mg_index_build(&ix, map) != 0) {
+        return -1;
+    }
+    for (i = 0; i < pts->n; ++i) {
+        mg_hist_add(&col->map_dist,
+                    mg_index_dist(&ix, (double)pts->xy[2u * i], (double)pts->xy[2u * i + 1u]));
+    }
+    mg_index_free(&ix);
+    return 0;
+}
+
+static int map_begin(column_t *col, size_t max_scans)
+{
+    bsf_map_params_t mp;
+    bsf_map_params_default(&mp);
+    if (bsf_map_init(&g_map, &mp) != BSF_OK) {
+        return -1;
+    }
+    bsf_map_rx_init(&g_rx);
+    bsf_decoder_init(&g_dec);
+    col->fuse_us = (double *)malloc((max_scans ? max_scans : 1u) * sizeof(double));
+    return col->fuse_us != NULL ? 0 : -1;
+}
+
+static int map_end(column_t *col, const mg_points_t *pts, mg_curves_t *map)
+{
+    if (map_flush(col, NULL) != 0) {
+        return -1;
+    }
+    col->map_update_bytes = g_map.stats.map_bytes;
+    col->map_pose_bytes = g_map.stats.pose_bytes;
+    col->map_forgotten = g_map.stats.n_forgotten;
+    col->map_dropped = g_map.stats.n_dropped_obs;
+    if (map_once_bytes(col) != 0) {
+        fprintf(stderr, "bench_map: %s: snapshot cycle did not cover the map\n", col->name);
+    }
+    if (final_map(col, map) != 0 || map_coverage(col, pts, map) != 0) {
+        return -1;
+    }
+    qsort(col->fuse_us, col->n_fuse_us, sizeof(double), cmp_double);
     return 0;
 }
 
@@ -266,7 +481,7 @@ static int run_log(column_t *col, const char *path, long max_scans)
     carmen_reader_t *rd = carmen_open(path, stderr);
     carmen_scan_t rec;
     mg_points_t pts;
-    mg_curves_t scratch;
+    mg_curves_t scratch, map;
     uint32_t seq = 0;
     int r, rc = 0;
     if (rd == NULL) {
@@ -275,9 +490,15 @@ static int run_log(column_t *col, const char *path, long max_scans)
     }
     mg_points_init(&pts);
     mg_curves_init(&scratch);
+    mg_curves_init(&map);
+    if (map_begin(col, max_scans > 0 ? (size_t)max_scans : 100000u) != 0) {
+        carmen_close(rd);
+        return -1;
+    }
     g_stream_n = 0;
     g_source = strrchr(path, '/') != NULL ? strrchr(path, '/') + 1 : path;
-    while ((r = carmen_next(rd, &rec)) > 0 && (max_scans < 0 || (long)seq < max_scans)) {
+    while ((r = carmen_next(rd, &rec)) > 0 && (max_scans < 0 || (long)seq < max_scans) &&
+           seq < 100000u) {
         const bsf_scan_t sc = scan_of_record(&rec, 0.0);
         const int t = take_scan(col, &sc, seq, llround(rec.timestamp * 1e6), rec.laser_pose.x,
                                 rec.laser_pose.y, rec.laser_pose.theta, &pts, &scratch);
@@ -294,8 +515,12 @@ static int run_log(column_t *col, const char *path, long max_scans)
     if (rc == 0) {
         rc = finish_baselines(col, &pts);
     }
+    if (rc == 0) {
+        rc = map_end(col, &pts, &map);
+    }
     mg_points_free(&pts);
     mg_curves_free(&scratch);
+    mg_curves_free(&map);
     return rc;
 }
 
@@ -381,18 +606,20 @@ static int run_scene(column_t *col, int which, long n_poses)
     const size_t beams = 361u;
     bsf_scene_rng_t rng;
     mg_points_t pts;
-    mg_curves_t scratch;
+    mg_curves_t scratch, map;
     seen_t seen;
     long k;
+    size_t m;
     int rc = 0;
     make_scene(which, &scene);
     bsf_scene_rng_seed(&rng, 4321u + (uint64_t)which);
     mg_points_init(&pts);
     mg_curves_init(&scratch);
+    mg_curves_init(&map);
     memset(g_corner_scans, 0, sizeof g_corner_scans);
     g_stream_n = 0;
     g_source = scene_names[which];
-    if (seen_init(&seen, &scene) != 0) {
+    if (seen_init(&seen, &scene) != 0 || map_begin(col, (size_t)n_poses) != 0) {
         return -1;
     }
     for (k = 0; k < n_poses && rc == 0; ++k) {
@@ -447,8 +674,34 @@ static int run_scene(column_t *col, int which, long n_poses)
     if (rc == 0) {
         rc = finish_baselines(col, &pts);
     }
+    if (rc == 0) {
+        rc = map_end(col, &pts, &map);
+    }
+    if (rc == 0) {
+        for (m = 0; m < map.n_seg; ++m) {
+            mg_hist_add(&col->map_truth,
+                        bsf_scene_distance_to_surface(&scene, (double)map.seg[4u * m],
+                                                      (double)map.seg[4u * m + 1u], NULL));
+        }
+        for (m = 0; m < g_n_corners; ++m) {
+            size_t v, near = 0;
+            if (g_corner_scans[m] < CORNER_MIN_SCANS) {
+                continue;
+            }
+            ++col->corners_5;
+            for (v = 0; v < map.n_vtx; ++v) {
+                near += hypot(map.vtx[2u * v] - g_corners[m].wx,
+                              map.vtx[2u * v + 1u] - g_corners[m].wy) <= CORNER_MATCH
+                            ? 1u
+                            : 0u;
+            }
+            col->corners_one += near == 1u ? 1u : 0u;
+            col->corners_many += near > 1u ? 1u : 0u;
+        }
+    }
     mg_points_free(&pts);
     mg_curves_free(&scratch);
+    mg_curves_free(&map);
     return rc;
 }
 
@@ -484,7 +737,43 @@ static void print_table(void)
         }                                                                                          \
         printf("\n");                                                                              \
     } while (0)
-    ROW("scans (failed)", printf(" %lu (%lu) |", col->scans, col->failed));
+    ROW("scans (extraction failed, fuse failed)",
+        printf(" %lu (%lu, %lu) |", col->scans, col->failed, col->fuse_failed));
+    ROW("**map: bytes of the final map, sent once**",
+        printf(" %lu%s |", (unsigned long)col->map_once_bytes,
+               col->map_once_missing ? " (+forgotten)" : ""));
+    ROW("**map: bytes of the whole update stream (map only)**",
+        printf(" %lu |", (unsigned long)col->map_update_bytes));
+    ROW("map: pose bytes (a pose per scan, apart)",
+        printf(" %lu |", (unsigned long)col->map_pose_bytes));
+    ROW("map: frames", printf(" %lu |", col->map_frames));
+    ROW("**map: median point distance mm**",
+        printf(" %.1f |", 1000.0 * mg_hist_quantile(&col->map_dist, 0.5)));
+    ROW("**map: points within 5 cm**",
+        printf(" %.1f %% |", 100.0 * mg_hist_share_below(&col->map_dist, 0.05)));
+    ROW("**map: curve to true surface p99 / max mm**",
+        col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->map_truth, 0.99),
+                                1000.0 * col->map_truth.max)
+                       : printf(" – |"));
+    ROW("**map: curve length per metre of true surface seen**",
+        col->synthetic && col->seen_m > 0.0 ? printf(" %.3f |", col->map_length / col->seen_m)
+                                            : printf(" – |"));
+    ROW("**map: corners seen in >= 5 scans that are one map vertex within 3 cm**",
+        col->synthetic
+            ? printf(" %.1f %% (%lu of %lu; %lu with several) |",
+                     col->corners_5 ? 100.0 * (double)col->corners_one / (double)col->corners_5
+                                    : 0.0,
+                     col->corners_one, col->corners_5, col->corners_many)
+            : printf(" – |"));
+    ROW("map: features, vertices, curve m",
+        printf(" %lu, %lu, %.1f |", col->map_features, col->map_vertices, col->map_length));
+    ROW("map: forgotten features, scan features left out",
+        printf(" %lu, %lu |", col->map_forgotten, col->map_dropped));
+    ROW("map: receiver = robot (features differing / compared)",
+        printf(" %lu / %lu |", col->rx_mismatch, col->rx_compared));
+    ROW("map: host fuse time median / max us",
+        printf(" %.0f / %.0f |", col->n_fuse_us ? col->fuse_us[col->n_fuse_us / 2u] : 0.0,
+               col->n_fuse_us ? col->fuse_us[col->n_fuse_us - 1u] : 0.0));
     ROW("per-scan stream bytes (bsf extract)", printf(" %lu |", (unsigned long)col->stream_bytes));
     ROW("per-scan stream, gzip'd", printf(" %lu |", (unsigned long)col->stream_gz_bytes));
     ROW("per-scan features: median point distance mm",
@@ -502,6 +791,10 @@ static void print_table(void)
     ROW("5 cm grid, PNG bytes", printf(" %lu |", (unsigned long)col->grid.png_bytes));
     ROW("true surface seen m", col->synthetic ? printf(" %.1f |", col->seen_m) : printf(" – |"));
 #undef ROW
+    printf("\nRAM of the map (sizeof bsf_map_t, this build's caps: %d features, %d control "
+           "points): %lu bytes; receiver (sizeof bsf_map_rx_t): %lu bytes\n",
+           BSF_MAP_MAX_FEATURES, BSF_MAP_MAX_CTRL, (unsigned long)sizeof(bsf_map_t),
+           (unsigned long)sizeof(bsf_map_rx_t));
 }
 
 int main(int argc, char **argv)

@@ -335,11 +335,10 @@ static int run_extract(const extract_opts_t *o)
                 ++index;
                 continue;
             }
-            if (write_map_frames(out, o->out,
-                                 o->pose_every > 0 && done % (unsigned long)o->pose_every == 0u
-                                     ? &pose
-                                     : NULL,
-                                 &bytes) != 0) {
+            if (write_map_frames(
+                    out, o->out,
+                    o->pose_every > 0 && done % (unsigned long)o->pose_every == 0u ? &pose : NULL,
+                    &bytes) != 0) {
                 write_failed = 1;
                 break;
             }

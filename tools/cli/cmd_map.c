@@ -11,7 +11,8 @@ static const char map_help[] =
     "standard input) with the library's receiver, frame by frame, and print it.\n"
     "\n"
     "  --json        one JSON object per map feature on stdout:\n"
-    "                {\"id\": N, \"stale\": false, \"ctrl\": [[x, y], ...], \"vertex\": [0, 1, ...]}\n"
+    "                {\"id\": N, \"stale\": false, \"ctrl\": [[x, y], ...], \"vertex\": [0, 1, "
+    "...]}\n"
     "                world-frame control points in metres of a clamped uniform\n"
     "                quadratic B-spline; a vertex (corner) is a control point given\n"
     "                twice, both copies flagged 1, as in a scan's features\n"
@@ -50,8 +51,8 @@ static int feature_points(const map_view_t *v, uint32_t id, bsf_point_t *ctrl, u
 {
     const int n = bsf_map_rx_feature_ctrl(v->rx, id, ctrl, vtx, MAP_MAX_POINTS, stale);
     if (n > (int)MAP_MAX_POINTS) {
-        fail_msg("feature %lu has %d control points, more than this tool holds",
-                 (unsigned long)id, n);
+        fail_msg("feature %lu has %d control points, more than this tool holds", (unsigned long)id,
+                 n);
         return -1;
     }
     return n;
@@ -84,8 +85,7 @@ static void print_json(const map_view_t *v, bsf_point_t *ctrl, uint8_t *vtx)
 /* Point of span s (of `spans`) at u in [0, 1] of a clamped uniform quadratic
  * B-spline with any number of control points (bsf_bspline_eval stops at a
  * scan feature's cap; a map feature is longer). */
-static void span_point(const bsf_point_t *c, size_t spans, size_t s, double u, double *x,
-                       double *y)
+static void span_point(const bsf_point_t *c, size_t spans, size_t s, double u, double *x, double *y)
 {
     const double a = (1.0 - u) * (1.0 - u), b = 2.0 * u * (1.0 - u), q = u * u;
     double w0 = 0.5 * a, w1 = 0.5 * a + b + 0.5 * q, w2 = 0.5 * q;
@@ -226,8 +226,9 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
         }
     }
     render_legend(&svg, v->n_path > 0u, 0, 0);
-    snprintf(caption, sizeof caption, "map: %lu features, %lu vertices, %.1f m of curve; %lu frames",
-             t->features, t->vertices, t->length, v->frames);
+    snprintf(caption, sizeof caption,
+             "map: %lu features, %lu vertices, %.1f m of curve; %lu frames", t->features,
+             t->vertices, t->length, v->frames);
     rc = bsf_svg_end(&svg, caption) != 0 || close_out(out, out_path) != 0 ? -1 : 0;
     free(xy);
     return rc;
@@ -307,8 +308,7 @@ int cmd_map(int argc, char **argv)
     if (json) {
         print_json(&ctx.view, ctrl, vtx);
     }
-    if (out_path != NULL &&
-        write_svg(out_path, in_path, &ctx.view, width, ctrl, vtx, &t) != 0) {
+    if (out_path != NULL && write_svg(out_path, in_path, &ctx.view, width, ctrl, vtx, &t) != 0) {
         rc = -1;
     }
     info = (json || (out_path != NULL && strcmp(out_path, "-") == 0)) ? stderr : stdout;
@@ -320,9 +320,8 @@ int cmd_map(int argc, char **argv)
             "%lu map frames, %llu bytes (%lu pose-only frames, %llu bytes), %lu missing by "
             "sequence, %lu records skipped, %lu frames dropped\n",
             in_path, t.features, t.ctrl, t.vertices, t.length, t.stale, ctx.view.frames,
-            ctx.view.bytes, ctx.view.pose_only_frames, ctx.view.pose_only_bytes,
-            sum.map_seq_gaps, (unsigned long)ctx.view.rx->stats.records_skipped,
-            frames_dropped(&sum.stats));
+            ctx.view.bytes, ctx.view.pose_only_frames, ctx.view.pose_only_bytes, sum.map_seq_gaps,
+            (unsigned long)ctx.view.rx->stats.records_skipped, frames_dropped(&sum.stats));
     map_view_free(&ctx.view);
     if (close_out(stdout, "stdout") != 0) {
         rc = -1;

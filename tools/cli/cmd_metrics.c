@@ -63,8 +63,7 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
 {
     static metrics_map_ctx_t c;
     stream_summary_t s2;
-    const unsigned long long other =
-        s->bytes_in - s->map_frame_bytes - s->metadata_bytes;
+    const unsigned long long other = s->bytes_in - s->map_frame_bytes - s->metadata_bytes;
     unsigned long features = 0, ctrl = 0, stale = 0;
     uint32_t id;
     memset(&c, 0, sizeof c);
@@ -87,14 +86,13 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
     printf("map frames        %lu, %llu bytes: %llu in frames with map records, %llu in %lu "
            "pose-only frames (%lu pose records in all)\n",
            s->n_map_frames, s->map_frame_bytes, s->map_frame_bytes - c.view.pose_only_bytes,
-           c.view.pose_only_bytes, c.view.pose_only_frames,
-           (unsigned long)c.view.rx->stats.poses);
+           c.view.pose_only_bytes, c.view.pose_only_frames, (unsigned long)c.view.rx->stats.poses);
     printf("other bytes       %llu metadata, %llu per-scan frames and unframed bytes\n",
            s->metadata_bytes, other);
     printf("map               %lu features, %lu control points (vertices twice), %lu stale; "
            "%lu map frames missing by sequence, %lu records skipped, %lu frames refused\n",
-           features, ctrl, stale, s->map_seq_gaps,
-           (unsigned long)c.view.rx->stats.records_skipped, c.failed ? c.view.frames_bad : 0ul);
+           features, ctrl, stale, s->map_seq_gaps, (unsigned long)c.view.rx->stats.records_skipped,
+           c.failed ? c.view.frames_bad : 0ul);
     map_view_free(&c.view);
     return 0;
 }

@@ -17,7 +17,6 @@ static const char render_help[] =
     "several times (a pipe is spooled to a temporary file), so memory does not grow\n"
     "with its length. Exits 1 when a non-empty input holds no valid frame.\n";
 
-
 typedef struct {
     double x, y, c, s;
 } pose2_t;

@@ -95,9 +95,9 @@ typedef struct {
     uint32_t last_seq;                 /**< internal: the last one */
     unsigned long n_map_frames;        /**< map-update frames delivered */
     unsigned long long map_frame_bytes; /**< their bytes on the wire */
-    unsigned long map_seq_gaps;        /**< map frames missing according to their numbers */
-    int have_map_seq;                  /**< internal: a map frame number was seen */
-    uint32_t last_map_seq;             /**< internal: the last one */
+    unsigned long map_seq_gaps;         /**< map frames missing according to their numbers */
+    int have_map_seq;                   /**< internal: a map frame number was seen */
+    uint32_t last_map_seq;              /**< internal: the last one */
 } stream_summary_t;
 
 /** Called for every decoded frame (features and metadata: check f->type)
@@ -210,14 +210,14 @@ typedef struct {
 
 /** A receiver map plus the path of pose records and byte counts. */
 typedef struct {
-    bsf_map_rx_t *rx;   /**< heap: the receiver is large */
-    uint32_t *n_ctrl;   /**< per id: points before the frame (change tracking) */
-    uint32_t *hash;     /**< per id: hash of the points before the frame */
-    double *path;       /**< x, y, theta per pose record */
+    bsf_map_rx_t *rx; /**< heap: the receiver is large */
+    uint32_t *n_ctrl; /**< per id: points before the frame (change tracking) */
+    uint32_t *hash;   /**< per id: hash of the points before the frame */
+    double *path;     /**< x, y, theta per pose record */
     size_t n_path, cap_path;
     unsigned long frames, frames_bad, pose_only_frames;
     unsigned long long bytes, pose_only_bytes;
-    int track;          /**< compute map_change_t in map_view_apply */
+    int track;                /**< compute map_change_t in map_view_apply */
     unsigned long n_features; /**< features the receiver holds (when tracking) */
 } map_view_t;
 
