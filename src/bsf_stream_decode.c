@@ -3,6 +3,7 @@
 
 #include <string.h>
 
+#include "bsf_map_internal.h"
 #include "bsf_wire.h"
 
 /* Bit reader over the payload after byte 0, most significant bit first. */
@@ -381,8 +382,12 @@ static bsf_status_t parse_payload(const uint8_t *p, size_t len, bsf_frame_t *out
     version = (uint32_t)b0 >> 4;
     type = b0 & 0x0Fu;
     if (version < BSF_FORMAT_VERSION_MIN || version > BSF_FORMAT_VERSION ||
-        (type != BSF_FRAME_TYPE_FEATURES && (version < 2u || type != BSF_FRAME_TYPE_METADATA))) {
+        (type != BSF_FRAME_TYPE_FEATURES &&
+         (version < 2u || (type != BSF_FRAME_TYPE_METADATA && type != BSF_FRAME_TYPE_MAP)))) {
         return BSF_ERR_VERSION;
+    }
+    if (type == BSF_FRAME_TYPE_MAP) {
+        return bsf_map_frame_parse(p, len, out);
     }
     r.p = p + 1;
     r.len = len - 1u;
@@ -573,6 +578,10 @@ static bsf_status_t decode_checked(const uint8_t *body, size_t len, bsf_frame_t 
     bsf_status_t st = parse_payload(body, payload_len, NULL);
     if (st == BSF_OK) {
         st = parse_payload(body, payload_len, out);
+    }
+    if (st == BSF_OK) {
+        out->payload = body;
+        out->payload_len = payload_len;
     }
     return st;
 }

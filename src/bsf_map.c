@@ -1,0 +1,1088 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * bsf_map.c - the robot's fused map: association of a scan's features with
+ * map curves, refinement, extension, merging, vertex fusion and the
+ * forgetting policy (docs/MAP-notes.md says why each works as it does).
+ */
+#include "bsf/bsf_map.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "bsf/bsf_bspline.h"
+#include "bsf/bsf_stream.h"
+#include "bsf_map_internal.h"
+
+/* Scan curve samples per metre of control polygon, and their bounds. */
+#define SAMPLE_STEP 0.05f
+#define MIN_SAMPLES 4u
+#define MAX_SAMPLES 64u
+/* Control points one scan feature may refine at once. */
+#define MAX_ACC 96u
+/* Fraction of a control point's basis mass a scan must cover to refine it. */
+#define MIN_SUPPORT 0.3f
+/* A run of unmatched samples shorter than this many spacings makes nothing. */
+#define MIN_RUN_SPACINGS 1.5f
+/* Largest |world coordinate| a map point may have, metres (wire range at 5 mm
+ * steps is 41 km; kept well inside it for any step >= 1 mm). */
+#define MAP_COORD_MAX 8000.0f
+
+typedef struct {
+    float x, y;   /* world position */
+    float dx, dy; /* unit tangent */
+    uint8_t vertex;
+} sample_t;
+
+typedef struct {
+    uint16_t feature; /* map feature slot or BSF_MAP_NONE */
+    uint16_t seg;
+    float u; /* position along the segment's chord, 0..1 */
+} label_t;
+
+typedef struct {
+    uint16_t idx;
+    float a;      /* sum of basis weights */
+    float bx, by; /* sum of basis weight times normal residual */
+} acc_t;
+
+typedef struct {
+    float x, y;
+    uint8_t vertex;
+} newpt_t;
+
+void bsf_map_params_default(bsf_map_params_t *p)
+{
+    p->match_dist = 0.10f;
+    p->match_angle = 0.5f;
+    p->vertex_dist = 0.05f;
+    p->ctrl_spacing = 0.25f;
+    p->send_tol = 0.015f;
+    p->quant_step = BSF_QUANT_STEP_DEFAULT;
+    p->weight_cap = 32u;
+    p->forget_after = 50u;
+    p->snapshot_budget = 0u;
+}
+
+static int finite_f(float v)
+{
+    return v == v && v - v == 0.0f;
+}
+
+static bsf_status_t check_params(const bsf_map_params_t *p, int32_t *step_code)
+{
+    float code;
+    if (!finite_f(p->match_dist) || !finite_f(p->match_angle) || !finite_f(p->vertex_dist) ||
+        !finite_f(p->ctrl_spacing) || !finite_f(p->send_tol) || !finite_f(p->quant_step)) {
+        return BSF_ERR_PARAM;
+    }
+    if (p->match_dist <= 0.0f || p->match_dist > 1.0f || p->match_angle <= 0.0f ||
+        p->match_angle > 1.5707964f || p->vertex_dist < 0.0f || p->vertex_dist > p->match_dist ||
+        p->ctrl_spacing < 0.02f || p->ctrl_spacing > 2.0f || p->send_tol < 0.0f ||
+        p->send_tol > 1.0f || p->quant_step < BSF_QUANT_STEP_MIN ||
+        p->quant_step > BSF_QUANT_STEP_MAX || p->weight_cap < 1u || p->weight_cap > 255u) {
+        return BSF_ERR_PARAM;
+    }
+    code = floorf(p->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    *step_code = (int32_t)(code < 1.0f ? 1.0f : code);
+    return BSF_OK;
+}
+
+bsf_status_t bsf_map_init(bsf_map_t *map, const bsf_map_params_t *params)
+{
+    bsf_map_params_t p;
+    int32_t step_code;
+    bsf_status_t st;
+    size_t i;
+    if (map == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (params != NULL) {
+        p = *params;
+    } else {
+        bsf_map_params_default(&p);
+    }
+    st = check_params(&p, &step_code);
+    if (st != BSF_OK) {
+        return st;
+    }
+    memset(map, 0, sizeof *map);
+    map->params = p;
+    map->step_code = step_code;
+    /* the wire's step, so that fused values quantise as the receiver reads them */
+    map->params.quant_step = (float)step_code * BSF_QUANT_STEP_UNIT;
+    for (i = 0; i < BSF_MAP_MAX_CTRL; ++i) {
+        map->ctrl[i].next = (uint16_t)(i + 1u < BSF_MAP_MAX_CTRL ? i + 1u : BSF_MAP_NONE);
+        map->ctrl[i].prev = BSF_MAP_NONE;
+    }
+    map->free_ctrl = 0u;
+    map->n_free_ctrl = BSF_MAP_MAX_CTRL;
+    return BSF_OK;
+}
+
+/* ---- Pool and chains ----------------------------------------------------- */
+
+static uint16_t ctrl_alloc(bsf_map_t *m, float x, float y, uint8_t vertex)
+{
+    const uint16_t i = m->free_ctrl;
+    bsf_map_ctrl_t *c;
+    if (i == BSF_MAP_NONE) {
+        return BSF_MAP_NONE;
+    }
+    c = &m->ctrl[i];
+    m->free_ctrl = c->next;
+    --m->n_free_ctrl;
+    c->x = x;
+    c->y = y;
+    c->qx = 0;
+    c->qy = 0;
+    c->next = BSF_MAP_NONE;
+    c->prev = BSF_MAP_NONE;
+    c->weight = 1u;
+    c->flags = vertex ? BSF_MAP_CF_VERTEX : 0u;
+    return i;
+}
+
+static void chain_free(bsf_map_t *m, uint16_t head)
+{
+    while (head != BSF_MAP_NONE) {
+        const uint16_t next = m->ctrl[head].next;
+        m->ctrl[head].next = m->free_ctrl;
+        m->ctrl[head].prev = BSF_MAP_NONE;
+        m->free_ctrl = head;
+        ++m->n_free_ctrl;
+        head = next;
+    }
+}
+
+static void feature_bbox(bsf_map_t *m, bsf_map_feature_t *f)
+{
+    uint16_t i = f->head;
+    f->min_x = f->min_y = 3.0e38f;
+    f->max_x = f->max_y = -3.0e38f;
+    while (i != BSF_MAP_NONE) {
+        const bsf_map_ctrl_t *c = &m->ctrl[i];
+        f->min_x = c->x < f->min_x ? c->x : f->min_x;
+        f->max_x = c->x > f->max_x ? c->x : f->max_x;
+        f->min_y = c->y < f->min_y ? c->y : f->min_y;
+        f->max_y = c->y > f->max_y ? c->y : f->max_y;
+        i = c->next;
+    }
+}
+
+static void chain_reverse(bsf_map_t *m, bsf_map_feature_t *f)
+{
+    uint16_t i = f->head;
+    uint16_t t;
+    while (i != BSF_MAP_NONE) {
+        bsf_map_ctrl_t *c = &m->ctrl[i];
+        t = c->next;
+        c->next = c->prev;
+        c->prev = t;
+        i = t;
+    }
+    t = f->head;
+    f->head = f->tail;
+    f->tail = t;
+}
+
+/* Stored (expanded) control points of a chain: a vertex counts twice. */
+static size_t chain_expanded(const bsf_map_t *m, const bsf_map_feature_t *f)
+{
+    size_t n = 0;
+    uint16_t i = f->head;
+    while (i != BSF_MAP_NONE) {
+        n += (m->ctrl[i].flags & BSF_MAP_CF_VERTEX) ? 2u : 1u;
+        i = m->ctrl[i].next;
+    }
+    return n;
+}
+
+/* 1 when every point is sent and within the tolerance of its sent value. */
+int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f)
+{
+    const float step = m->params.quant_step;
+    const float tol = m->params.send_tol;
+    uint16_t i = f->head;
+    if (!(f->flags & BSF_MAP_FF_SENT)) {
+        return 0;
+    }
+    while (i != BSF_MAP_NONE) {
+        const bsf_map_ctrl_t *c = &m->ctrl[i];
+        float ex;
+        float ey;
+        if (!(c->flags & BSF_MAP_CF_SENT)) {
+            return 0;
+        }
+        ex = c->x - (float)c->qx * step;
+        ey = c->y - (float)c->qy * step;
+        if (ex * ex + ey * ey > tol * tol) {
+            return 0;
+        }
+        i = c->next;
+    }
+    return 1;
+}
+
+static void feature_remove_slot(bsf_map_t *m, uint16_t slot)
+{
+    const uint16_t last = (uint16_t)(m->n_features - 1u);
+    if (slot != last) {
+        m->features[slot] = m->features[last];
+    }
+    memset(&m->features[last], 0, sizeof m->features[last]);
+    --m->n_features;
+}
+
+/* Forget features fully sent and unseen for forget_after calls, oldest
+ * first, until need_pts points and need_feat slots are free. */
+static int make_room(bsf_map_t *m, size_t need_pts, size_t need_feat)
+{
+    const uint32_t tick = m->stats.n_fused;
+    while (m->n_free_ctrl < need_pts ||
+           (size_t)m->n_features + need_feat > (size_t)BSF_MAP_MAX_FEATURES) {
+        uint16_t best = BSF_MAP_NONE;
+        uint32_t best_seen = 0;
+        uint16_t s;
+        for (s = 0; s < m->n_features; ++s) {
+            const bsf_map_feature_t *f = &m->features[s];
+            if ((f->flags & (BSF_MAP_FF_OP | BSF_MAP_FF_FRESH)) != 0u ||
+                tick - f->last_seen < m->params.forget_after) {
+                continue;
+            }
+            if ((best == BSF_MAP_NONE || f->last_seen < best_seen) && bsf_map_chain_clean(m, f)) {
+                best = s;
+                best_seen = f->last_seen;
+            }
+        }
+        if (best == BSF_MAP_NONE) {
+            return 0;
+        }
+        ++m->stats.n_forgotten;
+        m->stats.n_forgotten_ctrl += m->features[best].n_ctrl;
+        chain_free(m, m->features[best].head);
+        feature_remove_slot(m, best);
+    }
+    return 1;
+}
+
+/* ---- Geometry ------------------------------------------------------------- */
+
+/* Basis of a span at chord position u: interior uniform quadratic, or the
+ * clamped first / last span (ends bit 1 / 2), or a single Bezier span. */
+static void span_basis(uint8_t ends, float u, float b[3])
+{
+    const float v = 1.0f - u;
+    if (ends == 3u) {
+        b[0] = v * v;
+        b[1] = 2.0f * u * v;
+        b[2] = u * u;
+    } else if (ends & 1u) {
+        b[0] = v * v;
+        b[1] = 2.0f * u - 1.5f * u * u;
+        b[2] = 0.5f * u * u;
+    } else if (ends & 2u) {
+        b[0] = 0.5f * v * v;
+        b[1] = 2.0f * v - 1.5f * v * v;
+        b[2] = u * u;
+    } else {
+        b[0] = 0.5f * v * v;
+        b[1] = 0.5f + u - u * u;
+        b[2] = 0.5f * u * u;
+    }
+}
+
+/* Spans of feature slot fs whose chord box meets box[] (min x, min y, max x,
+ * max y), appended to m->segs. */
+static void build_segs(bsf_map_t *m, uint16_t fs, const float box[4])
+{
+    const bsf_map_feature_t *f = &m->features[fs];
+    const size_t n = chain_expanded(m, f);
+    uint16_t e[3] = {BSF_MAP_NONE, BSF_MAP_NONE, BSF_MAP_NONE};
+    size_t have = 0;
+    uint16_t i = f->head;
+    if (n < 3u) {
+        return;
+    }
+    while (i != BSF_MAP_NONE && m->n_segs < BSF_MAP_SEG_WINDOW) {
+        const unsigned reps = (m->ctrl[i].flags & BSF_MAP_CF_VERTEX) ? 2u : 1u;
+        unsigned r;
+        for (r = 0; r < reps && m->n_segs < BSF_MAP_SEG_WINDOW; ++r) {
+            e[0] = e[1];
+            e[1] = e[2];
+            e[2] = i;
+            ++have;
+            if (have >= 3u) {
+                const size_t s = have - 3u;
+                const bsf_map_ctrl_t *c0 = &m->ctrl[e[0]];
+                const bsf_map_ctrl_t *c1 = &m->ctrl[e[1]];
+                const bsf_map_ctrl_t *c2 = &m->ctrl[e[2]];
+                const uint8_t ends = (uint8_t)((s == 0u ? 1u : 0u) | (s + 3u == n ? 2u : 0u));
+                const float ax = (ends & 1u) ? c0->x : 0.5f * (c0->x + c1->x);
+                const float ay = (ends & 1u) ? c0->y : 0.5f * (c0->y + c1->y);
+                const float bx = (ends & 2u) ? c2->x : 0.5f * (c1->x + c2->x);
+                const float by = (ends & 2u) ? c2->y : 0.5f * (c1->y + c2->y);
+                if ((ax < bx ? bx : ax) >= box[0] && (ax < bx ? ax : bx) <= box[2] &&
+                    (ay < by ? by : ay) >= box[1] && (ay < by ? ay : by) <= box[3]) {
+                    bsf_map_seg_t *g = &m->segs[m->n_segs++];
+                    g->ax = ax;
+                    g->ay = ay;
+                    g->bx = bx;
+                    g->by = by;
+                    g->feature = fs;
+                    g->p[0] = e[0];
+                    g->p[1] = e[1];
+                    g->p[2] = e[2];
+                    g->ends = ends;
+                }
+            }
+        }
+        i = m->ctrl[i].next;
+    }
+}
+
+/* Samples of a scan curve (world frame), evenly in t plus its vertices. */
+static size_t sample_curve(const bsf_point_t *w, const uint8_t *vtx, size_t n, sample_t *out)
+{
+    float len = 0.0f;
+    size_t ns;
+    size_t k;
+    size_t i;
+    for (i = 1; i < n; ++i) {
+        const float dx = w[i].x - w[i - 1u].x;
+        const float dy = w[i].y - w[i - 1u].y;
+        len += sqrtf(dx * dx + dy * dy);
+    }
+    ns = (size_t)(len / SAMPLE_STEP) + 1u;
+    ns = ns < MIN_SAMPLES ? MIN_SAMPLES : (ns > MAX_SAMPLES ? MAX_SAMPLES : ns);
+    for (k = 0; k < ns; ++k) {
+        const float t = (float)k / (float)(ns - 1u);
+        bsf_point_t p;
+        bsf_point_t d;
+        float dl;
+        if (bsf_bspline_eval(w, n, t, &p, &d, NULL) != BSF_OK) {
+            return 0;
+        }
+        dl = sqrtf(d.x * d.x + d.y * d.y);
+        out[k].x = p.x;
+        out[k].y = p.y;
+        out[k].dx = dl > 0.0f ? d.x / dl : 0.0f;
+        out[k].dy = dl > 0.0f ? d.y / dl : 0.0f;
+        out[k].vertex = 0u;
+    }
+    /* a vertex (slots i, i + 1 flagged) sits on the curve at t = i / (n - 2) */
+    for (i = 0; i + 1u < n; ++i) {
+        if (vtx[i] && vtx[i + 1u]) {
+            const float t = (float)i / (float)(n - 2u);
+            size_t kk = (size_t)(t * (float)(ns - 1u) + 0.5f);
+            kk = kk >= ns ? ns - 1u : kk;
+            out[kk].x = w[i].x;
+            out[kk].y = w[i].y;
+            out[kk].vertex = 1u;
+            ++i;
+        }
+    }
+    return ns;
+}
+
+static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, label_t *lab)
+{
+    const float d2max = m->params.match_dist * m->params.match_dist;
+    const float cmin = cosf(m->params.match_angle);
+    size_t k;
+    uint16_t g;
+    for (k = 0; k < ns; ++k) {
+        float best = d2max;
+        lab[k].feature = BSF_MAP_NONE;
+        lab[k].seg = 0u;
+        lab[k].u = 0.0f;
+        for (g = 0; g < m->n_segs; ++g) {
+            const bsf_map_seg_t *sg = &m->segs[g];
+            const float ux = sg->bx - sg->ax;
+            const float uy = sg->by - sg->ay;
+            const float l2 = ux * ux + uy * uy;
+            float t = 0.0f;
+            float ex;
+            float ey;
+            float d2;
+            if (l2 > 1e-10f) {
+                t = ((s[k].x - sg->ax) * ux + (s[k].y - sg->ay) * uy) / l2;
+                t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+            }
+            ex = s[k].x - (sg->ax + t * ux);
+            ey = s[k].y - (sg->ay + t * uy);
+            d2 = ex * ex + ey * ey;
+            if (d2 >= best) {
+                continue;
+            }
+            if (l2 > 1e-6f && !s[k].vertex) {
+                const float c = fabsf(ux * s[k].dx + uy * s[k].dy) / sqrtf(l2);
+                if (c < cmin) {
+                    continue;
+                }
+            }
+            best = d2;
+            lab[k].feature = sg->feature;
+            lab[k].seg = g;
+            lab[k].u = t;
+        }
+    }
+}
+
+/* ---- Fusion steps -------------------------------------------------------- */
+
+/* Refine the control points that the samples matched to map feature fs
+ * cover: per point, the basis-weighted mean of the samples' normal
+ * residuals, folded into its running mean (weight = observations, capped). */
+static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *lab, size_t ns)
+{
+    acc_t acc[MAX_ACC];
+    size_t n_acc = 0;
+    size_t k;
+    size_t a;
+    for (k = 0; k < ns; ++k) {
+        const bsf_map_seg_t *sg;
+        const bsf_map_ctrl_t *c[3];
+        float b[3];
+        float cx;
+        float cy;
+        float nx;
+        float ny;
+        float nl;
+        float r;
+        unsigned j;
+        if (lab[k].feature != fs || s[k].vertex) {
+            continue;
+        }
+        sg = &m->segs[lab[k].seg];
+        span_basis(sg->ends, lab[k].u, b);
+        for (j = 0; j < 3u; ++j) {
+            c[j] = &m->ctrl[sg->p[j]];
+        }
+        cx = b[0] * c[0]->x + b[1] * c[1]->x + b[2] * c[2]->x;
+        cy = b[0] * c[0]->y + b[1] * c[1]->y + b[2] * c[2]->y;
+        nx = -(sg->by - sg->ay);
+        ny = sg->bx - sg->ax;
+        nl = sqrtf(nx * nx + ny * ny);
+        if (nl < 1e-6f) {
+            continue;
+        }
+        nx /= nl;
+        ny /= nl;
+        r = (s[k].x - cx) * nx + (s[k].y - cy) * ny;
+        for (j = 0; j < 3u; ++j) {
+            const uint16_t idx = sg->p[j];
+            size_t q;
+            for (q = 0; q < n_acc && acc[q].idx != idx; ++q) {
+            }
+            if (q == n_acc) {
+                if (n_acc == MAX_ACC) {
+                    continue;
+                }
+                acc[q].idx = idx;
+                acc[q].a = 0.0f;
+                acc[q].bx = 0.0f;
+                acc[q].by = 0.0f;
+                ++n_acc;
+            }
+            acc[q].a += b[j];
+            acc[q].bx += b[j] * r * nx;
+            acc[q].by += b[j] * r * ny;
+        }
+    }
+    for (a = 0; a < n_acc; ++a) {
+        bsf_map_ctrl_t *c = &m->ctrl[acc[a].idx];
+        float w;
+        if (acc[a].a < MIN_SUPPORT || (c->flags & BSF_MAP_CF_VERTEX)) {
+            continue;
+        }
+        w = (float)c->weight + 1.0f;
+        c->x += acc[a].bx / acc[a].a / w;
+        c->y += acc[a].by / acc[a].a / w;
+        if (c->weight < m->params.weight_cap) {
+            ++c->weight;
+        }
+        ++m->stats.n_refined;
+    }
+}
+
+/* Points along samples from..to (step +1 or -1), every ctrl_spacing and at
+ * every vertex, starting after the anchor (ax, ay); the last one ends the
+ * run. Returns the count (at most cap). */
+static size_t resample(const bsf_map_t *m, const sample_t *s, long from, long to, int has_anchor,
+                       float ax, float ay, newpt_t *out, size_t cap)
+{
+    const float sp = m->params.ctrl_spacing;
+    const long dir = to >= from ? 1 : -1;
+    float px = ax;
+    float py = ay;
+    int have_prev = has_anchor;
+    size_t n = 0;
+    long k;
+    for (k = from;; k += dir) {
+        const sample_t *q = &s[k];
+        const int last = k == to;
+        const float dx = q->x - px;
+        const float dy = q->y - py;
+        const float d2 = dx * dx + dy * dy;
+        if (!have_prev || q->vertex || d2 >= sp * sp) {
+            if (q->vertex && n > 0u && !out[n - 1u].vertex && d2 < 0.09f * sp * sp) {
+                --n; /* a point just before a vertex gives way to it */
+            }
+            if (n < cap) {
+                out[n].x = q->x;
+                out[n].y = q->y;
+                out[n].vertex = q->vertex;
+                ++n;
+            }
+            px = q->x;
+            py = q->y;
+            have_prev = 1;
+        } else if (last) {
+            if (d2 >= 0.16f * sp * sp && n < cap) {
+                out[n].x = q->x;
+                out[n].y = q->y;
+                out[n].vertex = 0u;
+                ++n;
+            } else if (n > 0u && !out[n - 1u].vertex) {
+                out[n - 1u].x = q->x;
+                out[n - 1u].y = q->y;
+            }
+        }
+        if (last) {
+            break;
+        }
+    }
+    return n;
+}
+
+static float run_length(const sample_t *s, long from, long to)
+{
+    float len = 0.0f;
+    const long dir = to >= from ? 1 : -1;
+    long k;
+    for (k = from; k != to; k += dir) {
+        const float dx = s[k + dir].x - s[k].x;
+        const float dy = s[k + dir].y - s[k].y;
+        len += sqrtf(dx * dx + dy * dy);
+    }
+    return len;
+}
+
+/* Link new points after the tail (at_head = 0) or before the head. */
+static int chain_extend(bsf_map_t *m, bsf_map_feature_t *f, const newpt_t *p, size_t n,
+                        int at_head)
+{
+    size_t i;
+    if (m->n_free_ctrl < n) {
+        return 0;
+    }
+    for (i = 0; i < n; ++i) {
+        const uint16_t c = ctrl_alloc(m, p[i].x, p[i].y, p[i].vertex);
+        if (at_head) {
+            m->ctrl[c].next = f->head;
+            m->ctrl[f->head].prev = c;
+            f->head = c;
+        } else {
+            m->ctrl[c].prev = f->tail;
+            m->ctrl[f->tail].next = c;
+            f->tail = c;
+        }
+        ++f->n_ctrl;
+    }
+    return 1;
+}
+
+static int feature_new(bsf_map_t *m, const newpt_t *p, size_t n)
+{
+    bsf_map_feature_t *f;
+    size_t i;
+    size_t expanded = 0;
+    for (i = 0; i < n; ++i) {
+        expanded += p[i].vertex ? 2u : 1u;
+    }
+    if (n < 2u || expanded < 3u || m->n_free_ctrl < n || m->n_features >= BSF_MAP_MAX_FEATURES) {
+        return 0;
+    }
+    f = &m->features[m->n_features++];
+    memset(f, 0, sizeof *f);
+    f->id = m->next_id++;
+    f->last_seen = m->stats.n_fused;
+    f->flags = BSF_MAP_FF_FRESH;
+    f->head = ctrl_alloc(m, p[0].x, p[0].y, p[0].vertex);
+    f->tail = f->head;
+    f->n_ctrl = 1u;
+    (void)chain_extend(m, f, p + 1, n - 1u, 0);
+    feature_bbox(m, f);
+    ++m->stats.n_new;
+    return 1;
+}
+
+uint16_t bsf_map_slot_of_id(const bsf_map_t *m, uint32_t id)
+{
+    uint16_t s;
+    for (s = 0; s < m->n_features; ++s) {
+        if (m->features[s].id == id) {
+            return s;
+        }
+    }
+    return BSF_MAP_NONE;
+}
+
+/* End of feature fs a segment touches: 1 head, 2 tail, 3 both, 0 neither. */
+static unsigned seg_end(const bsf_map_t *m, const label_t *l)
+{
+    return m->segs[l->seg].ends;
+}
+
+/* Which end of fs sample (x, y) is nearer to: 1 head, 2 tail. */
+static unsigned nearer_end(const bsf_map_t *m, const bsf_map_feature_t *f, float x, float y)
+{
+    const bsf_map_ctrl_t *h = &m->ctrl[f->head];
+    const bsf_map_ctrl_t *t = &m->ctrl[f->tail];
+    const float dh = (h->x - x) * (h->x - x) + (h->y - y) * (h->y - y);
+    const float dt = (t->x - x) * (t->x - x) + (t->y - y) * (t->y - y);
+    return dh <= dt ? 1u : 2u;
+}
+
+/* The end of fs a matched sample joins, or 0 when it is not at an end. */
+static unsigned joining_end(const bsf_map_t *m, const label_t *l, const sample_t *s)
+{
+    const unsigned ends = seg_end(m, l);
+    if (ends == 3u) {
+        return nearer_end(m, &m->features[l->feature], s->x, s->y);
+    }
+    if ((ends & 1u) && l->u < 0.5f) {
+        return 1u;
+    }
+    if ((ends & 2u) && l->u > 0.5f) {
+        return 2u;
+    }
+    return 0u;
+}
+
+/* Extend slot fs at end (1 head, 2 tail) with samples from..to, walking
+ * outward from the matched part. */
+static void extend(bsf_map_t *m, uint16_t fs, unsigned end, const sample_t *s, long from, long to)
+{
+    bsf_map_feature_t *f = &m->features[fs];
+    const bsf_map_ctrl_t *e = &m->ctrl[end == 1u ? f->head : f->tail];
+    newpt_t p[MAX_SAMPLES];
+    size_t n;
+    if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing * 0.5f) {
+        return;
+    }
+    n = resample(m, s, from, to, 1, e->x, e->y, p, MAX_SAMPLES);
+    if (n > 0u && chain_extend(m, f, p, n, end == 1u)) {
+        feature_bbox(m, f);
+        ++m->stats.n_extended;
+    }
+}
+
+static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
+{
+    newpt_t p[MAX_SAMPLES];
+    size_t n;
+    if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing) {
+        return;
+    }
+    n = resample(m, s, from, to, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
+    (void)feature_new(m, p, n);
+}
+
+/* Join slot fa (its end ea) to slot fb (its end eb) through samples
+ * from..to (may be empty: from > to). Both must be fully sent, so that the
+ * merge record can go before any other change to them. */
+static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned eb, const sample_t *s,
+                 long from, long to)
+{
+    bsf_map_feature_t *a = &m->features[fa];
+    bsf_map_feature_t *b = &m->features[fb];
+    bsf_map_op_t *op;
+    newpt_t p[MAX_SAMPLES];
+    size_t n = 0;
+    uint16_t first_bridge = BSF_MAP_NONE;
+    if (m->n_ops >= BSF_MAP_MAX_OPS || ((a->flags | b->flags) & BSF_MAP_FF_OP) != 0u ||
+        !bsf_map_chain_clean(m, a) || !bsf_map_chain_clean(m, b)) {
+        return 0;
+    }
+    if ((size_t)a->n_ctrl + b->n_ctrl + MAX_SAMPLES > BSF_MAP_REC_MAX_POINTS) {
+        return 0;
+    }
+    op = &m->ops[m->n_ops];
+    op->flags = 0u;
+    if (ea == 1u) {
+        chain_reverse(m, a);
+        op->flags |= BSF_MAP_OP_REV_A;
+    }
+    if (eb == 2u) {
+        chain_reverse(m, b);
+        op->flags |= BSF_MAP_OP_REV_B;
+    }
+    if (from <= to) {
+        const bsf_map_ctrl_t *at = &m->ctrl[a->tail];
+        const bsf_map_ctrl_t *bh = &m->ctrl[b->head];
+        const float sp = m->params.ctrl_spacing;
+        n = resample(m, s, from, to, 1, at->x, at->y, p, MAX_SAMPLES);
+        /* no bridge point crowding b's head */
+        while (n > 0u && !p[n - 1u].vertex &&
+               (p[n - 1u].x - bh->x) * (p[n - 1u].x - bh->x) +
+                       (p[n - 1u].y - bh->y) * (p[n - 1u].y - bh->y) <
+                   0.25f * sp * sp) {
+            --n;
+        }
+    }
+    if (n > m->n_free_ctrl) {
+        n = 0;
+    }
+    if (n > 0u) {
+        const uint16_t old_tail = a->tail;
+        (void)chain_extend(m, a, p, n, 0);
+        first_bridge = m->ctrl[old_tail].next;
+    }
+    op->id_a = a->id;
+    op->id_b = b->id;
+    op->bridge = first_bridge;
+    op->n_bridge = (uint16_t)n;
+    op->upd_a = a->upd;
+    op->upd_b = b->upd;
+    ++m->n_ops;
+    /* link b after a */
+    m->ctrl[a->tail].next = b->head;
+    m->ctrl[b->head].prev = a->tail;
+    a->tail = b->tail;
+    a->n_ctrl = (uint16_t)(a->n_ctrl + b->n_ctrl);
+    a->upd = (uint8_t)((a->upd + 1u) & 15u);
+    a->flags |= BSF_MAP_FF_OP;
+    a->last_seen = m->stats.n_fused;
+    feature_bbox(m, a);
+    feature_remove_slot(m, fb);
+    ++m->stats.n_merged;
+    return 1;
+}
+
+/* Scan vertices near a map vertex move it by their running mean. */
+static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
+{
+    const float d2max = m->params.vertex_dist * m->params.vertex_dist;
+    size_t k;
+    uint16_t g;
+    for (k = 0; k < ns; ++k) {
+        uint16_t best = BSF_MAP_NONE;
+        float bd = d2max;
+        if (!s[k].vertex) {
+            continue;
+        }
+        for (g = 0; g < m->n_segs; ++g) {
+            unsigned j;
+            for (j = 0; j < 3u; ++j) {
+                const bsf_map_ctrl_t *c = &m->ctrl[m->segs[g].p[j]];
+                float d2;
+                if (!(c->flags & BSF_MAP_CF_VERTEX)) {
+                    continue;
+                }
+                d2 = (c->x - s[k].x) * (c->x - s[k].x) + (c->y - s[k].y) * (c->y - s[k].y);
+                if (d2 <= bd) {
+                    bd = d2;
+                    best = m->segs[g].p[j];
+                }
+            }
+        }
+        if (best != BSF_MAP_NONE) {
+            bsf_map_ctrl_t *c = &m->ctrl[best];
+            const float w = (float)c->weight + 1.0f;
+            c->x += (s[k].x - c->x) / w;
+            c->y += (s[k].y - c->y) / w;
+            if (c->weight < m->params.weight_cap) {
+                ++c->weight;
+            }
+            ++m->stats.n_vertex_merged;
+            /* the map has this corner: the sample is matched as a plain point */
+            s[k].vertex = 0u;
+        }
+    }
+}
+
+static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n)
+{
+    sample_t s[MAX_SAMPLES];
+    label_t lab[MAX_SAMPLES];
+    float box[4];
+    size_t ns;
+    size_t k;
+    uint16_t fs;
+    long first = -1;
+    long last = -1;
+
+    if (!make_room(m, n + MAX_SAMPLES, 1u)) {
+        ++m->stats.n_dropped_obs;
+        return;
+    }
+    ns = sample_curve(w, vtx, n, s);
+    if (ns == 0u) {
+        return;
+    }
+    box[0] = box[1] = 3.0e38f;
+    box[2] = box[3] = -3.0e38f;
+    for (k = 0; k < ns; ++k) {
+        box[0] = s[k].x < box[0] ? s[k].x : box[0];
+        box[1] = s[k].y < box[1] ? s[k].y : box[1];
+        box[2] = s[k].x > box[2] ? s[k].x : box[2];
+        box[3] = s[k].y > box[3] ? s[k].y : box[3];
+    }
+    box[0] -= m->params.match_dist;
+    box[1] -= m->params.match_dist;
+    box[2] += m->params.match_dist;
+    box[3] += m->params.match_dist;
+    m->n_segs = 0u;
+    for (fs = 0; fs < m->n_features; ++fs) {
+        const bsf_map_feature_t *f = &m->features[fs];
+        if ((f->flags & BSF_MAP_FF_FRESH) || f->max_x < box[0] || f->min_x > box[2] ||
+            f->max_y < box[1] || f->min_y > box[3]) {
+            continue;
+        }
+        build_segs(m, fs, box);
+    }
+    fuse_vertices(m, s, ns);
+    label_samples(m, s, ns, lab);
+    ++m->stats.n_obs;
+
+    for (k = 0; k < ns; ++k) {
+        if (lab[k].feature != BSF_MAP_NONE) {
+            if (first < 0) {
+                first = (long)k;
+            }
+            last = (long)k;
+        }
+    }
+    if (first < 0) {
+        /* nothing known: a new feature with the scan's own control points */
+        newpt_t p[BSF_MAX_CTRL_PER_FEATURE];
+        size_t np = 0;
+        for (k = 0; k < n; ++k) {
+            p[np].x = w[k].x;
+            p[np].y = w[k].y;
+            p[np].vertex = vtx[k] && k + 1u < n && vtx[k + 1u];
+            ++np;
+            if (p[np - 1u].vertex) {
+                ++k;
+            }
+        }
+        (void)feature_new(m, p, np);
+        return;
+    }
+    /* refine every feature the samples matched, once each */
+    for (k = 0; k < ns; ++k) {
+        const uint16_t f = lab[k].feature;
+        size_t j;
+        int seen = 0;
+        if (f == BSF_MAP_NONE) {
+            continue;
+        }
+        for (j = 0; j < k && !seen; ++j) {
+            seen = lab[j].feature == f;
+        }
+        if (!seen) {
+            refine(m, f, s, lab, ns);
+            m->features[f].last_seen = m->stats.n_fused;
+            feature_bbox(m, &m->features[f]);
+        }
+    }
+    /* a gap or a change of feature between matched samples: a bridge */
+    for (k = (size_t)first; k < (size_t)last; ++k) {
+        if (lab[k].feature != BSF_MAP_NONE && lab[k + 1u].feature != lab[k].feature) {
+            size_t g = k + 1u;
+            while (lab[g].feature == BSF_MAP_NONE) {
+                ++g;
+            }
+            if (lab[g].feature != lab[k].feature) {
+                const unsigned ea = joining_end(m, &lab[k], &s[k]);
+                const unsigned eb = joining_end(m, &lab[g], &s[g]);
+                if (ea != 0u && eb != 0u &&
+                    merge(m, lab[k].feature, ea, lab[g].feature, eb, s, (long)k + 1, (long)g - 1)) {
+                    /* slots moved: this observation's work ends here */
+                    return;
+                }
+            }
+            if (g > k + 1u) {
+                new_from_run(m, s, (long)k + 1, (long)g - 1);
+            }
+            k = g - 1u;
+        }
+    }
+    /* unmatched ends: extend the feature they continue, or start a new one */
+    if (first > 0) {
+        const unsigned e = joining_end(m, &lab[first], &s[first]);
+        if (e != 0u) {
+            extend(m, lab[first].feature, e, s, first - 1, 0);
+        } else {
+            new_from_run(m, s, 0, first - 1);
+        }
+    }
+    if (last + 1 < (long)ns) {
+        const unsigned e = joining_end(m, &lab[last], &s[last]);
+        if (e != 0u) {
+            extend(m, lab[last].feature, e, s, last + 1, (long)ns - 1);
+        } else {
+            new_from_run(m, s, last + 1, (long)ns - 1);
+        }
+    }
+}
+
+static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
+{
+    size_t i;
+    if (!finite_f(pose->x) || !finite_f(pose->y) || !finite_f(pose->theta) ||
+        fabsf(pose->x) > BSF_POSE_XY_MAX || fabsf(pose->y) > BSF_POSE_XY_MAX ||
+        fabsf(pose->theta) > BSF_POSE_THETA_MAX) {
+        return BSF_ERR_ARG;
+    }
+    if (scan->n_features > BSF_MAX_SEGMENTS || scan->n_ctrl > BSF_MAX_CTRL_POINTS) {
+        return BSF_ERR_CAPACITY;
+    }
+    for (i = 0; i < scan->n_features; ++i) {
+        const bsf_feature_t *f = &scan->features[i];
+        size_t j;
+        if (f->n_ctrl < 3u || f->n_ctrl > BSF_MAX_CTRL_PER_FEATURE ||
+            (size_t)f->ctrl_first + f->n_ctrl > scan->n_ctrl) {
+            return BSF_ERR_ARG;
+        }
+        for (j = f->ctrl_first; j < (size_t)f->ctrl_first + f->n_ctrl; ++j) {
+            const float x = scan->ctrl[j].x;
+            const float y = scan->ctrl[j].y;
+            if (!finite_f(x) || !finite_f(y) || fabsf(x) > MAP_COORD_MAX ||
+                fabsf(y) > MAP_COORD_MAX) {
+                return BSF_ERR_ARG;
+            }
+            if (fabsf(pose->x) + fabsf(x) + fabsf(y) > MAP_COORD_MAX ||
+                fabsf(pose->y) + fabsf(x) + fabsf(y) > MAP_COORD_MAX) {
+                return BSF_ERR_ARG;
+            }
+        }
+    }
+    return BSF_OK;
+}
+
+int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pose)
+{
+    float c;
+    float sn;
+    size_t i;
+    bsf_status_t st;
+    uint16_t fs;
+    if (map == NULL || scan == NULL || pose == NULL) {
+        return BSF_ERR_ARG;
+    }
+    st = check_scan(scan, pose);
+    if (st != BSF_OK) {
+        return st;
+    }
+    ++map->stats.n_fused;
+    for (fs = 0; fs < map->n_features; ++fs) {
+        map->features[fs].flags &= (uint8_t)~BSF_MAP_FF_FRESH;
+    }
+    c = cosf(pose->theta);
+    sn = sinf(pose->theta);
+    for (i = 0; i < scan->n_features; ++i) {
+        const bsf_feature_t *f = &scan->features[i];
+        bsf_point_t w[BSF_MAX_CTRL_PER_FEATURE];
+        size_t j;
+        for (j = 0; j < f->n_ctrl; ++j) {
+            const bsf_point_t *p = &scan->ctrl[f->ctrl_first + j];
+            w[j].x = pose->x + c * p->x - sn * p->y;
+            w[j].y = pose->y + sn * p->x + c * p->y;
+        }
+        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl);
+    }
+    return (int)scan->n_features;
+}
+
+/* ---- Accessors ------------------------------------------------------------ */
+
+size_t bsf_map_feature_count(const bsf_map_t *map)
+{
+    return map != NULL ? map->n_features : 0u;
+}
+
+int bsf_map_feature_ctrl(const bsf_map_t *map, size_t index, int sent, bsf_point_t *ctrl,
+                         uint8_t *is_vertex, size_t cap, uint32_t *id)
+{
+    const bsf_map_feature_t *f;
+    uint16_t i;
+    size_t n = 0;
+    if (map == NULL || index >= map->n_features) {
+        return BSF_ERR_ARG;
+    }
+    f = &map->features[index];
+    if (id != NULL) {
+        *id = f->id;
+    }
+    for (i = f->head; i != BSF_MAP_NONE; i = map->ctrl[i].next) {
+        const bsf_map_ctrl_t *c = &map->ctrl[i];
+        const unsigned reps = (c->flags & BSF_MAP_CF_VERTEX) ? 2u : 1u;
+        unsigned r;
+        if (sent && !(c->flags & BSF_MAP_CF_SENT)) {
+            continue;
+        }
+        for (r = 0; r < reps; ++r, ++n) {
+            if (n < cap) {
+                if (ctrl != NULL) {
+                    ctrl[n].x = sent ? (float)c->qx * map->params.quant_step : c->x;
+                    ctrl[n].y = sent ? (float)c->qy * map->params.quant_step : c->y;
+                }
+                if (is_vertex != NULL) {
+                    is_vertex[n] = (uint8_t)(reps - 1u);
+                }
+            }
+        }
+    }
+    return (int)n;
+}
+
+int bsf_map_feature_q(const bsf_map_t *map, size_t index, int32_t *q, uint8_t *is_vertex,
+                      size_t cap, uint32_t *id)
+{
+    const bsf_map_feature_t *f;
+    uint16_t i;
+    size_t n = 0;
+    if (map == NULL || index >= map->n_features) {
+        return BSF_ERR_ARG;
+    }
+    f = &map->features[index];
+    if (id != NULL) {
+        *id = f->id;
+    }
+    for (i = f->head; i != BSF_MAP_NONE; i = map->ctrl[i].next) {
+        const bsf_map_ctrl_t *c = &map->ctrl[i];
+        if (!(c->flags & BSF_MAP_CF_SENT)) {
+            continue;
+        }
+        if (n < cap) {
+            if (q != NULL) {
+                q[2u * n] = c->qx;
+                q[2u * n + 1u] = c->qy;
+            }
+            if (is_vertex != NULL) {
+                is_vertex[n] = (uint8_t)(c->flags & BSF_MAP_CF_VERTEX);
+            }
+        }
+        ++n;
+    }
+    return (int)n;
+}
+
+int bsf_map_pending(const bsf_map_t *map)
+{
+    uint16_t s;
+    if (map == NULL) {
+        return 0;
+    }
+    if (map->n_ops > 0u) {
+        return 1;
+    }
+    for (s = 0; s < map->n_features; ++s) {
+        if (!bsf_map_chain_clean(map, &map->features[s])) {
+            return 1;
+        }
+    }
+    return 0;
+}
