@@ -128,7 +128,9 @@ def covered(x0, y0, x1, y1):
     return near / max(1, len(pts))
 
 
-check(covered(0.5, 0.0, 7.5, 0.0) > 0.8, "the wall y = 0 is in the map")
+# the robot (y = 1.2, heading 0.3 rad, 180 degrees) faces the far wall and the notch
+check(covered(4.5, 6.0, 0.5, 6.0) > 0.8, "the far wall y = 6 is in the map")
+check(covered(7.5, 3.5, 5.5, 3.5) > 0.8, "the notch wall y = 3.5 is in the map")
 vertices = [tuple(f["ctrl"][i]) for f in feats for i, v in enumerate(f["vertex"]) if v]
 found = [c for c in corners if any(math.hypot(c[0] - vx, c[1] - vy) < 0.05 for vx, vy in vertices)]
 check(len(found) >= 2, f"true corners are map vertices within 5 cm ({len(found)} of {len(corners)})")
