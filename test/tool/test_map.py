@@ -116,6 +116,8 @@ for f in feats:
 check(ok_form, "every feature: id, >= 3 control points, vertex flags in equal pairs")
 check(len({f["id"] for f in feats}) == len(feats), "feature ids are unique")
 samples = [p for f in feats for p in curve_samples(f["ctrl"])]
+# a straight wall between two vertices is one span: dense samples for coverage
+dense = [p for f in feats for p in curve_samples(f["ctrl"], 128)]
 d = sorted(dist_to_shapes(x, y, shapes) for x, y in samples)
 p99 = d[int(0.99 * (len(d) - 1))] if d else math.inf
 check(bool(d) and p99 < 0.05, f"map curves lie on the true walls (p99 {1000 * p99:.1f} mm < 50 mm)")
@@ -124,11 +126,12 @@ check(bool(d) and d[len(d) // 2] < 0.015, "median curve distance to the walls < 
 def covered(x0, y0, x1, y1):
     n = int(math.hypot(x1 - x0, y1 - y0) / 0.05)
     pts = [(x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(1, n)]
-    near = sum(1 for px, py in pts if min(math.hypot(px - sx, py - sy) for sx, sy in samples) < 0.05)
+    near = sum(1 for px, py in pts if min(math.hypot(px - sx, py - sy) for sx, sy in dense) < 0.05)
     return near / max(1, len(pts))
 
 
 # the robot (y = 1.2, heading 0.3 rad, 180 degrees) faces the far wall and the notch
+check(covered(0.5, 0.0, 7.5, 0.0) > 0.8, "the wall y = 0 is in the map")
 check(covered(4.5, 6.0, 0.5, 6.0) > 0.8, "the far wall y = 6 is in the map")
 check(covered(7.5, 3.5, 5.5, 3.5) > 0.8, "the notch wall y = 3.5 is in the map")
 vertices = [tuple(f["ctrl"][i]) for f in feats for i, v in enumerate(f["vertex"]) if v]

@@ -108,7 +108,8 @@ def test_map_equals_bsf_map_json(bsf_tool, map_stream):
 def test_map_lies_on_the_walls(map_stream):
     _, out = map_stream
     feats = bsf.read_map(out).features
-    pts = np.concatenate([f.sample(8) for f in feats])
+    # a straight wall between two vertices is one span: sample densely
+    pts = np.concatenate([f.sample(256) for f in feats])
     d = _dist_to_room(pts)
     assert np.median(d) < 0.015
     assert np.quantile(d, 0.99) < 0.05
