@@ -1001,8 +1001,13 @@ def _round_us(seconds: float) -> int:
     return int(i) + (1 if x - i >= 0.5 else 0)
 
 
+# The submodule is imported here, before the function of the same name is
+# defined: importing it later (inside the function) would rebind bsf.plot to
+# the module and break every call after the first. It needs matplotlib only
+# when drawing.
+from . import plot as _plot_module  # noqa: E402
+
+
 def plot(frames: Union[Frame, Iterable[Frame], Map], ax: Any = None, **kwargs: Any) -> Any:
     """Draw frames or a :class:`Map` with matplotlib (the ``plot`` extra); see :func:`bsf.plot.plot`."""
-    from .plot import plot as _plot
-
-    return _plot(frames, ax=ax, **kwargs)
+    return _plot_module.plot(frames, ax=ax, **kwargs)
