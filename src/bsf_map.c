@@ -26,6 +26,10 @@
 /* Largest |world coordinate| a map point may have, metres (wire range at 5 mm
  * steps is 41 km; kept well inside it for any step >= 1 mm). */
 #define MAP_COORD_MAX 8000.0f
+/* A span whose second difference exceeds 4 cm (squared here) is curved: it is
+ * searched as CHORDS chords. */
+#define CURVED_SPAN2 0.0016f
+#define CHORDS 4u
 
 typedef struct {
     float x, y;   /* world position */
@@ -317,22 +321,40 @@ static void build_segs(bsf_map_t *m, uint16_t fs, const float box[4])
                 const bsf_map_ctrl_t *c1 = &m->ctrl[e[1]];
                 const bsf_map_ctrl_t *c2 = &m->ctrl[e[2]];
                 const uint8_t ends = (uint8_t)((s == 0u ? 1u : 0u) | (s + 3u == n ? 2u : 0u));
-                const float ax = (ends & 1u) ? c0->x : 0.5f * (c0->x + c1->x);
-                const float ay = (ends & 1u) ? c0->y : 0.5f * (c0->y + c1->y);
-                const float bx = (ends & 2u) ? c2->x : 0.5f * (c1->x + c2->x);
-                const float by = (ends & 2u) ? c2->y : 0.5f * (c1->y + c2->y);
-                if ((ax < bx ? bx : ax) >= box[0] && (ax < bx ? ax : bx) <= box[2] &&
-                    (ay < by ? by : ay) >= box[1] && (ay < by ? ay : by) <= box[3]) {
-                    bsf_map_seg_t *g = &m->segs[m->n_segs++];
-                    g->ax = ax;
-                    g->ay = ay;
-                    g->bx = bx;
-                    g->by = by;
-                    g->feature = fs;
-                    g->p[0] = e[0];
-                    g->p[1] = e[1];
-                    g->p[2] = e[2];
-                    g->ends = ends;
+                /* a curved span becomes CHORDS chords, so that chord distance
+                 * stays close to curve distance */
+                const float ddx = c0->x - 2.0f * c1->x + c2->x;
+                const float ddy = c0->y - 2.0f * c1->y + c2->y;
+                const unsigned pieces = ddx * ddx + ddy * ddy > CURVED_SPAN2 ? CHORDS : 1u;
+                unsigned piece;
+                float px = 0.0f;
+                float py = 0.0f;
+                for (piece = 0; piece <= pieces; ++piece) {
+                    const float u = (float)piece / (float)pieces;
+                    float b[3];
+                    float qx;
+                    float qy;
+                    span_basis(ends, u, b);
+                    qx = b[0] * c0->x + b[1] * c1->x + b[2] * c2->x;
+                    qy = b[0] * c0->y + b[1] * c1->y + b[2] * c2->y;
+                    if (piece > 0u && m->n_segs < BSF_MAP_SEG_WINDOW &&
+                        (px < qx ? qx : px) >= box[0] && (px < qx ? px : qx) <= box[2] &&
+                        (py < qy ? qy : py) >= box[1] && (py < qy ? py : qy) <= box[3]) {
+                        bsf_map_seg_t *g = &m->segs[m->n_segs++];
+                        g->ax = px;
+                        g->ay = py;
+                        g->bx = qx;
+                        g->by = qy;
+                        g->u0 = (float)(piece - 1u) / (float)pieces;
+                        g->du = 1.0f / (float)pieces;
+                        g->feature = fs;
+                        g->p[0] = e[0];
+                        g->p[1] = e[1];
+                        g->p[2] = e[2];
+                        g->ends = ends;
+                    }
+                    px = qx;
+                    py = qy;
                 }
             }
         }
@@ -423,7 +445,7 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
             best = d2;
             lab[k].feature = sg->feature;
             lab[k].seg = g;
-            lab[k].u = t;
+            lab[k].u = sg->u0 + t * sg->du;
         }
     }
 }
@@ -569,8 +591,7 @@ static float run_length(const sample_t *s, long from, long to)
 }
 
 /* Link new points after the tail (at_head = 0) or before the head. */
-static int chain_extend(bsf_map_t *m, bsf_map_feature_t *f, const newpt_t *p, size_t n,
-                        int at_head)
+static int chain_extend(bsf_map_t *m, bsf_map_feature_t *f, const newpt_t *p, size_t n, int at_head)
 {
     size_t i;
     if (m->n_free_ctrl < n) {
@@ -692,8 +713,8 @@ static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
 /* Join slot fa (its end ea) to slot fb (its end eb) through samples
  * from..to (may be empty: from > to). Both must be fully sent, so that the
  * merge record can go before any other change to them. */
-static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned eb, const sample_t *s,
-                 long from, long to)
+static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned eb,
+                 const sample_t *s, long from, long to)
 {
     bsf_map_feature_t *a = &m->features[fa];
     bsf_map_feature_t *b = &m->features[fb];

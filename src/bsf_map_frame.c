@@ -139,10 +139,11 @@ typedef struct {
     unsigned upd;
     unsigned high;
     uint32_t id;
-    uint32_t id_b;  /* merge */
-    unsigned upd_b; /* merge */
-    unsigned rev_b; /* merge */
-    uint32_t n;     /* points of the record */
+    uint32_t id_b;      /* merge */
+    unsigned upd_b;     /* merge */
+    unsigned rev_b;     /* merge */
+    uint32_t start;     /* snapshot: index of its first point */
+    uint32_t n;         /* points of the record */
     const uint8_t *pts; /* where its points start */
     int32_t pose[3];
 } rec_t;
@@ -178,7 +179,8 @@ static int get_record(rd_t *r, int64_t *prev_id, rec_t *rec)
         rec->pose[2] = (int32_t)th;
         return 1;
     }
-    if (rec->high && rec->op != BSF_MAP_REC_APPEND && rec->op != BSF_MAP_REC_MERGE) {
+    if (rec->high && rec->op != BSF_MAP_REC_APPEND && rec->op != BSF_MAP_REC_MERGE &&
+        rec->op != BSF_MAP_REC_SNAPSHOT) {
         return 0;
     }
     if (rec->op == BSF_MAP_REC_NEW && rec->upd != 0u) {
@@ -207,7 +209,11 @@ static int get_record(rd_t *r, int64_t *prev_id, rec_t *rec)
         }
         rec->id_b = (uint32_t)(*prev_id + db);
     }
-    if (!get_u(r, BSF_MAP_REC_MAX_POINTS, &rec->n)) {
+    if (rec->op == BSF_MAP_REC_SNAPSHOT && !get_u(r, BSF_MAP_REC_MAX_POINTS - 1u, &rec->start)) {
+        return 0;
+    }
+    if (!get_u(r, BSF_MAP_REC_MAX_POINTS, &rec->n) ||
+        (uint64_t)rec->start + rec->n > BSF_MAP_REC_MAX_POINTS) {
         return 0;
     }
     if ((rec->op == BSF_MAP_REC_NEW && rec->n < 2u) ||
@@ -329,8 +335,8 @@ static int32_t quant_clamped(float v, float inv_step)
 
 static void put_tag(wr_t *w, unsigned op, unsigned upd, unsigned high)
 {
-    put_byte(w, (uint8_t)(op | ((upd & 15u) << BSF_MAP_TAG_UPD_SHIFT) |
-                          (high ? BSF_MAP_TAG_HIGH : 0u)));
+    put_byte(
+        w, (uint8_t)(op | ((upd & 15u) << BSF_MAP_TAG_UPD_SHIFT) | (high ? BSF_MAP_TAG_HIGH : 0u)));
 }
 
 static void put_id(wr_t *w, int64_t *prev_id, uint32_t id)
@@ -450,8 +456,8 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
     if (!(f->flags & BSF_MAP_FF_SENT)) {
         int32_t qx = 0;
         int32_t qy = 0;
-        const uint32_t n = span_points(m, f->head, 0, BSF_MAP_REC_MAX_POINTS, room_of(w), NULL,
-                                       &qx, &qy);
+        const uint32_t n =
+            span_points(m, f->head, 0, BSF_MAP_REC_MAX_POINTS, room_of(w), NULL, &qx, &qy);
         if (n < 2u) {
             return 0;
         }
@@ -548,8 +554,8 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
                 if (ex * ex + ey * ey > tol2) {
                     const int32_t dx = quant_clamped(c->x, inv) - c->qx;
                     const int32_t dy = quant_clamped(c->y, inv) - c->qy;
-                    const unsigned l = ulen((uint32_t)((int32_t)idx - last_idx - 1)) +
-                                       ulen(zz(dx)) + ulen(zz(dy));
+                    const unsigned l =
+                        ulen((uint32_t)((int32_t)idx - last_idx - 1)) + ulen(zz(dx)) + ulen(zz(dy));
                     if (l > room) {
                         full = 1;
                         break;
@@ -601,82 +607,124 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
     return 1;
 }
 
-/* Snapshots of fully sent features in id order from snapshot_next, within
- * the byte budget. */
+/* Snapshot records: the sent values of fully sent features, in id order
+ * from snapshot_next, within the byte budget; a feature larger than what is
+ * left goes in parts over several frames (restarted when its head changes
+ * in between: moves and appends at the tail do not disturb the parts). */
 static void put_snapshots(bsf_map_t *m, wr_t *w, int64_t *prev_id)
 {
     size_t budget = m->params.snapshot_budget;
     uint16_t tries;
-    for (tries = 0; tries < m->n_features; ++tries) {
-        uint16_t best = BSF_MAP_NONE;
-        uint16_t lowest = BSF_MAP_NONE;
-        uint16_t s;
+    for (tries = 0; tries <= m->n_features; ++tries) {
+        uint16_t slot = BSF_MAP_NONE;
         bsf_map_feature_t *f;
+        uint16_t i;
+        uint32_t pos;
+        uint32_t k;
+        uint32_t n;
+        size_t room;
+        size_t head;
+        size_t used = 0;
         int32_t qx = 0;
         int32_t qy = 0;
-        uint32_t n;
-        size_t need;
         uint8_t *save;
-        for (s = 0; s < m->n_features; ++s) {
-            const uint32_t id = m->features[s].id;
-            if (id >= m->snapshot_next &&
-                (best == BSF_MAP_NONE || id < m->features[best].id)) {
-                best = s;
-            }
-            if (lowest == BSF_MAP_NONE || id < m->features[lowest].id) {
-                lowest = s;
+        if (m->snapshot_pos > 0u) {
+            slot = bsf_map_slot_of_id(m, m->snapshot_next);
+            if (slot == BSF_MAP_NONE || m->features[slot].head != m->snapshot_head ||
+                m->features[slot].n_ctrl <= m->snapshot_pos) {
+                slot = BSF_MAP_NONE;
+                m->snapshot_pos = 0u;
             }
         }
-        if (best == BSF_MAP_NONE) {
-            best = lowest;
+        if (slot == BSF_MAP_NONE) {
+            uint16_t lowest = BSF_MAP_NONE;
+            uint16_t s;
+            for (s = 0; s < m->n_features; ++s) {
+                const uint32_t id = m->features[s].id;
+                if (id >= m->snapshot_next && (slot == BSF_MAP_NONE || id < m->features[slot].id)) {
+                    slot = s;
+                }
+                if (lowest == BSF_MAP_NONE || id < m->features[lowest].id) {
+                    lowest = s;
+                }
+            }
+            if (slot == BSF_MAP_NONE) {
+                slot = lowest;
+            }
+            if (slot == BSF_MAP_NONE) {
+                return;
+            }
+            m->snapshot_next = m->features[slot].id;
+            m->snapshot_pos = 0u;
         }
-        f = &m->features[best];
-        m->snapshot_next = f->id + 1u;
+        f = &m->features[slot];
         if (!bsf_map_chain_clean(m, f)) {
+            m->snapshot_next = f->id + 1u;
+            m->snapshot_pos = 0u;
             continue;
         }
-        {
-            /* the snapshot sends the values the receiver should hold */
-            uint16_t i;
-            size_t len = 0;
-            for (i = f->head; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
-                const bsf_map_ctrl_t *c = &m->ctrl[i];
-                len += point_len(c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u);
-                qx = c->qx;
-                qy = c->qy;
-            }
-            n = f->n_ctrl;
-            need = 1u + ulen((uint32_t)bsf_wire_zigzag((int64_t)f->id - *prev_id)) + ulen(n) + len;
+        pos = m->snapshot_pos;
+        n = f->n_ctrl;
+        head = 1u + ulen((uint32_t)bsf_wire_zigzag((int64_t)f->id - *prev_id)) + ulen(pos) +
+               ulen(n - pos);
+        room = (size_t)(w->end - w->p);
+        room = room < budget ? room : budget;
+        if (room <= head) {
+            return;
         }
-        if (need > budget || need > (size_t)(w->end - w->p)) {
-            m->snapshot_next = f->id; /* try it again next frame */
-            break;
+        room -= head;
+        /* how many points from pos fit */
+        for (i = f->head, k = 0; i != BSF_MAP_NONE && k < pos; i = m->ctrl[i].next) {
+            ++k;
+        }
+        for (k = 0; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
+            const bsf_map_ctrl_t *c = &m->ctrl[i];
+            const unsigned l =
+                point_len(c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u);
+            if (used + l > room) {
+                break;
+            }
+            used += l;
+            qx = c->qx;
+            qy = c->qy;
+            ++k;
+        }
+        if (k == 0u) {
+            return;
         }
         save = w->p;
-        put_tag(w, BSF_MAP_REC_SNAPSHOT, f->upd, 0u);
+        put_tag(w, BSF_MAP_REC_SNAPSHOT, f->upd, pos + k == n);
         put_id(w, prev_id, f->id);
-        put_u(w, n);
-        {
-            uint16_t i;
-            qx = 0;
-            qy = 0;
-            for (i = f->head; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
-                const bsf_map_ctrl_t *c = &m->ctrl[i];
-                put_point(w, c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u);
-                qx = c->qx;
-                qy = c->qy;
-            }
+        put_u(w, pos);
+        put_u(w, k);
+        for (i = f->head, n = 0; n < pos; i = m->ctrl[i].next) {
+            ++n;
+        }
+        qx = 0;
+        qy = 0;
+        for (n = 0; n < k; ++n, i = m->ctrl[i].next) {
+            const bsf_map_ctrl_t *c = &m->ctrl[i];
+            put_point(w, c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u);
+            qx = c->qx;
+            qy = c->qy;
         }
         budget -= (size_t)(w->p - save);
         ++m->stats.n_snapshots;
+        if (pos + k == f->n_ctrl) {
+            m->snapshot_next = f->id + 1u;
+            m->snapshot_pos = 0u;
+        } else {
+            m->snapshot_pos = (uint16_t)(pos + k);
+            m->snapshot_head = f->head;
+            return;
+        }
     }
 }
 
 static int pose_ok(const bsf_pose_t *p)
 {
-    return p->x == p->x && p->y == p->y && p->theta == p->theta &&
-           fabsf(p->x) <= BSF_POSE_XY_MAX && fabsf(p->y) <= BSF_POSE_XY_MAX &&
-           fabsf(p->theta) <= BSF_POSE_THETA_MAX;
+    return p->x == p->x && p->y == p->y && p->theta == p->theta && fabsf(p->x) <= BSF_POSE_XY_MAX &&
+           fabsf(p->y) <= BSF_POSE_XY_MAX && fabsf(p->theta) <= BSF_POSE_THETA_MAX;
 }
 
 bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf, size_t cap,
@@ -758,8 +806,7 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
     buf[offset + payload_len + 1u] = (uint8_t)(crc >> 8);
     buf[offset + payload_len + 2u] = (uint8_t)(crc >> 16);
     buf[offset + payload_len + 3u] = (uint8_t)(crc >> 24);
-    code_len =
-        bsf_cobs_encode_in_place(buf, offset, payload_len + BSF_FRAME_CRC_SIZE);
+    code_len = bsf_cobs_encode_in_place(buf, offset, payload_len + BSF_FRAME_CRC_SIZE);
     buf[code_len] = 0u;
     *out_len = code_len + 1u;
     ++map->frame_seq;
@@ -779,6 +826,7 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
 #define RX_PRESENT 1u
 #define RX_STALE 2u
 #define RX_GONE 3u
+#define RX_SNAP 4u /* a snapshot in parts is arriving */
 
 void bsf_map_rx_init(bsf_map_rx_t *rx)
 {
@@ -925,7 +973,6 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
     f = &rx->features[rec->id];
     switch (rec->op) {
     case BSF_MAP_REC_NEW:
-    case BSF_MAP_REC_SNAPSHOT:
         rx_free_chain(rx, f);
         if (!rx_link(rx, f, rec->pts, end, rec->n, 0, 0, 0)) {
             rx_free_chain(rx, f);
@@ -933,13 +980,33 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             return 0;
         }
         f->state = RX_PRESENT;
-        f->upd = (uint8_t)(rec->op == BSF_MAP_REC_NEW ? 1u : rec->upd);
-        if (rec->op == BSF_MAP_REC_SNAPSHOT) {
-            ++rx->stats.snapshots;
+        f->upd = 1u;
+        return 1;
+    case BSF_MAP_REC_SNAPSHOT:
+        /* a first part restarts the feature; a later part continues it only
+         * when every part before it arrived */
+        if (rec->start == 0u) {
+            rx_free_chain(rx, f);
+        } else if (f->state != RX_SNAP || f->n_ctrl != rec->start || f->upd != rec->upd) {
+            return 0;
         }
+        if (!rx_link(rx, f, rec->pts, end, rec->n, 0, 0, 0)) {
+            rx_free_chain(rx, f);
+            f->state = RX_STALE;
+            return 0;
+        }
+        f->state = rec->high ? RX_PRESENT : RX_SNAP;
+        f->upd = (uint8_t)rec->upd;
+        ++rx->stats.snapshots;
         return 1;
     case BSF_MAP_REC_APPEND: {
         const uint16_t e = rec->high ? f->head : f->tail;
+        if (f->state == RX_SNAP && f->upd == rec->upd) {
+            /* the snapshot's later parts carry these points (the robot
+             * restarts it when its head grows) */
+            f->upd = (uint8_t)((f->upd + 1u) & 15u);
+            return 1;
+        }
         if (f->state != RX_PRESENT || f->upd != rec->upd || e == BSF_MAP_NONE ||
             !rx_link(rx, f, rec->pts, end, rec->n, (int)rec->high, rx->ctrl[e].qx,
                      rx->ctrl[e].qy)) {
@@ -955,11 +1022,12 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         int64_t idx = -1;
         uint16_t c;
         int64_t at = 0;
-        if (f->state != RX_PRESENT || f->upd != rec->upd) {
+        if ((f->state != RX_PRESENT && f->state != RX_SNAP) || f->upd != rec->upd) {
             rx_stale(f);
             return 0;
         }
-        /* every index inside the feature and every value in range first */
+        /* every index inside the feature and every value in range first; a
+         * snapshot still arriving takes the moves of the points it has */
         r.p = rec->pts;
         r.end = end;
         c = f->head;
@@ -974,6 +1042,9 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             while (c != BSF_MAP_NONE && at < idx) {
                 c = rx->ctrl[c].next;
                 ++at;
+            }
+            if (c == BSF_MAP_NONE && f->state == RX_SNAP) {
+                break;
             }
             if (c == BSF_MAP_NONE || !q_ok(rx->ctrl[c].qx + dx) || !q_ok(rx->ctrl[c].qy + dy)) {
                 rx_stale(f);
@@ -992,9 +1063,12 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             (void)get_s(&r, DELTA_MAX, &dx);
             (void)get_s(&r, DELTA_MAX, &dy);
             idx += (int64_t)gap + 1;
-            while (at < idx) {
+            while (c != BSF_MAP_NONE && at < idx) {
                 c = rx->ctrl[c].next;
                 ++at;
+            }
+            if (c == BSF_MAP_NONE) {
+                break;
             }
             rx->ctrl[c].qx = (int32_t)(rx->ctrl[c].qx + dx);
             rx->ctrl[c].qy = (int32_t)(rx->ctrl[c].qy + dy);
@@ -1037,8 +1111,7 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         f->upd = (uint8_t)((f->upd + 1u) & 15u);
         return 1;
     }
-    default:
-        return 0;
+    default: return 0;
     }
 }
 
@@ -1106,7 +1179,7 @@ int bsf_map_rx_feature_ctrl(const bsf_map_rx_t *rx, uint32_t id, bsf_point_t *ct
     }
     f = &rx->features[id];
     if (stale != NULL) {
-        *stale = f->state == RX_STALE ? 1u : 0u;
+        *stale = (f->state == RX_STALE || f->state == RX_SNAP) ? 1u : 0u;
     }
     for (i = f->head; i != BSF_MAP_NONE; i = rx->ctrl[i].next) {
         const bsf_map_rx_ctrl_t *c = &rx->ctrl[i];

@@ -204,13 +204,14 @@ static void test_map_curves_lie_on_true_surfaces(void)
         TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
         /* evaluate in windows the evaluator accepts; spans overlap by 2 */
         for (first = 0; first + 2 < n; first += BSF_MAX_CTRL_PER_FEATURE - 2) {
-            const int m = n - first < BSF_MAX_CTRL_PER_FEATURE ? n - first : BSF_MAX_CTRL_PER_FEATURE;
+            const int m =
+                n - first < BSF_MAX_CTRL_PER_FEATURE ? n - first : BSF_MAX_CTRL_PER_FEATURE;
             int j;
             memcpy(c, all + first, (size_t)m * sizeof c[0]);
-            for (j = 0; j <= 20; ++j) {
+            for (j = 0; j <= 40; ++j) {
                 bsf_point_t pt;
                 double d;
-                if (bsf_bspline_eval(c, (size_t)m, (float)j / 20.0f, &pt, NULL, NULL) != BSF_OK) {
+                if (bsf_bspline_eval(c, (size_t)m, (float)j / 40.0f, &pt, NULL, NULL) != BSF_OK) {
                     continue;
                 }
                 d = bsf_scene_distance_to_surface(&scene, pt.x, pt.y, NULL);
@@ -220,7 +221,7 @@ static void test_map_curves_lie_on_true_surfaces(void)
             }
         }
     }
-    TEST_ASSERT_TRUE(n_samples > 200u);
+    TEST_ASSERT_TRUE(n_samples > 100u);
     /* at most 5 % of the curve farther than 5 cm from the truth */
     TEST_ASSERT_TRUE_MESSAGE(n_far * 20u <= n_samples, "curves far from the true surfaces");
     TEST_ASSERT_TRUE(worst < 0.5);
@@ -254,7 +255,7 @@ static void test_map_loss_then_snapshots_recover(void)
     uint32_t id;
     int stale_seen = 0;
     bsf_map_params_default(&p);
-    p.snapshot_budget = 200u;
+    p.snapshot_budget = 40u;
     start(&p);
     for (k = 0; k < 3 * N_SCANS; ++k) {
         bsf_pose_t pose;
@@ -262,7 +263,7 @@ static void test_map_loss_then_snapshots_recover(void)
         scan_k(k % N_SCANS, N_SCANS, 5u, &pose);
         TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
-        if (k == 4 || k == 9) {
+        if (k == 0 || k == 4 || k == 9) {
             continue; /* lost */
         }
         if (k == 6 && len > 8u) {
@@ -276,7 +277,7 @@ static void test_map_loss_then_snapshots_recover(void)
             continue;
         }
         (void)deliver(buf, len);
-        if (k == 12) {
+        {
             for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
                 uint8_t stale = 0;
                 TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
@@ -284,9 +285,29 @@ static void test_map_loss_then_snapshots_recover(void)
             }
         }
     }
+    /* with nothing new, one round of snapshots (the map's sent bytes over
+     * the budget) restores every feature */
+    for (k = 0; k < 200; ++k) {
+        size_t len = 0;
+        int any_stale = 0;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        TEST_ASSERT_TRUE(len <= 40u + 16u);
+        (void)deliver(buf, len);
+        for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+            uint8_t stale = 0;
+            TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
+            any_stale |= stale;
+        }
+        if (!any_stale) {
+            break;
+        }
+    }
+    TEST_ASSERT_TRUE(k < 200);
     TEST_ASSERT_TRUE(dec.stats.bad_crc + dec.stats.malformed >= 1u);
-    TEST_ASSERT_TRUE(rx.stats.frames_missed >= 2u);
-    TEST_ASSERT_TRUE(stale_seen || rx.stats.records_skipped == 0u);
+    TEST_ASSERT_EQUAL_UINT32(3u, rx.stats.frames_missed); /* the first loss is unseen */
+    /* the lost frames' features were reported stale, then healed */
+    TEST_ASSERT_TRUE(rx.stats.records_skipped > 0u);
+    TEST_ASSERT_TRUE(stale_seen);
     TEST_ASSERT_TRUE(map.stats.n_snapshots > 0u);
     assert_rx_equals_sent();
 }

@@ -123,7 +123,9 @@ typedef struct {
 
 /** One span of a map curve as a chord between its knot points (internal). */
 typedef struct {
-    float ax, ay, bx, by; /**< chord from the span's start knot point to its end */
+    float ax, ay, bx, by; /**< chord between two points of the span (a curved span is cut in
+                               several chords) */
+    float u0, du;         /**< span parameter at a, and its increase to b */
     uint16_t feature;     /**< slot in features[] */
     uint16_t p[3];        /**< pool indices of the span's three control points */
     uint8_t ends;         /**< 1: the chain's first span, 2: its last span */
@@ -151,6 +153,8 @@ typedef struct {
     uint32_t next_id;                       /**< id of the next new feature */
     uint32_t frame_seq;                     /**< sequence number of the next frame */
     uint32_t snapshot_next;                 /**< round-robin position of snapshots (feature id) */
+    uint16_t snapshot_pos;                  /**< next point of a snapshot sent in parts */
+    uint16_t snapshot_head;                 /**< head point of that feature at its first part */
     int32_t step_code;                      /**< quant_step in 0.1 mm */
     bsf_map_seg_t segs[BSF_MAP_SEG_WINDOW]; /**< work area of bsf_map_fuse */
     uint16_t n_segs;
