@@ -76,6 +76,7 @@ typedef struct {
     unsigned long map_frames, map_once_missing; /* forgotten features not in the snapshot */
     unsigned long map_features, map_vertices, map_forgotten, map_dropped;
     unsigned long rx_mismatch, rx_compared, fuse_failed;
+    unsigned long rx_points, robot_points; /* distinct control points */
     double map_length;
     mg_hist_t map_dist;  /* raw point to the final map */
     mg_hist_t map_truth; /* map curve samples to the true surface */
@@ -344,29 +345,48 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* The bytes of the final map sent once: snapshot records of every feature
- * the robot still holds, on a copy of the map (the library has no call that
- * writes the whole map at once). */
+ * the robot still holds, one full round of the round robin from id 0, on a
+ * copy of the map (the library has no call that writes the whole map at
+ * once). Features the robot forgot are not in it: map_once_est scales the
+ * bytes by the receiver's control points over the robot's. */
 static int map_once_bytes(column_t *col)
 {
     const size_t n = bsf_map_feature_count(&g_map);
-    uint32_t bytes0, snaps0;
+    uint32_t bytes0, max_id = 0, last_next;
+    size_t i;
     int guard = 0;
+    if (n == 0u) {
+        return 0;
+    }
+    for (i = 0; i < n; ++i) {
+        uint32_t id = 0;
+        if (bsf_map_feature_q(&g_map, i, NULL, NULL, 0u, &id) >= 0 && id > max_id) {
+            max_id = id;
+        }
+    }
     memcpy(&g_map_copy, &g_map, sizeof g_map);
     g_map_copy.params.snapshot_budget = 3000u;
+    g_map_copy.snapshot_next = 0u;
+    g_map_copy.snapshot_pos = 0u;
+    last_next = 0u;
     bytes0 = g_map_copy.stats.map_bytes;
-    snaps0 = g_map_copy.stats.n_snapshots;
-    while ((size_t)(g_map_copy.stats.n_snapshots - snaps0) < n && guard++ < 100000) {
+    while (guard++ < 100000) {
         size_t len = 0;
         if (bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
             return -1;
         }
         if (len == 0u) {
+            return -1;
+        }
+        if (g_map_copy.snapshot_pos == 0u &&
+            (g_map_copy.snapshot_next > max_id || g_map_copy.snapshot_next < last_next)) {
             break;
         }
+        last_next = g_map_copy.snapshot_next;
     }
     col->map_once_bytes = (size_t)(g_map_copy.stats.map_bytes - bytes0);
     col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
-    return (size_t)(g_map_copy.stats.n_snapshots - snaps0) >= n ? 0 : -1;
+    return guard < 100000 ? 0 : -1;
 }
 
 /* The receiver's final map as curves; robot and receiver compared value for value. */
@@ -394,6 +414,14 @@ static int final_map(column_t *col, mg_curves_t *map)
         if (mg_curves_add_bspline(map, xy, (size_t)n, vtx) != 0) {
             return -1;
         }
+    }
+    for (id = 0; id < limit; ++id) {
+        const int n = bsf_map_rx_feature_q(&g_rx, id, NULL, NULL, 0u);
+        col->rx_points += n > 0 ? (unsigned long)n : 0u;
+    }
+    for (i = 0; i < bsf_map_feature_count(&g_map); ++i) {
+        const int n = bsf_map_feature_q(&g_map, i, NULL, NULL, 0u, NULL);
+        col->robot_points += n > 0 ? (unsigned long)n : 0u;
     }
     col->map_features = (unsigned long)map->n_curves;
     col->map_vertices = (unsigned long)map->n_vtx;
@@ -739,9 +767,13 @@ static void print_table(void)
     } while (0)
     ROW("scans (extraction failed, fuse failed)",
         printf(" %lu (%lu, %lu) |", col->scans, col->failed, col->fuse_failed));
-    ROW("**map: bytes of the final map, sent once**",
-        printf(" %lu%s |", (unsigned long)col->map_once_bytes,
-               col->map_once_missing ? " (+forgotten)" : ""));
+    ROW("**map: bytes of the final map, sent once** (snapshot of the robot's RAM; "
+        "with forgotten features, scaled by control points)",
+        col->map_once_missing && col->robot_points
+            ? printf(" %lu (%.0f) |", (unsigned long)col->map_once_bytes,
+                     (double)col->map_once_bytes * (double)col->rx_points /
+                         (double)col->robot_points)
+            : printf(" %lu |", (unsigned long)col->map_once_bytes));
     ROW("**map: bytes of the whole update stream (map only)**",
         printf(" %lu |", (unsigned long)col->map_update_bytes));
     ROW("map: pose bytes (a pose per scan, apart)",
