@@ -9,6 +9,7 @@ Usage: test_map.py BSF_EXE SYNTH_LOG_EXE WORK_DIR
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -86,6 +87,8 @@ for a in segs:
 # 1. extract --map writes a map stream: metadata first, then map frames only.
 r = run(["extract", "room.log", "--map", "--reproducible", "-o", "room.map"])
 check(r.returncode == 0, "bsf extract --map exits 0")
+m = re.search(rb"map: (\d+) frames, (\d+) bytes of map records and headers, (\d+) of pose records", r.stderr)
+encoder_bytes = (int(m.group(2)), int(m.group(3))) if m else None
 check(b"map:" in r.stderr and b"bytes of RAM" in r.stderr, "extract --map reports the map (bytes, RAM)")
 r2 = run(["extract", "room.log", "--reproducible", "-o", "room.bsf"])
 check(r2.returncode == 0, "bsf extract (per-scan) exits 0")
@@ -155,6 +158,9 @@ check(ok, "room.svg: curves, robot path and legend as bsf render draws them")
 # 4. metrics and listen on the map stream.
 r = run(["metrics", "room.map"])
 check(r.returncode == 0 and b"map frames" in r.stdout and b"pose-only" in r.stdout, "bsf metrics reports the map's bytes")
+m = re.search(rb"map frames +\d+, \d+ bytes: map (\d+), pose (\d+)", r.stdout)
+check(m is not None and encoder_bytes == (int(m.group(1)), int(m.group(2))),
+      f"metrics splits map and pose bytes as the encoder counted them {encoder_bytes}")
 with open(os.path.join(WORK, "room.map"), "rb") as f:
     data = f.read()
 r = run(["listen", "-"], input=data)

@@ -83,10 +83,13 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
             stale += st;
         }
     }
-    printf("map frames        %lu, %llu bytes: %llu in frames with map records, %llu in %lu "
-           "pose-only frames (%lu pose records in all)\n",
-           s->n_map_frames, s->map_frame_bytes, s->map_frame_bytes - c.view.pose_only_bytes,
-           c.view.pose_only_bytes, c.view.pose_only_frames, (unsigned long)c.view.rx->stats.poses);
+    {
+        const unsigned long long pose = c.view.pose_only_bytes + c.view.pose_record_bytes;
+        printf("map frames        %lu, %llu bytes: map %llu, pose %llu (%lu pose records; %lu "
+               "pose-only frames)\n",
+               s->n_map_frames, s->map_frame_bytes, s->map_frame_bytes - pose, pose,
+               (unsigned long)c.view.rx->stats.poses, c.view.pose_only_frames);
+    }
     printf("other bytes       %llu metadata, %llu per-scan frames and unframed bytes\n",
            s->metadata_bytes, other);
     printf("map               %lu features, %lu control points (vertices twice), %lu stale; "

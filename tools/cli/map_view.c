@@ -82,6 +82,33 @@ static int path_push(map_view_t *v, const bsf_pose_t *p)
     return 0;
 }
 
+static unsigned varint_len(uint32_t v)
+{
+    unsigned n = 1;
+    while (v >= 0x80u) {
+        v >>= 7;
+        ++n;
+    }
+    return n;
+}
+
+static uint32_t zigzag(long v)
+{
+    return v < 0 ? (uint32_t)(-2L * v - 1L) : (uint32_t)(2L * v);
+}
+
+/* Bytes of a pose record on the wire (before COBS): a tag byte, then x and
+ * y in millimetres (zigzag varints) and theta in 65536ths of a turn (a
+ * varint), as docs/FORMAT.md lays it out; recomputed from the decoded pose,
+ * which holds exactly those integers. */
+static unsigned pose_record_bytes(const bsf_pose_t *p)
+{
+    const long x = lround((double)p->x * 1000.0), y = lround((double)p->y * 1000.0);
+    long th = lround((double)p->theta * (65536.0 / (2.0 * M_PI))) % 65536L;
+    th = th < 0 ? th + 65536L : th;
+    return 1u + varint_len(zigzag(x)) + varint_len(zigzag(y)) + varint_len((uint32_t)th);
+}
+
 int map_view_apply(map_view_t *v, const bsf_frame_t *f, size_t bytes, map_change_t *chg)
 {
     const bsf_map_rx_stats_t before = v->rx->stats;
@@ -103,9 +130,13 @@ int map_view_apply(map_view_t *v, const bsf_frame_t *f, size_t bytes, map_change
         if (path_push(v, &v->rx->pose) != 0) {
             return -1;
         }
-        if (v->rx->stats.records == before.records && v->rx->stats.snapshots == before.snapshots) {
+        /* the receiver counts a pose record among its records */
+        if (v->rx->stats.records - before.records == v->rx->stats.poses - before.poses &&
+            v->rx->stats.records_skipped == before.records_skipped) {
             ++v->pose_only_frames;
             v->pose_only_bytes += bytes;
+        } else {
+            v->pose_record_bytes += pose_record_bytes(&v->rx->pose);
         }
     }
     if (v->track) {
