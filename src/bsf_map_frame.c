@@ -25,6 +25,9 @@ typedef struct {
     uint8_t *p;
     uint8_t *end;
     int full;
+    uint8_t *rec_start; /* the record being written, for the byte tally */
+    unsigned rec_op;
+    uint32_t bytes[BSF_MAP_REC_OPS];
 } wr_t;
 
 static unsigned ulen(uint32_t v)
@@ -333,8 +336,21 @@ static int32_t quant_clamped(float v, float inv_step)
     return q;
 }
 
+/* Payload bytes by record operation: each record runs from its tag to the
+ * next tag or the end of the records. */
+static void tally_close(wr_t *w)
+{
+    if (w->rec_start != NULL && w->p > w->rec_start) {
+        w->bytes[w->rec_op] += (uint32_t)(w->p - w->rec_start);
+    }
+    w->rec_start = NULL;
+}
+
 static void put_tag(wr_t *w, unsigned op, unsigned upd, unsigned high)
 {
+    tally_close(w);
+    w->rec_start = w->p;
+    w->rec_op = op;
     put_byte(
         w, (uint8_t)(op | ((upd & 15u) << BSF_MAP_TAG_UPD_SHIFT) | (high ? BSF_MAP_TAG_HIGH : 0u)));
 }
@@ -402,6 +418,30 @@ static uint32_t unsent_run(const bsf_map_t *m, uint16_t from, int dir)
     return n;
 }
 
+/* A new point is held back until it has been observed HOLD_OBS times, or
+ * its feature has gone unseen for HOLD_CALLS fuse calls: the first
+ * observations move it most, and a point sent early would be sent again as
+ * a move. */
+#define HOLD_OBS 3u
+#define HOLD_CALLS 5u
+
+static int ripe(const bsf_map_t *m, const bsf_map_feature_t *f, const bsf_map_ctrl_t *c)
+{
+    return c->weight >= HOLD_OBS || m->stats.n_fused - f->last_seen >= HOLD_CALLS;
+}
+
+/* Ripe points of a run of unsent points from `from` outward (dir as above). */
+static uint32_t ripe_run(const bsf_map_t *m, const bsf_map_feature_t *f, uint16_t from, int dir)
+{
+    uint32_t n = 0;
+    while (from != BSF_MAP_NONE && !(m->ctrl[from].flags & BSF_MAP_CF_SENT) &&
+           ripe(m, f, &m->ctrl[from])) {
+        ++n;
+        from = dir ? m->ctrl[from].prev : m->ctrl[from].next;
+    }
+    return n;
+}
+
 /* A merge record; 0 when it does not fit. */
 static int put_merge(bsf_map_t *m, wr_t *w, int64_t *prev_id, const bsf_map_op_t *op)
 {
@@ -431,6 +471,7 @@ static int put_merge(bsf_map_t *m, wr_t *w, int64_t *prev_id, const bsf_map_op_t
         if (n < op->n_bridge || w->full) {
             w->p = save;
             w->full = 0;
+            w->rec_start = NULL;
             *prev_id = save_id;
             return 0;
         }
@@ -439,11 +480,53 @@ static int put_merge(bsf_map_t *m, wr_t *w, int64_t *prev_id, const bsf_map_op_t
     if (w->full) {
         w->p = save;
         w->full = 0;
+        w->rec_start = NULL;
         *prev_id = save_id;
         return 0;
     }
     m->features[sa].flags &= (uint8_t)~BSF_MAP_FF_OP;
     return 1;
+}
+
+/* An append record with the ripe unsent points at one end of f, outward
+ * from the sent point next to them; 0 when the frame is full. */
+static int put_append(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_t *f, int at_head)
+{
+    const int dir = at_head ? 1 : 0; /* span_points: 1 follows prev */
+    const uint32_t unsent = unsent_run(m, at_head ? f->head : f->tail, at_head ? 0 : 1);
+    uint16_t edge = at_head ? f->head : f->tail;
+    uint16_t first;
+    uint32_t k;
+    uint32_t run;
+    uint32_t n;
+    int32_t qx;
+    int32_t qy;
+    if (unsent == 0u || unsent >= f->n_ctrl) {
+        return 1;
+    }
+    for (k = 0; k < unsent; ++k) {
+        edge = at_head ? m->ctrl[edge].next : m->ctrl[edge].prev;
+    }
+    first = at_head ? m->ctrl[edge].prev : m->ctrl[edge].next;
+    run = ripe_run(m, f, first, dir);
+    if (run == 0u) {
+        return 1;
+    }
+    qx = m->ctrl[edge].qx;
+    qy = m->ctrl[edge].qy;
+    n = span_points(m, first, dir, run, room_of(w), NULL, &qx, &qy);
+    if (n == 0u) {
+        return 0;
+    }
+    qx = m->ctrl[edge].qx;
+    qy = m->ctrl[edge].qy;
+    put_tag(w, BSF_MAP_REC_APPEND, f->upd, (unsigned)at_head);
+    put_id(w, prev_id, f->id);
+    put_u(w, n);
+    (void)span_points(m, first, dir, n, 0u, w, &qx, &qy);
+    f->upd = (uint8_t)((f->upd + 1u) & 15u);
+    ++m->stats.n_records;
+    return n == run;
 }
 
 /* New-feature, append and move records of one feature; 0 when the frame is full. */
@@ -456,7 +539,11 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
     if (!(f->flags & BSF_MAP_FF_SENT)) {
         int32_t qx = 0;
         int32_t qy = 0;
-        const uint32_t n =
+        uint32_t n;
+        if (ripe_run(m, f, f->head, 0) < f->n_ctrl) {
+            return 1; /* held back */
+        }
+        n =
             span_points(m, f->head, 0, BSF_MAP_REC_MAX_POINTS, room_of(w), NULL, &qx, &qy);
         if (n < 2u) {
             return 0;
@@ -475,66 +562,9 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
         }
         return 1;
     }
-    /* unsent points at the head, sent outward from the first sent one */
-    {
-        const uint32_t run = unsent_run(m, f->head, 0);
-        if (run > 0u && run < f->n_ctrl) {
-            uint16_t first_sent = f->head;
-            uint32_t k;
-            int32_t qx;
-            int32_t qy;
-            uint32_t n;
-            for (k = 0; k < run; ++k) {
-                first_sent = m->ctrl[first_sent].next;
-            }
-            qx = m->ctrl[first_sent].qx;
-            qy = m->ctrl[first_sent].qy;
-            n = span_points(m, m->ctrl[first_sent].prev, 1, run, room_of(w), NULL, &qx, &qy);
-            if (n == 0u) {
-                return 0;
-            }
-            qx = m->ctrl[first_sent].qx;
-            qy = m->ctrl[first_sent].qy;
-            put_tag(w, BSF_MAP_REC_APPEND, f->upd, 1u);
-            put_id(w, prev_id, f->id);
-            put_u(w, n);
-            (void)span_points(m, m->ctrl[first_sent].prev, 1, n, 0u, w, &qx, &qy);
-            f->upd = (uint8_t)((f->upd + 1u) & 15u);
-            ++m->stats.n_records;
-            if (n < run) {
-                return 0;
-            }
-        }
-    }
-    {
-        const uint32_t run = unsent_run(m, f->tail, 1);
-        if (run > 0u && run < f->n_ctrl) {
-            uint16_t last_sent = f->tail;
-            uint32_t k;
-            int32_t qx;
-            int32_t qy;
-            uint32_t n;
-            for (k = 0; k < run; ++k) {
-                last_sent = m->ctrl[last_sent].prev;
-            }
-            qx = m->ctrl[last_sent].qx;
-            qy = m->ctrl[last_sent].qy;
-            n = span_points(m, m->ctrl[last_sent].next, 0, run, room_of(w), NULL, &qx, &qy);
-            if (n == 0u) {
-                return 0;
-            }
-            qx = m->ctrl[last_sent].qx;
-            qy = m->ctrl[last_sent].qy;
-            put_tag(w, BSF_MAP_REC_APPEND, f->upd, 0u);
-            put_id(w, prev_id, f->id);
-            put_u(w, n);
-            (void)span_points(m, m->ctrl[last_sent].next, 0, n, 0u, w, &qx, &qy);
-            f->upd = (uint8_t)((f->upd + 1u) & 15u);
-            ++m->stats.n_records;
-            if (n < run) {
-                return 0;
-            }
-        }
+    /* unsent points at either end, sent outward from the sent part */
+    if (!put_append(m, w, prev_id, f, 1) || !put_append(m, w, prev_id, f, 0)) {
+        return 0;
     }
     /* moved points: two passes, counting what fits, then writing it */
     {
@@ -756,9 +786,9 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
     /* payload written after room for the COBS overhead, encoded in place */
     offset = 2u + cap / 254u;
     limit = cap - offset - BSF_FRAME_CRC_SIZE - 1u;
+    memset(&w, 0, sizeof w);
     w.p = buf + offset;
     w.end = w.p + limit;
-    w.full = 0;
     put_byte(&w, MAP_BYTE0);
     put_u(&w, map->frame_seq);
     put_u(&w, (uint32_t)map->step_code);
@@ -793,10 +823,12 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
         if (w.full) {
             w.p = save;
             w.full = 0;
+            w.rec_start = NULL;
         } else {
             pose_len = (size_t)(w.p - save);
         }
     }
+    tally_close(&w);
     payload_len = (size_t)(w.p - (buf + offset));
     if (payload_len == header_len) {
         return BSF_OK; /* nothing to send */
@@ -811,6 +843,9 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
     *out_len = code_len + 1u;
     ++map->frame_seq;
     ++map->stats.n_frames;
+    for (s = 0; s < BSF_MAP_REC_OPS; ++s) {
+        map->stats.record_bytes[s] += w.bytes[s];
+    }
     if (map_records_end == header_len && payload_len == header_len + pose_len) {
         map->stats.pose_bytes += (uint32_t)*out_len;
     } else {

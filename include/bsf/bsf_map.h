@@ -92,6 +92,9 @@ typedef struct {
     uint32_t n_records;        /**< update records written (pose records excluded) */
     uint32_t n_snapshots;      /**< snapshot records written */
     uint32_t n_moved_ctrl;     /**< control point moves sent */
+    uint32_t record_bytes[6]; /**< payload bytes of the records by operation: new feature,
+                                   append, move, merge, snapshot, pose (FORMAT.md section 11);
+                                   the rest of map_bytes + pose_bytes is frame overhead */
 } bsf_map_stats_t;
 
 /** One control point of the robot's map (internal layout; read it through
