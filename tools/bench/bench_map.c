@@ -344,11 +344,15 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
-/* The bytes of the final map sent once: snapshot records of every feature
- * the robot still holds, one full round of the round robin from id 0, on a
- * copy of the map (the library has no call that writes the whole map at
- * once). Features the robot forgot are not in it: map_once_est scales the
- * bytes by the receiver's control points over the robot's. */
+/* The bytes of the final map sent once: the snapshot records of one round
+ * of the round robin from id 0 over every feature the robot still holds, on
+ * a copy of the map (the library has no call that writes the whole map at
+ * once), in frames of a small snapshot budget so that the round's end is
+ * seen within SNAP_BUDGET bytes (counted twice at most); frame headers
+ * are left out. Features the
+ * robot forgot are not in it: the table scales the bytes by the receiver's
+ * control points over the robot's. */
+#define SNAP_BUDGET 128u
 static int map_once_bytes(column_t *col)
 {
     const size_t n = bsf_map_feature_count(&g_map);
@@ -365,11 +369,11 @@ static int map_once_bytes(column_t *col)
         }
     }
     memcpy(&g_map_copy, &g_map, sizeof g_map);
-    g_map_copy.params.snapshot_budget = 3000u;
+    g_map_copy.params.snapshot_budget = SNAP_BUDGET;
     g_map_copy.snapshot_next = 0u;
     g_map_copy.snapshot_pos = 0u;
     last_next = 0u;
-    bytes0 = g_map_copy.stats.map_bytes;
+    bytes0 = g_map_copy.stats.record_bytes[4];
     while (guard++ < 100000) {
         size_t len = 0;
         if (bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
@@ -378,13 +382,15 @@ static int map_once_bytes(column_t *col)
         if (len == 0u) {
             return -1;
         }
-        if (g_map_copy.snapshot_pos == 0u &&
-            (g_map_copy.snapshot_next > max_id || g_map_copy.snapshot_next < last_next)) {
+        /* the round ends at the last id or where the next round starts
+         * (within this frame: at most SNAP_BUDGET bytes counted twice) */
+        if ((g_map_copy.snapshot_pos == 0u && g_map_copy.snapshot_next > max_id) ||
+            g_map_copy.snapshot_next < last_next) {
             break;
         }
         last_next = g_map_copy.snapshot_next;
     }
-    col->map_once_bytes = (size_t)(g_map_copy.stats.map_bytes - bytes0);
+    col->map_once_bytes = (size_t)(g_map_copy.stats.record_bytes[4] - bytes0);
     col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
     return guard < 100000 ? 0 : -1;
 }
@@ -767,8 +773,8 @@ static void print_table(void)
     } while (0)
     ROW("scans (extraction failed, fuse failed)",
         printf(" %lu (%lu, %lu) |", col->scans, col->failed, col->fuse_failed));
-    ROW("**map: bytes of the final map, sent once** (snapshot of the robot's RAM; "
-        "with forgotten features, scaled by control points)",
+    ROW("**map: bytes of the final map, sent once** (snapshot records of the robot's RAM; "
+        "in brackets, scaled to the receiver's control points when features were forgotten)",
         col->map_once_missing && col->robot_points
             ? printf(" %lu (%.0f) |", (unsigned long)col->map_once_bytes,
                      (double)col->map_once_bytes * (double)col->rx_points /
@@ -797,8 +803,9 @@ static void print_table(void)
                                     : 0.0,
                      col->corners_one, col->corners_5, col->corners_many)
             : printf(" – |"));
-    ROW("map: features, vertices, curve m",
-        printf(" %lu, %lu, %.1f |", col->map_features, col->map_vertices, col->map_length));
+    ROW("map: features, control points, vertices, curve m",
+        printf(" %lu, %lu, %lu, %.1f |", col->map_features, col->rx_points, col->map_vertices,
+               col->map_length));
     ROW("map: forgotten features, scan features left out",
         printf(" %lu, %lu |", col->map_forgotten, col->map_dropped));
     ROW("map: receiver = robot (features differing / compared)",
