@@ -73,6 +73,7 @@ typedef struct {
     int grid_ok;
     /* the map */
     size_t map_update_bytes, map_pose_bytes, map_once_bytes;
+    uint32_t record_bytes[6];                   /* of the update stream, by record type */
     unsigned long map_frames, map_once_missing; /* forgotten features not in the snapshot */
     unsigned long map_features, map_vertices, map_forgotten, map_dropped;
     unsigned long rx_mismatch, rx_compared, fuse_failed;
@@ -481,6 +482,7 @@ static int map_end(column_t *col, const mg_points_t *pts, mg_curves_t *map)
         return -1;
     }
     col->map_update_bytes = g_map.stats.map_bytes;
+    memcpy(col->record_bytes, g_map.stats.record_bytes, sizeof col->record_bytes);
     col->map_pose_bytes = g_map.stats.pose_bytes;
     col->map_forgotten = g_map.stats.n_forgotten;
     col->map_dropped = g_map.stats.n_dropped_obs;
@@ -782,6 +784,13 @@ static void print_table(void)
             : printf(" %lu |", (unsigned long)col->map_once_bytes));
     ROW("**map: bytes of the whole update stream (map only)**",
         printf(" %lu |", (unsigned long)col->map_update_bytes));
+    ROW("map: update records new / append / move / merge bytes, the rest frame overhead",
+        printf(" %lu / %lu / %lu / %lu, %lu |", (unsigned long)col->record_bytes[0],
+               (unsigned long)col->record_bytes[1], (unsigned long)col->record_bytes[2],
+               (unsigned long)col->record_bytes[3],
+               (unsigned long)(col->map_update_bytes - col->record_bytes[0] - col->record_bytes[1] -
+                               col->record_bytes[2] - col->record_bytes[3] -
+                               col->record_bytes[4])));
     ROW("map: pose bytes (a pose per scan, apart)",
         printf(" %lu |", (unsigned long)col->map_pose_bytes));
     ROW("map: frames", printf(" %lu |", col->map_frames));
