@@ -9,7 +9,7 @@ static const char main_help[] =
     "B-spline map features from 2D LIDAR scans.\n"
     "\n"
     "  extract LOG|- [--method M] [--first K] [--count N] [--range-max M] [--reproducible]\n"
-    "                [--meta-every K] [-o OUT|-]\n"
+    "                [--meta-every K] [--map [--pose-every K]] [-o OUT|-]\n"
     "  decode IN [--json]          frames as text or JSON Lines, then decoder counters\n"
     "  metrics IN                  retrievability, compactness, accuracy, time, bytes\n"
     "  render IN -o MAP.svg [--scans K..L] [--points LOG] [--width PX]\n"
