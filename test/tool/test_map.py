@@ -99,6 +99,11 @@ r = run(["decode", "room.map", "--json"])
 lines = [json.loads(l) for l in r.stdout.decode().splitlines() if l.startswith("{")]
 check(r.returncode == 0 and len(lines) > 1, "bsf decode reads the map stream")
 check(bool(lines) and "metadata" in json.dumps(lines[0]), "the metadata frame comes first")
+maps = [l["map"] for l in lines if "map" in l]
+check(len(maps) == 80 and [m["seq"] for m in maps] == list(range(80)), "decode --json: one map frame per scan, in sequence")
+check(all(m["payload"].startswith("23") for m in maps), "decode --json: payloads of version 2, type 3")
+r = run(["render", "room.map", "-o", "render.svg"])
+check(r.returncode == 1 and b"bsf map" in r.stderr, "bsf render on a map stream: exit 1, points to bsf map")
 r3 = run(["extract", "room.log", "--map", "--reproducible", "-o", "room2.map"])
 with open(os.path.join(WORK, "room.map"), "rb") as f1, open(os.path.join(WORK, "room2.map"), "rb") as f2:
     check(f1.read() == f2.read(), "extract --map --reproducible gives the same bytes twice")

@@ -80,10 +80,11 @@ typedef struct {
     double min[2], max[2];
     unsigned long long n;
     uint32_t *hist[2];
-    long lo, hi;           /* sequence range drawn */
-    unsigned long frames;  /* features frames in range */
-    unsigned long no_pose; /* of which without a pose */
-    uint32_t max_seq;      /* largest sequence number in the stream */
+    long lo, hi;              /* sequence range drawn */
+    unsigned long frames;     /* features frames in range */
+    unsigned long no_pose;    /* of which without a pose */
+    unsigned long map_frames; /* map-update frames (not drawn here: bsf map) */
+    uint32_t max_seq;         /* largest sequence number in the stream */
     int have_seq;
 } bounds_ctx_t;
 
@@ -391,6 +392,9 @@ static int render_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
 {
     render_ctx_t *rc = (render_ctx_t *)vctx;
     (void)bytes;
+    if (fr->type == BSF_FRAME_TYPE_MAP && rc->pass == PASS_EXTREMES) {
+        ++rc->b->map_frames;
+    }
     if (fr->type != BSF_FRAME_TYPE_FEATURES) {
         return 0;
     }
@@ -451,6 +455,12 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     rc.svg = &svg;
     bsf_bounds_init(&b);
     if (render_pass(in, in_name, &rc, PASS_EXTREMES) != 0) {
+        return -1;
+    }
+    if (bc.frames == 0u && bc.map_frames > 0u) {
+        fail_msg("%s holds map-update frames, not per-scan features: bsf map %s -o MAP.svg "
+                 "draws its map",
+                 in_name, in_name);
         return -1;
     }
     if (bc.n >= 1000u) {
