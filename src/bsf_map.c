@@ -60,11 +60,12 @@ void bsf_map_params_default(bsf_map_params_t *p)
     p->match_angle = 0.5f;
     p->vertex_dist = 0.05f;
     p->ctrl_spacing = 0.25f;
-    p->send_tol = 0.015f;
+    p->send_tol = 0.02f;
     p->quant_step = BSF_QUANT_STEP_DEFAULT;
     p->weight_cap = 32u;
     p->forget_after = 50u;
     p->snapshot_budget = 0u;
+    p->frame_interval = 5u;
 }
 
 static int finite_f(float v)
@@ -83,7 +84,8 @@ static bsf_status_t check_params(const bsf_map_params_t *p, int32_t *step_code)
         p->match_angle > 1.5707964f || p->vertex_dist < 0.0f || p->vertex_dist > p->match_dist ||
         p->ctrl_spacing < 0.02f || p->ctrl_spacing > 2.0f || p->send_tol < 0.0f ||
         p->send_tol > 1.0f || p->quant_step < BSF_QUANT_STEP_MIN ||
-        p->quant_step > BSF_QUANT_STEP_MAX || p->weight_cap < 1u || p->weight_cap > 255u) {
+        p->quant_step > BSF_QUANT_STEP_MAX || p->weight_cap < 1u || p->weight_cap > 255u ||
+        p->frame_interval < 1u || p->frame_interval > 1000u) {
         return BSF_ERR_PARAM;
     }
     code = floorf(p->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
@@ -408,7 +410,8 @@ static size_t sample_curve(const bsf_point_t *w, const uint8_t *vtx, size_t n, s
 
 static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, label_t *lab)
 {
-    const float d2max = m->params.match_dist * m->params.match_dist;
+    const float md = m->params.match_dist;
+    const float d2max = md * md;
     const float cmin = cosf(m->params.match_angle);
     size_t k;
     uint16_t g;
@@ -421,11 +424,20 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
             const bsf_map_seg_t *sg = &m->segs[g];
             const float ux = sg->bx - sg->ax;
             const float uy = sg->by - sg->ay;
-            const float l2 = ux * ux + uy * uy;
+            float l2;
             float t = 0.0f;
             float ex;
             float ey;
             float d2;
+            /* cheap rejection: the sample is beyond the chord's box grown by
+             * the match distance */
+            if ((s[k].x < sg->ax - md && s[k].x < sg->bx - md) ||
+                (s[k].x > sg->ax + md && s[k].x > sg->bx + md) ||
+                (s[k].y < sg->ay - md && s[k].y < sg->by - md) ||
+                (s[k].y > sg->ay + md && s[k].y > sg->by + md)) {
+                continue;
+            }
+            l2 = ux * ux + uy * uy;
             if (l2 > 1e-10f) {
                 t = ((s[k].x - sg->ax) * ux + (s[k].y - sg->ay) * uy) / l2;
                 t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
@@ -713,6 +725,58 @@ static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
 /* Join slot fa (its end ea) to slot fb (its end eb) through samples
  * from..to (may be empty: from > to). Both must be fully sent, so that the
  * merge record can go before any other change to them. */
+/* Join feature slot fu, never sent, to slot fs at fs's end es (fu's end eu
+ * meeting it) through samples lo..hi (none when lo > hi), walked from fs
+ * toward fu: upward, or downward when `down`. fu's points become unsent points at that end of fs,
+ * so the next frame carries them as an append (or fs's new-feature record): no merge record is
+ * needed. */
+static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned eu,
+                  const sample_t *s, long lo, long hi, int down)
+{
+    bsf_map_feature_t *a = &m->features[fs];
+    bsf_map_feature_t *u = &m->features[fu];
+    newpt_t p[MAX_SAMPLES];
+    size_t n = 0;
+    if ((size_t)a->n_ctrl + u->n_ctrl + MAX_SAMPLES > BSF_MAP_REC_MAX_POINTS) {
+        return 0;
+    }
+    if (lo <= hi) {
+        const bsf_map_ctrl_t *e = &m->ctrl[es == 1u ? a->head : a->tail];
+        const bsf_map_ctrl_t *o = &m->ctrl[eu == 1u ? u->head : u->tail];
+        const float sp = m->params.ctrl_spacing;
+        n = resample(m, s, down ? hi : lo, down ? lo : hi, 1, e->x, e->y, p, MAX_SAMPLES);
+        while (n > 0u && !p[n - 1u].vertex &&
+               (p[n - 1u].x - o->x) * (p[n - 1u].x - o->x) +
+                       (p[n - 1u].y - o->y) * (p[n - 1u].y - o->y) <
+                   0.25f * sp * sp) {
+            --n;
+        }
+    }
+    if (n > m->n_free_ctrl) {
+        n = 0;
+    }
+    /* u oriented so that its joining end meets a's */
+    if ((es == 2u) == (eu == 2u)) {
+        chain_reverse(m, u);
+    }
+    (void)chain_extend(m, a, p, n, es == 1u); /* outward from a's end */
+    if (es == 2u) {
+        m->ctrl[a->tail].next = u->head;
+        m->ctrl[u->head].prev = a->tail;
+        a->tail = u->tail;
+    } else {
+        m->ctrl[a->head].prev = u->tail;
+        m->ctrl[u->tail].next = a->head;
+        a->head = u->head;
+    }
+    a->n_ctrl = (uint16_t)(a->n_ctrl + u->n_ctrl);
+    a->last_seen = m->stats.n_fused;
+    feature_bbox(m, a);
+    feature_remove_slot(m, fu);
+    ++m->stats.n_merged;
+    return 1;
+}
+
 static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned eb,
                  const sample_t *s, long from, long to)
 {
@@ -722,6 +786,12 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
     newpt_t p[MAX_SAMPLES];
     size_t n = 0;
     uint16_t first_bridge = BSF_MAP_NONE;
+    if (!(b->flags & BSF_MAP_FF_SENT)) {
+        return absorb(m, fa, ea, fb, eb, s, from, to, 0);
+    }
+    if (!(a->flags & BSF_MAP_FF_SENT)) {
+        return absorb(m, fb, eb, fa, ea, s, from, to, 1);
+    }
     if (m->n_ops >= BSF_MAP_MAX_OPS || ((a->flags | b->flags) & BSF_MAP_FF_OP) != 0u ||
         !bsf_map_chain_clean(m, a) || !bsf_map_chain_clean(m, b)) {
         return 0;
@@ -1089,21 +1159,4 @@ int bsf_map_feature_q(const bsf_map_t *map, size_t index, int32_t *q, uint8_t *i
         ++n;
     }
     return (int)n;
-}
-
-int bsf_map_pending(const bsf_map_t *map)
-{
-    uint16_t s;
-    if (map == NULL) {
-        return 0;
-    }
-    if (map->n_ops > 0u) {
-        return 1;
-    }
-    for (s = 0; s < map->n_features; ++s) {
-        if (!bsf_map_chain_clean(map, &map->features[s])) {
-            return 1;
-        }
-    }
-    return 0;
 }

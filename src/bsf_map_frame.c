@@ -442,6 +442,45 @@ static uint32_t ripe_run(const bsf_map_t *m, const bsf_map_feature_t *f, uint16_
     return n;
 }
 
+int bsf_map_pending(const bsf_map_t *map)
+{
+    const float step = map != NULL ? map->params.quant_step : 0.0f;
+    const float tol2 = map != NULL ? map->params.send_tol * map->params.send_tol : 0.0f;
+    uint16_t s;
+    if (map == NULL) {
+        return 0;
+    }
+    if (map->n_ops > 0u) {
+        return 1;
+    }
+    for (s = 0; s < map->n_features; ++s) {
+        const bsf_map_feature_t *f = &map->features[s];
+        uint16_t i;
+        if (!(f->flags & BSF_MAP_FF_SENT)) {
+            if (ripe_run(map, f, f->head, 0) == f->n_ctrl) {
+                return 1;
+            }
+            continue;
+        }
+        for (i = f->head; i != BSF_MAP_NONE; i = map->ctrl[i].next) {
+            const bsf_map_ctrl_t *c = &map->ctrl[i];
+            if (c->flags & BSF_MAP_CF_SENT) {
+                const float ex = c->x - (float)c->qx * step;
+                const float ey = c->y - (float)c->qy * step;
+                if (ex * ex + ey * ey > tol2) {
+                    return 1;
+                }
+            } else if (ripe(map, f, c) &&
+                       ((c->prev != BSF_MAP_NONE && (map->ctrl[c->prev].flags & BSF_MAP_CF_SENT)) ||
+                        (c->next != BSF_MAP_NONE &&
+                         (map->ctrl[c->next].flags & BSF_MAP_CF_SENT)))) {
+                return 1; /* a ripe point next to the sent part: an append */
+            }
+        }
+    }
+    return 0;
+}
+
 /* A merge record; 0 when it does not fit. */
 static int put_merge(bsf_map_t *m, wr_t *w, int64_t *prev_id, const bsf_map_op_t *op)
 {
@@ -543,8 +582,7 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
         if (ripe_run(m, f, f->head, 0) < f->n_ctrl) {
             return 1; /* held back */
         }
-        n =
-            span_points(m, f->head, 0, BSF_MAP_REC_MAX_POINTS, room_of(w), NULL, &qx, &qy);
+        n = span_points(m, f->head, 0, BSF_MAP_REC_MAX_POINTS, room_of(w), NULL, &qx, &qy);
         if (n < 2u) {
             return 0;
         }
@@ -794,7 +832,10 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
     put_u(&w, (uint32_t)map->step_code);
     header_len = (size_t)(w.p - (buf + offset));
 
-    while (map->n_ops > 0u) {
+    if (map->stats.n_fused - map->last_frame_call < map->params.frame_interval) {
+        full = 1; /* not yet: map changes wait to share a frame */
+    }
+    while (map->n_ops > 0u && !full) {
         if (!put_merge(map, &w, &prev_id, &map->ops[0])) {
             full = 1;
             break;
@@ -809,6 +850,11 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
         }
     }
     map_records_end = (size_t)(w.p - (buf + offset));
+    if (map->stats.n_fused - map->last_frame_call >= map->params.frame_interval) {
+        /* a frame cut by cap lets the rest follow in the next call */
+        map->last_frame_call =
+            full ? map->stats.n_fused - map->params.frame_interval : map->stats.n_fused;
+    }
     if (map->params.snapshot_budget > 0u && !full) {
         put_snapshots(map, &w, &prev_id);
     }

@@ -100,10 +100,14 @@ static void assert_rx_equals_sent(void)
     }
 }
 
+/* Start a map (NULL: the defaults, but a frame every call) and a receiver. */
 static void start(const bsf_map_params_t *p)
 {
+    bsf_map_params_t every_call;
+    bsf_map_params_default(&every_call);
+    every_call.frame_interval = 1u;
     bsf_scene_demo_office(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, p));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, p != NULL ? p : &every_call));
     bsf_map_rx_init(&rx);
     bsf_decoder_init(&dec);
 }
@@ -256,6 +260,7 @@ static void test_map_loss_then_snapshots_recover(void)
     int stale_seen = 0;
     bsf_map_params_default(&p);
     p.snapshot_budget = 40u;
+    p.frame_interval = 1u;
     start(&p);
     for (k = 0; k < 3 * N_SCANS; ++k) {
         bsf_pose_t pose;
@@ -290,6 +295,10 @@ static void test_map_loss_then_snapshots_recover(void)
     for (k = 0; k < 200; ++k) {
         size_t len = 0;
         int any_stale = 0;
+        bsf_pose_t still = {1.0f, 1.0f, 0.0f};
+        res.n_features = 0u; /* a scan that sees nothing: time passes */
+        res.n_ctrl = 0u;
+        TEST_ASSERT_EQUAL_INT(0, bsf_map_fuse(&map, &res, &still));
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
         TEST_ASSERT_TRUE(len <= 40u + 16u);
         (void)deliver(buf, len);
@@ -363,6 +372,39 @@ static void test_map_small_frames_carry_everything(void)
     TEST_ASSERT_EQUAL_UINT32(0u, rx.stats.records_skipped);
 }
 
+/* With frame_interval n, map changes go out once per n fuse calls, and the
+ * receiver still ends equal to the robot's sent copy. */
+static void test_map_frame_interval_batches_changes(void)
+{
+    bsf_map_params_t p;
+    long k;
+    uint32_t frames_with_map = 0;
+    bsf_map_params_default(&p);
+    TEST_ASSERT_EQUAL_UINT16(5u, p.frame_interval);
+    start(&p);
+    for (k = 0; k < N_SCANS; ++k) {
+        bsf_pose_t pose;
+        size_t len = 0;
+        const uint32_t before = map.stats.map_bytes;
+        scan_k(k, N_SCANS, 7u, &pose);
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, &pose, buf, sizeof buf, &len));
+        /* a pose record goes in every call, map records every 5th */
+        TEST_ASSERT_TRUE(len > 0u);
+        (void)deliver(buf, len);
+        if (map.stats.map_bytes != before) {
+            TEST_ASSERT_EQUAL_INT(0, (int)(map.stats.n_fused % 5u));
+            ++frames_with_map;
+            /* between map frames a queued merge is the robot's alone */
+            assert_rx_equals_sent();
+        }
+    }
+    TEST_ASSERT_TRUE(frames_with_map > 0u && frames_with_map <= N_SCANS / 5);
+    TEST_ASSERT_EQUAL_UINT32(N_SCANS, rx.stats.poses);
+    p.frame_interval = 0u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -373,5 +415,6 @@ int main(void)
     RUN_TEST(test_map_loss_then_snapshots_recover);
     RUN_TEST(test_map_frame_through_frame_decode);
     RUN_TEST(test_map_small_frames_carry_everything);
+    RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();
 }

@@ -101,6 +101,7 @@ static void test_map_forgets_sent_features_and_receiver_keeps_them(void)
     uint32_t n_kept = 0;
     bsf_map_params_default(&p);
     p.forget_after = 10u;
+    p.frame_interval = 1u;
     bsf_scene_demo_office(&scene);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, &p));
     bsf_map_rx_init(&rx);

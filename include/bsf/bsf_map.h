@@ -58,7 +58,7 @@ typedef struct {
                                    map feature (default 0.25) */
     float send_tol;           /**< metres, [0, 1]: a control point is re-sent when its fused
                                    position is farther than this from the value the receiver
-                                   holds (default 0.015) */
+                                   holds (default 0.02) */
     float quant_step;         /**< metres, [BSF_QUANT_STEP_MIN, BSF_QUANT_STEP_MAX], rounded
                                    to 0.1 mm: the wire's unit of control points (default 0.005) */
     uint16_t weight_cap;      /**< 1..255: observation weight at which a control point's
@@ -67,6 +67,10 @@ typedef struct {
                                    calls may be forgotten when the caps fill (default 50) */
     uint16_t snapshot_budget; /**< bytes per frame for snapshot records of old features,
                                    round robin (0: no snapshots; default 0) */
+    uint16_t frame_interval;  /**< 1..1000 fuse calls: bsf_map_encode sends map changes at most
+                                   once per this many calls since its last map frame,
+                                   so that changes share a frame's overhead (default 5;
+                                   1: every call) */
 } bsf_map_params_t;
 
 /** Fill p with the defaults documented in bsf_map_params_t. p must not be NULL. */
@@ -92,9 +96,9 @@ typedef struct {
     uint32_t n_records;        /**< update records written (pose records excluded) */
     uint32_t n_snapshots;      /**< snapshot records written */
     uint32_t n_moved_ctrl;     /**< control point moves sent */
-    uint32_t record_bytes[6]; /**< payload bytes of the records by operation: new feature,
-                                   append, move, merge, snapshot, pose (FORMAT.md section 11);
-                                   the rest of map_bytes + pose_bytes is frame overhead */
+    uint32_t record_bytes[6];  /**< payload bytes of the records by operation: new feature,
+                                    append, move, merge, snapshot, pose (FORMAT.md section 11);
+                                    the rest of map_bytes + pose_bytes is frame overhead */
 } bsf_map_stats_t;
 
 /** One control point of the robot's map (internal layout; read it through
@@ -159,6 +163,7 @@ typedef struct {
     uint16_t snapshot_pos;                  /**< next point of a snapshot sent in parts */
     uint16_t snapshot_head;                 /**< head point of that feature at its first part */
     int32_t step_code;                      /**< quant_step in 0.1 mm */
+    uint32_t last_frame_call;               /**< stats.n_fused at the last frame with map records */
     bsf_map_seg_t segs[BSF_MAP_SEG_WINDOW]; /**< work area of bsf_map_fuse */
     uint16_t n_segs;
     bsf_map_stats_t stats;
@@ -192,7 +197,9 @@ BSF_NODISCARD int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const b
  * Write one map-update frame (COBS(payload || CRC) || 0x00) with the changes
  * not yet sent, as many as fit in cap bytes (the rest wait for the next
  * frame), plus snapshot records within params.snapshot_budget and, when pose
- * is not NULL, a pose record. What is written counts as received: the
+ * is not NULL, a pose record. Map changes and snapshots go out only once
+ * params.frame_interval fuse calls have passed since the last frame that
+ * carried them (a pose record may go in any call). What is written counts as received: the
  * robot's copy of the receiver's values is updated. *out_len is 0 (and no
  * frame is written) when there is nothing to send. Returns BSF_OK, or a
  * negative bsf_status_t on failure: BSF_ERR_ARG for NULL map, buf or
@@ -202,8 +209,9 @@ BSF_NODISCARD int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const b
 BSF_NODISCARD bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf,
                                           size_t cap, size_t *out_len);
 
-/** 1 when bsf_map_encode() has map changes (not counting snapshots or a pose)
- *  waiting to be sent, else 0 (also for NULL). */
+/** 1 when bsf_map_encode() has map changes ready to send (not counting
+ *  snapshots, a pose, new points still held back, or params.frame_interval),
+ *  else 0 (also for NULL). */
 int bsf_map_pending(const bsf_map_t *map);
 
 /** Number of features in the robot's RAM; features are indexed 0 .. count - 1
