@@ -478,6 +478,8 @@ static int map_begin(column_t *col, size_t max_scans)
 
 static int map_end(column_t *col, const mg_points_t *pts, mg_curves_t *map)
 {
+    /* the end of the log: what waits for the frame interval goes out now */
+    g_map.params.frame_interval = 1u;
     if (map_flush(col, NULL) != 0) {
         return -1;
     }

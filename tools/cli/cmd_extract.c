@@ -369,8 +369,12 @@ static int run_extract(const extract_opts_t *o)
         progress_tick(&prog, done, "extract");
     }
     progress_end(&prog);
-    if (o->map && !write_failed && write_map_frames(out, o->out, NULL, &bytes) != 0) {
-        write_failed = 1;
+    if (o->map && !write_failed) {
+        /* the end of the log: what waits for the frame interval goes out now */
+        g_map.params.frame_interval = 1u;
+        if (write_map_frames(out, o->out, NULL, &bytes) != 0) {
+            write_failed = 1;
+        }
     }
     malformed = carmen_malformed_count(rd);
     carmen_close(rd);
