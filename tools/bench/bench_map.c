@@ -91,6 +91,8 @@ typedef struct {
 static bsf_extractor_t g_ex;
 static bsf_map_t g_map;
 static bsf_map_t g_map_copy;
+static bsf_result_t g_empty;   /* a scan without features */
+static bsf_pose_t g_last_pose; /* the pose of the last scan fused */
 static bsf_map_rx_t g_rx;
 static bsf_decoder_t g_dec;
 static bsf_frame_t g_frame;
@@ -327,6 +329,7 @@ static int fuse_scan(column_t *col, double px, double py, double pth)
     pose.x = (float)px;
     pose.y = (float)py;
     pose.theta = (float)remainder(pth, 2.0 * PI);
+    g_last_pose = pose;
     t0 = now_us();
     r = bsf_map_fuse(&g_map, &g_res, &pose);
     if (col->fuse_us != NULL) {
@@ -375,9 +378,13 @@ static int map_once_bytes(column_t *col)
     g_map_copy.snapshot_pos = 0u;
     last_next = 0u;
     bytes0 = g_map_copy.stats.record_bytes[4];
+    g_map_copy.params.frame_interval = 1u;
+    memset(&g_empty, 0, sizeof g_empty);
     while (guard++ < 100000) {
         size_t len = 0;
-        if (bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
+        /* a scan without features lets the frame interval pass */
+        if (bsf_map_fuse(&g_map_copy, &g_empty, &g_last_pose) < 0 ||
+            bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
             return -1;
         }
         if (len == 0u) {
