@@ -163,3 +163,16 @@ def test_plot_map(map_stream):
     labels = [l.get_label() for l in ax.get_lines()]
     assert "vertices" in labels or all(len(f.vertices) == 0 for f in m.features)
     assert "robot path" in labels
+
+
+def test_python_m_bsf_plot_draws_a_map_stream(map_stream, tmp_path):
+    pytest.importorskip("matplotlib")
+    import subprocess
+    import sys
+
+    _, out = map_stream
+    png = tmp_path / "map.png"
+    r = subprocess.run([sys.executable, "-m", "bsf", "plot", str(out), "-o", str(png)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "map features drawn" in r.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
