@@ -5,14 +5,17 @@
  * with known geometry and true poses. One column per input, one row per
  * figure; docs/MAP.md pastes the output.
  *
- *   bench_map [--data DIR] [--scans N] [--poses N] [--grid-out DIR] [--only NAME]
+ *   bench_map [--data DIR] [--scans N] [--poses N] [--grid-out DIR] [--only NAME] [--check]
  *
  * --data: the shared data directory (its alt/ holds the corrected logs;
  * default: the build's BSF_SHARED_DIR/data); a log that is absent is left out
  * with a message. --scans N: only the first N scans of each log (quick runs).
  * --poses N: poses per synthetic scene (default 300). --grid-out DIR: also
  * write each input's grid as NAME.pgm.gz and NAME.png. --only NAME: one input
- * (intel, mit, fr079, office, angles, curved).
+ * (intel, mit, fr079, office, angles, curved). --check: exit 1 unless every
+ * scan was extracted and fused, the receiver's map equals the robot's sent
+ * copy feature for feature, and every figure was measured (ctest runs it on
+ * a short scene).
  *
  * Definitions:
  *  - valid raw point: a return the extractor would accept (bsf_range_is_valid
@@ -862,6 +865,7 @@ int main(int argc, char **argv)
     const char *data = BSF_SHARED_DIR_DEFAULT "/data";
     const char *only = NULL;
     long max_scans = -1, poses = 300;
+    int check = 0;
     bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
     int i;
     for (i = 1; i < argc; ++i) {
@@ -875,10 +879,12 @@ int main(int argc, char **argv)
             g_grid_out = argv[++i];
         } else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc) {
             only = argv[++i];
+        } else if (strcmp(argv[i], "--check") == 0) {
+            check = 1;
         } else {
             fprintf(stderr,
                     "usage: bench_map [--data DIR] [--scans N] [--poses N] [--grid-out DIR] "
-                    "[--only NAME]\n");
+                    "[--only NAME] [--check]\n");
             return 2;
         }
     }
@@ -927,5 +933,19 @@ int main(int argc, char **argv)
     }
     print_table();
     free(g_stream);
+    if (check) {
+        size_t c;
+        int bad = 0;
+        for (c = 0; c < g_n_cols; ++c) {
+            const column_t *col = &g_cols[c];
+            if (col->failed || col->fuse_failed || col->rx_mismatch || col->rx_compared == 0u ||
+                col->map_update_bytes == 0u || col->map_once_bytes == 0u || col->map_dist.n == 0u ||
+                !col->grid_ok || col->grid.pgm_gz_bytes == 0u || col->grid.png_bytes == 0u) {
+                printf("CHECK FAILED: %s\n", col->name);
+                bad = 1;
+            }
+        }
+        return bad;
+    }
     return 0;
 }
