@@ -183,7 +183,17 @@ r = run(["map", "damaged.map", "--json"])
 check(r.returncode == 0, "bsf map on a stream with a damaged frame exits 0")
 check(len(r.stdout.splitlines()) >= len(feats) // 2, "most of the map survives one damaged frame")
 
-# 6. errors: clear messages, non-zero exits.
+# 6. pipes: extract --map -o - | bsf map - and | bsf metrics -
+p1 = subprocess.Popen([BSF, "extract", "room.log", "--map", "--reproducible", "-o", "-"], cwd=WORK,
+                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+r = subprocess.run([BSF, "map", "-", "--json"], cwd=WORK, stdin=p1.stdout, capture_output=True)
+p1.stdout.close()
+check(p1.wait() == 0 and r.returncode == 0 and len(r.stdout.splitlines()) == len(feats),
+      "extract --map -o - | bsf map - --json gives the same features")
+r = run(["metrics", "-"], input=data)
+check(r.returncode == 0 and b"map frames" in r.stdout, "bsf metrics - reads a map stream from a pipe")
+
+# 7. errors: clear messages, non-zero exits.
 with open(os.path.join(WORK, "garbage.bin"), "wb") as f:
     f.write(bytes(range(1, 256)) * 40)
 r = run(["map", "garbage.bin"])
