@@ -218,8 +218,8 @@ typedef struct {
     unsigned long frames, frames_bad, pose_only_frames;
     unsigned long long bytes, pose_only_bytes;
     unsigned long long pose_record_bytes; /**< pose records inside frames with map records */
-    int track;                /**< compute map_change_t in map_view_apply */
-    unsigned long n_features; /**< features the receiver holds (when tracking) */
+    int track;                            /**< compute map_change_t in map_view_apply */
+    unsigned long n_features;             /**< features the receiver holds (when tracking) */
 } map_view_t;
 
 /** Empty view; track != 0 makes map_view_apply report changes (costs a pass

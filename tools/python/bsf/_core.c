@@ -1041,7 +1041,8 @@ static PyObject *MapReceiver_features(MapReceiverObject *self, PyObject *unused)
         }
         if (n > (int)BSF_MAP_RX_MAX_CTRL) {
             Py_DECREF(out);
-            PyErr_SetString(g_bsf_error, "a map feature has more control points than the receiver holds");
+            PyErr_SetString(g_bsf_error,
+                            "a map feature has more control points than the receiver holds");
             return NULL;
         }
         t = Py_BuildValue("(ky#y#O)", (unsigned long)id, (const char *)self->ctrl,
