@@ -24,8 +24,5 @@ extern const float bench_log_ranges[];
 extern const bench_log_scan_t bench_log_scans[];
 extern const size_t bench_log_n_scans;
 extern const char bench_log_description[];
-/** Laser pose of each scan in the world (x, y, theta), 3 floats per scan;
- *  generated only with gen_scan_array.py --with-poses. */
-extern const float bench_log_poses[];
 
 #endif /* BSF_BENCH_LOG_SCANS_H */
