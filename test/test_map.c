@@ -218,7 +218,7 @@ static void test_map_curves_lie_on_true_surfaces(void)
                 if (bsf_bspline_eval(c, (size_t)m, (float)j / 40.0f, &pt, NULL, NULL) != BSF_OK) {
                     continue;
                 }
-                d = bsf_scene_distance_to_surface(&scene, pt.x, pt.y, NULL);
+                d = bsf_scene_distance_to_surface(&scene, (double)pt.x, (double)pt.y, NULL);
                 worst = d > worst ? d : worst;
                 n_far += d > 0.05 ? 1u : 0u;
                 ++n_samples;
