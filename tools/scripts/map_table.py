@@ -129,7 +129,10 @@ def main():
     if m4:
         print()
         print("Cortex-M4F (QEMU -icount, test/bench_m4_map.c):")
+        print()
+        print("```")
         print(m4_text.rstrip())
+        print("```")
     return 0
 
 
