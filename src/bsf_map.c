@@ -13,8 +13,9 @@
 #include "bsf/bsf_stream.h"
 #include "bsf_map_internal.h"
 
-/* Scan curve samples per metre of control polygon, and their bounds. */
-#define SAMPLE_STEP 0.05f
+/* Spacing of scan curve samples along the control polygon, metres, and the
+ * bounds of their count. */
+#define SAMPLE_STEP 0.07f
 #define MIN_SAMPLES 4u
 #define MAX_SAMPLES 64u
 /* Control points one scan feature may refine at once. */
@@ -331,6 +332,14 @@ static void build_segs(bsf_map_t *m, uint16_t fs, const float box[4])
                 unsigned piece;
                 float px = 0.0f;
                 float py = 0.0f;
+                /* the span lies in its control points' hull: skip it when
+                 * that hull's box misses the search box */
+                if ((c0->x < box[0] && c1->x < box[0] && c2->x < box[0]) ||
+                    (c0->x > box[2] && c1->x > box[2] && c2->x > box[2]) ||
+                    (c0->y < box[1] && c1->y < box[1] && c2->y < box[1]) ||
+                    (c0->y > box[3] && c1->y > box[3] && c2->y > box[3])) {
+                    continue;
+                }
                 for (piece = 0; piece <= pieces; ++piece) {
                     const float u = (float)piece / (float)pieces;
                     float b[3];
@@ -408,56 +417,98 @@ static size_t sample_curve(const bsf_point_t *w, const uint8_t *vtx, size_t n, s
     return ns;
 }
 
+/* Test chord g for sample q: when it is nearer than *best (squared) and
+ * runs in the sample's direction, it becomes the sample's label. */
+static void seg_test(const bsf_map_t *m, uint16_t g, const sample_t *q, float cmin, float *best,
+                     label_t *lab)
+{
+    const float md = m->params.match_dist;
+    const bsf_map_seg_t *sg = &m->segs[g];
+    const float ux = sg->bx - sg->ax;
+    const float uy = sg->by - sg->ay;
+    float l2;
+    float t = 0.0f;
+    float ex;
+    float ey;
+    float d2;
+    /* cheap rejection: the sample is beyond the chord's box grown by the
+     * match distance */
+    if ((q->x < sg->ax - md && q->x < sg->bx - md) || (q->x > sg->ax + md && q->x > sg->bx + md) ||
+        (q->y < sg->ay - md && q->y < sg->by - md) || (q->y > sg->ay + md && q->y > sg->by + md)) {
+        return;
+    }
+    l2 = ux * ux + uy * uy;
+    if (l2 > 1e-10f) {
+        t = ((q->x - sg->ax) * ux + (q->y - sg->ay) * uy) / l2;
+        t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    }
+    ex = q->x - (sg->ax + t * ux);
+    ey = q->y - (sg->ay + t * uy);
+    d2 = ex * ex + ey * ey;
+    if (d2 >= *best) {
+        return;
+    }
+    if (l2 > 1e-6f && !q->vertex) {
+        const float c = fabsf(ux * q->dx + uy * q->dy) / sqrtf(l2);
+        if (c < cmin) {
+            return;
+        }
+    }
+    *best = d2;
+    lab->feature = sg->feature;
+    lab->seg = g;
+    lab->u = sg->u0 + t * sg->du;
+}
+
+/* Samples are labelled in runs of LABEL_RUN: the chords whose box (grown by
+ * the match distance) meets the run's box are gathered once, then each
+ * sample is tested against those alone. */
+#define LABEL_RUN 8u
+
+/* Nearest chord of each sample within the match distance, running in the
+ * sample's direction. */
 static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, label_t *lab)
 {
     const float md = m->params.match_dist;
-    const float d2max = md * md;
     const float cmin = cosf(m->params.match_angle);
-    size_t k;
-    uint16_t g;
-    for (k = 0; k < ns; ++k) {
-        float best = d2max;
-        lab[k].feature = BSF_MAP_NONE;
-        lab[k].seg = 0u;
-        lab[k].u = 0.0f;
+    uint16_t near[BSF_MAP_SEG_WINDOW];
+    size_t k0;
+    for (k0 = 0; k0 < ns; k0 += LABEL_RUN) {
+        const size_t k1 = k0 + LABEL_RUN < ns ? k0 + LABEL_RUN : ns;
+        float bx0 = s[k0].x;
+        float by0 = s[k0].y;
+        float bx1 = s[k0].x;
+        float by1 = s[k0].y;
+        size_t n_near = 0;
+        size_t k;
+        uint16_t g;
+        for (k = k0 + 1u; k < k1; ++k) {
+            bx0 = s[k].x < bx0 ? s[k].x : bx0;
+            by0 = s[k].y < by0 ? s[k].y : by0;
+            bx1 = s[k].x > bx1 ? s[k].x : bx1;
+            by1 = s[k].y > by1 ? s[k].y : by1;
+        }
+        bx0 -= md;
+        by0 -= md;
+        bx1 += md;
+        by1 += md;
         for (g = 0; g < m->n_segs; ++g) {
             const bsf_map_seg_t *sg = &m->segs[g];
-            const float ux = sg->bx - sg->ax;
-            const float uy = sg->by - sg->ay;
-            float l2;
-            float t = 0.0f;
-            float ex;
-            float ey;
-            float d2;
-            /* cheap rejection: the sample is beyond the chord's box grown by
-             * the match distance */
-            if ((s[k].x < sg->ax - md && s[k].x < sg->bx - md) ||
-                (s[k].x > sg->ax + md && s[k].x > sg->bx + md) ||
-                (s[k].y < sg->ay - md && s[k].y < sg->by - md) ||
-                (s[k].y > sg->ay + md && s[k].y > sg->by + md)) {
+            if ((sg->ax < bx0 && sg->bx < bx0) || (sg->ax > bx1 && sg->bx > bx1) ||
+                (sg->ay < by0 && sg->by < by0) || (sg->ay > by1 && sg->by > by1)) {
                 continue;
             }
-            l2 = ux * ux + uy * uy;
-            if (l2 > 1e-10f) {
-                t = ((s[k].x - sg->ax) * ux + (s[k].y - sg->ay) * uy) / l2;
-                t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+            near[n_near++] = g;
+        }
+        for (k = k0; k < k1; ++k) {
+            float best = md * md;
+            size_t j;
+            lab[k].feature = BSF_MAP_NONE;
+            lab[k].seg = 0u;
+            lab[k].u = 0.0f;
+            for (j = 0; j < n_near; ++j) {
+                seg_test(m, near[j], &s[k], cmin, &best, &lab[k]);
             }
-            ex = s[k].x - (sg->ax + t * ux);
-            ey = s[k].y - (sg->ay + t * uy);
-            d2 = ex * ex + ey * ey;
-            if (d2 >= best) {
-                continue;
-            }
-            if (l2 > 1e-6f && !s[k].vertex) {
-                const float c = fabsf(ux * s[k].dx + uy * s[k].dy) / sqrtf(l2);
-                if (c < cmin) {
-                    continue;
-                }
-            }
-            best = d2;
-            lab[k].feature = sg->feature;
-            lab[k].seg = g;
-            lab[k].u = sg->u0 + t * sg->du;
         }
     }
 }
@@ -506,7 +557,13 @@ static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *
         for (j = 0; j < 3u; ++j) {
             const uint16_t idx = sg->p[j];
             size_t q;
-            for (q = 0; q < n_acc && acc[q].idx != idx; ++q) {
+            /* samples run along the chain: the point is most likely a recent entry */
+            for (q = n_acc; q > 0u && acc[q - 1u].idx != idx; --q) {
+            }
+            if (q > 0u) {
+                --q;
+            } else {
+                q = n_acc;
             }
             if (q == n_acc) {
                 if (n_acc == MAX_ACC) {
