@@ -933,6 +933,9 @@ int main(int argc, char **argv)
     }
     print_table();
     free(g_stream);
+    for (i = 0; i < (int)g_n_cols; ++i) {
+        free(g_cols[i].fuse_us);
+    }
     if (check) {
         size_t c;
         int bad = 0;
