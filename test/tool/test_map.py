@@ -160,6 +160,17 @@ except (OSError, ET.ParseError) as e:
     ok = False
 check(ok, "room.svg: curves, robot path and legend as bsf render draws them")
 
+r = run(["map", "room.map", "-o", "points.svg", "--points", "room.log"])
+try:
+    text = ET.tostring(ET.parse(os.path.join(WORK, "points.svg")).getroot()).decode()
+    ok = r.returncode == 0 and 'class="points"' in text and "raw LIDAR points" in text
+except (OSError, ET.ParseError) as e:
+    print(e)
+    ok = False
+check(ok, "bsf map --points draws the log's raw points under the map")
+r = run(["map", "room.map", "--points", "room.log"])
+check(r.returncode == 2, "--points without -o: usage error")
+
 # 4. metrics and listen on the map stream.
 r = run(["metrics", "room.map"])
 check(r.returncode == 0 and b"map frames" in r.stdout and b"pose-only" in r.stdout, "bsf metrics reports the map's bytes")

@@ -6,7 +6,7 @@
 #include "tool.h"
 
 static const char map_help[] =
-    "Usage: bsf map IN [--json] [-o MAP.svg] [--width PX]\n"
+    "Usage: bsf map IN [--json] [-o MAP.svg] [--points LOG] [--width PX]\n"
     "Rebuild the fused map a map stream carries (bsf extract --map; '-' reads\n"
     "standard input) with the library's receiver, frame by frame, and print it.\n"
     "\n"
@@ -18,6 +18,9 @@ static const char map_help[] =
     "                twice, both copies flagged 1, as in a scan's features\n"
     "  -o MAP.svg    draw the map: the same grid, curves, vertices, robot path (from\n"
     "                the stream's pose records) and legend as bsf render\n"
+    "  --points LOG  with -o: draw the raw points of a CARMEN log underneath (every\n"
+    "                scan through its laser pose, thinned as bsf render thins them),\n"
+    "                to judge the map against what the robot saw\n"
     "  --width PX    drawing width in pixels (default 1600)\n"
     "  -h, --help    this help\n"
     "\n"
@@ -153,7 +156,7 @@ static map_totals_t totals_of(const map_view_t *v, bsf_point_t *ctrl, uint8_t *v
 }
 
 static int write_svg(const char *out_path, const char *title, const map_view_t *v, double width,
-                     bsf_point_t *ctrl, uint8_t *vtx, const map_totals_t *t)
+                     const char *points_log, bsf_point_t *ctrl, uint8_t *vtx, const map_totals_t *t)
 {
     const uint32_t limit = bsf_map_rx_id_limit(v->rx);
     bsf_bounds_t b;
@@ -165,6 +168,8 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
     uint32_t id;
     size_t i;
     int rc;
+    unsigned long pts_read = 0, pts_drawn = 0;
+    double cell_m = 0.0;
     bsf_bounds_init(&b);
     for (id = 0; id < limit; ++id) {
         const int n = feature_points(v, id, ctrl, vtx, NULL);
@@ -175,6 +180,10 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
     }
     for (i = 0; i < v->n_path; ++i) {
         bsf_bounds_add(&b, v->path[3u * i], v->path[3u * i + 1u]);
+    }
+    if (b.empty && points_log != NULL &&
+        render_log_points(NULL, points_log, &b, NULL, NULL, NULL) != 0) {
+        return -1;
     }
     xy = (double *)malloc(2u * MAP_MAX_POINTS * sizeof(double));
     if (xy == NULL) {
@@ -195,6 +204,14 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
         return -1;
     }
     bsf_svg_grid(&svg);
+    if (points_log != NULL &&
+        render_log_points(&svg, points_log, NULL, &pts_read, &pts_drawn, &cell_m) != 0) {
+        if (out != stdout) {
+            fclose(out);
+        }
+        free(xy);
+        return -1;
+    }
     bsf_svg_curves_begin(&svg, RENDER_CURVE_COLOUR, 1.6);
     for (id = 0; id < limit; ++id) {
         const int n = feature_points(v, id, ctrl, vtx, NULL);
@@ -225,10 +242,15 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
             }
         }
     }
-    render_legend(&svg, v->n_path > 0u, 0, 0);
+    render_legend(&svg, v->n_path > 0u, points_log != NULL, 0);
     snprintf(caption, sizeof caption,
              "map: %lu features, %lu vertices, %.1f m of curve; %lu frames", t->features,
              t->vertices, t->length, v->frames);
+    if (points_log != NULL) {
+        const size_t len = strlen(caption);
+        snprintf(caption + len, sizeof caption - len, "; %lu raw points, %lu drawn (%.0f cm grid)",
+                 pts_read, pts_drawn, 100.0 * cell_m);
+    }
     rc = bsf_svg_end(&svg, caption) != 0 || close_out(out, out_path) != 0 ? -1 : 0;
     free(xy);
     return rc;
@@ -239,7 +261,7 @@ int cmd_map(int argc, char **argv)
     static map_ctx_t ctx;
     static bsf_point_t ctrl[MAP_MAX_POINTS];
     static uint8_t vtx[MAP_MAX_POINTS];
-    const char *in_path = NULL, *out_path = NULL;
+    const char *in_path = NULL, *out_path = NULL, *points = NULL;
     double width = 1600.0;
     int json = 0, i, err = 0, rc = 0;
     stream_summary_t sum;
@@ -254,6 +276,8 @@ int cmd_map(int argc, char **argv)
             json = 1;
         } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
             out_path = v;
+        } else if ((v = opt_value(argc, argv, &i, "--points", &err)) != NULL) {
+            points = v;
         } else if ((v = opt_value(argc, argv, &i, "--width", &err)) != NULL) {
             if (parse_float(v, 100.0, 20000.0, &width) != 0) {
                 return usage_error("--width needs pixels in [100, 20000], got '%s'", v);
@@ -273,6 +297,9 @@ int cmd_map(int argc, char **argv)
     }
     if (in_path == NULL) {
         return usage_error("map needs an input stream (or '-')");
+    }
+    if (points != NULL && out_path == NULL) {
+        return usage_error("--points goes with -o MAP.svg");
     }
     if (json && out_path != NULL && strcmp(out_path, "-") == 0) {
         return usage_error("--json and -o - would both write to stdout");
@@ -308,7 +335,8 @@ int cmd_map(int argc, char **argv)
     if (json) {
         print_json(&ctx.view, ctrl, vtx);
     }
-    if (out_path != NULL && write_svg(out_path, in_path, &ctx.view, width, ctrl, vtx, &t) != 0) {
+    if (out_path != NULL &&
+        write_svg(out_path, in_path, &ctx.view, width, points, ctrl, vtx, &t) != 0) {
         rc = -1;
     }
     info = (json || (out_path != NULL && strcmp(out_path, "-") == 0)) ? stderr : stdout;

@@ -240,6 +240,32 @@ static int draw_log_points(bsf_svg_points_t *pts, const char *log, long lo, long
     return r < 0 ? -1 : 0;
 }
 
+int render_log_points(bsf_svg_t *svg, const char *log, bsf_bounds_t *bounds, unsigned long *read,
+                      unsigned long *drawn, double *cell_m)
+{
+    static bounds_ctx_t all; /* every scan: no sequence range, no stream */
+    bsf_svg_points_t pts;
+    int rc;
+    memset(&all, 0, sizeof all);
+    all.hi = -1;
+    if (svg == NULL) {
+        return draw_log_points(NULL, log, 0, -1, &all, bounds);
+    }
+    memset(&pts, 0, sizeof pts);
+    if (bsf_svg_points_begin(&pts, svg, RENDER_POINT_CELL_M,
+                             fmin(5.0, fmax(1.8, RENDER_POINT_DOT_M * svg->px_per_m)),
+                             RENDER_POINT_COLOUR) != 0) {
+        fail_msg("out of memory");
+        return -1;
+    }
+    rc = draw_log_points(&pts, log, 0, -1, &all, NULL);
+    *read = pts.kept + pts.merged + pts.outside;
+    *drawn = pts.kept;
+    *cell_m = pts.cell_m;
+    bsf_svg_points_end(&pts);
+    return rc;
+}
+
 /* The robot's path: poses fed in order to render_path_point(), one
  * polyline; a jump of more than 5 m (a new log segment, a relocalisation)
  * starts a new line. render_path_end() marks the last pose. */

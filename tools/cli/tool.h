@@ -192,6 +192,12 @@ typedef struct {
 void render_path_point(bsf_svg_t *svg, render_path_t *p, double x, double y, double theta);
 /** Close the path and mark the last pose. */
 void render_path_end(bsf_svg_t *svg, const render_path_t *p);
+/** Every valid point of a CARMEN log in the world frame (its laser poses):
+ *  into bounds when svg is NULL, else drawn as bsf render draws them (thinned
+ *  to one per cell; *read, *drawn and *cell_m say how many and at what cell).
+ *  0, or -1 with a message. */
+int render_log_points(bsf_svg_t *svg, const char *log, bsf_bounds_t *bounds, unsigned long *read,
+                      unsigned long *drawn, double *cell_m);
 /** The legend row of bsf render: curves, vertices, and the optional layers. */
 void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene);
 
