@@ -183,6 +183,14 @@ r = run(["listen", "-"], input=data)
 map_lines = [l for l in r.stdout.decode().splitlines() if l.startswith("map seq=")]
 check(r.returncode == 0 and len(map_lines) > 1, "bsf listen prints one line per map frame")
 check(any("created=" in l and "created=0 " not in l for l in map_lines), "listen shows features created")
+def field(line, name):
+    m = re.search(r"\b" + name + r"=(\d+)", line)
+    return int(m.group(1)) if m else 0
+
+
+net = sum(field(l, "created") - field(l, "merged") - field(l, "removed") for l in map_lines)
+check(net == len(feats), f"listen: created - merged - removed over all frames = the map's features ({net}, {len(feats)})")
+check(map_lines and field(map_lines[-1], "features") == len(feats), "listen's last line counts the map's features")
 
 # 5. loss: a damaged frame in the middle costs only what it carried.
 mid = len(data) // 2
@@ -221,6 +229,13 @@ r = run(["map", "--help"])
 check(r.returncode == 0 and b"--json" in r.stdout, "bsf map --help")
 r = run(["extract", "room.log", "--pose-every", "2", "-o", "x.bsf"])
 check(r.returncode == 2, "--pose-every without --map: usage error")
+r = run(["extract", "room.log", "--snapshot-budget", "64", "-o", "x.bsf"])
+check(r.returncode == 2, "--snapshot-budget without --map: usage error")
+r = run(["extract", "room.log", "--map", "--snapshot-budget", "99999", "-o", "x.bsf"])
+check(r.returncode == 2, "--snapshot-budget out of range: usage error")
+r = run(["extract", "room.log", "--map", "--snapshot-budget", "64", "--reproducible", "-o", "snap.map"])
+check(r.returncode == 0 and os.path.getsize(os.path.join(WORK, "snap.map")) > map_size,
+      "--snapshot-budget adds snapshot bytes")
 r = run(["extract", "room.log", "--map", "--pose-every", "x", "-o", "x.bsf"])
 check(r.returncode == 2, "--pose-every with a bad count: usage error")
 r = run(["extract", "room.log", "--map", "--pose-every", "0", "-o", "nopose.map"])

@@ -28,6 +28,9 @@ static const char extract_help[] =
     "                   points, merges, removals); bsf map rebuilds the map\n"
     "  --pose-every K   with --map: a pose record every K scans (default 1; 0: none);\n"
     "                   pose bytes are counted apart from the map's\n"
+    "  --snapshot-budget B  with --map: up to B bytes per map frame of snapshots of the\n"
+    "                   features the robot holds, round robin (default 0: none), so that\n"
+    "                   a receiver that joined late or lost frames catches up\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
@@ -83,8 +86,9 @@ typedef struct {
     double quant;
     long meta_every;
     int reproducible;
-    int map;         /* write map-update frames */
-    long pose_every; /* with map: a pose record every K scans, 0 none */
+    int map;              /* write map-update frames */
+    long pose_every;      /* with map: a pose record every K scans, 0 none */
+    long snapshot_budget; /* with map: snapshot bytes per frame */
     const char *out;
 } extract_opts_t;
 
@@ -218,6 +222,7 @@ static int run_extract(const extract_opts_t *o)
         bsf_status_t st;
         bsf_map_params_default(&mp);
         mp.quant_step = (float)o->quant;
+        mp.snapshot_budget = (uint16_t)o->snapshot_budget;
         st = bsf_map_init(&g_map, &mp);
         if (st != BSF_OK) {
             fail_msg("cannot initialise the map: %s", bsf_status_str(st));
@@ -478,6 +483,12 @@ int cmd_extract(int argc, char **argv)
                 return usage_error("--pose-every needs a count >= 0, got '%s'", v);
             }
             pose_every_set = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--snapshot-budget", &err)) != NULL) {
+            if (parse_long(v, 0, BSF_MAP_FRAME_MAX_SIZE / 2, &o.snapshot_budget) != 0) {
+                return usage_error("--snapshot-budget needs bytes in [0, %u], got '%s'",
+                                   (unsigned)(BSF_MAP_FRAME_MAX_SIZE / 2), v);
+            }
+            pose_every_set = 1;
         } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
             o.out = v;
         } else if (err) {
@@ -497,7 +508,7 @@ int cmd_extract(int argc, char **argv)
         return usage_error("extract needs a LOG file");
     }
     if (pose_every_set && !o.map) {
-        return usage_error("--pose-every goes with --map");
+        return usage_error("--pose-every and --snapshot-budget go with --map");
     }
     return run_extract(&o);
 }

@@ -176,3 +176,29 @@ def test_python_m_bsf_plot_draws_a_map_stream(map_stream, tmp_path):
     assert r.returncode == 0, r.stderr
     assert "map features drawn" in r.stderr
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_snapshots_repair_a_lost_frame(bsf_tool, map_stream, tmp_path):
+    log, _ = map_stream
+    out = tmp_path / "snap.map"
+    run_tool(bsf_tool, "extract", log, "--map", "--snapshot-budget", "200", "--reproducible", "-o", out)
+    frames = [f for f in bsf.decode(out.read_bytes()) if isinstance(f, bsf.MapFrame)]
+    full = bsf.Map()
+    for f in frames:
+        full.apply(f)
+    # lose the first frame that carries more than a pose: the one that made the map
+    lost = [i for i, f in enumerate(frames) if len(f.payload) > 16][0]
+    lossy = bsf.Map()
+    for i, f in enumerate(frames):
+        if i != lost:
+            lossy.apply(f)
+    assert lossy.counters["frames_missed"] == 1
+    assert lossy.counters["snapshots"] > 0
+    # the snapshot rounds after the loss restore every feature exactly (without
+    # snapshots the whole map of this room would be missing)
+    got = {f.id: f for f in lossy.features}
+    want = {f.id: f for f in full.features}
+    assert set(got) == set(want)
+    for fid, f in want.items():
+        assert np.array_equal(got[fid].ctrl, f.ctrl) and np.array_equal(got[fid].vertex, f.vertex)
+        assert not got[fid].stale
