@@ -9,7 +9,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "bsf/bsf_bspline.h"
 #include "bsf/bsf_stream.h"
 #include "bsf_map_internal.h"
 
@@ -54,6 +53,32 @@ typedef struct {
     float x, y;
     uint8_t vertex;
 } newpt_t;
+
+/* Map features near the whole scan, gathered once per scan (and again
+ * after a merge or a forgotten feature moved slots). */
+typedef struct {
+    float box[4]; /* the scan's control points' box grown by match_dist */
+    uint16_t slot[BSF_MAP_MAX_FEATURES];
+    uint16_t n;
+    uint32_t removed; /* n_merged + n_forgotten when gathered */
+    int valid;
+} near_t;
+
+static void gather_near(const bsf_map_t *m, near_t *nr)
+{
+    uint16_t fs;
+    nr->n = 0u;
+    for (fs = 0; fs < m->n_features; ++fs) {
+        const bsf_map_feature_t *f = &m->features[fs];
+        if (f->max_x < nr->box[0] || f->min_x > nr->box[2] || f->max_y < nr->box[1] ||
+            f->min_y > nr->box[3]) {
+            continue;
+        }
+        nr->slot[nr->n++] = fs;
+    }
+    nr->removed = m->stats.n_merged + m->stats.n_forgotten;
+    nr->valid = 1;
+}
 
 void bsf_map_params_default(bsf_map_params_t *p)
 {
@@ -298,6 +323,29 @@ static void span_basis(uint8_t ends, float u, float b[3])
     }
 }
 
+/* Derivatives of span_basis with respect to u (a tangent direction). */
+static void span_deriv(uint8_t ends, float u, float d[3])
+{
+    const float v = 1.0f - u;
+    if (ends == 3u) {
+        d[0] = -2.0f * v;
+        d[1] = 2.0f * (v - u);
+        d[2] = 2.0f * u;
+    } else if (ends & 1u) {
+        d[0] = -2.0f * v;
+        d[1] = 2.0f - 3.0f * u;
+        d[2] = u;
+    } else if (ends & 2u) {
+        d[0] = -v;
+        d[1] = 3.0f * v - 2.0f;
+        d[2] = 2.0f * u;
+    } else {
+        d[0] = -v;
+        d[1] = 1.0f - 2.0f * u;
+        d[2] = u;
+    }
+}
+
 /* Spans of feature slot fs whose chord box meets box[] (min x, min y, max x,
  * max y), appended to m->segs. */
 static void build_segs(bsf_map_t *m, uint16_t fs, const float box[4])
@@ -388,18 +436,32 @@ static size_t sample_curve(const bsf_point_t *w, const uint8_t *vtx, size_t n, s
     ns = (size_t)(len / SAMPLE_STEP) + 1u;
     ns = ns < MIN_SAMPLES ? MIN_SAMPLES : (ns > MAX_SAMPLES ? MAX_SAMPLES : ns);
     for (k = 0; k < ns; ++k) {
-        const float t = (float)k / (float)(ns - 1u);
-        bsf_point_t p;
-        bsf_point_t d;
+        /* span and local parameter of t = k / (ns - 1), the last sample at
+         * the end of the last span */
+        const float ts = (float)k * (float)(n - 2u) / (float)(ns - 1u);
+        size_t span = (size_t)ts;
+        float u;
+        float b[3];
+        float d[3];
+        float dx;
+        float dy;
         float dl;
-        if (bsf_bspline_eval(w, n, t, &p, &d, NULL) != BSF_OK) {
-            return 0;
+        uint8_t ends;
+        if (span > n - 3u) {
+            span = n - 3u;
         }
-        dl = sqrtf(d.x * d.x + d.y * d.y);
-        out[k].x = p.x;
-        out[k].y = p.y;
-        out[k].dx = dl > 0.0f ? d.x / dl : 0.0f;
-        out[k].dy = dl > 0.0f ? d.y / dl : 0.0f;
+        u = ts - (float)span;
+        u = u > 1.0f ? 1.0f : u;
+        ends = (uint8_t)((span == 0u ? 1u : 0u) | (span + 3u == n ? 2u : 0u));
+        span_basis(ends, u, b);
+        span_deriv(ends, u, d);
+        out[k].x = b[0] * w[span].x + b[1] * w[span + 1u].x + b[2] * w[span + 2u].x;
+        out[k].y = b[0] * w[span].y + b[1] * w[span + 1u].y + b[2] * w[span + 2u].y;
+        dx = d[0] * w[span].x + d[1] * w[span + 1u].x + d[2] * w[span + 2u].x;
+        dy = d[0] * w[span].y + d[1] * w[span + 1u].y + d[2] * w[span + 2u].y;
+        dl = sqrtf(dx * dx + dy * dy);
+        out[k].dx = dl > 0.0f ? dx / dl : 0.0f;
+        out[k].dy = dl > 0.0f ? dy / dl : 0.0f;
         out[k].vertex = 0u;
     }
     /* a vertex (slots i, i + 1 flagged) sits on the curve at t = i / (n - 2) */
@@ -950,14 +1012,15 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
     }
 }
 
-static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n)
+static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
+                         near_t *nr)
 {
     sample_t s[MAX_SAMPLES];
     label_t lab[MAX_SAMPLES];
     float box[4];
     size_t ns;
     size_t k;
-    uint16_t fs;
+    size_t j;
     long first = -1;
     long last = -1;
 
@@ -982,7 +1045,11 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     box[2] += m->params.match_dist;
     box[3] += m->params.match_dist;
     m->n_segs = 0u;
-    for (fs = 0; fs < m->n_features; ++fs) {
+    if (!nr->valid || nr->removed != m->stats.n_merged + m->stats.n_forgotten) {
+        gather_near(m, nr);
+    }
+    for (j = 0; j < nr->n; ++j) {
+        const uint16_t fs = nr->slot[j];
         const bsf_map_feature_t *f = &m->features[fs];
         if ((f->flags & BSF_MAP_FF_FRESH) || f->max_x < box[0] || f->min_x > box[2] ||
             f->max_y < box[1] || f->min_y > box[3]) {
@@ -1021,7 +1088,6 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     /* refine every feature the samples matched, once each */
     for (k = 0; k < ns; ++k) {
         const uint16_t f = lab[k].feature;
-        size_t j;
         int seen = 0;
         if (f == BSF_MAP_NONE) {
             continue;
@@ -1112,6 +1178,7 @@ static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
 
 int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pose)
 {
+    near_t nr;
     float c;
     float sn;
     size_t i;
@@ -1130,6 +1197,28 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     }
     c = cosf(pose->theta);
     sn = sinf(pose->theta);
+    nr.valid = 0;
+    nr.n = 0u;
+    nr.removed = 0u;
+    nr.box[0] = nr.box[1] = 3.0e38f;
+    nr.box[2] = nr.box[3] = -3.0e38f;
+    for (i = 0; i < scan->n_features; ++i) {
+        const bsf_feature_t *f = &scan->features[i];
+        size_t j;
+        for (j = f->ctrl_first; j < (size_t)f->ctrl_first + f->n_ctrl; ++j) {
+            const bsf_point_t *p = &scan->ctrl[j];
+            const float x = pose->x + c * p->x - sn * p->y;
+            const float y = pose->y + sn * p->x + c * p->y;
+            nr.box[0] = x < nr.box[0] ? x : nr.box[0];
+            nr.box[1] = y < nr.box[1] ? y : nr.box[1];
+            nr.box[2] = x > nr.box[2] ? x : nr.box[2];
+            nr.box[3] = y > nr.box[3] ? y : nr.box[3];
+        }
+    }
+    nr.box[0] -= map->params.match_dist;
+    nr.box[1] -= map->params.match_dist;
+    nr.box[2] += map->params.match_dist;
+    nr.box[3] += map->params.match_dist;
     for (i = 0; i < scan->n_features; ++i) {
         const bsf_feature_t *f = &scan->features[i];
         bsf_point_t w[BSF_MAX_CTRL_PER_FEATURE];
@@ -1139,7 +1228,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
             w[j].x = pose->x + c * p->x - sn * p->y;
             w[j].y = pose->y + sn * p->x + c * p->y;
         }
-        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl);
+        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, &nr);
     }
     return (int)scan->n_features;
 }
