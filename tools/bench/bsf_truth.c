@@ -186,6 +186,12 @@ static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, con
     return 1;
 }
 
+int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                          const float *ranges, const int16_t *hit_shape)
+{
+    return c->visible && c->range <= BSF_TRUTH_RANGE_MAX && walls_seen(c, lidar, ranges, hit_shape);
+}
+
 int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                   const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
                   size_t bytes, double time_ns)
@@ -216,8 +222,7 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
         const bsf_scene_corner_t *c = &corners[k];
         int band;
         double best = 1e300;
-        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX ||
-            !walls_seen(c, lidar, ranges, hit_shape)) {
+        if (!bsf_truth_corner_seen(c, lidar, ranges, hit_shape)) {
             continue;
         }
         band = c->range < 3.0 ? 0 : (c->range < 6.0 ? 1 : 2);

@@ -22,6 +22,15 @@ static const char extract_help[] =
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
     "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
+    "  --map            fuse every scan into the robot's map (bsf_map.h) with its pose from\n"
+    "                   the log and write map-update frames instead of per-scan features:\n"
+    "                   only what changed (new features, appended spans, moved control\n"
+    "                   points, merges, removals); bsf map rebuilds the map\n"
+    "  --pose-every K   with --map: a pose record every K scans (default 1; 0: none);\n"
+    "                   pose bytes are counted apart from the map's\n"
+    "  --snapshot-budget B  with --map: up to B bytes per map frame of snapshots of the\n"
+    "                   features the robot holds, round robin (default 0: none), so that\n"
+    "                   a receiver that joined late or lost frames catches up\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
@@ -77,8 +86,42 @@ typedef struct {
     double quant;
     long meta_every;
     int reproducible;
+    int map;              /* write map-update frames */
+    long pose_every;      /* with map: a pose record every K scans, 0 none */
+    long snapshot_budget; /* with map: snapshot bytes per frame */
     const char *out;
 } extract_opts_t;
+
+/* The robot's map (--map): fixed size, as on the robot. */
+static bsf_map_t g_map;
+
+/* Every map change waiting, as frames of at most BSF_MAP_FRAME_MAX_SIZE
+ * bytes; pose (may be NULL) rides in the first. 0, or -1 on an error. */
+static int write_map_frames(FILE *out, const char *out_name, const bsf_pose_t *pose,
+                            unsigned long long *bytes)
+{
+    const size_t cap =
+        sizeof g_frame_buf < BSF_MAP_FRAME_MAX_SIZE ? sizeof g_frame_buf : BSF_MAP_FRAME_MAX_SIZE;
+    int first = 1;
+    while (first || bsf_map_pending(&g_map)) {
+        size_t len = 0;
+        const bsf_status_t st = bsf_map_encode(&g_map, first ? pose : NULL, g_frame_buf, cap, &len);
+        if (st != BSF_OK) {
+            fail_msg("cannot encode a map frame: %s", bsf_status_str(st));
+            return -1;
+        }
+        if (len == 0u) {
+            break;
+        }
+        if (fwrite(g_frame_buf, 1, len, out) != len) {
+            fail_msg("write error on %s", out_name);
+            return -1;
+        }
+        *bytes += len;
+        first = 0;
+    }
+    return 0;
+}
 
 /* The stream's current metadata and when it was last sent. */
 typedef struct {
@@ -171,6 +214,18 @@ static int run_extract(const extract_opts_t *o)
             p.no_return.min_run = 0u;
         }
         if (init_extractor_params(&p, !o->reproducible) != 0) {
+            return EXIT_FAIL;
+        }
+    }
+    if (o->map) {
+        bsf_map_params_t mp;
+        bsf_status_t st;
+        bsf_map_params_default(&mp);
+        mp.quant_step = (float)o->quant;
+        mp.snapshot_budget = (uint16_t)o->snapshot_budget;
+        st = bsf_map_init(&g_map, &mp);
+        if (st != BSF_OK) {
+            fail_msg("cannot initialise the map: %s", bsf_status_str(st));
             return EXIT_FAIL;
         }
     }
@@ -271,6 +326,33 @@ static int run_extract(const extract_opts_t *o)
         info.pose_x = (float)rec.laser_pose.x;
         info.pose_y = (float)rec.laser_pose.y;
         info.pose_theta = (float)remainder(rec.laser_pose.theta, 2.0 * M_PI);
+        if (o->map) {
+            bsf_pose_t pose;
+            int fused;
+            pose.x = info.pose_x;
+            pose.y = info.pose_y;
+            pose.theta = info.pose_theta;
+            fused = bsf_map_fuse(&g_map, &g_res, &pose);
+            if (fused < 0) {
+                fprintf(stderr, "%s:%lu: scan %lu not fused into the map: %s\n", o->log, rec.line,
+                        index, bsf_status_str((bsf_status_t)fused));
+                ++failed;
+                ++index;
+                continue;
+            }
+            if (write_map_frames(
+                    out, o->out,
+                    o->pose_every > 0 && done % (unsigned long)o->pose_every == 0u ? &pose : NULL,
+                    &bytes) != 0) {
+                write_failed = 1;
+                break;
+            }
+            ++ms.frames_since;
+            ++done;
+            ++index;
+            progress_tick(&prog, done, "extract");
+            continue;
+        }
         st = bsf_frame_encode(&info, &g_res, g_frame_buf, sizeof g_frame_buf, &len);
         if (st != BSF_OK) {
             fprintf(stderr, "%s:%lu: scan %lu not encoded: %s\n", o->log, rec.line, index,
@@ -292,6 +374,13 @@ static int run_extract(const extract_opts_t *o)
         progress_tick(&prog, done, "extract");
     }
     progress_end(&prog);
+    if (o->map && !write_failed) {
+        /* the end of the log: what waits for the frame interval goes out now */
+        g_map.params.frame_interval = 1u;
+        if (write_map_frames(out, o->out, NULL, &bytes) != 0) {
+            write_failed = 1;
+        }
+    }
     malformed = carmen_malformed_count(rd);
     carmen_close(rd);
     if (close_out(out, o->out) != 0 || r < 0 || write_failed) {
@@ -309,6 +398,20 @@ static int run_extract(const extract_opts_t *o)
             o->log, done, bsf_method_name(o->method), bytes,
             done ? (double)bytes / (double)done : 0.0, ms.n_sent, own_geometry, cut.scans, failed,
             bad_time, malformed);
+    if (o->map) {
+        const bsf_map_stats_t *m = &g_map.stats;
+        fprintf(stderr,
+                "%s: map: %lu frames, %lu bytes of map records and headers, %lu of pose records; "
+                "%lu features in RAM (%lu created, %lu extended, %lu merged, %lu vertex merges), "
+                "%lu forgotten (%lu control points; the receiver keeps them), %lu scan features "
+                "left out (caps full), %lu bytes of RAM\n",
+                o->log, (unsigned long)m->n_frames, (unsigned long)m->map_bytes,
+                (unsigned long)m->pose_bytes, (unsigned long)bsf_map_feature_count(&g_map),
+                (unsigned long)m->n_new, (unsigned long)m->n_extended, (unsigned long)m->n_merged,
+                (unsigned long)m->n_vertex_merged, (unsigned long)m->n_forgotten,
+                (unsigned long)m->n_forgotten_ctrl, (unsigned long)m->n_dropped_obs,
+                (unsigned long)sizeof g_map);
+    }
     if (cut.scans > 0u) {
         fprintf(stderr,
                 "%s: the caps left out %lu keypoints, %lu segments and %lu points in %lu scans "
@@ -323,11 +426,13 @@ int cmd_extract(int argc, char **argv)
     extract_opts_t o;
     int i;
     int err = 0;
+    int pose_every_set = 0;
     memset(&o, 0, sizeof o);
     o.method = BSF_METHOD_DEFAULT;
     o.count = -1;
     o.quant = (double)BSF_QUANT_STEP_DEFAULT;
     o.meta_every = 64;
+    o.pose_every = 1;
     o.out = "-";
     for (i = 1; i < argc; ++i) {
         const char *v;
@@ -371,6 +476,19 @@ int cmd_extract(int argc, char **argv)
             }
         } else if (strcmp(argv[i], "--reproducible") == 0) {
             o.reproducible = 1;
+        } else if (strcmp(argv[i], "--map") == 0) {
+            o.map = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--pose-every", &err)) != NULL) {
+            if (parse_long(v, 0, 1000000000L, &o.pose_every) != 0) {
+                return usage_error("--pose-every needs a count >= 0, got '%s'", v);
+            }
+            pose_every_set = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--snapshot-budget", &err)) != NULL) {
+            if (parse_long(v, 0, BSF_MAP_FRAME_MAX_SIZE / 2, &o.snapshot_budget) != 0) {
+                return usage_error("--snapshot-budget needs bytes in [0, %u], got '%s'",
+                                   (unsigned)(BSF_MAP_FRAME_MAX_SIZE / 2), v);
+            }
+            pose_every_set = 1;
         } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
             o.out = v;
         } else if (err) {
@@ -388,6 +506,9 @@ int cmd_extract(int argc, char **argv)
     }
     if (o.log == NULL) {
         return usage_error("extract needs a LOG file");
+    }
+    if (pose_every_set && !o.map) {
+        return usage_error("--pose-every and --snapshot-budget go with --map");
     }
     return run_extract(&o);
 }
