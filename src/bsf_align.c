@@ -20,7 +20,7 @@
 /* A span whose curve passes this close to its chord is one chord, else two. */
 #define ALIGN_STRAIGHT_TOL 0.005f
 /* Step below which Gauss-Newton has converged (metres, scaled radians). */
-#define ALIGN_STEP_DONE 1e-4f
+#define ALIGN_STEP_DONE 5e-4f
 #define ALIGN_JACOBI_SWEEPS 8
 /* Feature curves are sampled about this often (metres), at most so many per span. */
 #define ALIGN_SAMPLE_SPACING 0.05f
@@ -37,7 +37,7 @@ void bsf_align_params_default(bsf_align_params_t *p)
     p->free_ratio = 0.005f;
     p->free_min = 3.0f;
     p->max_iter = 10u;
-    p->max_points = 96u;
+    p->max_points = 80u;
     p->min_matches = 12u;
 }
 
@@ -258,21 +258,39 @@ static int add_chord(bsf_align_work_t *w, bsf_point_t a, bsf_point_t b, float ga
     return 0;
 }
 
-/* Next control point of a map chain with its vertex given twice: *idx is the
- * pool index, *rep how many copies of it were given. 0 at the end. */
-static int chain_next(const bsf_map_t *m, uint16_t *idx, uint8_t *rep, bsf_point_t org,
-                      bsf_point_t *out, int *vtx)
+/* Whether the local point (x, y) lies in a marked cell. */
+static int near_scan(const bsf_align_work_t *w, float x, float y)
+{
+    int cx;
+    int cy;
+    return cell_of(w, x, y, &cx, &cy) && w->mark[cy * BSF_ALIGN_GRID + cx];
+}
+
+/* Next control point of a map chain with its vertex given twice, local
+ * frame: *idx is the pool index, *rep how many copies of it were given; a
+ * vertex near the scan is added to w->mverts at its first copy (*cut set
+ * when they are full). 0 at the end of the chain. */
+static int chain_next(bsf_align_work_t *w, const bsf_map_t *m, uint16_t *idx, uint8_t *rep,
+                      bsf_point_t org, bsf_point_t *out, int *cut)
 {
     const bsf_map_ctrl_t *c;
+    int vtx;
     if (*idx == BSF_MAP_NONE || *idx >= BSF_MAP_MAX_CTRL) {
         return 0;
     }
     c = &m->ctrl[*idx];
     out->x = c->x - org.x;
     out->y = c->y - org.y;
-    *vtx = (c->flags & BSF_MAP_CF_VERTEX) != 0u;
+    vtx = (c->flags & BSF_MAP_CF_VERTEX) != 0u;
+    if (vtx && *rep == 0u && near_scan(w, out->x, out->y)) {
+        if (w->n_mverts < BSF_ALIGN_MAX_VERTICES) {
+            w->mverts[w->n_mverts++] = *out;
+        } else {
+            *cut = 1;
+        }
+    }
     ++*rep;
-    if (!*vtx || *rep >= 2u) {
+    if (!vtx || *rep >= 2u) {
         *idx = c->next;
         *rep = 0u;
     }
@@ -280,7 +298,10 @@ static int chain_next(const bsf_map_t *m, uint16_t *idx, uint8_t *rep, bsf_point
 }
 
 /* Collect the map's chords and vertices near the scan (local frame) into w;
- * returns 1 when a cap cut them. */
+ * returns 1 when a cap cut them. A span is sampled only when one of its
+ * three control points lies in a marked cell: the marks reach max_xy +
+ * max_dist beyond the scan points, farther than any chord within the gate
+ * of a point can have its control points (map spans are shorter). */
 static int collect_map(bsf_align_work_t *w, const bsf_map_t *m, bsf_point_t org, float gate)
 {
     const float bx0 = w->grid_x0 + org.x - gate;
@@ -294,63 +315,51 @@ static int collect_map(bsf_align_work_t *w, const bsf_map_t *m, bsf_point_t org,
     for (fi = 0; fi < m->n_features && fi < BSF_MAP_MAX_FEATURES; ++fi) {
         const bsf_map_feature_t *f = &m->features[fi];
         bsf_point_t q[3];
+        int near[3];
         bsf_point_t prev;
         uint16_t idx = f->head;
         uint8_t rep = 0u;
-        long n_total = 0;
         long s;
-        int vtx = 0;
-        uint16_t j;
         if (f->max_x < bx0 || f->min_x > bx1 || f->max_y < by0 || f->min_y > by1) {
             continue;
         }
-        /* n_total = stored points with vertices twice; bounded by the pool. */
-        for (j = f->head;
-             j != BSF_MAP_NONE && j < BSF_MAP_MAX_CTRL && n_total <= 2L * BSF_MAP_MAX_CTRL;
-             j = m->ctrl[j].next) {
-            n_total += (m->ctrl[j].flags & BSF_MAP_CF_VERTEX) != 0u ? 2 : 1;
-            if ((m->ctrl[j].flags & BSF_MAP_CF_VERTEX) != 0u) {
-                const float vx = m->ctrl[j].x - org.x;
-                const float vy = m->ctrl[j].y - org.y;
-                int cx;
-                int cy;
-                if (cell_of(w, vx, vy, &cx, &cy) && w->mark[cy * BSF_ALIGN_GRID + cx]) {
-                    if (w->n_mverts < BSF_ALIGN_MAX_VERTICES) {
-                        w->mverts[w->n_mverts].x = vx;
-                        w->mverts[w->n_mverts].y = vy;
-                        ++w->n_mverts;
-                    } else {
-                        cut = 1;
-                    }
-                }
-            }
-        }
-        if (n_total < 3) {
+        if (!chain_next(w, m, &idx, &rep, org, &q[0], &cut) ||
+            !chain_next(w, m, &idx, &rep, org, &q[1], &cut)) {
             continue;
         }
-        if (!chain_next(m, &idx, &rep, org, &q[0], &vtx) ||
-            !chain_next(m, &idx, &rep, org, &q[1], &vtx)) {
-            continue;
-        }
+        near[0] = near_scan(w, q[0].x, q[0].y);
+        near[1] = near_scan(w, q[1].x, q[1].y);
         prev = q[0];
-        for (s = 0; s + 2 < n_total; ++s) {
+        /* bounded by the pool: every step consumes a copy of a point */
+        for (s = 0; s <= 2L * BSF_MAP_MAX_CTRL; ++s) {
             bsf_point_t s0;
             bsf_point_t sm;
             bsf_point_t s1;
-            const int last = s + 3 == n_total;
-            if (!chain_next(m, &idx, &rep, org, &q[2], &vtx)) {
+            int last;
+            if (!chain_next(w, m, &idx, &rep, org, &q[2], &cut)) {
                 break;
             }
-            span_points(q[0], q[1], q[2], s == 0, last, &s0, &sm, &s1);
-            if (span_straight(s0, sm, s1)) {
-                cut |= add_chord(w, prev, s1, gate);
+            last = idx == BSF_MAP_NONE;
+            near[2] = near_scan(w, q[2].x, q[2].y);
+            if (near[0] || near[1] || near[2]) {
+                span_points(q[0], q[1], q[2], s == 0, last, &s0, &sm, &s1);
+                if (span_straight(s0, sm, s1)) {
+                    cut |= add_chord(w, prev, s1, gate);
+                } else {
+                    cut |= add_chord(w, prev, sm, gate);
+                    cut |= add_chord(w, sm, s1, gate);
+                }
+                prev = s1;
+            } else if (last) {
+                prev = q[2];
             } else {
-                cut |= add_chord(w, prev, sm, gate);
-                cut |= add_chord(w, sm, s1, gate);
+                prev.x = 0.5f * (q[1].x + q[2].x);
+                prev.y = 0.5f * (q[1].y + q[2].y);
             }
-            prev = s1;
             q[0] = q[1];
             q[1] = q[2];
+            near[0] = near[1];
+            near[1] = near[2];
         }
     }
     return cut;
@@ -541,8 +550,11 @@ static void add_row(align_normal_t *ne, float jx, float jy, float jt, float r, f
     ne->g[2] += w * jt * r;
 }
 
-static void associate(const bsf_align_work_t *w, const bsf_align_params_t *p, float tx, float ty,
-                      float th, float gate, align_normal_t *ne)
+/* One association pass. search = 1: each point's nearest chord through the
+ * grid (remembered in w->match); search = 0: the chord of the last search
+ * again, its line as the tangent (the pose moved by millimetres since). */
+static void associate(bsf_align_work_t *w, const bsf_align_params_t *p, float tx, float ty,
+                      float th, float gate, int search, align_normal_t *ne)
 {
     float s;
     float c;
@@ -561,27 +573,41 @@ static void associate(const bsf_align_work_t *w, const bsf_align_params_t *p, fl
         int cy;
         uint16_t e;
         uint16_t e1;
-        if (!cell_of(w, qx, qy, &cx, &cy)) {
-            continue;
-        }
-        e = w->cell_start[cy * BSF_ALIGN_GRID + cx];
-        e1 = w->cell_start[cy * BSF_ALIGN_GRID + cx + 1];
-        for (; e < e1; ++e) {
-            const bsf_align_seg_t *sg = &w->segs[w->entries[e]];
-            const float dx = qx - sg->ax;
-            const float dy = qy - sg->ay;
-            float t = dx * sg->ux + dy * sg->uy;
-            float ex;
-            float ey;
-            float d2;
-            t = t < 0.0f ? 0.0f : (t > sg->len ? sg->len : t);
-            ex = dx - t * sg->ux;
-            ey = dy - t * sg->uy;
-            d2 = ex * ex + ey * ey;
-            if (d2 < best) {
-                best = d2;
-                best_k = (int)w->entries[e];
+        if (!search) {
+            best_k = w->match[i] == 0xFFFFu ? -1 : (int)w->match[i];
+            if (best_k >= 0) {
+                const bsf_align_seg_t *sg = &w->segs[best_k];
+                const float t = (qx - sg->ax) * sg->ux + (qy - sg->ay) * sg->uy;
+                const float r = sg->ux * (qy - sg->ay) - sg->uy * (qx - sg->ax);
+                if (!(fabsf(r) < gate && t > -gate && t < sg->len + gate)) {
+                    best_k = -1;
+                }
             }
+        } else {
+            if (!cell_of(w, qx, qy, &cx, &cy)) {
+                w->match[i] = 0xFFFFu;
+                continue;
+            }
+            e = w->cell_start[cy * BSF_ALIGN_GRID + cx];
+            e1 = w->cell_start[cy * BSF_ALIGN_GRID + cx + 1];
+            for (; e < e1; ++e) {
+                const bsf_align_seg_t *sg = &w->segs[w->entries[e]];
+                const float dx = qx - sg->ax;
+                const float dy = qy - sg->ay;
+                float t = dx * sg->ux + dy * sg->uy;
+                float ex;
+                float ey;
+                float d2;
+                t = t < 0.0f ? 0.0f : (t > sg->len ? sg->len : t);
+                ex = dx - t * sg->ux;
+                ey = dy - t * sg->uy;
+                d2 = ex * ex + ey * ey;
+                if (d2 < best) {
+                    best = d2;
+                    best_k = (int)w->entries[e];
+                }
+            }
+            w->match[i] = best_k >= 0 ? (uint16_t)best_k : 0xFFFFu;
         }
         if (best_k >= 0) {
             const bsf_align_seg_t *sg = &w->segs[best_k];
@@ -685,7 +711,7 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
     if (collect_map(w, map, org, p->max_dist)) {
         out->flags |= BSF_ALIGN_FLAG_CUT;
     }
-    if (build_grid(w, p->max_dist)) {
+    if (build_grid(w, 0.5f * p->max_dist)) {
         out->flags |= BSF_ALIGN_FLAG_CUT;
     }
     out->n_segs = w->n_segs;
@@ -697,7 +723,7 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
         float step[3];
         float g2[3];
         gate = p->max_dist * (it < 3 ? (it == 0 ? 1.0f : (it == 1 ? 0.6f : 0.36f)) : 0.25f);
-        associate(w, p, tx, ty, prior->theta + dth, gate, &ne);
+        associate(w, p, tx, ty, prior->theta + dth, gate, it < 3, &ne);
         out->n_iter = (uint8_t)(it + 1);
         if (ne.n_match < p->min_matches) {
             out->declined = it == 0 ? BSF_ALIGN_DECLINE_FEW_MATCHES : BSF_ALIGN_DECLINE_DIVERGED;
@@ -739,7 +765,7 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
     }
     /* Final correspondences: the reported information, and the free
      * directions, along which the correction is taken back to the prior. */
-    associate(w, p, tx, ty, prior->theta + dth, gate, &ne);
+    associate(w, p, tx, ty, prior->theta + dth, gate, 1, &ne);
     if (ne.n_match < p->min_matches) {
         out->declined = BSF_ALIGN_DECLINE_DIVERGED;
         return;

@@ -55,7 +55,7 @@ typedef struct {
                                about three points seen squarely) */
     uint16_t max_iter;    /**< 1..50 Gauss-Newton iterations (default 10) */
     uint16_t max_points;  /**< 3..BSF_ALIGN_MAX_POINTS: scan points used, evenly
-                               subsampled (default 96) */
+                               subsampled (default 80) */
     uint16_t min_matches; /**< 3..max_points: fewer correspondences decline (default 12) */
 } bsf_align_params_t;
 
@@ -122,6 +122,7 @@ typedef struct {
     uint16_t cell_start[BSF_ALIGN_GRID * BSF_ALIGN_GRID + 1]; /**< grid: first entry per cell */
     uint16_t entries[BSF_ALIGN_MAX_ENTRIES];                  /**< grid: chord indices by cell */
     uint8_t mark[BSF_ALIGN_GRID * BSF_ALIGN_GRID];            /**< cells near a scan point */
+    uint16_t match[BSF_ALIGN_MAX_POINTS]; /**< chord of each point in the last search */
     uint16_t n_pts, n_verts, n_mverts, n_segs;
     float grid_x0, grid_y0, cell, inv_cell; /**< grid origin (local) and cell size */
 } bsf_align_work_t;

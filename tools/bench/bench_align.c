@@ -53,7 +53,7 @@
 #endif
 
 #define PI 3.14159265358979323846
-#define MAX_COLS 8
+#define MAX_COLS 10
 #define SNAP_BUDGET 128u
 
 typedef struct {
@@ -151,7 +151,7 @@ static void run_free(run_t *r)
 
 /* A log's scans with their corrected poses, and its sequential EDGE2 edges
  * as the robot's motions. 0, 1 when the log is absent, -1 on error. */
-static int load_log(run_t *r, const char *path, long max_scans)
+static int load_log(run_t *r, const char *path, long max_scans, int edges)
 {
     carmen_reader_t *rd = carmen_open(path, NULL);
     carmen_scan_t rec;
@@ -188,12 +188,22 @@ static int load_log(run_t *r, const char *path, long max_scans)
         r->s[r->n - 1].truth = l;
         r->s[r->n - 1].mount = compose(inverse(rb), l);
         r->s[r->n - 1].mount.t = wrap(r->s[r->n - 1].mount.t);
-        r->s[r->n - 1].motion.t = NAN; /* until an edge gives it */
+        /* the corrected motion (perturbed later), or NaN until an edge gives it */
+        if (edges || r->n == 1u) {
+            r->s[r->n - 1].motion.t = NAN;
+        } else {
+            r->s[r->n - 1].motion = compose(inverse(robot[r->n - 2]), rb);
+            r->s[r->n - 1].motion.t = wrap(r->s[r->n - 1].motion.t);
+        }
     }
     carmen_close(rd);
     if (rc < 0) {
         free(robot);
         return -1;
+    }
+    if (!edges) {
+        free(robot);
+        return 0;
     }
     gz = gzopen(path, "rb");
     if (gz == NULL) {
@@ -299,6 +309,7 @@ static int load_scene(run_t *r, const bsf_scene_t *sc, const pose_d *poses, size
         r->s[k].mount.x = r->s[k].mount.y = r->s[k].mount.t = 0.0;
         if (k > 0) {
             r->s[k].motion = compose(inverse(poses[k - 1]), poses[k]);
+            r->s[k].motion.t = wrap(r->s[k].motion.t);
         }
     }
     return 0;
@@ -309,7 +320,7 @@ static int load_scene(run_t *r, const bsf_scene_t *sc, const pose_d *poses, size
 typedef enum { MODE_TRUTH = 0, MODE_PRIOR = 1, MODE_ALIGN = 2 } mode_t_;
 
 typedef struct {
-    double err_rms, err_max, head_rms, head_max, along_max;
+    double err_rms, err_max, head_rms, head_max, along_max, along_corr_max;
     double length;
     unsigned long stream_bytes, final_bytes;
     unsigned long declined[BSF_ALIGN_DECLINE_COUNT];
@@ -471,6 +482,20 @@ static int fuse_run(const run_t *r, mode_t_ mode, run_result_t *out)
             ++out->n_aligned;
             ++out->declined[ar.declined];
             out->n_free += ar.n_free > 0u;
+            if (getenv("BENCH_ALIGN_TRACE") != NULL) {
+                fprintf(stderr,
+                        "ALIGN %zu dec %d free %d it %d pts %d m %d vm %d rms %.3f segs %d corr "
+                        "%.3f %.3f %.2f eig %.2f\n",
+                        k, ar.declined, ar.n_free, ar.n_iter, ar.n_points, ar.n_matches,
+                        ar.n_vertex_matches, (double)ar.rms, ar.n_segs, (double)(ar.pose.x - p.x),
+                        (double)(ar.pose.y - p.y), (double)(ar.pose.theta - p.theta) * 180.0 / PI,
+                        (double)ar.min_eig);
+            }
+            if (r->axis_x != 0.0 || r->axis_y != 0.0) {
+                out->along_corr_max =
+                    fmax(out->along_corr_max, fabs((double)(ar.pose.x - p.x) * r->axis_x +
+                                                   (double)(ar.pose.y - p.y) * r->axis_y));
+            }
             if (ar.declined == BSF_ALIGN_ACCEPTED) {
                 laser.x += (double)(ar.pose.x - p.x);
                 laser.y += (double)(ar.pose.y - p.y);
@@ -481,6 +506,10 @@ static int fuse_run(const run_t *r, mode_t_ mode, run_result_t *out)
         }
         e = hypot(laser.x - s->truth.x, laser.y - s->truth.y);
         h = fabs(wrap(laser.t - s->truth.t));
+        if (getenv("BENCH_ALIGN_TRACE") != NULL && mode == MODE_ALIGN) {
+            fprintf(stderr, "TRACE %zu err %.3f head %.2f motion %.3f %.3f %.3f\n", k, e,
+                    h * 180.0 / PI, s->motion.x, s->motion.y, s->motion.t);
+        }
         se += e * e;
         sh += h * h;
         out->err_max = fmax(out->err_max, e);
@@ -594,6 +623,15 @@ static void print_table(void)
         }
     }
     printf("\n");
+    row("largest along-axis move by alignment, m");
+    for (i = 0; i < g_n_cols; ++i) {
+        if (g_cols[i].has_axis) {
+            printf(" %.4f |", g_cols[i].res[2].along_corr_max);
+        } else {
+            printf(" – |");
+        }
+    }
+    printf("\n");
     ROW("true-pose map: curve length m, final map bytes, update stream bytes", "%.1f, %lu, %lu",
         c->res[0].length, c->res[0].final_bytes, c->res[0].stream_bytes);
     ROW("curve length vs true-pose map, prior / aligned", "%+.1f %% / %+.1f %%",
@@ -662,8 +700,29 @@ int main(int argc, char **argv)
         }
         memset(&r, 0, sizeof r);
         snprintf(path, sizeof path, "%s/%s.log.gz", data, logs[i]);
-        rc = load_log(&r, path, max_scans);
+        rc = load_log(&r, path, max_scans, 1);
         if (rc < 0 || (rc == 0 && run_column(log_cols[i], &r) != 0)) {
+            run_free(&r);
+            return 1;
+        }
+        run_free(&r);
+    }
+    for (i = 0; i < 2; ++i) {
+        static const char *const sim_logs[2] = {"intel", "alt/intel-corrected"};
+        static const char *const sim_cols[2] = {"intel-sim-2", "intel-kf-sim-2"};
+        char path[4096];
+        run_t r;
+        int rc;
+        if (only != NULL && strcmp(only, sim_cols[i]) != 0) {
+            continue;
+        }
+        memset(&r, 0, sizeof r);
+        snprintf(path, sizeof path, "%s/%s.log.gz", data, sim_logs[i]);
+        rc = load_log(&r, path, max_scans, 0);
+        if (rc == 0) {
+            perturb(&r, 0.02, seed + 20u + (uint64_t)i);
+        }
+        if (rc < 0 || (rc == 0 && run_column(sim_cols[i], &r) != 0)) {
             run_free(&r);
             return 1;
         }
