@@ -2,6 +2,7 @@
 /*
  * cmd_extract.c - bsf extract: a CARMEN log into a bsf stream.
  */
+#include "align_odometry.h"
 #include "tool.h"
 
 static const char extract_help[] =
@@ -31,6 +32,12 @@ static const char extract_help[] =
     "  --snapshot-budget B  with --map: up to B bytes per map frame of snapshots of the\n"
     "                   features the robot holds, round robin (default 0: none), so that\n"
     "                   a receiver that joined late or lost frames catches up\n"
+    "  --align          with --map: align each scan to the map before fusing it\n"
+    "                   (bsf_align.h), its prior the previous aligned pose moved by the\n"
+    "                   odometry; the map and the pose records get the aligned poses\n"
+    "  --odometry SRC   with --align: 'log' (default) the motion between the log's\n"
+    "                   odometry poses (ROBOTLASER1 robot pose, FLASER odom pose);\n"
+    "                   'edges' the '#SEQUENTIAL' EDGE2 edges of the log's pose graph\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
@@ -89,11 +96,81 @@ typedef struct {
     int map;              /* write map-update frames */
     long pose_every;      /* with map: a pose record every K scans, 0 none */
     long snapshot_budget; /* with map: snapshot bytes per frame */
+    int align;            /* with map: align each scan before fusing it */
+    int odo_edges;        /* with align: odometry from the sequential edges */
     const char *out;
 } extract_opts_t;
 
 /* The robot's map (--map): fixed size, as on the robot. */
 static bsf_map_t g_map;
+/* Alignment (--align): its work area, the odometry and the counts. */
+static bsf_align_work_t g_align_work;
+typedef struct {
+    odo_edges_t edges;
+    int odo_edges;            /* odometry from the edges, not the log's poses */
+    int have_prev;            /* a scan was placed */
+    unsigned long prev_index; /* its index in the log */
+    odo_pose_t prev_odo;      /* its odometry pose (log source) */
+    bsf_pose_t prev_pose;     /* its aligned laser pose */
+    unsigned long n_aligned, n_free;
+    unsigned long declined[BSF_ALIGN_DECLINE_COUNT];
+} align_state_t;
+static align_state_t g_as;
+
+/* The laser pose scan `index` is fused at: the log's for the first scan,
+ * then the previous aligned pose moved by the odometry and aligned to the
+ * map. 0, or -1 with a message when the odometry lacks the motion. */
+static int aligned_pose(const char *log, unsigned long line, unsigned long index,
+                        const carmen_scan_t *rec, bsf_pose_t *pose)
+{
+    const odo_pose_t odo = {rec->robot_pose.x, rec->robot_pose.y, rec->robot_pose.theta};
+    if (g_as.have_prev) {
+        odo_pose_t m = {0.0, 0.0, 0.0};
+        odo_pose_t prior;
+        const odo_pose_t prev = {(double)g_as.prev_pose.x, (double)g_as.prev_pose.y,
+                                 (double)g_as.prev_pose.theta};
+        bsf_pose_t p;
+        bsf_align_result_t ar;
+        bsf_status_t st;
+        if (g_as.odo_edges) {
+            unsigned long k;
+            for (k = g_as.prev_index + 1u; k <= index; ++k) {
+                if (k >= g_as.edges.n || !g_as.edges.have[k]) {
+                    fprintf(stderr, "%s:%lu: scan %lu: no sequential edge from scan %lu\n", log,
+                            line, index, k - 1u);
+                    return -1;
+                }
+                m = odo_compose(m, g_as.edges.motion[k]);
+            }
+        } else {
+            m = odo_between(g_as.prev_odo, odo);
+        }
+        prior = odo_compose(prev, m);
+        p.x = (float)prior.x;
+        p.y = (float)prior.y;
+        p.theta = (float)remainder(prior.t, 2.0 * M_PI);
+        st = bsf_align_points(&g_align_work, NULL, &g_map, &g_ex.points, &g_res, &p, &ar);
+        if (st != BSF_OK) {
+            fprintf(stderr, "%s:%lu: scan %lu not aligned: %s\n", log, line, index,
+                    bsf_status_str(st));
+            return -1;
+        }
+        ++g_as.n_aligned;
+        ++g_as.declined[ar.declined];
+        g_as.n_free += ar.n_free > 0u;
+        *pose = ar.pose;
+        pose->theta = (float)remainder((double)pose->theta, 2.0 * M_PI);
+    } else {
+        pose->x = (float)rec->laser_pose.x;
+        pose->y = (float)rec->laser_pose.y;
+        pose->theta = (float)remainder(rec->laser_pose.theta, 2.0 * M_PI);
+    }
+    g_as.have_prev = 1;
+    g_as.prev_index = index;
+    g_as.prev_odo = odo;
+    g_as.prev_pose = *pose;
+    return 0;
+}
 
 /* Every map change waiting, as frames of at most BSF_MAP_FRAME_MAX_SIZE
  * bytes; pose (may be NULL) rides in the first. 0, or -1 on an error. */
@@ -229,8 +306,14 @@ static int run_extract(const extract_opts_t *o)
             return EXIT_FAIL;
         }
     }
+    memset(&g_as, 0, sizeof g_as);
+    g_as.odo_edges = o->odo_edges;
+    if (o->align && o->odo_edges && odo_edges_load(o->log, &g_as.edges) != 0) {
+        return EXIT_FAIL;
+    }
     rd = open_log(o->log);
     if (rd == NULL) {
+        odo_edges_free(&g_as.edges);
         return EXIT_FAIL;
     }
     out = open_out(o->out, 1);
@@ -332,6 +415,11 @@ static int run_extract(const extract_opts_t *o)
             pose.x = info.pose_x;
             pose.y = info.pose_y;
             pose.theta = info.pose_theta;
+            if (o->align && aligned_pose(o->log, rec.line, index, &rec, &pose) != 0) {
+                ++failed;
+                ++index;
+                continue;
+            }
             fused = bsf_map_fuse(&g_map, &g_res, &pose);
             if (fused < 0) {
                 fprintf(stderr, "%s:%lu: scan %lu not fused into the map: %s\n", o->log, rec.line,
@@ -412,6 +500,19 @@ static int run_extract(const extract_opts_t *o)
                 (unsigned long)m->n_forgotten_ctrl, (unsigned long)m->n_dropped_obs,
                 (unsigned long)sizeof g_map);
     }
+    if (o->align) {
+        int d;
+        fprintf(stderr,
+                "%s: align: %lu scans aligned (odometry: %s), %lu with a direction left "
+                "free; declined:",
+                o->log, g_as.n_aligned, o->odo_edges ? "sequential edges" : "the log's poses",
+                g_as.n_free);
+        for (d = 1; d < BSF_ALIGN_DECLINE_COUNT; ++d) {
+            fprintf(stderr, " %lu %s%s", g_as.declined[d], bsf_align_decline_str(d),
+                    d + 1 < BSF_ALIGN_DECLINE_COUNT ? "," : "\n");
+        }
+    }
+    odo_edges_free(&g_as.edges);
     if (cut.scans > 0u) {
         fprintf(stderr,
                 "%s: the caps left out %lu keypoints, %lu segments and %lu points in %lu scans "
@@ -427,6 +528,7 @@ int cmd_extract(int argc, char **argv)
     int i;
     int err = 0;
     int pose_every_set = 0;
+    int odometry_set = 0;
     memset(&o, 0, sizeof o);
     o.method = BSF_METHOD_DEFAULT;
     o.count = -1;
@@ -478,6 +580,17 @@ int cmd_extract(int argc, char **argv)
             o.reproducible = 1;
         } else if (strcmp(argv[i], "--map") == 0) {
             o.map = 1;
+        } else if (strcmp(argv[i], "--align") == 0) {
+            o.align = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--odometry", &err)) != NULL) {
+            if (strcmp(v, "log") == 0) {
+                o.odo_edges = 0;
+            } else if (strcmp(v, "edges") == 0) {
+                o.odo_edges = 1;
+            } else {
+                return usage_error("--odometry takes 'log' or 'edges', got '%s'", v);
+            }
+            odometry_set = 1;
         } else if ((v = opt_value(argc, argv, &i, "--pose-every", &err)) != NULL) {
             if (parse_long(v, 0, 1000000000L, &o.pose_every) != 0) {
                 return usage_error("--pose-every needs a count >= 0, got '%s'", v);
@@ -509,6 +622,12 @@ int cmd_extract(int argc, char **argv)
     }
     if (pose_every_set && !o.map) {
         return usage_error("--pose-every and --snapshot-budget go with --map");
+    }
+    if (o.align && !o.map) {
+        return usage_error("--align goes with --map");
+    }
+    if (odometry_set && !o.align) {
+        return usage_error("--odometry goes with --align");
     }
     return run_extract(&o);
 }
