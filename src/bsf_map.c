@@ -14,7 +14,7 @@
 
 /* Spacing of scan curve samples along the control polygon, metres, and the
  * bounds of their count. */
-#define SAMPLE_STEP 0.07f
+#define SAMPLE_STEP 0.08f
 #define MIN_SAMPLES 4u
 #define MAX_SAMPLES 64u
 /* Control points one scan feature may refine at once. */
@@ -23,8 +23,8 @@
 #define MIN_SUPPORT 0.3f
 /* A run of unmatched samples shorter than this many spacings makes nothing. */
 #define MIN_RUN_SPACINGS 1.5f
-/* Largest |world coordinate| a map point may have, metres (wire range at 5 mm
- * steps is 41 km; kept well inside it for any step >= 1 mm). */
+/* Largest |world coordinate| a map point may have, metres; smaller when the
+ * wire's range (2^23 - 1 steps) is: 838 m at 0.1 mm steps. */
 #define MAP_COORD_MAX 8000.0f
 /* A span whose second difference exceeds 4 cm (squared here) is curved: it is
  * searched as CHORDS chords. */
@@ -232,7 +232,6 @@ static size_t chain_expanded(const bsf_map_t *m, const bsf_map_feature_t *f)
 /* 1 when every point is sent and within the tolerance of its sent value. */
 int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f)
 {
-    const float step = m->params.quant_step;
     const float tol = m->params.send_tol;
     uint16_t i = f->head;
     if (!(f->flags & BSF_MAP_FF_SENT)) {
@@ -240,14 +239,8 @@ int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f)
     }
     while (i != BSF_MAP_NONE) {
         const bsf_map_ctrl_t *c = &m->ctrl[i];
-        float ex;
-        float ey;
-        if (!(c->flags & BSF_MAP_CF_SENT)) {
-            return 0;
-        }
-        ex = c->x - (float)c->qx * step;
-        ey = c->y - (float)c->qy * step;
-        if (ex * ex + ey * ey > tol * tol) {
+        if (!(c->flags & BSF_MAP_CF_SENT) ||
+            bsf_map_ctrl_moved(c, m->params.quant_step, tol * tol)) {
             return 0;
         }
         i = c->next;
@@ -1012,6 +1005,39 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
     }
 }
 
+/* A scan vertex that matched a map curve where the map has no vertex (the
+ * curve was first seen without its corner): the span's control point nearest
+ * to it, if not a chain end and within ctrl_spacing, becomes a vertex there.
+ * The receiver gets it as a move with a vertex toggle; later observations of
+ * the corner merge into it. */
+static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
+{
+    const bsf_map_seg_t *sg = &m->segs[l->seg];
+    const float sp = m->params.ctrl_spacing;
+    float best = sp * sp;
+    uint16_t pick = BSF_MAP_NONE;
+    unsigned j;
+    for (j = 0; j < 3u; ++j) {
+        const bsf_map_ctrl_t *c = &m->ctrl[sg->p[j]];
+        const float d2 = (c->x - q->x) * (c->x - q->x) + (c->y - q->y) * (c->y - q->y);
+        if ((c->flags & BSF_MAP_CF_VERTEX) != 0u) {
+            return; /* the span already has its corner */
+        }
+        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && d2 < best) {
+            best = d2;
+            pick = sg->p[j];
+        }
+    }
+    if (pick != BSF_MAP_NONE) {
+        bsf_map_ctrl_t *c = &m->ctrl[pick];
+        c->x = q->x;
+        c->y = q->y;
+        c->flags |= BSF_MAP_CF_VERTEX;
+        c->weight = 1u;
+        ++m->stats.n_vertex_made;
+    }
+}
+
 static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
                          near_t *nr)
 {
@@ -1085,6 +1111,12 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
         (void)feature_new(m, p, np);
         return;
     }
+    /* corners the map has not got yet */
+    for (k = 0; k < ns; ++k) {
+        if (s[k].vertex && lab[k].feature != BSF_MAP_NONE) {
+            make_vertex(m, &lab[k], &s[k]);
+        }
+    }
     /* refine every feature the samples matched, once each */
     for (k = 0; k < ns; ++k) {
         const uint16_t f = lab[k].feature;
@@ -1142,8 +1174,40 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     }
 }
 
-static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
+/* A feature never seen again (every point observed once) and never sent,
+ * unseen for TRANSIENT_CALLS calls: a passer-by or noise; it is dropped
+ * before it costs bytes. */
+#define TRANSIENT_CALLS 5u
+
+static void drop_transients(bsf_map_t *m)
 {
+    uint16_t fs = 0;
+    while (fs < m->n_features) {
+        const bsf_map_feature_t *f = &m->features[fs];
+        int once = 1;
+        uint16_t i;
+        if ((f->flags & BSF_MAP_FF_SENT) || m->stats.n_fused - f->last_seen < TRANSIENT_CALLS) {
+            ++fs;
+            continue;
+        }
+        for (i = f->head; i != BSF_MAP_NONE && once; i = m->ctrl[i].next) {
+            once = m->ctrl[i].weight <= 1u;
+        }
+        if (!once) {
+            ++fs;
+            continue;
+        }
+        chain_free(m, f->head);
+        feature_remove_slot(m, fs);
+        ++m->stats.n_transient;
+    }
+}
+
+static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose, float step)
+{
+    /* world coordinates stay within what the wire's quantised values hold */
+    const float wire_max = 0.9f * (float)BSF_MAP_Q_MAX * step;
+    const float coord_max = wire_max < MAP_COORD_MAX ? wire_max : MAP_COORD_MAX;
     size_t i;
     if (!finite_f(pose->x) || !finite_f(pose->y) || !finite_f(pose->theta) ||
         fabsf(pose->x) > BSF_POSE_XY_MAX || fabsf(pose->y) > BSF_POSE_XY_MAX ||
@@ -1163,12 +1227,11 @@ static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
         for (j = f->ctrl_first; j < (size_t)f->ctrl_first + f->n_ctrl; ++j) {
             const float x = scan->ctrl[j].x;
             const float y = scan->ctrl[j].y;
-            if (!finite_f(x) || !finite_f(y) || fabsf(x) > MAP_COORD_MAX ||
-                fabsf(y) > MAP_COORD_MAX) {
+            if (!finite_f(x) || !finite_f(y) || fabsf(x) > coord_max || fabsf(y) > coord_max) {
                 return BSF_ERR_ARG;
             }
-            if (fabsf(pose->x) + fabsf(x) + fabsf(y) > MAP_COORD_MAX ||
-                fabsf(pose->y) + fabsf(x) + fabsf(y) > MAP_COORD_MAX) {
+            if (fabsf(pose->x) + fabsf(x) + fabsf(y) > coord_max ||
+                fabsf(pose->y) + fabsf(x) + fabsf(y) > coord_max) {
                 return BSF_ERR_ARG;
             }
         }
@@ -1187,7 +1250,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     if (map == NULL || scan == NULL || pose == NULL) {
         return BSF_ERR_ARG;
     }
-    st = check_scan(scan, pose);
+    st = check_scan(scan, pose, map->params.quant_step);
     if (st != BSF_OK) {
         return st;
     }
@@ -1195,6 +1258,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     for (fs = 0; fs < map->n_features; ++fs) {
         map->features[fs].flags &= (uint8_t)~BSF_MAP_FF_FRESH;
     }
+    drop_transients(map);
     c = cosf(pose->theta);
     sn = sinf(pose->theta);
     nr.valid = 0;
@@ -1255,7 +1319,8 @@ int bsf_map_feature_ctrl(const bsf_map_t *map, size_t index, int sent, bsf_point
     }
     for (i = f->head; i != BSF_MAP_NONE; i = map->ctrl[i].next) {
         const bsf_map_ctrl_t *c = &map->ctrl[i];
-        const unsigned reps = (c->flags & BSF_MAP_CF_VERTEX) ? 2u : 1u;
+        const unsigned reps =
+            (c->flags & (sent ? BSF_MAP_CF_SENT_VTX : BSF_MAP_CF_VERTEX)) != 0u ? 2u : 1u;
         unsigned r;
         if (sent && !(c->flags & BSF_MAP_CF_SENT)) {
             continue;
@@ -1299,7 +1364,7 @@ int bsf_map_feature_q(const bsf_map_t *map, size_t index, int32_t *q, uint8_t *i
                 q[2u * n + 1u] = c->qy;
             }
             if (is_vertex != NULL) {
-                is_vertex[n] = (uint8_t)(c->flags & BSF_MAP_CF_VERTEX);
+                is_vertex[n] = (c->flags & BSF_MAP_CF_SENT_VTX) ? 1u : 0u;
             }
         }
         ++n;

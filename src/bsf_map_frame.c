@@ -232,11 +232,11 @@ static int get_record(rd_t *r, int64_t *prev_id, rec_t *rec)
             uint32_t gap;
             int64_t dx;
             int64_t dy;
-            if (!get_u(r, BSF_MAP_REC_MAX_POINTS, &gap) || !get_s(r, DELTA_MAX, &dx) ||
+            if (!get_u(r, 2u * BSF_MAP_REC_MAX_POINTS + 1u, &gap) || !get_s(r, DELTA_MAX, &dx) ||
                 !get_s(r, DELTA_MAX, &dy)) {
                 return 0;
             }
-            idx += (int64_t)gap + 1;
+            idx += (int64_t)(gap >> 1) + 1;
             if (idx >= (int64_t)BSF_MAP_REC_MAX_POINTS) {
                 return 0;
             }
@@ -389,7 +389,8 @@ static uint32_t span_points(bsf_map_t *m, uint16_t from, int dir, uint32_t max_n
             put_point(w, x - px, y - py, v);
             c->qx = x;
             c->qy = y;
-            c->flags |= BSF_MAP_CF_SENT;
+            c->flags = (uint8_t)((c->flags & ~BSF_MAP_CF_SENT_VTX) | BSF_MAP_CF_SENT |
+                                 (v ? BSF_MAP_CF_SENT_VTX : 0u));
         }
         px = x;
         py = y;
@@ -465,9 +466,7 @@ int bsf_map_pending(const bsf_map_t *map)
         for (i = f->head; i != BSF_MAP_NONE; i = map->ctrl[i].next) {
             const bsf_map_ctrl_t *c = &map->ctrl[i];
             if (c->flags & BSF_MAP_CF_SENT) {
-                const float ex = c->x - (float)c->qx * step;
-                const float ey = c->y - (float)c->qy * step;
-                if (ex * ex + ey * ey > tol2) {
+                if (bsf_map_ctrl_moved(c, step, tol2)) {
                     return 1;
                 }
             } else if (ripe(map, f, c) &&
@@ -616,22 +615,18 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
             if (!(c->flags & BSF_MAP_CF_SENT)) {
                 continue;
             }
-            {
-                const float ex = c->x - (float)c->qx * step;
-                const float ey = c->y - (float)c->qy * step;
-                if (ex * ex + ey * ey > tol2) {
-                    const int32_t dx = quant_clamped(c->x, inv) - c->qx;
-                    const int32_t dy = quant_clamped(c->y, inv) - c->qy;
-                    const unsigned l =
-                        ulen((uint32_t)((int32_t)idx - last_idx - 1)) + ulen(zz(dx)) + ulen(zz(dy));
-                    if (l > room) {
-                        full = 1;
-                        break;
-                    }
-                    room -= l;
-                    last_idx = (int32_t)idx;
-                    ++n;
+            if (bsf_map_ctrl_moved(c, step, tol2)) {
+                const int32_t dx = quant_clamped(c->x, inv) - c->qx;
+                const int32_t dy = quant_clamped(c->y, inv) - c->qy;
+                const unsigned l = ulen(2u * (uint32_t)((int32_t)idx - last_idx - 1) + 1u) +
+                                   ulen(zz(dx)) + ulen(zz(dy));
+                if (l > room) {
+                    full = 1;
+                    break;
                 }
+                room -= l;
+                last_idx = (int32_t)idx;
+                ++n;
             }
             ++idx;
         }
@@ -644,21 +639,21 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
             last_idx = -1;
             for (i = f->head; i != BSF_MAP_NONE && written < n; i = m->ctrl[i].next) {
                 bsf_map_ctrl_t *c = &m->ctrl[i];
-                float ex;
-                float ey;
                 if (!(c->flags & BSF_MAP_CF_SENT)) {
                     continue;
                 }
-                ex = c->x - (float)c->qx * step;
-                ey = c->y - (float)c->qy * step;
-                if (ex * ex + ey * ey > tol2) {
+                if (bsf_map_ctrl_moved(c, step, tol2)) {
                     const int32_t x = quant_clamped(c->x, inv);
                     const int32_t y = quant_clamped(c->y, inv);
-                    put_u(w, (uint32_t)((int32_t)idx - last_idx - 1));
+                    const unsigned v = (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u;
+                    const unsigned toggle = v != ((c->flags & BSF_MAP_CF_SENT_VTX) ? 1u : 0u);
+                    put_u(w, 2u * (uint32_t)((int32_t)idx - last_idx - 1) + toggle);
                     put_u(w, zz(x - c->qx));
                     put_u(w, zz(y - c->qy));
                     c->qx = x;
                     c->qy = y;
+                    c->flags = (uint8_t)((c->flags & ~BSF_MAP_CF_SENT_VTX) |
+                                         (v ? BSF_MAP_CF_SENT_VTX : 0u));
                     last_idx = (int32_t)idx;
                     ++written;
                 }
@@ -748,7 +743,7 @@ static void put_snapshots(bsf_map_t *m, wr_t *w, int64_t *prev_id)
         for (k = 0; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
             const bsf_map_ctrl_t *c = &m->ctrl[i];
             const unsigned l =
-                point_len(c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u);
+                point_len(c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_SENT_VTX) ? 1u : 0u);
             if (used + l > room) {
                 break;
             }
@@ -772,7 +767,7 @@ static void put_snapshots(bsf_map_t *m, wr_t *w, int64_t *prev_id)
         qy = 0;
         for (n = 0; n < k; ++n, i = m->ctrl[i].next) {
             const bsf_map_ctrl_t *c = &m->ctrl[i];
-            put_point(w, c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_VERTEX) ? 1u : 0u);
+            put_point(w, c->qx - qx, c->qy - qy, (c->flags & BSF_MAP_CF_SENT_VTX) ? 1u : 0u);
             qx = c->qx;
             qy = c->qy;
         }
@@ -818,8 +813,12 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
     if (cap < BSF_MAP_FRAME_MIN_SIZE) {
         return BSF_ERR_BUFFER;
     }
+    /* no frame longer than a decoder of the same caps can hold */
     if (cap > BSF_MAP_FRAME_MAX_SIZE) {
         cap = BSF_MAP_FRAME_MAX_SIZE;
+    }
+    if (cap > BSF_FRAME_MAX_SIZE) {
+        cap = BSF_FRAME_MAX_SIZE;
     }
     /* payload written after room for the COBS overhead, encoded in place */
     offset = 2u + cap / 254u;
@@ -1116,10 +1115,10 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             uint32_t gap = 0u;
             int64_t dx = 0;
             int64_t dy = 0;
-            (void)get_u(&r, BSF_MAP_REC_MAX_POINTS, &gap);
+            (void)get_u(&r, 2u * BSF_MAP_REC_MAX_POINTS + 1u, &gap);
             (void)get_s(&r, DELTA_MAX, &dx);
             (void)get_s(&r, DELTA_MAX, &dy);
-            idx += (int64_t)gap + 1;
+            idx += (int64_t)(gap >> 1) + 1;
             while (c != BSF_MAP_NONE && at < idx) {
                 c = rx->ctrl[c].next;
                 ++at;
@@ -1140,10 +1139,10 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             uint32_t gap = 0u;
             int64_t dx = 0;
             int64_t dy = 0;
-            (void)get_u(&r, BSF_MAP_REC_MAX_POINTS, &gap);
+            (void)get_u(&r, 2u * BSF_MAP_REC_MAX_POINTS + 1u, &gap);
             (void)get_s(&r, DELTA_MAX, &dx);
             (void)get_s(&r, DELTA_MAX, &dy);
-            idx += (int64_t)gap + 1;
+            idx += (int64_t)(gap >> 1) + 1;
             while (c != BSF_MAP_NONE && at < idx) {
                 c = rx->ctrl[c].next;
                 ++at;
@@ -1153,6 +1152,7 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             }
             rx->ctrl[c].qx = (int32_t)(rx->ctrl[c].qx + dx);
             rx->ctrl[c].qy = (int32_t)(rx->ctrl[c].qy + dy);
+            rx->ctrl[c].vertex ^= (uint8_t)(gap & 1u);
         }
         f->upd = (uint8_t)((f->upd + 1u) & 15u);
         return 1;
@@ -1160,7 +1160,8 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
     case BSF_MAP_REC_MERGE: {
         bsf_map_rx_feature_t *b = &rx->features[rec->id_b];
         int ok = f->state == RX_PRESENT && b->state == RX_PRESENT && f->upd == rec->upd &&
-                 b->upd == rec->upd_b && f->head != BSF_MAP_NONE && b->head != BSF_MAP_NONE;
+                 b->upd == rec->upd_b && f->head != BSF_MAP_NONE && b->head != BSF_MAP_NONE &&
+                 (uint32_t)f->n_ctrl + rec->n + b->n_ctrl <= BSF_MAP_REC_MAX_POINTS;
         if (ok) {
             if (rec->high) {
                 rx_reverse(rx, f);

@@ -16,8 +16,9 @@
 #define BSF_MAP_NONE 0xFFFFu
 
 /* bsf_map_ctrl_t.flags */
-#define BSF_MAP_CF_VERTEX 1u /* a vertex (multiplicity 2) */
-#define BSF_MAP_CF_SENT 2u   /* qx, qy hold what the receiver has */
+#define BSF_MAP_CF_VERTEX 1u   /* a vertex (multiplicity 2) */
+#define BSF_MAP_CF_SENT 2u     /* qx, qy hold what the receiver has */
+#define BSF_MAP_CF_SENT_VTX 4u /* the receiver's vertex flag of the point */
 
 /* bsf_map_feature_t.flags */
 #define BSF_MAP_FF_SENT 1u  /* its new-feature record went out */
@@ -56,6 +57,16 @@ static inline int32_t bsf_map_quant(float v, float inv_step)
 
 /* Slot of the robot feature with this id, or BSF_MAP_NONE. */
 uint16_t bsf_map_slot_of_id(const bsf_map_t *m, uint32_t id);
+
+/* 1 when a sent point differs from what the receiver holds: farther than
+ * send_tol, or another vertex flag. */
+static inline int bsf_map_ctrl_moved(const bsf_map_ctrl_t *c, float step, float tol2)
+{
+    const float ex = c->x - (float)c->qx * step;
+    const float ey = c->y - (float)c->qy * step;
+    return ex * ex + ey * ey > tol2 ||
+           ((c->flags & BSF_MAP_CF_VERTEX) != 0u) != ((c->flags & BSF_MAP_CF_SENT_VTX) != 0u);
+}
 
 /* 1 when the feature is sent whole and no point is farther than send_tol
  * from its sent value: nothing of it waits for a frame. */

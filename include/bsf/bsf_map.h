@@ -40,8 +40,9 @@ BSF_BEGIN_DECLS
 #define BSF_FRAME_TYPE_MAP 3u
 /** Smallest frame buffer bsf_map_encode() accepts, bytes. */
 #define BSF_MAP_FRAME_MIN_SIZE 64u
-/** Largest map-update frame on the wire (COBS body + delimiter), bytes; the
- *  receiver's decoder buffer holds any frame up to BSF_FRAME_BODY_MAX_SIZE. */
+/** Largest map-update frame on the wire (COBS body + delimiter), bytes;
+ *  bsf_map_encode also keeps frames within BSF_FRAME_MAX_SIZE, what a stream
+ *  decoder of the same caps holds. */
 #define BSF_MAP_FRAME_MAX_SIZE 4096u
 
 /* ---- Parameters ------------------------------------------------------------ */
@@ -91,6 +92,7 @@ typedef struct {
     uint32_t n_forgotten;      /**< features dropped from RAM (the receiver keeps them) */
     uint32_t n_forgotten_ctrl; /**< their control points */
     uint32_t n_dropped_obs;    /**< scan features left out: caps full, nothing to forget */
+    uint32_t n_transient;      /**< features seen in one scan only, never sent, dropped */
     uint32_t n_frames;         /**< frames written by bsf_map_encode */
     uint32_t map_bytes;        /**< bytes of those frames, pose records excluded */
     uint32_t pose_bytes;       /**< bytes of pose records (and of pose-only frames) */
@@ -188,9 +190,11 @@ BSF_NODISCARD bsf_status_t bsf_map_init(bsf_map_t *map, const bsf_map_params_t *
  * (>= 0), or a negative bsf_status_t on failure: BSF_ERR_ARG for NULL
  * pointers, a non-finite or out-of-range pose (|x|, |y| > BSF_POSE_XY_MAX,
  * |theta| > BSF_POSE_THETA_MAX), or a feature with non-finite control
- * points, n_ctrl < 3 or control points outside scan->n_ctrl; BSF_ERR_CAPACITY
- * when scan->n_features or n_ctrl exceed the caps. On error the map is
- * unchanged.
+ * points, points that could land farther than 8 km (or 0.9 * (2^23 - 1)
+ * quant steps) from the world origin, n_ctrl < 3 or control points outside
+ * scan->n_ctrl; BSF_ERR_CAPACITY when scan->n_features or n_ctrl exceed the
+ * caps. On error the map is unchanged. A feature seen in one scan only and
+ * never sent is dropped after 5 calls (stats.n_transient).
  */
 BSF_NODISCARD int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pose);
 

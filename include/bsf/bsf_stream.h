@@ -335,7 +335,7 @@ typedef struct {
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers; BSF_ERR_CRC when the CRC
  *         does not match (or len < 5); BSF_ERR_VERSION for a version other
  *         than 1 or 2, or a type this decoder does not know (version 1: type
- *         1 only; version 2: types 1 and 2); BSF_ERR_FORMAT for
+ *         1 only; version 2: types 1, 2 and 3); BSF_ERR_FORMAT for
  *         any malformed or out-of-range field (including an extraction time
  *         above 4 294 967 us, which bsf_stats_t.time_ns cannot hold), a
  *         truncated code, non-zero padding or a trailing byte;
@@ -386,7 +386,8 @@ void bsf_decoder_init(bsf_decoder_t *dec);
  *
  * @param consumed receives the number of bytes of data used (<= len).
  * @return the type of the frame delivered into *out: BSF_FRAME_TYPE_FEATURES
- *         (1) or BSF_FRAME_TYPE_METADATA (2), equal to out->type; 0 when all
+ *         (1), BSF_FRAME_TYPE_METADATA (2) or BSF_FRAME_TYPE_MAP (3, bsf_map.h),
+ *         equal to out->type; 0 when all
  *         of data was consumed without completing a frame; BSF_ERR_ARG for
  *         NULL pointers (data may be NULL when len is 0).
  */
