@@ -23,8 +23,8 @@
 #define MIN_SUPPORT 0.3f
 /* A run of unmatched samples shorter than this many spacings makes nothing. */
 #define MIN_RUN_SPACINGS 1.5f
-/* Largest |world coordinate| a map point may have, metres (wire range at 5 mm
- * steps is 41 km; kept well inside it for any step >= 1 mm). */
+/* Largest |world coordinate| a map point may have, metres; smaller when the
+ * wire's range (2^23 - 1 steps) is: 838 m at 0.1 mm steps. */
 #define MAP_COORD_MAX 8000.0f
 /* A span whose second difference exceeds 4 cm (squared here) is curved: it is
  * searched as CHORDS chords. */
@@ -1203,8 +1203,11 @@ static void drop_transients(bsf_map_t *m)
     }
 }
 
-static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
+static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose, float step)
 {
+    /* world coordinates stay within what the wire's quantised values hold */
+    const float wire_max = 0.9f * (float)BSF_MAP_Q_MAX * step;
+    const float coord_max = wire_max < MAP_COORD_MAX ? wire_max : MAP_COORD_MAX;
     size_t i;
     if (!finite_f(pose->x) || !finite_f(pose->y) || !finite_f(pose->theta) ||
         fabsf(pose->x) > BSF_POSE_XY_MAX || fabsf(pose->y) > BSF_POSE_XY_MAX ||
@@ -1224,12 +1227,11 @@ static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose)
         for (j = f->ctrl_first; j < (size_t)f->ctrl_first + f->n_ctrl; ++j) {
             const float x = scan->ctrl[j].x;
             const float y = scan->ctrl[j].y;
-            if (!finite_f(x) || !finite_f(y) || fabsf(x) > MAP_COORD_MAX ||
-                fabsf(y) > MAP_COORD_MAX) {
+            if (!finite_f(x) || !finite_f(y) || fabsf(x) > coord_max || fabsf(y) > coord_max) {
                 return BSF_ERR_ARG;
             }
-            if (fabsf(pose->x) + fabsf(x) + fabsf(y) > MAP_COORD_MAX ||
-                fabsf(pose->y) + fabsf(x) + fabsf(y) > MAP_COORD_MAX) {
+            if (fabsf(pose->x) + fabsf(x) + fabsf(y) > coord_max ||
+                fabsf(pose->y) + fabsf(x) + fabsf(y) > coord_max) {
                 return BSF_ERR_ARG;
             }
         }
@@ -1248,7 +1250,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     if (map == NULL || scan == NULL || pose == NULL) {
         return BSF_ERR_ARG;
     }
-    st = check_scan(scan, pose);
+    st = check_scan(scan, pose, map->params.quant_step);
     if (st != BSF_OK) {
         return st;
     }

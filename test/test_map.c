@@ -137,10 +137,27 @@ static void test_map_rejects_bad_input(void)
     res.ctrl[res.features[0].ctrl_first].y = INFINITY;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
     res.ctrl[res.features[0].ctrl_first].y = 0.0f;
-    res.features[0].n_ctrl = 2u;
-    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
+    {
+        const uint8_t n_ctrl = res.features[0].n_ctrl;
+        res.features[0].n_ctrl = 2u;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
+        res.features[0].n_ctrl = n_ctrl;
+    }
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, NULL, &pose));
     TEST_ASSERT_EQUAL_MEMORY(&before, &map.stats, sizeof before);
+    {
+        /* at 0.1 mm steps the wire holds 838 m: a scan 1 km out is refused,
+         * not clamped */
+        static bsf_map_t fine;
+        bsf_map_params_default(&p);
+        p.quant_step = 0.0001f;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&fine, &p));
+        pose.x = 1000.0f;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&fine, &res, &pose));
+        pose.x = 100.0f;
+        TEST_ASSERT_EQUAL_INT((int)res.n_features, bsf_map_fuse(&fine, &res, &pose));
+        pose.x = 0.0f;
+    }
     TEST_ASSERT_EQUAL_UINT(0u, bsf_map_feature_count(&map));
     {
         size_t len = 1;

@@ -190,9 +190,11 @@ BSF_NODISCARD bsf_status_t bsf_map_init(bsf_map_t *map, const bsf_map_params_t *
  * (>= 0), or a negative bsf_status_t on failure: BSF_ERR_ARG for NULL
  * pointers, a non-finite or out-of-range pose (|x|, |y| > BSF_POSE_XY_MAX,
  * |theta| > BSF_POSE_THETA_MAX), or a feature with non-finite control
- * points, n_ctrl < 3 or control points outside scan->n_ctrl; BSF_ERR_CAPACITY
- * when scan->n_features or n_ctrl exceed the caps. On error the map is
- * unchanged.
+ * points, points that could land farther than 8 km (or 0.9 * (2^23 - 1)
+ * quant steps) from the world origin, n_ctrl < 3 or control points outside
+ * scan->n_ctrl; BSF_ERR_CAPACITY when scan->n_features or n_ctrl exceed the
+ * caps. On error the map is unchanged. A feature seen in one scan only and
+ * never sent is dropped after 5 calls (stats.n_transient).
  */
 BSF_NODISCARD int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pose);
 

@@ -127,9 +127,10 @@ samples = [p for f in feats for p in curve_samples(f["ctrl"])]
 # a straight wall between two vertices is one span: dense samples for coverage
 dense = [p for f in feats for p in curve_samples(f["ctrl"], 128)]
 d = sorted(dist_to_shapes(x, y, shapes) for x, y in samples)
-p99 = d[int(0.99 * (len(d) - 1))] if d else math.inf
-check(bool(d) and p99 < 0.05, f"map curves lie on the true walls (p99 {1000 * p99:.1f} mm < 50 mm)")
+p90 = d[int(0.90 * (len(d) - 1))] if d else math.inf
+check(bool(d) and p90 < 0.03, f"map curves lie on the true walls (p90 {1000 * p90:.1f} mm < 30 mm)")
 check(bool(d) and d[len(d) // 2] < 0.015, "median curve distance to the walls < 15 mm")
+check(bool(d) and d[-1] < 0.15, f"no map curve strays from the walls (max {1000 * d[-1]:.1f} mm < 150 mm)")
 # the walls the robot saw are covered: points every 5 cm along the two long walls in view
 def covered(x0, y0, x1, y1):
     n = int(math.hypot(x1 - x0, y1 - y0) / 0.05)

@@ -6,7 +6,7 @@
  * figure; docs/MAP.md pastes the output.
  *
  *   bench_map [--data DIR] [--scans N] [--poses N] [--grid-out DIR] [--only NAME]
- *             [--pose-every K] [--check]
+ *             [--pose-every K] [--map-param NAME=VALUE]... [--check]
  *
  * --data: the shared data directory (its alt/ holds the corrected logs;
  * default: the build's BSF_SHARED_DIR/data); a log that is absent is left out
@@ -14,7 +14,10 @@
  * --poses N: poses per synthetic scene (default 300). --grid-out DIR: also
  * write each input's grid as NAME.pgm.gz and NAME.png. --only NAME: one input
  * (intel, mit, fr079, office, angles, curved). --pose-every K: a pose record
- * every K scans (default 1; 0: none), counted apart from the map. --check: exit 1 unless every
+ * every K scans (default 1; 0: none), counted apart from the map.
+ * --map-param NAME=VALUE: a field of bsf_map_params_t other than the default
+ * (match_dist, match_angle, vertex_dist, ctrl_spacing, send_tol, weight_cap,
+ * forget_after, frame_interval), to measure a trade-off. --check: exit 1 unless every
  * scan was extracted and fused, the receiver's map equals the robot's sent
  * copy feature for feature, and every figure was measured (ctest runs it on
  * a short scene).
@@ -480,11 +483,51 @@ static int map_coverage(column_t *col, const mg_points_t *pts, const mg_curves_t
     return 0;
 }
 
+/* The map's parameters: the defaults, changed by --map-param. */
+static bsf_map_params_t g_map_params;
+
+/* NAME=VALUE into g_map_params: 0, or -1 for an unknown name or a bad value
+ * (the range is checked by bsf_map_init). */
+static int set_map_param(const char *arg)
+{
+    static const char *const names[] = {"match_dist",   "match_angle",   "vertex_dist",
+                                        "ctrl_spacing", "send_tol",      "weight_cap",
+                                        "forget_after", "frame_interval"};
+    const char *eq = strchr(arg, '=');
+    char *end = NULL;
+    double v;
+    size_t k;
+    if (eq == NULL) {
+        return -1;
+    }
+    v = strtod(eq + 1, &end);
+    if (end == eq + 1 || *end != '\0' || !(v >= 0.0 && v <= 1e6)) {
+        return -1;
+    }
+    for (k = 0; k < sizeof names / sizeof names[0]; ++k) {
+        if (strlen(names[k]) == (size_t)(eq - arg) &&
+            strncmp(arg, names[k], (size_t)(eq - arg)) == 0) {
+            break;
+        }
+    }
+    switch (k) {
+    case 0: g_map_params.match_dist = (float)v; break;
+    case 1: g_map_params.match_angle = (float)v; break;
+    case 2: g_map_params.vertex_dist = (float)v; break;
+    case 3: g_map_params.ctrl_spacing = (float)v; break;
+    case 4: g_map_params.send_tol = (float)v; break;
+    case 5: g_map_params.weight_cap = (uint16_t)v; break;
+    case 6: g_map_params.forget_after = (uint32_t)v; break;
+    case 7: g_map_params.frame_interval = (uint16_t)v; break;
+    default: return -1;
+    }
+    return 0;
+}
+
 static int map_begin(column_t *col, size_t max_scans)
 {
-    bsf_map_params_t mp;
-    bsf_map_params_default(&mp);
-    if (bsf_map_init(&g_map, &mp) != BSF_OK) {
+    if (bsf_map_init(&g_map, &g_map_params) != BSF_OK) {
+        fprintf(stderr, "bench_map: the map parameters are out of range (bsf_map_init)\n");
         return -1;
     }
     bsf_map_rx_init(&g_rx);
@@ -876,6 +919,7 @@ int main(int argc, char **argv)
     int check = 0;
     bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
     int i;
+    bsf_map_params_default(&g_map_params);
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--data") == 0 && i + 1 < argc) {
             data = argv[++i];
@@ -885,6 +929,16 @@ int main(int argc, char **argv)
             poses = atol(argv[++i]);
         } else if (strcmp(argv[i], "--grid-out") == 0 && i + 1 < argc) {
             g_grid_out = argv[++i];
+        } else if (strcmp(argv[i], "--map-param") == 0 && i + 1 < argc) {
+            if (set_map_param(argv[++i]) != 0) {
+                fprintf(stderr,
+                        "bench_map: --map-param needs NAME=VALUE with a name of "
+                        "bsf_map_params_t (match_dist, match_angle, vertex_dist, "
+                        "ctrl_spacing, send_tol, weight_cap, forget_after, "
+                        "frame_interval), got '%s'\n",
+                        argv[i]);
+                return 2;
+            }
         } else if (strcmp(argv[i], "--pose-every") == 0 && i + 1 < argc) {
             g_pose_every = atol(argv[++i]);
         } else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc) {
@@ -894,7 +948,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr,
                     "usage: bench_map [--data DIR] [--scans N] [--poses N] [--grid-out DIR] "
-                    "[--only NAME] [--pose-every K] [--check]\n");
+                    "[--only NAME] [--pose-every K] [--map-param NAME=VALUE]... [--check]\n");
             return 2;
         }
     }

@@ -112,7 +112,8 @@ def test_map_lies_on_the_walls(map_stream):
     pts = np.concatenate([f.sample(256) for f in feats])
     d = _dist_to_room(pts)
     assert np.median(d) < 0.015
-    assert np.quantile(d, 0.99) < 0.05
+    assert np.quantile(d, 0.90) < 0.03
+    assert d.max() < 0.15  # no curve strays from the room
     # the wall y = 0 is covered along most of its length
     xs = np.linspace(0.3, 5.7, 55)
     near = [np.min(np.hypot(pts[:, 0] - x, pts[:, 1])) < 0.05 for x in xs]
