@@ -320,7 +320,7 @@ static int load_scene(run_t *r, const bsf_scene_t *sc, const pose_d *poses, size
 typedef enum { MODE_TRUTH = 0, MODE_PRIOR = 1, MODE_ALIGN = 2 } mode_t_;
 
 typedef struct {
-    double err_rms, err_max, head_rms, head_max, along_max, along_corr_max;
+    double err_rms, err_max, head_rms, head_max, along_max, along_corr_max, along_prior_max;
     double length;
     unsigned long stream_bytes, final_bytes;
     unsigned long declined[BSF_ALIGN_DECLINE_COUNT];
@@ -482,16 +482,10 @@ static int fuse_run(const run_t *r, mode_t_ mode, run_result_t *out)
             ++out->n_aligned;
             ++out->declined[ar.declined];
             out->n_free += ar.n_free > 0u;
-            if (getenv("BENCH_ALIGN_TRACE") != NULL) {
-                fprintf(stderr,
-                        "ALIGN %zu dec %d free %d it %d pts %d m %d vm %d rms %.3f segs %d corr "
-                        "%.3f %.3f %.2f eig %.2f\n",
-                        k, ar.declined, ar.n_free, ar.n_iter, ar.n_points, ar.n_matches,
-                        ar.n_vertex_matches, (double)ar.rms, ar.n_segs, (double)(ar.pose.x - p.x),
-                        (double)(ar.pose.y - p.y), (double)(ar.pose.theta - p.theta) * 180.0 / PI,
-                        (double)ar.min_eig);
-            }
             if (r->axis_x != 0.0 || r->axis_y != 0.0) {
+                out->along_prior_max =
+                    fmax(out->along_prior_max, fabs((laser.x - s->truth.x) * r->axis_x +
+                                                    (laser.y - s->truth.y) * r->axis_y));
                 out->along_corr_max =
                     fmax(out->along_corr_max, fabs((double)(ar.pose.x - p.x) * r->axis_x +
                                                    (double)(ar.pose.y - p.y) * r->axis_y));
@@ -506,10 +500,6 @@ static int fuse_run(const run_t *r, mode_t_ mode, run_result_t *out)
         }
         e = hypot(laser.x - s->truth.x, laser.y - s->truth.y);
         h = fabs(wrap(laser.t - s->truth.t));
-        if (getenv("BENCH_ALIGN_TRACE") != NULL && mode == MODE_ALIGN) {
-            fprintf(stderr, "TRACE %zu err %.3f head %.2f motion %.3f %.3f %.3f\n", k, e,
-                    h * 180.0 / PI, s->motion.x, s->motion.y, s->motion.t);
-        }
         se += e * e;
         sh += h * h;
         out->err_max = fmax(out->err_max, e);
@@ -614,10 +604,11 @@ static void print_table(void)
         c->res[1].head_max * 180.0 / PI);
     ROW("aligned: heading error RMS / max, deg", "%.2f / %.2f", c->res[2].head_rms * 180.0 / PI,
         c->res[2].head_max * 180.0 / PI);
-    row("along-axis error max, prior / aligned, m");
+    row("along-axis error max, m: prior-only run / aligned run's priors / aligned run");
     for (i = 0; i < g_n_cols; ++i) {
         if (g_cols[i].has_axis) {
-            printf(" %.3f / %.3f |", g_cols[i].res[1].along_max, g_cols[i].res[2].along_max);
+            printf(" %.3f / %.3f / %.3f |", g_cols[i].res[1].along_max,
+                   g_cols[i].res[2].along_prior_max, g_cols[i].res[2].along_max);
         } else {
             printf(" – |");
         }
