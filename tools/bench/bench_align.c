@@ -13,6 +13,13 @@
  *    (scan-matched relative motions between consecutive scans, no loop
  *    closures) chained from the first corrected pose; truth = the
  *    corrected poses (VERTEX2, the ROBOTLASER1 laser pose).
+ *  - mit-raw: mit-csail.log.gz's scans and corrected poses, with the raw
+ *    wheel odometry of the same run (alt/mit-csail-slameval.clf.gz, FLASER
+ *    odometry poses matched by time stamp).
+ *  - intel-sim-2, intel-kf-sim-2: intel.log.gz (2672 scans) and the
+ *    corrected keyframe log alt/intel-corrected.log.gz (910 scans, about
+ *    1 m apart) with their corrected motions perturbed by the drift model
+ *    below at 2 %.
  *  - office-1, office-2, office-5: the demo office loop (tools/scene, 361
  *    beams over 270 degrees, 1 cm noise) with its true poses; each relative
  *    motion perturbed by the drift model below at 1 %, 2 % and 5 %.
@@ -53,7 +60,7 @@
 #endif
 
 #define PI 3.14159265358979323846
-#define MAX_COLS 10
+#define MAX_COLS 12
 #define SNAP_BUDGET 128u
 
 typedef struct {
@@ -107,6 +114,7 @@ typedef struct {
     run_scan_t *s;
     size_t n, cap;
     double axis_x, axis_y; /* unit axis for the along-axis row (0, 0: none) */
+    double *stamps;        /* time stamps of the scans (logs) */
 } run_t;
 
 static int run_push(run_t *r, const float *ranges, size_t count, const bsf_scan_t *g)
@@ -144,6 +152,7 @@ static void run_free(run_t *r)
         free(r->s[i].ranges);
     }
     free(r->s);
+    free(r->stamps);
     memset(r, 0, sizeof *r);
 }
 
@@ -185,6 +194,16 @@ static int load_log(run_t *r, const char *path, long max_scans, int edges)
         }
         robot = p;
         robot[r->n - 1] = rb;
+        {
+            double *ts = realloc(r->stamps, r->n * sizeof *ts);
+            if (ts == NULL) {
+                carmen_close(rd);
+                free(robot);
+                return -1;
+            }
+            r->stamps = ts;
+            ts[r->n - 1] = rec.timestamp;
+        }
         r->s[r->n - 1].truth = l;
         r->s[r->n - 1].mount = compose(inverse(rb), l);
         r->s[r->n - 1].mount.t = wrap(r->s[r->n - 1].mount.t);
@@ -235,6 +254,61 @@ static int load_log(run_t *r, const char *path, long max_scans, int edges)
         }
     }
     (void)n_edges;
+    return 0;
+}
+
+/* Replace the motions of r (a log with ROBOTLASER1 time stamps) by those of
+ * the raw odometry of another log of the same run (FLASER odometry poses),
+ * matched by time stamp. 0, 1 when the odometry log is absent, -1 when a
+ * scan has no match or on error. */
+static int raw_odometry(run_t *r, const double *stamps, const char *odo_path)
+{
+    carmen_reader_t *rd = carmen_open(odo_path, NULL);
+    carmen_scan_t rec;
+    pose_d *odo;
+    uint8_t *have;
+    size_t k = 0, n_have = 0;
+    int rc;
+    if (rd == NULL) {
+        fprintf(stderr, "bench_align: %s: cannot open; column left out\n", odo_path);
+        return 1;
+    }
+    odo = calloc(r->n ? r->n : 1u, sizeof *odo);
+    have = calloc(r->n ? r->n : 1u, 1u);
+    if (odo == NULL || have == NULL) {
+        free(odo);
+        free(have);
+        carmen_close(rd);
+        return -1;
+    }
+    /* both logs are in time order: one merge pass */
+    while ((rc = carmen_next(rd, &rec)) > 0 && k < r->n) {
+        while (k < r->n && stamps[k] < rec.timestamp - 1e-4) {
+            ++k;
+        }
+        if (k < r->n && fabs(stamps[k] - rec.timestamp) <= 1e-4) {
+            odo[k].x = rec.robot_pose.x;
+            odo[k].y = rec.robot_pose.y;
+            odo[k].t = rec.robot_pose.theta;
+            have[k] = 1u;
+            ++n_have;
+            ++k;
+        }
+    }
+    carmen_close(rd);
+    if (rc < 0 || n_have != r->n) {
+        fprintf(stderr, "bench_align: %s: %zu of %zu scans matched by time stamp\n", odo_path,
+                n_have, r->n);
+        free(odo);
+        free(have);
+        return -1;
+    }
+    for (k = 1; k < r->n; ++k) {
+        r->s[k].motion = compose(inverse(odo[k - 1]), odo[k]);
+        r->s[k].motion.t = wrap(r->s[k].motion.t);
+    }
+    free(odo);
+    free(have);
     return 0;
 }
 
@@ -693,6 +767,24 @@ int main(int argc, char **argv)
         snprintf(path, sizeof path, "%s/%s.log.gz", data, logs[i]);
         rc = load_log(&r, path, max_scans, 1);
         if (rc < 0 || (rc == 0 && run_column(log_cols[i], &r) != 0)) {
+            run_free(&r);
+            return 1;
+        }
+        run_free(&r);
+    }
+    if (only == NULL || strcmp(only, "mit-raw") == 0) {
+        char path[4096];
+        char odo_path[4096];
+        run_t r;
+        int rc;
+        memset(&r, 0, sizeof r);
+        snprintf(path, sizeof path, "%s/mit-csail.log.gz", data);
+        snprintf(odo_path, sizeof odo_path, "%s/alt/mit-csail-slameval.clf.gz", data);
+        rc = load_log(&r, path, max_scans, 0);
+        if (rc == 0) {
+            rc = raw_odometry(&r, r.stamps, odo_path);
+        }
+        if (rc < 0 || (rc == 0 && run_column("mit-raw", &r) != 0)) {
             run_free(&r);
             return 1;
         }
