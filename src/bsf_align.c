@@ -28,7 +28,7 @@
 
 void bsf_align_params_default(bsf_align_params_t *p)
 {
-    p->max_dist = 0.5f;
+    p->max_dist = 0.8f;
     p->huber = 0.03f;
     p->max_xy = 0.5f;
     p->max_theta = 0.2f;
@@ -299,9 +299,11 @@ static int chain_next(bsf_align_work_t *w, const bsf_map_t *m, uint16_t *idx, ui
 
 /* Collect the map's chords and vertices near the scan (local frame) into w;
  * returns 1 when a cap cut them. A span is sampled only when one of its
- * three control points lies in a marked cell: the marks reach max_xy +
- * max_dist beyond the scan points, farther than any chord within the gate
- * of a point can have its control points (map spans are shorter). */
+ * three control points lies in a marked cell: the marks reach at least
+ * max_xy + max_dist / 2 beyond the scan points (whole cells), which covers
+ * the spans of the chords a point can be matched to through the grid
+ * (their control points lie within a span's length of the chord, and map
+ * spans are a few decimetres). */
 static int collect_map(bsf_align_work_t *w, const bsf_map_t *m, bsf_point_t org, float gate)
 {
     const float bx0 = w->grid_x0 + org.x - gate;
@@ -707,7 +709,7 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
         return;
     }
     bsf_sincosf(prior->theta, &s0, &c0);
-    grid_mark(w, c0, s0, p->max_xy + p->max_dist, p->max_dist);
+    grid_mark(w, c0, s0, p->max_xy + 0.5f * p->max_dist, 0.5f * p->max_dist);
     if (collect_map(w, map, org, p->max_dist)) {
         out->flags |= BSF_ALIGN_FLAG_CUT;
     }

@@ -38,7 +38,9 @@ BSF_BEGIN_DECLS
 /** Runtime parameters of alignment (bsf_align_params_default gives the defaults). */
 typedef struct {
     float max_dist;       /**< metres, (0, 2]: correspondence gate of the first iteration;
-                               it shrinks to a quarter over the iterations (default 0.5) */
+                               it shrinks to a quarter over the iterations. A map curve
+                               within max_dist / 2 of a point is always found, a farther
+                               one when it crosses the point's grid cell (default 0.8) */
     float huber;          /**< metres, (0, 1]: residual beyond which the loss is linear
                                (default 0.03) */
     float max_xy;         /**< metres, (0, 10]: largest accepted translation correction
