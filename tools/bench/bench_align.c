@@ -6,7 +6,11 @@
  * alone, and with each prior aligned to the map (bsf_align_points). One
  * column per source; docs/ALIGN-notes.md pastes the output.
  *
- *   bench_align [--data DIR] [--scans N] [--poses N] [--only NAME] [--seed S]
+ *   bench_align [--data DIR] [--scans N] [--poses N] [--only NAME] [--seed S] [--check]
+ *
+ * --check: exit 1 unless, in every column, every figure is finite and the
+ * aligned trajectory's RMS translation and heading errors are below the
+ * prior's (ctest runs it on a short synthetic run).
  *
  * Drift sources:
  *  - intel-seq, mit-seq, fr079-seq: the logs' `#SEQUENTIAL` EDGE2 edges
@@ -730,6 +734,7 @@ int main(int argc, char **argv)
     long max_scans = -1;
     long n_poses = 300;
     uint64_t seed = 1;
+    int check = 0;
     int i;
     static const char *const logs[3] = {"intel", "mit-csail", "fr079"};
     static const char *const log_cols[3] = {"intel-seq", "mit-seq", "fr079-seq"};
@@ -744,11 +749,13 @@ int main(int argc, char **argv)
             n_poses = strtol(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc) {
             only = argv[++i];
+        } else if (strcmp(argv[i], "--check") == 0) {
+            check = 1;
         } else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) {
             seed = (uint64_t)strtoull(argv[++i], NULL, 10);
         } else {
             fprintf(stderr, "usage: bench_align [--data DIR] [--scans N] [--poses N] "
-                            "[--only NAME] [--seed S]\n");
+                            "[--only NAME] [--seed S] [--check]\n");
             return 2;
         }
     }
@@ -872,5 +879,17 @@ int main(int argc, char **argv)
         return 1;
     }
     print_table();
+    if (check) {
+        size_t c;
+        for (c = 0; c < g_n_cols; ++c) {
+            const run_result_t *p = &g_cols[c].res[1], *a = &g_cols[c].res[2];
+            if (!(isfinite(a->err_rms) && isfinite(a->head_rms) && isfinite(a->length) &&
+                  a->length > 0.0 && a->err_rms < p->err_rms && a->head_rms < p->head_rms)) {
+                fprintf(stderr, "bench_align: --check: %s: aligned no better than the prior\n",
+                        g_cols[c].name);
+                return 1;
+            }
+        }
+    }
     return 0;
 }
