@@ -8,7 +8,8 @@
  * curves; both in the sensor frame), a pose prior (odometry) and the map
  * (bsf_map.h), bsf_align_points() / bsf_align_features() return a corrected
  * pose. Method: Gauss-Newton over (x, y, theta) on point-to-chord distances
- * (each map span is cut into two chords on the curve), with a Huber loss,
+ * (each map span is one chord between its knots, or two through its mid
+ * point where it bends), with a Huber loss,
  * a shrinking correspondence gate and a bounded number of iterations; scan
  * vertices near a map vertex pull point to point with a higher weight.
  * Correspondences are found through a grid built, for each call, from the
@@ -80,13 +81,14 @@ typedef enum {
 #define BSF_ALIGN_DECLINE_COUNT 7
 
 /** Bits of bsf_align_result_t.flags. */
-#define BSF_ALIGN_FLAG_FREE                                                                        \
-    0x1u                              /**< a direction was left free: the pose keeps the prior     \
-                                           along min_eigvec (n_free directions) */
-#define BSF_ALIGN_FLAG_CONVERGED 0x2u /**< the last step was below 0.1 mm / 0.1 mrad */
-#define BSF_ALIGN_FLAG_CUT                                                                         \
-    0x4u /**< a cap cut the map curves or grid entries near the                                    \
-              prior (BSF_ALIGN_MAX_SEGS, BSF_ALIGN_MAX_ENTRIES) */
+/** A direction was left free: the pose keeps the prior along min_eigvec
+ *  (n_free directions). */
+#define BSF_ALIGN_FLAG_FREE 0x1u
+/** The last step was below 0.5 mm (theta scaled by theta_scale). */
+#define BSF_ALIGN_FLAG_CONVERGED 0x2u
+/** A cap cut the map curves, vertices or grid entries near the prior
+ *  (BSF_ALIGN_MAX_SEGS, BSF_ALIGN_MAX_VERTICES, BSF_ALIGN_MAX_ENTRIES). */
+#define BSF_ALIGN_FLAG_CUT 0x4u
 
 /** Result of one alignment. */
 typedef struct {
