@@ -15,4 +15,7 @@ bsf_status_t bsf_features_parse(reader_t *r, unsigned version, bsf_frame_t *out)
 /* BSF_FRAME_TYPE_METADATA (bsf_metadata_decode.c). */
 bsf_status_t bsf_metadata_parse(reader_t *r, unsigned version, bsf_frame_t *out);
 
+/* BSF_FRAME_TYPE_MAP (bsf_map_frame.c): a map update, checked record by record. */
+bsf_status_t bsf_map_parse(reader_t *r, unsigned version, bsf_frame_t *out);
+
 #endif /* BSF_FRAME_PARSERS_H */

@@ -23,6 +23,7 @@ static const struct {
 } frame_types[] = {
     {BSF_FRAME_TYPE_FEATURES, BSF_FORMAT_VERSION_MIN, bsf_features_parse},
     {BSF_FRAME_TYPE_METADATA, 2u, bsf_metadata_parse},
+    {BSF_FRAME_TYPE_MAP, 2u, bsf_map_parse},
 };
 
 /*
@@ -62,6 +63,10 @@ static bsf_status_t decode_checked(const uint8_t *body, size_t len, bsf_frame_t 
     bsf_status_t st = parse_payload(body, payload_len, NULL);
     if (st == BSF_OK) {
         st = parse_payload(body, payload_len, out);
+    }
+    if (st == BSF_OK) {
+        out->payload = body;
+        out->payload_len = payload_len;
     }
     return st;
 }

@@ -22,5 +22,7 @@
 #include "bsf_bid.h"
 #include "bsf_extract.h"
 #include "bsf_stream.h"
+#include "bsf_map.h"
+#include "bsf_align.h"
 
 #endif /* BSF_H */

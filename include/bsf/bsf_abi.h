@@ -90,4 +90,37 @@
 #define bsf_decoder_init BSF_CAPS_NAME(bsf_decoder_init)
 #define bsf_decoder_feed BSF_CAPS_NAME(bsf_decoder_feed)
 
+/* The map's objects also follow the map caps (M: BSF_MAP_MAX_FEATURES, Q:
+ * BSF_MAP_MAX_CTRL, O: BSF_MAP_MAX_OPS, R: BSF_MAP_RX_MAX_FEATURES, Z:
+ * BSF_MAP_RX_MAX_CTRL), so their symbols carry those too. */
+/* A module's calls: the scan caps, an underscore, then the module's own caps
+ * (bsf_config.h, BSF_CONFIG_MAP_CAPS / BSF_CONFIG_ALIGN_CAPS), e.g.
+ * bsf_map_fuse_capsP1081K64S128F32C512_M256Q2048O16R8192Z32768. */
+/* One joining macro per level: a macro is not expanded again inside its own expansion. */
+#define BSF_CAPS_JOIN_MAP_(...) BSF_CAPS_JOIN16_(__VA_ARGS__, , , , , , , , , , , , , , , , )
+#define BSF_CAPS_JOIN_ALIGN_(...) BSF_CAPS_JOIN16_(__VA_ARGS__, , , , , , , , , , , , , , , , )
+#define BSF_MAP_CAPS_NAME(fn)                                                                      \
+    BSF_CAPS_JOIN_MAP_(BSF_CAPS_NAME(fn), _ BSF_CONFIG_MAP_CAPS(BSF_CAPS_ITEM_))
+#define BSF_ALIGN_CAPS_NAME(fn)                                                                    \
+    BSF_CAPS_JOIN_ALIGN_(BSF_MAP_CAPS_NAME(fn), _ BSF_CONFIG_ALIGN_CAPS(BSF_CAPS_ITEM_))
+
+#define bsf_map_init BSF_MAP_CAPS_NAME(bsf_map_init)
+#define bsf_map_fuse BSF_MAP_CAPS_NAME(bsf_map_fuse)
+#define bsf_map_encode BSF_MAP_CAPS_NAME(bsf_map_encode)
+#define bsf_map_pending BSF_MAP_CAPS_NAME(bsf_map_pending)
+#define bsf_map_feature_count BSF_MAP_CAPS_NAME(bsf_map_feature_count)
+#define bsf_map_feature_ctrl BSF_MAP_CAPS_NAME(bsf_map_feature_ctrl)
+#define bsf_map_feature_q BSF_MAP_CAPS_NAME(bsf_map_feature_q)
+#define bsf_map_rx_init BSF_MAP_CAPS_NAME(bsf_map_rx_init)
+#define bsf_map_rx_apply BSF_MAP_CAPS_NAME(bsf_map_rx_apply)
+#define bsf_map_rx_id_limit BSF_MAP_CAPS_NAME(bsf_map_rx_id_limit)
+#define bsf_map_rx_feature_ctrl BSF_MAP_CAPS_NAME(bsf_map_rx_feature_ctrl)
+#define bsf_map_rx_feature_q BSF_MAP_CAPS_NAME(bsf_map_rx_feature_q)
+
+/* Alignment's work area also follows the alignment caps (A: BSF_ALIGN_MAX_POINTS,
+ * V: BSF_ALIGN_MAX_VERTICES, S: BSF_ALIGN_MAX_SEGS, G: BSF_ALIGN_GRID, E:
+ * BSF_ALIGN_MAX_ENTRIES) and takes the map, so its symbols carry all three sets. */
+#define bsf_align_points BSF_ALIGN_CAPS_NAME(bsf_align_points)
+#define bsf_align_features BSF_ALIGN_CAPS_NAME(bsf_align_features)
+
 #endif /* BSF_ABI_H */

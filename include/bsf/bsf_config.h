@@ -74,6 +74,58 @@
 #define BSF_MAX_CTRL_POINTS 512
 #endif
 
+/* Fused map (bsf_map.h). The robot's map: */
+/** Largest number of features of the robot's map held in RAM. */
+#ifndef BSF_MAP_MAX_FEATURES
+#define BSF_MAP_MAX_FEATURES 256
+#endif
+
+/** Pool of control points shared by the robot map's features (a vertex counts once). */
+#ifndef BSF_MAP_MAX_CTRL
+#define BSF_MAP_MAX_CTRL 2048
+#endif
+
+/** Largest number of merges queued between two map frames. */
+#ifndef BSF_MAP_MAX_OPS
+#define BSF_MAP_MAX_OPS 16
+#endif
+
+/** Largest feature id + 1 the receiver's map holds (features ever sent). */
+#ifndef BSF_MAP_RX_MAX_FEATURES
+#define BSF_MAP_RX_MAX_FEATURES 8192
+#endif
+
+/** Pool of control points of the receiver's map. */
+#ifndef BSF_MAP_RX_MAX_CTRL
+#define BSF_MAP_RX_MAX_CTRL 32768
+#endif
+
+/* Alignment of a scan to the map (bsf_align.h): */
+/** Largest number of scan points one alignment uses (the rest are subsampled away). */
+#ifndef BSF_ALIGN_MAX_POINTS
+#define BSF_ALIGN_MAX_POINTS 128
+#endif
+
+/** Largest number of scan vertices, and of map vertices near the prior, one alignment uses. */
+#ifndef BSF_ALIGN_MAX_VERTICES
+#define BSF_ALIGN_MAX_VERTICES 64
+#endif
+
+/** Largest number of map chords (two per map span) near the prior one alignment holds. */
+#ifndef BSF_ALIGN_MAX_SEGS
+#define BSF_ALIGN_MAX_SEGS 1024
+#endif
+
+/** Cells per side of the correspondence grid of one alignment. */
+#ifndef BSF_ALIGN_GRID
+#define BSF_ALIGN_GRID 48
+#endif
+
+/** Entries (chord, cell) of that grid. */
+#ifndef BSF_ALIGN_MAX_ENTRIES
+#define BSF_ALIGN_MAX_ENTRIES 4096
+#endif
+
 /* Extraction methods compiled into the library: bit m of BSF_CONFIG_METHODS
  * stands for bsf_method_t m. Firmware that only ever runs one method sets
  * just its bit, so the link leaves the other detectors and fitters out (with
@@ -134,6 +186,37 @@
 #if (BSF_CONFIG_SIMD) != 0 && (BSF_CONFIG_SIMD) != 1
 #error "BSF_CONFIG_SIMD must be 0 or 1"
 #endif
+/* Map pools are indexed by uint16_t with 0xFFFF as "none". */
+#if BSF_MAP_MAX_FEATURES < 1 || BSF_MAP_MAX_FEATURES > 65535
+#error "BSF_MAP_MAX_FEATURES must be in [1, 65535]"
+#endif
+#if BSF_MAP_MAX_CTRL < 64 || BSF_MAP_MAX_CTRL > 65535
+#error "BSF_MAP_MAX_CTRL must be in [64, 65535]"
+#endif
+#if BSF_MAP_MAX_OPS < 1 || BSF_MAP_MAX_OPS > 255
+#error "BSF_MAP_MAX_OPS must be in [1, 255]"
+#endif
+#if BSF_MAP_RX_MAX_FEATURES < 1 || BSF_MAP_RX_MAX_FEATURES > 16777216
+#error "BSF_MAP_RX_MAX_FEATURES must be in [1, 16777216]"
+#endif
+#if BSF_MAP_RX_MAX_CTRL < 64 || BSF_MAP_RX_MAX_CTRL > 65535
+#error "BSF_MAP_RX_MAX_CTRL must be in [64, 65535]"
+#endif
+#if BSF_ALIGN_MAX_POINTS < 8 || BSF_ALIGN_MAX_POINTS > 4096
+#error "BSF_ALIGN_MAX_POINTS must be in [8, 4096]"
+#endif
+#if BSF_ALIGN_MAX_VERTICES < 1 || BSF_ALIGN_MAX_VERTICES > 4096
+#error "BSF_ALIGN_MAX_VERTICES must be in [1, 4096]"
+#endif
+#if BSF_ALIGN_MAX_SEGS < 16 || BSF_ALIGN_MAX_SEGS > 65535
+#error "BSF_ALIGN_MAX_SEGS must be in [16, 65535]"
+#endif
+#if BSF_ALIGN_GRID < 4 || BSF_ALIGN_GRID > 255
+#error "BSF_ALIGN_GRID must be in [4, 255]"
+#endif
+#if BSF_ALIGN_MAX_ENTRIES < 16 || BSF_ALIGN_MAX_ENTRIES > 65535
+#error "BSF_ALIGN_MAX_ENTRIES must be in [16, 65535]"
+#endif
 
 #if (BSF_CONFIG_METHODS) < 1 || (BSF_CONFIG_METHODS) > 15
 #error "BSF_CONFIG_METHODS must name at least one method and only BSF_CONFIG_METHOD_* bits"
@@ -154,13 +237,34 @@
     X(F, BSF_MAX_CTRL_PER_FEATURE)                                                                 \
     X(C, BSF_MAX_CTRL_POINTS)
 
+/*
+ * Caps of the modules built on a scan's result, in the same form: their calls
+ * carry the scan caps and then, after an underscore, their own (bsf_abi.h:
+ * BSF_MAP_CAPS_NAME, BSF_ALIGN_CAPS_NAME), so the scan functions' symbols do
+ * not change with them. A new module declares its list here and one naming
+ * macro in bsf_abi.h.
+ */
+#define BSF_CONFIG_MAP_CAPS(X)                                                                     \
+    X(M, BSF_MAP_MAX_FEATURES)                                                                     \
+    X(Q, BSF_MAP_MAX_CTRL)                                                                         \
+    X(O, BSF_MAP_MAX_OPS)                                                                          \
+    X(R, BSF_MAP_RX_MAX_FEATURES)                                                                  \
+    X(Z, BSF_MAP_RX_MAX_CTRL)
+#define BSF_CONFIG_ALIGN_CAPS(X)                                                                   \
+    X(A, BSF_ALIGN_MAX_POINTS)                                                                     \
+    X(V, BSF_ALIGN_MAX_VERTICES)                                                                   \
+    X(S, BSF_ALIGN_MAX_SEGS)                                                                       \
+    X(G, BSF_ALIGN_GRID)                                                                           \
+    X(E, BSF_ALIGN_MAX_ENTRIES)
+
 /* Plain decimal spelling: the caps become part of symbol names (see above).
  * Appending a 0 to a decimal literal multiplies it by ten; for any other
  * spelling this comparison fails or does not compile. */
 #define BSF_CONFIG_CAT_(a, b) a##b
 #define BSF_CONFIG_APPEND0_(x) BSF_CONFIG_CAT_(x, 0)
 #define BSF_CONFIG_NOT_DECIMAL_(tag, cap) BSF_CONFIG_APPEND0_(cap) != (cap)*10 ||
-#if BSF_CONFIG_CAPS(BSF_CONFIG_NOT_DECIMAL_) 0
+#if BSF_CONFIG_CAPS(BSF_CONFIG_NOT_DECIMAL_) BSF_CONFIG_MAP_CAPS(BSF_CONFIG_NOT_DECIMAL_)          \
+    BSF_CONFIG_ALIGN_CAPS(BSF_CONFIG_NOT_DECIMAL_) 0
 #error "bsf caps must be plain decimal integers such as 361 (they become part of symbol names)"
 #endif
 

@@ -75,6 +75,8 @@ BSF_BEGIN_DECLS
 #define BSF_FRAME_TYPE_FEATURES 1u
 /** Frame type "stream metadata" (version 2): what produced the stream. */
 #define BSF_FRAME_TYPE_METADATA 2u
+/** Frame type "map update" (version 2): changes to the fused map (bsf_map.h). */
+#define BSF_FRAME_TYPE_MAP 3u
 
 /** Longest source name of a metadata frame, bytes of UTF-8 (no terminator). */
 #define BSF_METADATA_SOURCE_MAX 64u
@@ -342,6 +344,10 @@ BSF_NODISCARD bsf_status_t bsf_metadata_encode_sink(bsf_encoder_t *work, const b
  * geometry are 0,
  * quant_step is metadata.quant_step, and result holds no features (counts
  * and stats 0; its arrays are not touched).
+ *
+ * Map update (BSF_FRAME_TYPE_MAP, bsf_map.h): the payload has been checked
+ * for well-formedness; seq is the map frame's sequence number, the other
+ * fields are 0 as for metadata; apply payload with bsf_map_rx_apply().
  */
 typedef struct {
     uint8_t version;       /**< format version of the frame (1 or 2) */
@@ -360,6 +366,11 @@ typedef struct {
     float angle_increment;   /**< radians (with has_geometry) */
     bsf_result_t result;     /**< features, control points, vertex flags, stats */
     bsf_metadata_t metadata; /**< only for type BSF_FRAME_TYPE_METADATA */
+    const uint8_t *payload;  /**< the frame's checked payload (CRC excluded), inside the
+                                  decoder's buffer (bsf_decoder_feed: valid until the next
+                                  call) or the caller's body (bsf_frame_decode); for a map
+                                  frame (BSF_FRAME_TYPE_MAP) hand it to bsf_map_rx_apply() */
+    size_t payload_len;      /**< bytes at payload */
 } bsf_frame_t;
 
 /**
@@ -369,7 +380,7 @@ typedef struct {
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers; BSF_ERR_CRC when the CRC
  *         does not match (or len < 5); BSF_ERR_VERSION for a version other
  *         than 1 or 2, or a type this decoder does not know (version 1: type
- *         1 only; version 2: types 1 and 2); BSF_ERR_FORMAT for
+ *         1 only; version 2: types 1, 2 and 3); BSF_ERR_FORMAT for
  *         any malformed or out-of-range field (including an extraction time
  *         above 4 294 967 us, which bsf_stats_t.time_ns cannot hold), a
  *         truncated code, non-zero padding or a trailing byte;
@@ -420,7 +431,8 @@ void bsf_decoder_init(bsf_decoder_t *dec);
  *
  * @param consumed receives the number of bytes of data used (<= len).
  * @return the type of the frame delivered into *out: BSF_FRAME_TYPE_FEATURES
- *         (1) or BSF_FRAME_TYPE_METADATA (2), equal to out->type; 0 when all
+ *         (1), BSF_FRAME_TYPE_METADATA (2) or BSF_FRAME_TYPE_MAP (3, bsf_map.h),
+ *         equal to out->type; 0 when all
  *         of data was consumed without completing a frame; BSF_ERR_ARG for
  *         NULL pointers (data may be NULL when len is 0).
  */

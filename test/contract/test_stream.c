@@ -639,7 +639,7 @@ static void test_unknown_version_and_type_are_counted_and_skipped(void)
     n = reframe(payload, len, scratch);
     TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
     TEST_ASSERT_EQUAL_UINT32(1u, dec.stats.unknown_type);
-    payload[0] = 0x23; /* version 2, type 3 */
+    payload[0] = 0x24; /* version 2, type 4 (type 3 is the map update) */
     n = reframe(payload, len, scratch);
     TEST_ASSERT_EQUAL_UINT32(0u, feed_all(scratch, n, 64u));
     TEST_ASSERT_EQUAL_UINT32(2u, dec.stats.unknown_type);

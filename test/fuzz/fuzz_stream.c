@@ -34,6 +34,7 @@
 
 static bsf_decoder_t dec;
 static bsf_decoder_t dec2;
+static bsf_map_rx_t map_rx;
 static bsf_frame_t frame;
 static bsf_frame_t again;
 static bsf_frame_t direct;
@@ -87,6 +88,26 @@ static void check_frame(const bsf_frame_t *fr)
     FUZZ_CHECK(fr->quant_step >= BSF_QUANT_STEP_MIN * 0.999f &&
                fr->quant_step <= BSF_QUANT_STEP_MAX * 1.001f);
     fuzz_check_result(&fr->result, 0);
+}
+
+/* A map frame the decoder delivered: the receiver applies it (or refuses a
+ * step that differs from the stream's) and its pool stays consistent: the
+ * points its features hold and its free list add up to the pool. */
+static void check_map(const bsf_frame_t *fr)
+{
+    size_t held = 0u;
+    uint32_t id;
+    int r;
+    FUZZ_CHECK(fr->type == BSF_FRAME_TYPE_MAP && fr->payload != NULL && fr->payload_len >= 3u);
+    r = bsf_map_rx_apply(&map_rx, fr->payload, fr->payload_len);
+    FUZZ_CHECK(r >= 0 || r == BSF_ERR_FORMAT);
+    FUZZ_CHECK(bsf_map_rx_id_limit(&map_rx) <= BSF_MAP_RX_MAX_FEATURES);
+    for (id = 0; id < bsf_map_rx_id_limit(&map_rx); ++id) {
+        const int n = bsf_map_rx_feature_q(&map_rx, id, NULL, NULL, 0u);
+        FUZZ_CHECK(n >= 0);
+        held += (size_t)n;
+    }
+    FUZZ_CHECK(held + map_rx.n_free_ctrl == BSF_MAP_RX_MAX_CTRL);
 }
 
 static int same_pose(float a, float b)
@@ -268,7 +289,7 @@ static uint32_t feed_and_check(size_t n, size_t chunk, size_t *last_delivered_at
         size_t used = 0u;
         const int got = bsf_decoder_feed(&dec, stream + pos, len, &used, &frame);
         FUZZ_CHECK(got == 0 || got == (int)BSF_FRAME_TYPE_FEATURES ||
-                   got == (int)BSF_FRAME_TYPE_METADATA);
+                   got == (int)BSF_FRAME_TYPE_METADATA || got == (int)BSF_FRAME_TYPE_MAP);
         FUZZ_CHECK(got == 0 || got == (int)frame.type);
         FUZZ_CHECK(used <= len);
         FUZZ_CHECK(got != 0 || used == len);
@@ -286,6 +307,8 @@ static uint32_t feed_and_check(size_t n, size_t chunk, size_t *last_delivered_at
             if (got == (int)BSF_FRAME_TYPE_METADATA) {
                 ++metadata;
                 check_metadata(&frame);
+            } else if (got == (int)BSF_FRAME_TYPE_MAP) {
+                check_map(&frame);
             } else {
                 check_frame(&frame);
                 reencode(&frame);
@@ -575,6 +598,8 @@ static void fuzz_frame_decode(const uint8_t *p, size_t n, uint8_t sel)
     }
     if (direct.type == BSF_FRAME_TYPE_METADATA) {
         check_metadata(&direct);
+    } else if (direct.type == BSF_FRAME_TYPE_MAP) {
+        check_map(&direct);
     } else {
         check_frame(&direct);
         reencode(&direct);
@@ -593,6 +618,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size == 0u) {
         return 0;
     }
+    bsf_map_rx_init(&map_rx);
     chunk = (size_t)(data[0] & 0x3Fu) + 1u;
     mode = (uint8_t)(data[0] & 0xC0u);
     data++;
@@ -634,6 +660,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FUZZ_CHECK(direct.type == frame.type);
             if (frame.type == BSF_FRAME_TYPE_FEATURES) {
                 check_equal(&frame, &direct);
+            } else if (frame.type == BSF_FRAME_TYPE_MAP) {
+                FUZZ_CHECK(direct.seq == frame.seq && direct.payload_len == frame.payload_len);
             } else {
                 FUZZ_CHECK(direct.metadata.source_len == frame.metadata.source_len);
                 FUZZ_CHECK(direct.metadata.time_origin_us == frame.metadata.time_origin_us);

@@ -4,10 +4,12 @@
  * must skip) and prints the metrics the library itself computes on the same
  * scans, as key=value lines, so the tool test can check that
  * `bsf extract | bsf metrics` reproduces them from the stream alone.
- * Usage: synth_log OUT.log N_SCANS [clutter]
+ * Usage: synth_log OUT.log N_SCANS [clutter|walls]
  * With `clutter`, the scans are 1081-beam views of a room of zig-zag shelves
  * whose corners exceed the keypoint cap in some scans (docs/DESIGN.md, Cut policy), and the
- * cut scans are counted too (cut_scans=).
+ * cut scans are counted too (cut_scans=). With `walls`, the default scene's
+ * surfaces follow as shape=segment,x0,y0,x1,y1 and shape=circle,cx,cy,r lines
+ * (the map tests check the fused map against them).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,8 +33,9 @@ int main(int argc, char **argv)
     FILE *f;
     int n, k;
     const int clutter = argc == 4 && strcmp(argv[3], "clutter") == 0;
-    if ((argc != 3 && !clutter) || (n = atoi(argv[2])) < 1 || n > 1000) {
-        fprintf(stderr, "usage: synth_log OUT.log N_SCANS(1..1000) [clutter]\n");
+    const int walls = argc == 4 && strcmp(argv[3], "walls") == 0;
+    if ((argc != 3 && !clutter && !walls) || (n = atoi(argv[2])) < 1 || n > 1000) {
+        fprintf(stderr, "usage: synth_log OUT.log N_SCANS(1..1000) [clutter|walls]\n");
         return 2;
     }
     /* What `bsf extract` uses by default; for the clutter log FALKO, which
@@ -116,5 +119,16 @@ int main(int argc, char **argv)
         (double)s.accuracy, (double)s.features_per_scan, (double)s.ctrl_per_scan,
         (unsigned long)s.n_cut_scans, (unsigned long)s.cut_keypoints, BSF_MAX_POINTS,
         BSF_MAX_KEYPOINTS, BSF_MAX_SEGMENTS, BSF_MAX_CTRL_POINTS);
+    if (walls) {
+        size_t i;
+        for (i = 0; i < scene.n_shapes; ++i) {
+            const bsf_shape_t *sh = &scene.shape[i];
+            if (sh->kind == BSF_SHAPE_CIRCLE) {
+                printf("shape=circle,%.6f,%.6f,%.6f\n", sh->x0, sh->y0, sh->r);
+            } else {
+                printf("shape=segment,%.6f,%.6f,%.6f,%.6f\n", sh->x0, sh->y0, sh->x1, sh->y1);
+            }
+        }
+    }
     return 0;
 }

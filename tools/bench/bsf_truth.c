@@ -280,6 +280,12 @@ static int corner_convex(const bsf_scene_t *scene, const bsf_scene_corner_t *c,
     return !(cas * cab > 0.0 && csb * cab > 0.0);
 }
 
+int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                          const float *ranges, const int16_t *hit_shape)
+{
+    return c->visible && c->range <= BSF_TRUTH_RANGE_MAX && walls_seen(c, lidar, ranges, hit_shape);
+}
+
 int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                   const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
                   size_t bytes, double time_ns)

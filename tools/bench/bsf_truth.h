@@ -107,6 +107,14 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
                   const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
                   size_t bytes, double time_ns);
 
+/**
+ * Is corner c (from bsf_scene_corners for this lidar) a visible corner in the
+ * sense above: visible, within BSF_TRUTH_RANGE_MAX, both walls seen? ranges
+ * and hit_shape are the simulated scan. 1 or 0.
+ */
+int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                          const float *ranges, const int16_t *hit_shape);
+
 /** Quantile q in [0,1] of a histogram (upper bin edge), metres; 0 when empty. */
 double bsf_truth_quantile(const bsf_truth_hist_t *h, double q);
 

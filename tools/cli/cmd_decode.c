@@ -9,7 +9,9 @@ static const char decode_help[] =
     "Decode a bsf stream ('-' for stdin): one line per frame (metadata frames\n"
     "included), then the decoder's counters. With --json, one JSON object per line\n"
     "(JSON Lines): {\"metadata\": ...} for a metadata frame, every scan's frame with\n"
-    "its features and control points, then {\"counters\": ...} (docs/TOOL.md).\n"
+    "its features and control points, {\"map\": ...} for a map-update frame (its\n"
+    "sequence number and payload; bsf map rebuilds the map), then {\"counters\": ...}\n"
+    "(docs/TOOL.md).\n"
     "Each line is written as soon as its frame's delimiter arrives (a live link on\n"
     "stdin works). Exits 1 when a non-empty input holds no valid frame.\n";
 
@@ -123,6 +125,18 @@ static int print_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
 
     if (fr->type == BSF_FRAME_TYPE_METADATA) {
         print_metadata(ctx, fr, bytes);
+    } else if (fr->type == BSF_FRAME_TYPE_MAP) {
+        size_t k;
+        if (ctx->json) {
+            fprintf(ctx->out, "{\"map\":{\"seq\":%lu,\"bytes\":%zu,\"payload\":\"",
+                    (unsigned long)fr->seq, bytes);
+        } else {
+            fprintf(ctx->out, "map seq=%lu bytes=%zu payload=", (unsigned long)fr->seq, bytes);
+        }
+        for (k = 0; k < fr->payload_len; ++k) {
+            fprintf(ctx->out, "%02x", (unsigned)fr->payload[k]);
+        }
+        fputs(ctx->json ? "\"}}\n" : "\n", ctx->out);
     } else if (!ctx->json) {
         fprintf(ctx->out, "seq=%lu t=%.3f pose=", (unsigned long)fr->seq,
                 1e-3 * (double)fr->timestamp_ms);
@@ -285,6 +299,6 @@ int cmd_decode(int argc, char **argv)
     if (rc != 0) {
         return EXIT_FAIL;
     }
-    print_counters(stdout, ctx.json, &sum.stats, sum.seq_gaps);
+    print_counters(stdout, ctx.json, &sum.stats, sum.seq_gaps + sum.map_seq_gaps);
     return close_out(stdout, "stdout") == 0 ? 0 : EXIT_FAIL;
 }

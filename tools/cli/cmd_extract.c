@@ -2,6 +2,7 @@
 /*
  * cmd_extract.c - bsf extract: a CARMEN log into a bsf stream.
  */
+#include "align_odometry.h"
 #include "tool.h"
 
 static const char extract_help[] =
@@ -25,6 +26,21 @@ static const char extract_help[] =
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
     "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
+    "  --map            fuse every scan into the robot's map (bsf_map.h) with its pose from\n"
+    "                   the log and write map-update frames instead of per-scan features:\n"
+    "                   only what changed (new features, appended spans, moved control\n"
+    "                   points, merges, removals); bsf map rebuilds the map\n"
+    "  --pose-every K   with --map: a pose record every K scans (default 1; 0: none);\n"
+    "                   pose bytes are counted apart from the map's\n"
+    "  --snapshot-budget B  with --map: up to B bytes per map frame of snapshots of the\n"
+    "                   features the robot holds, round robin (default 0: none), so that\n"
+    "                   a receiver that joined late or lost frames catches up\n"
+    "  --align          with --map: align each scan to the map before fusing it\n"
+    "                   (bsf_align.h), its prior the previous aligned pose moved by the\n"
+    "                   odometry; the map and the pose records get the aligned poses\n"
+    "  --odometry SRC   with --align: 'log' (default) the motion between the log's\n"
+    "                   odometry poses (ROBOTLASER1 robot pose, FLASER odom pose);\n"
+    "                   'edges' the '#SEQUENTIAL' EDGE2 edges of the log's pose graph\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
@@ -81,8 +97,112 @@ typedef struct {
     double quant;
     long meta_every;
     int reproducible;
+    int map;              /* write map-update frames */
+    long pose_every;      /* with map: a pose record every K scans, 0 none */
+    long snapshot_budget; /* with map: snapshot bytes per frame */
+    int align;            /* with map: align each scan before fusing it */
+    int odo_edges;        /* with align: odometry from the sequential edges */
     const char *out;
 } extract_opts_t;
+
+/* The robot's map (--map): fixed size, as on the robot. */
+static bsf_map_t g_map;
+/* Alignment (--align): its work area, the odometry and the counts. */
+static bsf_align_work_t g_align_work;
+typedef struct {
+    odo_edges_t edges;
+    int odo_edges;            /* odometry from the edges, not the log's poses */
+    int have_prev;            /* a scan was placed */
+    unsigned long prev_index; /* its index in the log */
+    odo_pose_t prev_odo;      /* its odometry pose (log source) */
+    bsf_pose_t prev_pose;     /* its aligned laser pose */
+    unsigned long n_aligned, n_free;
+    unsigned long declined[BSF_ALIGN_DECLINE_COUNT];
+} align_state_t;
+static align_state_t g_as;
+
+/* The laser pose scan `index` is fused at: the log's for the first scan,
+ * then the previous aligned pose moved by the odometry and aligned to the
+ * map. 0, or -1 with a message when the odometry lacks the motion. */
+static int aligned_pose(const char *log, unsigned long line, unsigned long index,
+                        const carmen_scan_t *rec, bsf_pose_t *pose)
+{
+    const odo_pose_t odo = {rec->robot_pose.x, rec->robot_pose.y, rec->robot_pose.theta};
+    if (g_as.have_prev) {
+        odo_pose_t m = {0.0, 0.0, 0.0};
+        odo_pose_t prior;
+        const odo_pose_t prev = {(double)g_as.prev_pose.x, (double)g_as.prev_pose.y,
+                                 (double)g_as.prev_pose.theta};
+        bsf_pose_t p;
+        bsf_align_result_t ar;
+        bsf_status_t st;
+        if (g_as.odo_edges) {
+            unsigned long k;
+            for (k = g_as.prev_index + 1u; k <= index; ++k) {
+                if (k >= g_as.edges.n || !g_as.edges.have[k]) {
+                    fprintf(stderr, "%s:%lu: scan %lu: no sequential edge from scan %lu\n", log,
+                            line, index, k - 1u);
+                    return -1;
+                }
+                m = odo_compose(m, g_as.edges.motion[k]);
+            }
+        } else {
+            m = odo_between(g_as.prev_odo, odo);
+        }
+        prior = odo_compose(prev, m);
+        p.x = (float)prior.x;
+        p.y = (float)prior.y;
+        p.theta = (float)remainder(prior.t, 2.0 * M_PI);
+        st = bsf_align_points(&g_align_work, NULL, &g_map, &g_ex.points, &g_res, &p, &ar);
+        if (st != BSF_OK) {
+            fprintf(stderr, "%s:%lu: scan %lu not aligned: %s\n", log, line, index,
+                    bsf_status_str(st));
+            return -1;
+        }
+        ++g_as.n_aligned;
+        ++g_as.declined[ar.declined];
+        g_as.n_free += ar.n_free > 0u;
+        *pose = ar.pose;
+        pose->theta = (float)remainder((double)pose->theta, 2.0 * M_PI);
+    } else {
+        pose->x = (float)rec->laser_pose.x;
+        pose->y = (float)rec->laser_pose.y;
+        pose->theta = (float)remainder(rec->laser_pose.theta, 2.0 * M_PI);
+    }
+    g_as.have_prev = 1;
+    g_as.prev_index = index;
+    g_as.prev_odo = odo;
+    g_as.prev_pose = *pose;
+    return 0;
+}
+
+/* Every map change waiting, as frames of at most BSF_MAP_FRAME_MAX_SIZE
+ * bytes; pose (may be NULL) rides in the first. 0, or -1 on an error. */
+static int write_map_frames(FILE *out, const char *out_name, const bsf_pose_t *pose,
+                            unsigned long long *bytes)
+{
+    const size_t cap =
+        sizeof g_frame_buf < BSF_MAP_FRAME_MAX_SIZE ? sizeof g_frame_buf : BSF_MAP_FRAME_MAX_SIZE;
+    int first = 1;
+    while (first || bsf_map_pending(&g_map)) {
+        size_t len = 0;
+        const bsf_status_t st = bsf_map_encode(&g_map, first ? pose : NULL, g_frame_buf, cap, &len);
+        if (st != BSF_OK) {
+            fail_msg("cannot encode a map frame: %s", bsf_status_str(st));
+            return -1;
+        }
+        if (len == 0u) {
+            break;
+        }
+        if (fwrite(g_frame_buf, 1, len, out) != len) {
+            fail_msg("write error on %s", out_name);
+            return -1;
+        }
+        *bytes += len;
+        first = 0;
+    }
+    return 0;
+}
 
 /* The stream's current metadata and when it was last sent. */
 typedef struct {
@@ -181,8 +301,26 @@ static int run_extract(const extract_opts_t *o)
             return EXIT_FAIL;
         }
     }
+    if (o->map) {
+        bsf_map_params_t mp;
+        bsf_status_t st;
+        bsf_map_params_default(&mp);
+        mp.quant_step = (float)o->quant;
+        mp.snapshot_budget = (uint16_t)o->snapshot_budget;
+        st = bsf_map_init(&g_map, &mp);
+        if (st != BSF_OK) {
+            fail_msg("cannot initialise the map: %s", bsf_status_str(st));
+            return EXIT_FAIL;
+        }
+    }
+    memset(&g_as, 0, sizeof g_as);
+    g_as.odo_edges = o->odo_edges;
+    if (o->align && o->odo_edges && odo_edges_load(o->log, &g_as.edges) != 0) {
+        return EXIT_FAIL;
+    }
     rd = open_log(o->log);
     if (rd == NULL) {
+        odo_edges_free(&g_as.edges);
         return EXIT_FAIL;
     }
     out = open_out(o->out, 1);
@@ -298,6 +436,38 @@ static int run_extract(const extract_opts_t *o)
         info.pose.x = (float)rec.laser_pose.x;
         info.pose.y = (float)rec.laser_pose.y;
         info.pose.theta = (float)remainder(rec.laser_pose.theta, 2.0 * M_PI);
+        if (o->map) {
+            bsf_pose_t pose;
+            int fused;
+            pose.x = info.pose.x;
+            pose.y = info.pose.y;
+            pose.theta = info.pose.theta;
+            if (o->align && aligned_pose(o->log, rec.line, index, &rec, &pose) != 0) {
+                ++failed;
+                ++index;
+                continue;
+            }
+            fused = bsf_map_fuse(&g_map, &g_res, &pose);
+            if (fused < 0) {
+                fprintf(stderr, "%s:%lu: scan %lu not fused into the map: %s\n", o->log, rec.line,
+                        index, bsf_status_str((bsf_status_t)fused));
+                ++failed;
+                ++index;
+                continue;
+            }
+            if (write_map_frames(
+                    out, o->out,
+                    o->pose_every > 0 && done % (unsigned long)o->pose_every == 0u ? &pose : NULL,
+                    &bytes) != 0) {
+                write_failed = 1;
+                break;
+            }
+            ++ms.frames_since;
+            ++done;
+            ++index;
+            progress_tick(&prog, done, "extract");
+            continue;
+        }
         st = bsf_frame_encode(&info, &g_res, g_frame_buf, sizeof g_frame_buf, &len);
         if (st != BSF_OK) {
             fprintf(stderr, "%s:%lu: scan %lu not encoded: %s\n", o->log, rec.line, index,
@@ -319,6 +489,13 @@ static int run_extract(const extract_opts_t *o)
         progress_tick(&prog, done, "extract");
     }
     progress_end(&prog);
+    if (o->map && !write_failed) {
+        /* the end of the log: what waits for the frame interval goes out now */
+        g_map.params.frame_interval = 1u;
+        if (write_map_frames(out, o->out, NULL, &bytes) != 0) {
+            write_failed = 1;
+        }
+    }
     malformed = carmen_malformed_count(rd);
     overlong = carmen_overlong_count(rd);
     carmen_close(rd);
@@ -337,6 +514,33 @@ static int run_extract(const extract_opts_t *o)
             o->log, done, bsf_method_name(o->method), bytes,
             done ? (double)bytes / (double)done : 0.0, ms.n_sent, own_geometry, cut.scans, failed,
             bad_time, malformed);
+    if (o->map) {
+        const bsf_map_stats_t *m = &g_map.stats;
+        fprintf(stderr,
+                "%s: map: %lu frames, %lu bytes of map records and headers, %lu of pose records; "
+                "%lu features in RAM (%lu created, %lu extended, %lu merged, %lu vertex merges), "
+                "%lu forgotten (%lu control points; the receiver keeps them), %lu scan features "
+                "left out (caps full), %lu bytes of RAM\n",
+                o->log, (unsigned long)m->n_frames, (unsigned long)m->map_bytes,
+                (unsigned long)m->pose_bytes, (unsigned long)bsf_map_feature_count(&g_map),
+                (unsigned long)m->n_new, (unsigned long)m->n_extended, (unsigned long)m->n_merged,
+                (unsigned long)m->n_vertex_merged, (unsigned long)m->n_forgotten,
+                (unsigned long)m->n_forgotten_ctrl, (unsigned long)m->n_dropped_obs,
+                (unsigned long)sizeof g_map);
+    }
+    if (o->align) {
+        int d;
+        fprintf(stderr,
+                "%s: align: %lu scans aligned (odometry: %s), %lu with a direction left "
+                "free; declined:",
+                o->log, g_as.n_aligned, o->odo_edges ? "sequential edges" : "the log's poses",
+                g_as.n_free);
+        for (d = 1; d < BSF_ALIGN_DECLINE_COUNT; ++d) {
+            fprintf(stderr, " %lu %s%s", g_as.declined[d], bsf_align_decline_str(d),
+                    d + 1 < BSF_ALIGN_DECLINE_COUNT ? "," : "\n");
+        }
+    }
+    odo_edges_free(&g_as.edges);
     if (cut.scans > 0u) {
         fprintf(stderr,
                 "%s: the caps left out %lu keypoints, %lu segments and %lu points in %lu scans "
@@ -356,11 +560,14 @@ int cmd_extract(int argc, char **argv)
     extract_opts_t o;
     int i;
     int err = 0;
+    int pose_every_set = 0;
+    int odometry_set = 0;
     memset(&o, 0, sizeof o);
     o.method = BSF_METHOD_DEFAULT;
     o.count = -1;
     o.quant = (double)BSF_QUANT_STEP_DEFAULT;
     o.meta_every = 64;
+    o.pose_every = 1;
     o.out = "-";
     for (i = 1; i < argc; ++i) {
         const char *v;
@@ -404,6 +611,30 @@ int cmd_extract(int argc, char **argv)
             }
         } else if (strcmp(argv[i], "--reproducible") == 0) {
             o.reproducible = 1;
+        } else if (strcmp(argv[i], "--map") == 0) {
+            o.map = 1;
+        } else if (strcmp(argv[i], "--align") == 0) {
+            o.align = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--odometry", &err)) != NULL) {
+            if (strcmp(v, "log") == 0) {
+                o.odo_edges = 0;
+            } else if (strcmp(v, "edges") == 0) {
+                o.odo_edges = 1;
+            } else {
+                return usage_error("--odometry takes 'log' or 'edges', got '%s'", v);
+            }
+            odometry_set = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--pose-every", &err)) != NULL) {
+            if (parse_long(v, 0, 1000000000L, &o.pose_every) != 0) {
+                return usage_error("--pose-every needs a count >= 0, got '%s'", v);
+            }
+            pose_every_set = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--snapshot-budget", &err)) != NULL) {
+            if (parse_long(v, 0, BSF_MAP_FRAME_MAX_SIZE / 2, &o.snapshot_budget) != 0) {
+                return usage_error("--snapshot-budget needs bytes in [0, %u], got '%s'",
+                                   (unsigned)(BSF_MAP_FRAME_MAX_SIZE / 2), v);
+            }
+            pose_every_set = 1;
         } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
             o.out = v;
         } else if (err) {
@@ -421,6 +652,15 @@ int cmd_extract(int argc, char **argv)
     }
     if (o.log == NULL) {
         return usage_error("extract needs a LOG file");
+    }
+    if (pose_every_set && !o.map) {
+        return usage_error("--pose-every and --snapshot-budget go with --map");
+    }
+    if (o.align && !o.map) {
+        return usage_error("--align goes with --map");
+    }
+    if (odometry_set && !o.align) {
+        return usage_error("--odometry goes with --align");
     }
     return run_extract(&o);
 }

@@ -26,10 +26,14 @@ static const char listen_help[] =
     "                default 115200. Ignored (with a note) on pipes and files.\n"
     "  -o, --save FILE  also write every byte received, unchanged, to FILE\n"
     "  --features    one more line per feature (kind, beams, E_curve, control points)\n"
-    "  --count N     stop after N scans (features frames) delivered\n"
+    "  --count N     stop after N features or map frames delivered\n"
     "\n"
     "Frame line: seq, time stamp, pose, features, control points, vertices, bytes\n"
-    "on the wire, then ok/dropped counters so far and frames missing by sequence.\n";
+    "on the wire, then ok/dropped counters so far and frames missing by sequence.\n"
+    "Map line (a map stream, bsf extract --map): the map frame's seq, how many map\n"
+    "features it created, extended, moved, merged and removed in the receiver's\n"
+    "map, snapshots, the pose it carried, records the receiver could not apply,\n"
+    "bytes, then the receiver's totals (features) and map frames missing.\n";
 
 typedef struct {
     long baud;
@@ -122,10 +126,16 @@ static void on_signal(int sig)
 
 typedef struct {
     int features;
-    unsigned long frames; /* scans delivered */
+    unsigned long frames; /* scans and map frames delivered */
     unsigned long seq_gaps;
     int have_seq;
     uint32_t last_seq;
+    map_view_t map; /* the receiver's map, from the first map frame on */
+    int have_map;
+    unsigned long map_features; /* features the receiver holds */
+    unsigned long map_seq_gaps;
+    int have_map_seq;
+    uint32_t last_map_seq;
 } listen_state_t;
 
 static unsigned long dropped(const bsf_decoder_stats_t *s)
@@ -204,18 +214,66 @@ static void note_seq(listen_state_t *ls, uint32_t seq)
     ls->last_seq = seq;
 }
 
+/* A map frame into the receiver's map, and its line. -1 out of memory. */
+static int map_frame(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
+                     const bsf_decoder_stats_t *s)
+{
+    map_change_t c;
+    const unsigned long poses_before = ls->have_map ? ls->map.n_path : 0u;
+    if (!ls->have_map) {
+        if (map_view_init(&ls->map, 1) != 0) {
+            return -1;
+        }
+        ls->have_map = 1;
+    }
+    if (ls->have_map_seq && fr->seq != ls->last_map_seq + 1u) {
+        const uint32_t gap = fr->seq - ls->last_map_seq - 1u;
+        if (gap < 0x80000000u) {
+            ls->map_seq_gaps += gap;
+        }
+    }
+    ls->have_map_seq = 1;
+    ls->last_map_seq = fr->seq;
+    if (map_view_apply(&ls->map, fr, bytes, &c) != 0) {
+        printf("map seq=%lu refused by the receiver bytes=%zu | ok=%lu dropped=%lu missing=%lu\n",
+               (unsigned long)fr->seq, bytes, (unsigned long)s->frames_ok, dropped(s),
+               ls->map_seq_gaps);
+        return 0;
+    }
+    ls->map_features = ls->map.n_features;
+    printf("map seq=%lu created=%lu extended=%lu moved=%lu merged=%lu removed=%lu snapshots=%lu "
+           "pose=",
+           (unsigned long)fr->seq, c.created, c.extended, c.moved, c.merged, c.removed,
+           c.snapshots);
+    if (ls->map.n_path > poses_before) {
+        const double *p = &ls->map.path[3u * (ls->map.n_path - 1u)];
+        printf("(%.3f,%.3f,%.4f)", p[0], p[1], p[2]);
+    } else {
+        fputs("none", stdout);
+    }
+    printf(" skipped=%lu bytes=%zu | features=%lu ok=%lu dropped=%lu missing=%lu\n", c.skipped,
+           bytes, ls->map_features, (unsigned long)s->frames_ok, dropped(s), ls->map_seq_gaps);
+    return 0;
+}
+
 /* One delivered frame: its line, and sequence accounting for scans (a
- * metadata frame has no place in the sequence of scans). */
-static void deliver(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
-                    const bsf_decoder_stats_t *s)
+ * metadata frame has no place in the sequence of scans; map frames have
+ * their own). -1 out of memory. */
+static int deliver(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
+                   const bsf_decoder_stats_t *s)
 {
     if (fr->type == BSF_FRAME_TYPE_METADATA) {
         print_metadata_line(fr, bytes, s);
-        return;
+        return 0;
+    }
+    if (fr->type == BSF_FRAME_TYPE_MAP) {
+        ++ls->frames;
+        return map_frame(ls, fr, bytes, s);
     }
     ++ls->frames;
     note_seq(ls, fr->seq);
     print_frame_line(ls, fr, bytes, s);
+    return 0;
 }
 
 static void print_summary(const bsf_decoder_stats_t *s, unsigned long gaps)
@@ -389,7 +447,10 @@ int cmd_listen(int argc, char **argv)
             }
             off += used;
             if (r > 0) {
-                deliver(&ls, &frame, frame_bytes, &dec.stats);
+                if (deliver(&ls, &frame, frame_bytes, &dec.stats) != 0) {
+                    rc = EXIT_FAIL;
+                    goto done;
+                }
                 if (fflush(stdout) != 0) {
                     fail_msg("write error on stdout");
                     rc = EXIT_FAIL;
@@ -401,10 +462,19 @@ int cmd_listen(int argc, char **argv)
         }
     }
     print_summary(&dec.stats, ls.seq_gaps);
+    if (ls.have_map) {
+        printf("map: %lu frames, %llu bytes, %lu features, %lu map frames missing by sequence, "
+               "%lu records skipped\n",
+               ls.map.frames, ls.map.bytes, ls.map_features, ls.map_seq_gaps,
+               (unsigned long)ls.map.rx->stats.records_skipped);
+    }
     if (fflush(stdout) != 0) {
         rc = EXIT_FAIL;
     }
 done:
+    if (ls.have_map) {
+        map_view_free(&ls.map);
+    }
     if (save_fd >= 0 && close(save_fd) != 0) {
         fail_msg("write error on %s: %s", save_path, strerror(errno));
         rc = EXIT_FAIL;

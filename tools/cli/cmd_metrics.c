@@ -12,6 +12,9 @@ static const char metrics_help[] =
     "frames, scans cut by a cap, frames dropped, intact frames of a type this build\n"
     "does not know. Memory does not grow with the stream (medians are exact:\n"
     "counting histograms over the wire's integer units).\n"
+    "A map stream (bsf extract --map) also gets its map's bytes: map frames, of which\n"
+    "pose-only frames, the metadata and anything else, and the map the receiver\n"
+    "rebuilds (features, control points, stale features).\n"
     "Exits 1 when a non-empty input holds no valid frame.\n";
 
 void print_metrics(FILE *f, const char *name, const stream_summary_t *s, const dataset_metrics_t *d)
@@ -45,6 +48,62 @@ void print_metrics(FILE *f, const char *name, const stream_summary_t *s, const d
     fprintf(f, "unknown type      %lu frames (skipped)\n", (unsigned long)s->stats.unknown_type);
 }
 
+/* The map section: a second pass through the receiver. */
+typedef struct {
+    map_view_t view;
+    int failed;
+} metrics_map_ctx_t;
+
+static int metrics_map_frame(void *vctx, const bsf_frame_t *f, size_t bytes)
+{
+    metrics_map_ctx_t *c = (metrics_map_ctx_t *)vctx;
+    if (f->type == BSF_FRAME_TYPE_MAP && map_view_apply(&c->view, f, bytes, NULL) != 0) {
+        c->failed = 1;
+    }
+    return 0;
+}
+
+static int print_map_metrics(FILE *in, const char *name, const stream_summary_t *s)
+{
+    static metrics_map_ctx_t c;
+    stream_summary_t s2;
+    const unsigned long long other = s->bytes_in - s->map_frame_bytes - s->metadata_bytes;
+    unsigned long features = 0, ctrl = 0, stale = 0;
+    uint32_t id;
+    memset(&c, 0, sizeof c);
+    if (map_view_init(&c.view, 0) != 0) {
+        return -1;
+    }
+    if (rewind_input(in, name) != 0 || decode_stream(in, name, metrics_map_frame, &c, &s2) != 0) {
+        map_view_free(&c.view);
+        return -1;
+    }
+    for (id = 0; id < bsf_map_rx_id_limit(c.view.rx); ++id) {
+        uint8_t st = 0;
+        const int n = bsf_map_rx_feature_ctrl(c.view.rx, id, NULL, NULL, 0u, &st);
+        if (n > 0) {
+            ++features;
+            ctrl += (unsigned long)n;
+            stale += st;
+        }
+    }
+    {
+        const unsigned long long pose = c.view.pose_only_bytes + c.view.pose_record_bytes;
+        printf("map frames        %lu, %llu bytes: map %llu, pose %llu (%lu pose records; %lu "
+               "pose-only frames)\n",
+               s->n_map_frames, s->map_frame_bytes, s->map_frame_bytes - pose, pose,
+               (unsigned long)c.view.rx->stats.poses, c.view.pose_only_frames);
+    }
+    printf("other bytes       %llu metadata, %llu per-scan frames and unframed bytes\n",
+           s->metadata_bytes, other);
+    printf("map               %lu features, %lu control points (vertices twice), %lu stale; "
+           "%lu map frames missing by sequence, %lu records skipped, %lu frames refused\n",
+           features, ctrl, stale, s->map_seq_gaps, (unsigned long)c.view.rx->stats.records_skipped,
+           c.failed ? c.view.frames_bad : 0ul);
+    map_view_free(&c.view);
+    return 0;
+}
+
 int cmd_metrics(int argc, char **argv)
 {
     const char *in_path = NULL;
@@ -67,15 +126,20 @@ int cmd_metrics(int argc, char **argv)
     if (in_path == NULL) {
         return usage_error("metrics needs an input stream (or '-')");
     }
-    in = open_in(in_path);
+    in = open_seekable(in_path);
     if (in == NULL) {
         return EXIT_FAIL;
     }
     rc = metrics_of_stream(in, in_path, &d, &sum);
-    close_in(in);
     if (rc != 0) {
+        close_in(in);
         return EXIT_FAIL;
     }
     print_metrics(stdout, in_path, &sum, &d);
+    if (sum.n_map_frames > 0u && print_map_metrics(in, in_path, &sum) != 0) {
+        close_in(in);
+        return EXIT_FAIL;
+    }
+    close_in(in);
     return close_out(stdout, "stdout") == 0 ? 0 : EXIT_FAIL;
 }

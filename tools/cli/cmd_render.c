@@ -17,12 +17,6 @@ static const char render_help[] =
     "several times (a pipe is spooled to a temporary file), so memory does not grow\n"
     "with its length. Exits 1 when a non-empty input holds no valid frame.\n";
 
-#define RENDER_CURVE_COLOUR "#1f5fbf"
-#define RENDER_VERTEX_COLOUR "#d62728"
-#define RENDER_PATH_COLOUR "#2ca02c"
-#define RENDER_POINT_COLOUR "#9a9a9a"
-#define RENDER_WALL_COLOUR "#c8c8c8"
-
 typedef struct {
     double x, y, c, s;
 } pose2_t;
@@ -86,10 +80,11 @@ typedef struct {
     double min[2], max[2];
     unsigned long long n;
     uint32_t *hist[2];
-    long lo, hi;           /* sequence range drawn */
-    unsigned long frames;  /* features frames in range */
-    unsigned long no_pose; /* of which without a pose */
-    uint32_t max_seq;      /* largest sequence number in the stream */
+    long lo, hi;              /* sequence range drawn */
+    unsigned long frames;     /* features frames in range */
+    unsigned long no_pose;    /* of which without a pose */
+    unsigned long map_frames; /* map-update frames (not drawn here: bsf map) */
+    uint32_t max_seq;         /* largest sequence number in the stream */
     int have_seq;
 } bounds_ctx_t;
 
@@ -245,20 +240,37 @@ static int draw_log_points(bsf_svg_points_t *pts, const char *log, long lo, long
     return r < 0 ? -1 : 0;
 }
 
-/* The robot's path: the poses of the frames drawn, fed in order to
- * path_add(), one polyline; a jump of more than 5 m (a new log segment, a
- * relocalisation) starts a new line. path_end() marks the last pose. */
-typedef struct {
-    unsigned long n;
-    double x, y, theta;
-} path_t;
-
-static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
+int render_log_points(bsf_svg_t *svg, const char *log, bsf_bounds_t *bounds, unsigned long *read,
+                      unsigned long *drawn, double *cell_m)
 {
-    const double x = (double)fr->pose.x, y = (double)fr->pose.y;
-    if (!fr->has_pose) {
-        return;
+    static bounds_ctx_t all; /* every scan: no sequence range, no stream */
+    bsf_svg_points_t pts;
+    int rc;
+    memset(&all, 0, sizeof all);
+    all.hi = -1;
+    if (svg == NULL) {
+        return draw_log_points(NULL, log, 0, -1, &all, bounds);
     }
+    memset(&pts, 0, sizeof pts);
+    if (bsf_svg_points_begin(&pts, svg, RENDER_POINT_CELL_M,
+                             fmin(5.0, fmax(1.8, RENDER_POINT_DOT_M * svg->px_per_m)),
+                             RENDER_POINT_COLOUR) != 0) {
+        fail_msg("out of memory");
+        return -1;
+    }
+    rc = draw_log_points(&pts, log, 0, -1, &all, NULL);
+    *read = pts.kept + pts.merged + pts.outside;
+    *drawn = pts.kept;
+    *cell_m = pts.cell_m;
+    bsf_svg_points_end(&pts);
+    return rc;
+}
+
+/* The robot's path: poses fed in order to render_path_point(), one
+ * polyline; a jump of more than 5 m (a new log segment, a relocalisation)
+ * starts a new line. render_path_end() marks the last pose. */
+void render_path_point(bsf_svg_t *svg, render_path_t *p, double x, double y, double theta)
+{
     if (p->n == 0 || hypot(x - p->x, y - p->y) > 5.0) {
         bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
         bsf_svg_path_begin(svg);
@@ -266,11 +278,18 @@ static void path_add(bsf_svg_t *svg, path_t *p, const bsf_frame_t *fr)
     bsf_svg_path_point(svg, x, y);
     p->x = x;
     p->y = y;
-    p->theta = (double)fr->pose.theta;
+    p->theta = theta;
     ++p->n;
 }
 
-static void path_end(bsf_svg_t *svg, const path_t *p)
+static void path_add(bsf_svg_t *svg, render_path_t *p, const bsf_frame_t *fr)
+{
+    if (fr->has_pose) {
+        render_path_point(svg, p, (double)fr->pose.x, (double)fr->pose.y, (double)fr->pose.theta);
+    }
+}
+
+void render_path_end(bsf_svg_t *svg, const render_path_t *p)
 {
     bsf_svg_path_end(svg, RENDER_PATH_COLOUR, 1.4);
     if (p->n > 0) {
@@ -298,7 +317,7 @@ static unsigned long draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
 }
 
 /* The legend row: the layers that are in the picture. */
-static void draw_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
+void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
 {
     bsf_svg_legend_item_t key[5];
     size_t n = 0;
@@ -391,7 +410,7 @@ typedef struct {
     render_pass_t pass;
     bounds_ctx_t *b;
     bsf_svg_t *svg;
-    path_t path;
+    render_path_t path;
     unsigned long vertices;
 } render_ctx_t;
 
@@ -399,6 +418,9 @@ static int render_frame(void *vctx, const bsf_frame_t *fr, size_t bytes)
 {
     render_ctx_t *rc = (render_ctx_t *)vctx;
     (void)bytes;
+    if (fr->type == BSF_FRAME_TYPE_MAP && rc->pass == PASS_EXTREMES) {
+        ++rc->b->map_frames;
+    }
     if (fr->type != BSF_FRAME_TYPE_FEATURES) {
         return 0;
     }
@@ -459,6 +481,12 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     rc.svg = &svg;
     bsf_bounds_init(&b);
     if (render_pass(in, in_name, &rc, PASS_EXTREMES) != 0) {
+        return -1;
+    }
+    if (bc.frames == 0u && bc.map_frames > 0u) {
+        fail_msg("%s holds map-update frames, not per-scan features: bsf map %s -o MAP.svg "
+                 "draws its map",
+                 in_name, in_name);
         return -1;
     }
     if (bc.n >= 1000u) {
@@ -527,13 +555,13 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     bsf_svg_curves_end(&svg);
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_PATH) != 0;
-        path_end(&svg, &rc.path);
+        render_path_end(&svg, &rc.path);
     }
     /* vertices on top */
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_VERTICES) != 0;
     }
-    draw_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL);
+    render_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL);
     snprintf(caption, sizeof caption, "%lu scans, %lu vertices", bc.frames, rc.vertices);
     if (points_log != NULL) {
         size_t len = strlen(caption);

@@ -9,13 +9,14 @@ static const char main_help[] =
     "B-spline map features from 2D LIDAR scans.\n"
     "\n"
     "  extract LOG|- [--method M] [--first K] [--count N] [--range-max M] [--reproducible]\n"
-    "                [--meta-every K] [-o OUT|-]\n"
+    "                [--meta-every K] [--map [--pose-every K]] [-o OUT|-]\n"
     "  decode IN [--json]          frames as text or JSON Lines, then decoder counters\n"
     "  metrics IN                  retrievability, compactness, accuracy, time, bytes\n"
     "  render IN -o MAP.svg [--scans K..L] [--points LOG] [--width PX]\n"
     "  table1 DATA_DIR             the paper's Table 1 on the four datasets\n"
     "  demo                        built-in synthetic scene, end to end\n"
     "  listen DEVICE|- [--baud N] [-o FILE]  live stream (serial port, pipe): frames as they come\n"
+    "  map IN [--json] [-o MAP.svg] the fused map of a map stream (extract --map), rebuilt\n"
     "\n"
     "'-' means stdin/stdout:  bsf extract x.log -o - | bsf metrics -\n";
 
@@ -26,7 +27,7 @@ int main(int argc, char **argv)
         int (*fn)(int, char **);
     } cmds[] = {{"extract", cmd_extract}, {"decode", cmd_decode}, {"metrics", cmd_metrics},
                 {"render", cmd_render},   {"table1", cmd_table1}, {"demo", cmd_demo},
-                {"listen", cmd_listen}};
+                {"listen", cmd_listen},   {"map", cmd_map}};
     static char cmd_name[64];
     size_t i;
     if (argc < 2) {

@@ -32,13 +32,26 @@ static const uint8_t *last_zero_in(const uint8_t *p, size_t n)
     return NULL;
 }
 
-/* Bookkeeping of one delivered frame: sequence gaps (features frames only;
- * a metadata frame has no sequence number), counts, then the callback. */
+/* Bookkeeping of one delivered frame: sequence gaps (features and map frames
+ * each have their own numbers; a metadata frame has none), counts, then the
+ * callback. */
 static int deliver(stream_summary_t *sum, frame_cb on_frame, void *ctx, size_t bytes)
 {
     if (g_frame.type == BSF_FRAME_TYPE_METADATA) {
         ++sum->n_metadata;
         sum->metadata_bytes += bytes;
+    } else if (g_frame.type == BSF_FRAME_TYPE_MAP) {
+        /* map frames number themselves apart from features frames */
+        if (sum->have_map_seq && g_frame.seq != sum->last_map_seq + 1u) {
+            const uint32_t gap = g_frame.seq - sum->last_map_seq - 1u;
+            if (gap < 0x80000000u) {
+                sum->map_seq_gaps += gap;
+            }
+        }
+        sum->have_map_seq = 1;
+        sum->last_map_seq = g_frame.seq;
+        ++sum->n_map_frames;
+        sum->map_frame_bytes += bytes;
     } else {
         if (sum->have_seq && g_frame.seq != sum->last_seq + 1u) {
             const uint32_t gap = g_frame.seq - sum->last_seq - 1u;

@@ -98,6 +98,11 @@ typedef struct {
     unsigned long long metadata_bytes; /**< their bytes on the wire */
     int have_seq;                      /**< internal: a sequence number was seen */
     uint32_t last_seq;                 /**< internal: the last one */
+    unsigned long n_map_frames;        /**< map-update frames delivered */
+    unsigned long long map_frame_bytes; /**< their bytes on the wire */
+    unsigned long map_seq_gaps;         /**< map frames missing according to their numbers */
+    int have_map_seq;                   /**< internal: a map frame number was seen */
+    uint32_t last_map_seq;              /**< internal: the last one */
 } stream_summary_t;
 
 /** Called for every decoded frame (features and metadata: check f->type)
@@ -172,6 +177,70 @@ int cmd_render(int argc, char **argv);
 int cmd_table1(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_listen(int argc, char **argv);
+int cmd_map(int argc, char **argv);
+
+/* ---- cmd_render.c: the drawing conventions bsf render and bsf map share -- */
+
+#define RENDER_CURVE_COLOUR "#1f5fbf"
+#define RENDER_VERTEX_COLOUR "#d62728"
+#define RENDER_PATH_COLOUR "#2ca02c"
+#define RENDER_POINT_COLOUR "#9a9a9a"
+#define RENDER_WALL_COLOUR "#c8c8c8"
+
+/** The robot's path being drawn (render_path_point, render_path_end). */
+typedef struct {
+    unsigned long n;
+    double x, y, theta;
+} render_path_t;
+
+/** Next pose of the path (world metres, radians); a jump over 5 m starts a new line. */
+void render_path_point(bsf_svg_t *svg, render_path_t *p, double x, double y, double theta);
+/** Close the path and mark the last pose. */
+void render_path_end(bsf_svg_t *svg, const render_path_t *p);
+/** Every valid point of a CARMEN log in the world frame (its laser poses):
+ *  into bounds when svg is NULL, else drawn as bsf render draws them (thinned
+ *  to one per cell; *read, *drawn and *cell_m say how many and at what cell).
+ *  0, or -1 with a message. */
+int render_log_points(bsf_svg_t *svg, const char *log, bsf_bounds_t *bounds, unsigned long *read,
+                      unsigned long *drawn, double *cell_m);
+/** The legend row of bsf render: curves, vertices, and the optional layers. */
+void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene);
+
+/* ---- map_view.c: the receiver's map of a map stream (bsf map, listen, metrics) */
+
+/** What one map frame changed in the receiver's map, by feature. */
+typedef struct {
+    unsigned long created;  /**< features that appeared */
+    unsigned long extended; /**< features that gained control points */
+    unsigned long moved;    /**< features whose points changed, same count */
+    unsigned long merged;   /**< features that vanished while another changed */
+    unsigned long removed;  /**< features that vanished otherwise */
+    unsigned long skipped;  /**< records the receiver could not apply */
+    unsigned long snapshots, poses;
+} map_change_t;
+
+/** A receiver map plus the path of pose records and byte counts. */
+typedef struct {
+    bsf_map_rx_t *rx; /**< heap: the receiver is large */
+    uint32_t *n_ctrl; /**< per id: points before the frame (change tracking) */
+    uint32_t *hash;   /**< per id: hash of the points before the frame */
+    double *path;     /**< x, y, theta per pose record */
+    size_t n_path, cap_path;
+    unsigned long frames, frames_bad, pose_only_frames;
+    unsigned long long bytes, pose_only_bytes;
+    unsigned long long pose_record_bytes; /**< pose records inside frames with map records */
+    int track;                            /**< compute map_change_t in map_view_apply */
+    unsigned long n_features;             /**< features the receiver holds (when tracking) */
+} map_view_t;
+
+/** Empty view; track != 0 makes map_view_apply report changes (costs a pass
+ *  over the map per frame). 0, or -1 with a message when out of memory. */
+int map_view_init(map_view_t *v, int track);
+void map_view_free(map_view_t *v);
+/** Apply a delivered map frame of `bytes` on the wire; chg (may be NULL) gets
+ *  its changes when tracking. 0; -1 when the receiver refuses the payload
+ *  (counted in frames_bad, message printed). */
+int map_view_apply(map_view_t *v, const bsf_frame_t *f, size_t bytes, map_change_t *chg);
 
 /** Print the metrics of a stream (cmd_metrics.c; also used by demo). */
 void print_metrics(FILE *f, const char *name, const stream_summary_t *s,

@@ -44,6 +44,10 @@ __all__ = [
     "ScanStats",
     "Frame",
     "Metadata",
+    "MapFrame",
+    "MapFeature",
+    "Map",
+    "read_map",
     "StreamWriter",
     "HAS_METADATA",
     "Extractor",
@@ -302,11 +306,15 @@ def _features_from(res: tuple, n_beams_hint: int = 0) -> Tuple[List[Feature], Sc
     return out, stats
 
 
-def _frame_from_tuple(t: tuple, nbytes: int = 0, meta: Optional[Metadata] = None) -> Union[Frame, Metadata, None]:
-    """A decoder tuple to a Frame or a Metadata; None for a frame type this version skips.
+def _frame_from_tuple(
+    t: tuple, nbytes: int = 0, meta: Optional[Metadata] = None
+) -> Union[Frame, Metadata, "MapFrame", None]:
+    """A decoder tuple to a Frame, a Metadata or a MapFrame; None for a frame type this version skips.
 
-    The tag in t[0] says the frame type ("features", "metadata", "other").
+    The tag in t[0] says the frame type ("features", "metadata", "map", "other").
     """
+    if t[0] == "map":
+        return MapFrame(seq=t[3], payload=bytes(t[4]), version=t[1], type=t[2], bytes=nbytes)
     if t[0] == "metadata":
         d = dict(t[3])
         d["lib_version"] = tuple(d["lib_version"])
@@ -330,6 +338,144 @@ def _frame_from_tuple(t: tuple, nbytes: int = 0, meta: Optional[Metadata] = None
         geometry=None if geometry is None else (float(geometry[0]), float(geometry[1])),
         metadata=meta,
     )
+
+
+# ---- the fused map --------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MapFrame:
+    """A map-update frame (``bsf extract --map``): what changed in the robot's map.
+
+    Apply it to a :class:`Map` (the library's receiver) to rebuild the map;
+    ``payload`` is the frame's checked content.
+    """
+
+    seq: int  #: map frame sequence number (its own numbering)
+    payload: bytes
+    version: int = 2
+    type: int = 3
+    bytes: int = 0  #: size on the wire
+
+
+def _bspline_points(ctrl: np.ndarray, per_span: int) -> np.ndarray:
+    """A clamped uniform quadratic B-spline with any number (>= 3) of control
+    points, ``per_span`` samples per span, shape (spans * per_span + 1, 2)."""
+    c = np.asarray(ctrl, dtype=np.float64)
+    spans = len(c) - 2
+    u = np.arange(per_span, dtype=np.float64) / per_span
+    a, b, q = (1 - u) ** 2, 2 * u * (1 - u), u * u
+    out = []
+    for s in range(spans):
+        if spans == 1:
+            w = (a, b, q)
+        elif s == 0:
+            w = (a, b + 0.5 * q, 0.5 * q)
+        elif s == spans - 1:
+            w = (0.5 * a, 0.5 * a + b, q)
+        else:
+            w = (0.5 * a, 0.5 * a + b + 0.5 * q, 0.5 * q)
+        out.append(w[0][:, None] * c[s] + w[1][:, None] * c[s + 1] + w[2][:, None] * c[s + 2])
+    out.append(c[-1][None, :])
+    return np.concatenate(out)
+
+
+@dataclass(frozen=True, eq=False)
+class MapFeature:
+    """One feature of the fused map: a clamped uniform quadratic B-spline in the
+    world frame (metres). A vertex (corner) is a control point given twice in a
+    row, both copies flagged in ``vertex``, as in a scan's :class:`Feature`.
+    ``stale`` is True when a frame it needed was lost and no snapshot has
+    repaired it yet."""
+
+    id: int
+    ctrl: np.ndarray  #: float32, shape (n, 2), world frame
+    vertex: np.ndarray  #: uint8, shape (n,)
+    stale: bool = False
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """Distinct vertex (corner) positions, shape (k, 2)."""
+        flagged = np.flatnonzero(self.vertex)
+        return self.ctrl[flagged[::2]]
+
+    def sample(self, per_span: int = 16) -> np.ndarray:
+        """Points along the curve, ``per_span`` per span, shape (m, 2), float64."""
+        if int(per_span) < 1:
+            raise BsfError(f"sample needs per_span >= 1, got {per_span}")
+        return _bspline_points(self.ctrl, int(per_span))
+
+    def length(self) -> float:
+        """Curve length, metres (through 16 samples per span)."""
+        p = self.sample(16)
+        return float(np.hypot(*np.diff(p, axis=0).T).sum())
+
+
+class Map:
+    """The receiver's map of a map stream: feed it :class:`MapFrame` objects
+    (or a whole stream with :func:`read_map`); it holds every feature the robot
+    ever sent, exactly the control point values the robot sent.
+
+    ``path`` collects the robot's poses from the stream's pose records.
+    """
+
+    def __init__(self) -> None:
+        if not hasattr(_core, "MapReceiver"):
+            raise BsfError("this build of bsf has no map (bsf_map.h)")
+        self._rx = _core.MapReceiver()
+        self.path: List[Pose] = []  #: poses received, in order
+        self.frames = 0  #: map frames applied
+        self.bytes = 0  #: their bytes on the wire
+
+    def apply(self, frame: MapFrame) -> int:
+        """Apply one map frame; returns the number of records the receiver
+        could not apply (a lost frame before them). Raises BsfError when the
+        payload is refused (not a map frame, malformed)."""
+        if not isinstance(frame, MapFrame):
+            raise TypeError(f"Map.apply needs a MapFrame, got {type(frame).__name__}")
+        poses = self._rx.counters["poses"]
+        skipped = self._rx.apply(frame.payload)
+        if self._rx.counters["poses"] != poses and self._rx.pose is not None:
+            self.path.append(tuple(self._rx.pose))
+        self.frames += 1
+        self.bytes += frame.bytes
+        return int(skipped)
+
+    @property
+    def features(self) -> List[MapFeature]:
+        """Every feature the receiver holds, by increasing id."""
+        out = []
+        for fid, ctrl_b, vtx_b, stale in self._rx.features():
+            ctrl = np.frombuffer(ctrl_b, dtype=np.float32).reshape(-1, 2).copy()
+            vtx = np.frombuffer(vtx_b, dtype=np.uint8).copy()
+            out.append(MapFeature(id=int(fid), ctrl=ctrl, vertex=vtx, stale=bool(stale)))
+        return out
+
+    @property
+    def counters(self) -> Dict[str, int]:
+        """frames, frames_missed, records, records_skipped, snapshots, poses."""
+        return dict(self._rx.counters)
+
+    @property
+    def pose(self) -> Optional[Pose]:
+        """The last pose record received, or None."""
+        p = self._rx.pose
+        return None if p is None else (float(p[0]), float(p[1]), float(p[2]))
+
+
+def read_map(source: "Source", **kwargs: Any) -> Map:
+    """The map of a whole map stream (a path, "-", a file object: as :func:`read`).
+
+    Raises BsfError when the stream holds no map frame (a per-scan stream, or
+    garbage) or the receiver refuses a frame.
+    """
+    m = Map()
+    for fr in read(source, **kwargs):
+        if isinstance(fr, MapFrame):
+            m.apply(fr)
+    if m.frames == 0:
+        raise BsfError("no map frame in the stream (bsf extract --map writes one)")
+    return m
 
 
 # ---- extraction ----------------------------------------------------------------------
@@ -925,8 +1071,13 @@ def _round_us(seconds: float) -> int:
     return int(i) + (1 if x - i >= 0.5 else 0)
 
 
-def plot(frames: Union[Frame, Iterable[Frame]], ax: Any = None, **kwargs: Any) -> Any:
-    """Draw frames with matplotlib (the ``plot`` extra); see :func:`bsf.plot.plot`."""
-    from .plot import plot as _plot
+# The submodule is imported here, before the function of the same name is
+# defined: importing it later (inside the function) would rebind bsf.plot to
+# the module and break every call after the first. It needs matplotlib only
+# when drawing.
+from . import plot as _plot_module  # noqa: E402
 
-    return _plot(frames, ax=ax, **kwargs)
+
+def plot(frames: Union[Frame, Iterable[Frame], Map], ax: Any = None, **kwargs: Any) -> Any:
+    """Draw frames or a :class:`Map` with matplotlib (the ``plot`` extra); see :func:`bsf.plot.plot`."""
+    return _plot_module.plot(frames, ax=ax, **kwargs)

@@ -128,18 +128,30 @@ def cmd_plot(a: argparse.Namespace) -> int:
         return 1
     from .plot import plot
 
-    from . import Frame
+    from . import Frame, Map, MapFrame
 
     try:
-        frames = [f for f in read(a.input) if isinstance(f, Frame)]  # metadata frames draw nothing
+        items = list(read(a.input))
+        frames = [f for f in items if isinstance(f, Frame)]  # metadata frames draw nothing
+        m = None
+        if not frames and any(isinstance(f, MapFrame) for f in items):
+            m = Map()  # a map stream: draw the receiver's map
+            for f in items:
+                if isinstance(f, MapFrame):
+                    m.apply(f)
     except (BsfError, OSError) as e:
         print(f"bsf: {e}", file=sys.stderr)
         return 1
-    ax = plot(frames, world=not a.sensor)
-    ax.set_title(f"{os.path.basename(a.input)}: {len(frames)} frames")
+    if m is not None:
+        ax = plot(m)
+        what = f"{len(m.features)} map features"
+    else:
+        ax = plot(frames, world=not a.sensor)
+        what = f"{len(frames)} frames"
+    ax.set_title(f"{os.path.basename(a.input)}: {what}")
     ax.figure.savefig(a.output, dpi=a.dpi, bbox_inches="tight")
     plt.close(ax.figure)
-    print(f"{a.output}: {len(frames)} frames drawn", file=sys.stderr)
+    print(f"{a.output}: {what} drawn", file=sys.stderr)
     return 0
 
 

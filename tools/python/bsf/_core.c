@@ -806,6 +806,14 @@ static PyObject *frame_to_tuple(const bsf_frame_t *f)
                              metadata_to_dict(&f->metadata));
     }
 #endif
+#ifdef BSF_FRAME_TYPE_MAP
+    if (f->type == BSF_FRAME_TYPE_MAP) {
+        /* the checked payload, for a MapReceiver */
+        return Py_BuildValue("(siiky#)", "map", (int)f->version, (int)f->type,
+                             (unsigned long)f->seq, (const char *)f->payload,
+                             (Py_ssize_t)f->payload_len);
+    }
+#endif
     if (f->type != BSF_FRAME_TYPE_FEATURES) {
         return Py_BuildValue("(sii)", "other", (int)f->version, (int)f->type);
     }
@@ -954,6 +962,163 @@ static PyTypeObject DecoderType = {
     .tp_methods = Decoder_methods,
     .tp_getset = Decoder_getset,
 };
+
+#ifdef BSF_FRAME_TYPE_MAP
+/* ---- Map receiver (bsf_map_rx_t): the map a map stream rebuilds ------------------ */
+
+typedef struct {
+    PyObject_HEAD bsf_map_rx_t *rx;
+    bsf_point_t *ctrl; /* scratch: one feature's points */
+    uint8_t *vtx;
+} MapReceiverObject;
+
+static void MapReceiver_dealloc(MapReceiverObject *self)
+{
+    PyMem_Free(self->rx);
+    PyMem_Free(self->ctrl);
+    PyMem_Free(self->vtx);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int MapReceiver_init(MapReceiverObject *self, PyObject *args, PyObject *kwds)
+{
+    static char *kwlist[] = {NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "", kwlist)) {
+        return -1;
+    }
+    if (self->rx == NULL) {
+        self->rx = (bsf_map_rx_t *)PyMem_Malloc(sizeof(bsf_map_rx_t));
+        self->ctrl = (bsf_point_t *)PyMem_Malloc(BSF_MAP_RX_MAX_CTRL * sizeof(bsf_point_t));
+        self->vtx = (uint8_t *)PyMem_Malloc(BSF_MAP_RX_MAX_CTRL);
+        if (self->rx == NULL || self->ctrl == NULL || self->vtx == NULL) {
+            PyErr_NoMemory();
+            return -1;
+        }
+    }
+    bsf_map_rx_init(self->rx);
+    return 0;
+}
+
+static int map_rx_ready(const MapReceiverObject *self)
+{
+    if (self->rx == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "MapReceiver not initialised");
+        return 0;
+    }
+    return 1;
+}
+
+/* apply(payload) -> records skipped; BsfError when the payload is refused. */
+static PyObject *MapReceiver_apply(MapReceiverObject *self, PyObject *arg)
+{
+    Py_buffer view;
+    int r;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    if (PyObject_GetBuffer(arg, &view, PyBUF_C_CONTIGUOUS) != 0) {
+        return NULL;
+    }
+    r = bsf_map_rx_apply(self->rx, (const uint8_t *)view.buf, (size_t)view.len);
+    PyBuffer_Release(&view);
+    if (r < 0) {
+        return raise_status((bsf_status_t)r, "map frame refused");
+    }
+    return PyLong_FromLong((long)r);
+}
+
+/* features() -> [(id, ctrl bytes (float32 x, y pairs), vertex bytes, stale)] */
+static PyObject *MapReceiver_features(MapReceiverObject *self, PyObject *unused)
+{
+    PyObject *out;
+    uint32_t id, limit;
+    (void)unused;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    out = PyList_New(0);
+    if (out == NULL) {
+        return NULL;
+    }
+    limit = bsf_map_rx_id_limit(self->rx);
+    for (id = 0; id < limit; ++id) {
+        uint8_t stale = 0;
+        const int n = bsf_map_rx_feature_ctrl(self->rx, id, self->ctrl, self->vtx,
+                                              BSF_MAP_RX_MAX_CTRL, &stale);
+        PyObject *t;
+        if (n <= 0) {
+            continue;
+        }
+        if (n > (int)BSF_MAP_RX_MAX_CTRL) {
+            Py_DECREF(out);
+            PyErr_SetString(g_bsf_error,
+                            "a map feature has more control points than the receiver holds");
+            return NULL;
+        }
+        t = Py_BuildValue("(ky#y#O)", (unsigned long)id, (const char *)self->ctrl,
+                          (Py_ssize_t)((size_t)n * sizeof(bsf_point_t)), (const char *)self->vtx,
+                          (Py_ssize_t)n, stale ? Py_True : Py_False);
+        if (t == NULL || PyList_Append(out, t) != 0) {
+            Py_XDECREF(t);
+            Py_DECREF(out);
+            return NULL;
+        }
+        Py_DECREF(t);
+    }
+    return out;
+}
+
+static PyObject *MapReceiver_get_pose(MapReceiverObject *self, void *closure)
+{
+    (void)closure;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    if (!self->rx->has_pose) {
+        Py_RETURN_NONE;
+    }
+    return Py_BuildValue("(ddd)", (double)self->rx->pose.x, (double)self->rx->pose.y,
+                         (double)self->rx->pose.theta);
+}
+
+static PyObject *MapReceiver_get_counters(MapReceiverObject *self, void *closure)
+{
+    const bsf_map_rx_stats_t *s;
+    (void)closure;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    s = &self->rx->stats;
+    return Py_BuildValue("{sksksksksksk}", "frames", (unsigned long)s->frames, "frames_missed",
+                         (unsigned long)s->frames_missed, "records", (unsigned long)s->records,
+                         "records_skipped", (unsigned long)s->records_skipped, "snapshots",
+                         (unsigned long)s->snapshots, "poses", (unsigned long)s->poses);
+}
+
+static PyMethodDef MapReceiver_methods[] = {
+    {"apply", (PyCFunction)MapReceiver_apply, METH_O,
+     "apply(payload) -> records skipped (a map frame's payload)"},
+    {"features", (PyCFunction)MapReceiver_features, METH_NOARGS,
+     "features() -> list of (id, float32 x/y bytes, vertex flag bytes, stale)"},
+    {NULL, NULL, 0, NULL}};
+
+static PyGetSetDef MapReceiver_getset[] = {
+    {"pose", (getter)MapReceiver_get_pose, NULL, "last pose record (x, y, theta) or None", NULL},
+    {"counters", (getter)MapReceiver_get_counters, NULL, "receiver counters (dict)", NULL},
+    {NULL, NULL, NULL, NULL, NULL}};
+
+static PyTypeObject MapReceiverType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "bsf._core.MapReceiver",
+    .tp_basicsize = sizeof(MapReceiverObject),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "MapReceiver(): bsf_map_rx_t owned by Python",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)MapReceiver_init,
+    .tp_dealloc = (destructor)MapReceiver_dealloc,
+    .tp_methods = MapReceiver_methods,
+    .tp_getset = MapReceiver_getset,
+};
+#endif
 
 /* ---- CARMEN reader (the host tool's reader, so geometry matches `bsf extract`) ------ */
 
@@ -1409,7 +1574,11 @@ PyMODINIT_FUNC PyInit__core(void)
     PyObject *m;
     PyObject *caps;
     if (PyType_Ready(&ExtractorType) < 0 || PyType_Ready(&DecoderType) < 0 ||
-        PyType_Ready(&CarmenType) < 0) {
+        PyType_Ready(&CarmenType) < 0
+#ifdef BSF_FRAME_TYPE_MAP
+        || PyType_Ready(&MapReceiverType) < 0
+#endif
+    ) {
         return NULL;
     }
     m = PyModule_Create(&core_module);
@@ -1435,6 +1604,14 @@ PyMODINIT_FUNC PyInit__core(void)
         Py_DECREF(m);
         return NULL;
     }
+#ifdef BSF_FRAME_TYPE_MAP
+    Py_INCREF(&MapReceiverType);
+    if (PyModule_AddObject(m, "MapReceiver", (PyObject *)&MapReceiverType) != 0) {
+        Py_DECREF(&MapReceiverType);
+        Py_DECREF(m);
+        return NULL;
+    }
+#endif
     caps = Py_BuildValue("{sisisisisisisi}", "BSF_MAX_POINTS", (int)BSF_MAX_POINTS,
                          "BSF_MAX_KEYPOINTS", (int)BSF_MAX_KEYPOINTS, "BSF_MAX_SEGMENTS",
                          (int)BSF_MAX_SEGMENTS, "BSF_MAX_CTRL_PER_FEATURE",

@@ -6,11 +6,51 @@ from typing import Any, Iterable, List, Union
 
 import numpy as np
 
-from . import Frame
+from . import Frame, Map
+
+
+def plot_map(
+    m: Map,
+    ax: Any = None,
+    *,
+    per_span: int = 8,
+    vertices: bool = True,
+    path: bool = True,
+    color: str = "tab:blue",
+    linewidth: float = 0.8,
+) -> Any:
+    """Draw a fused :class:`bsf.Map`: its curves (world frame), vertices as
+    markers and, with ``path``, the robot's path through the stream's pose
+    records. Returns the Axes (a new figure's when ``ax`` is None)."""
+    try:
+        import matplotlib.pyplot as plt
+        from matplotlib.collections import LineCollection
+    except ImportError:
+        raise ImportError("bsf.plot needs matplotlib: pip install './tools/python[plot]'") from None
+    if ax is None:
+        _, ax = plt.subplots(figsize=(8, 8))
+    feats = m.features
+    curves = [f.sample(per_span) for f in feats]
+    if curves:
+        ax.add_collection(LineCollection(curves, colors=color, linewidths=linewidth, label="map features"))
+    if vertices and feats:
+        v = np.concatenate([f.vertices for f in feats])
+        if len(v):
+            ax.plot(v[:, 0], v[:, 1], linestyle="none", marker="s", markersize=2.5, color="tab:red", label="vertices")
+    if path and len(m.path) > 1:
+        p = np.asarray(m.path)
+        ax.plot(p[:, 0], p[:, 1], color="tab:green", linewidth=0.6, label="robot path")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if curves:
+        ax.legend(loc="best", fontsize="small")
+    return ax
 
 
 def plot(
-    frames: Union[Frame, Iterable[Frame]],
+    frames: Union[Frame, Iterable[Frame], Map],
     ax: Any = None,
     *,
     world: bool = True,
@@ -26,8 +66,11 @@ def plot(
     frame's pose places them in the world frame (frames without a pose stay in
     the sensor frame). Vertices are drawn as markers and, with ``path``, the
     laser path through the poses as a line. Returns the Axes (a new figure's
-    when ``ax`` is None); axes are equal, in metres.
+    when ``ax`` is None); axes are equal, in metres. A :class:`bsf.Map` is
+    drawn by :func:`plot_map` (``samples`` is then ignored).
     """
+    if isinstance(frames, Map):
+        return plot_map(frames, ax, vertices=vertices, path=path, color=color, linewidth=linewidth)
     try:
         import matplotlib.pyplot as plt
         from matplotlib.collections import LineCollection

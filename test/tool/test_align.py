@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""CTest driver for `bsf extract --map --align`: a synthetic log whose
+odometry drifts (the robot pose fields) fuses into a map that lies on the
+true walls when aligned and off them when not; odometry from sequential
+pose-graph edges; errors on bad option combinations.
+
+Usage: test_align.py BSF_EXE SYNTH_LOG_EXE WORK_DIR
+"""
+import json
+import math
+import os
+import random
+import shutil
+import subprocess
+import sys
+
+BSF, SYNTH, WORK = sys.argv[1], sys.argv[2], sys.argv[3]
+failures = []
+
+
+def check(cond, what):
+    print(("ok      " if cond else "FAILED  ") + what, flush=True)
+    if not cond:
+        failures.append(what)
+
+
+def run(args):
+    return subprocess.run([BSF] + args, cwd=WORK, capture_output=True, text=True)
+
+
+def compose(a, b):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2])
+
+
+def between(a, b):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return (c * dx + s * dy, -s * dx + c * dy, math.remainder(b[2] - a[2], 2 * math.pi))
+
+
+def dist_to_segments(x, y, segs):
+    best = math.inf
+    for sh in segs:
+        if len(sh) == 3:
+            best = min(best, abs(math.hypot(x - sh[0], y - sh[1]) - sh[2]))
+            continue
+        x0, y0, x1, y1 = sh
+        dx, dy = x1 - x0, y1 - y0
+        t = max(0.0, min(1.0, ((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy)))
+        best = min(best, math.hypot(x0 + t * dx - x, y0 + t * dy - y))
+    return best
+
+
+def curve_points(ctrl):
+    spans = len(ctrl) - 2
+    out = []
+    for s in range(spans):
+        for j in range(5):
+            u = j / 4
+            a, b, q = (1 - u) ** 2, 2 * u * (1 - u), u * u
+            if spans == 1:
+                w = (a, b, q)
+            elif s == 0:
+                w = (a, b + 0.5 * q, 0.5 * q)
+            elif s == spans - 1:
+                w = (0.5 * a, 0.5 * a + b, q)
+            else:
+                w = (0.5 * a, 0.5 * a + b + 0.5 * q, 0.5 * q)
+            out.append(tuple(w[0] * ctrl[s][k] + w[1] * ctrl[s + 1][k] + w[2] * ctrl[s + 2][k] for k in range(2)))
+    return out
+
+
+def share_far(stream, segs, far):
+    res = run(["map", stream, "--json"])
+    check(res.returncode == 0, "bsf map --json reads " + stream)
+    pts = []
+    for line in res.stdout.splitlines():
+        pts += curve_points(json.loads(line)["ctrl"])
+    if not pts:
+        return 1.0
+    return sum(1 for p in pts if dist_to_segments(p[0], p[1], segs) > far) / len(pts)
+
+
+shutil.rmtree(WORK, ignore_errors=True)
+os.makedirs(WORK)
+room = os.path.join(WORK, "room.log")
+exp = subprocess.run([SYNTH, room, "120", "walls"], capture_output=True, text=True)
+check(exp.returncode == 0, "synth_log writes the log and its walls")
+segs = []
+for tok in exp.stdout.split():
+    if tok.startswith("shape=segment,") or tok.startswith("shape=circle,"):
+        segs.append(tuple(float(v) for v in tok.split(",")[1:]))
+check(len(segs) >= 4, "the room has walls")
+res = run(["extract", "room.log", "--map", "--reproducible", "-o", "true.bsf"])
+check(res.returncode == 0, "extract --map on the true poses")
+
+# Drifting odometry: the true motions with 3 % more distance and 2 degrees
+# per metre more turn, plus seeded noise; the laser pose of the first scan
+# stays true (it anchors the map), the rest carry the drifted poses in a
+# second log for the prior-only map.
+rng = random.Random(7)
+lines = open(room).read().splitlines()
+truth, odo, laser_fields = [], [], []
+for ln in lines:
+    t = ln.split()
+    if t and t[0] == "ROBOTLASER1":
+        n = int(t[8])
+        m = int(t[9 + n])
+        i = 10 + n + m
+        truth.append(tuple(float(v) for v in t[i:i + 3]))
+        laser_fields.append(i)
+for k, p in enumerate(truth):
+    if k == 0:
+        odo.append(p)
+        continue
+    d = between(truth[k - 1], p)
+    dist = math.hypot(d[0], d[1])
+    noisy = (d[0] * 1.03 + rng.gauss(0, 0.005), d[1] * 1.03 + rng.gauss(0, 0.005),
+             d[2] + math.radians(2.0) * dist + rng.gauss(0, 0.002))
+    odo.append(compose(odo[-1], noisy))
+drift = max(math.hypot(o[0] - p[0], o[1] - p[1]) for o, p in zip(odo, truth))
+check(drift > 0.15, "the odometry drifts (%.2f m at most)" % drift)
+
+aligned_log, prior_log = [], []
+k = 0
+for ln in lines:
+    t = ln.split()
+    if t and t[0] == "ROBOTLASER1":
+        i = laser_fields[k]
+        o = odo[k]
+        a = list(t)
+        a[i + 3:i + 6] = ["%.6f" % o[0], "%.6f" % o[1], "%.6f" % o[2]]
+        b = list(a)
+        b[i:i + 3] = ["%.6f" % o[0], "%.6f" % o[1], "%.6f" % o[2]]
+        aligned_log.append(" ".join(a))
+        prior_log.append(" ".join(b))
+        k += 1
+    else:
+        aligned_log.append(ln)
+        prior_log.append(ln)
+open(os.path.join(WORK, "drift.log"), "w").write("\n".join(aligned_log) + "\n")
+open(os.path.join(WORK, "prior.log"), "w").write("\n".join(prior_log) + "\n")
+
+res = run(["extract", "prior.log", "--map", "--reproducible", "-o", "prior.bsf"])
+check(res.returncode == 0, "extract --map on the drifted poses")
+res = run(["extract", "drift.log", "--map", "--align", "--reproducible", "-o", "aligned.bsf"])
+check(res.returncode == 0, "extract --map --align succeeds: " + res.stderr.strip()[-200:])
+check("align: 119 scans aligned (odometry: the log's poses)" in res.stderr,
+      "the summary counts the aligned scans")
+far_prior = share_far("prior.bsf", segs, 0.05)
+far_aligned = share_far("aligned.bsf", segs, 0.05)
+far_true = share_far("true.bsf", segs, 0.05)
+print("curve samples farther than 5 cm from a surface: true poses %.3f, prior %.3f, aligned %.3f"
+      % (far_true, far_prior, far_aligned))
+check(far_prior > 0.2, "the prior-only map is off the walls")
+check(far_aligned < 0.05 and far_aligned < far_prior / 10, "the aligned map lies on the walls")
+res2 = run(["extract", "drift.log", "--map", "--align", "--reproducible", "-o", "aligned2.bsf"])
+check(res2.returncode == 0 and open(os.path.join(WORK, "aligned.bsf"), "rb").read() ==
+      open(os.path.join(WORK, "aligned2.bsf"), "rb").read(), "--align is reproducible")
+
+# Odometry from sequential edges: the same drifted motions as a pose graph.
+edges = ["#SEQUENTIAL EDGES"]
+for k in range(1, len(odo)):
+    d = between(odo[k - 1], odo[k])
+    edges.append("EDGE2 %d %d %.6f %.6f %.6f 100 0 100 500 0 0" % (k - 1, k, d[0], d[1], d[2]))
+open(os.path.join(WORK, "edges.log"), "w").write("\n".join(lines + edges) + "\n")
+res = run(["extract", "edges.log", "--map", "--align", "--odometry", "edges", "--reproducible",
+           "-o", "edges.bsf"])
+check(res.returncode == 0, "extract --align --odometry edges succeeds")
+check("odometry: sequential edges" in res.stderr, "the summary names the edges")
+check(share_far("edges.bsf", segs, 0.05) < 0.05, "the map aligned with edge odometry lies on the walls")
+
+# Errors.
+res = run(["extract", "drift.log", "--align", "-o", "x.bsf"])
+check(res.returncode == 2 and "--align goes with --map" in res.stderr, "--align needs --map")
+res = run(["extract", "drift.log", "--map", "--odometry", "log", "-o", "x.bsf"])
+check(res.returncode == 2 and "--odometry goes with --align" in res.stderr, "--odometry needs --align")
+res = run(["extract", "drift.log", "--map", "--align", "--odometry", "wheels", "-o", "x.bsf"])
+check(res.returncode == 2 and "'log' or 'edges'" in res.stderr, "an unknown odometry source is refused")
+res = run(["extract", "drift.log", "--map", "--align", "--odometry", "edges", "-o", "x.bsf"])
+check(res.returncode == 1 and "no sequential EDGE2" in res.stderr, "a log without edges is refused")
+
+if failures:
+    print("%d checks failed" % len(failures))
+    sys.exit(1)
+print("all checks passed")

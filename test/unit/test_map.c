@@ -1,0 +1,506 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * test_map.c - the fused map: input checks, the receiver's map equal to the
+ * robot's sent copy value for value (every frame, through the stream
+ * decoder), a revisit that sends nothing, loss and damage, geometry against
+ * a synthetic scene with true poses.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "bsf/bsf.h"
+#include "bsf_scene.h"
+#include "unity.h"
+
+static bsf_extractor_t ex;
+static bsf_result_t res;
+static bsf_map_t map;
+static bsf_map_rx_t rx;
+static bsf_decoder_t dec;
+static bsf_frame_t frame;
+static bsf_scene_t scene;
+static float ranges[BSF_MAX_POINTS];
+static uint8_t buf[BSF_MAP_FRAME_MAX_SIZE];
+static int32_t q_robot[2 * 4096];
+static int32_t q_rx[2 * 4096];
+static uint8_t v_robot[4096];
+static uint8_t v_rx[4096];
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+#define N_SCANS 90
+
+/* Extract scan k of the demo office's loop; its true pose in *pose. */
+static void scan_k(long k, long n, uint64_t seed, bsf_pose_t *pose)
+{
+    bsf_scene_rng_t rng;
+    bsf_scan_t s;
+    bsf_lidar_t l;
+    double x;
+    double y;
+    double th;
+    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scene_demo_pose(k, n, &x, &y, &th);
+    l = bsf_lidar_default(x, y, th, 361u, 1.5 * 3.14159265358979);
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&rng, seed + (uint64_t)k);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
+    s = bsf_scene_lidar_scan(&l, ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
+    pose->x = (float)x;
+    pose->y = (float)y;
+    pose->theta = (float)th;
+}
+
+/* Feed one encoded frame through the stream decoder into the receiver;
+ * returns the frames delivered. */
+static int deliver(const uint8_t *data, size_t len)
+{
+    size_t off = 0;
+    int n = 0;
+    while (off < len) {
+        size_t used = 0;
+        const int t = bsf_decoder_feed(&dec, data + off, len - off, &used, &frame);
+        TEST_ASSERT_TRUE(t >= 0);
+        off += used;
+        if (t == (int)BSF_FRAME_TYPE_MAP) {
+            TEST_ASSERT_TRUE(bsf_map_rx_apply(&rx, frame.payload, frame.payload_len) >= 0);
+            ++n;
+        }
+    }
+    return n;
+}
+
+/* Every feature in the robot's RAM: the receiver holds exactly the values
+ * the robot believes it sent. */
+static void assert_rx_equals_sent(void)
+{
+    size_t i;
+    for (i = 0; i < bsf_map_feature_count(&map); ++i) {
+        uint32_t id = 0;
+        const int n = bsf_map_feature_q(&map, i, q_robot, v_robot, 4096u, &id);
+        int m;
+        uint8_t stale = 1;
+        TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
+        m = bsf_map_rx_feature_q(&rx, id, q_rx, v_rx, 4096u);
+        TEST_ASSERT_EQUAL_INT(n, m);
+        if (n > 0) {
+            TEST_ASSERT_EQUAL_MEMORY(q_robot, q_rx, (size_t)n * 2u * sizeof q_robot[0]);
+            TEST_ASSERT_EQUAL_MEMORY(v_robot, v_rx, (size_t)n);
+        }
+        TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
+        TEST_ASSERT_EQUAL_UINT8(0u, stale);
+    }
+}
+
+/* Start a map (NULL: the defaults, but a frame every call) and a receiver. */
+static void start(const bsf_map_params_t *p)
+{
+    bsf_map_params_t every_call;
+    bsf_map_params_default(&every_call);
+    every_call.frame_interval = 1u;
+    bsf_scene_demo_office(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, p != NULL ? p : &every_call));
+    bsf_map_rx_init(&rx);
+    bsf_decoder_init(&dec);
+}
+
+static void test_map_rejects_bad_input(void)
+{
+    bsf_map_params_t p;
+    bsf_pose_t pose = {0.0f, 0.0f, 0.0f};
+    bsf_map_stats_t before;
+    bsf_map_params_default(&p);
+    p.match_dist = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+    bsf_map_params_default(&p);
+    p.quant_step = 0.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_init(NULL, NULL));
+    start(NULL);
+    scan_k(0, N_SCANS, 1u, &pose);
+    TEST_ASSERT_TRUE(res.n_features > 0u);
+    before = map.stats;
+    pose.theta = NAN;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
+    pose.theta = 0.0f;
+    pose.x = 1e30f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
+    pose.x = 0.0f;
+    res.ctrl[res.features[0].ctrl_first].y = INFINITY;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
+    res.ctrl[res.features[0].ctrl_first].y = 0.0f;
+    {
+        const uint8_t n_ctrl = res.features[0].n_ctrl;
+        res.features[0].n_ctrl = 2u;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, &res, &pose));
+        res.features[0].n_ctrl = n_ctrl;
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&map, NULL, &pose));
+    TEST_ASSERT_EQUAL_MEMORY(&before, &map.stats, sizeof before);
+    {
+        /* at 0.1 mm steps the wire holds 838 m: a scan 1 km out is refused,
+         * not clamped */
+        static bsf_map_t fine;
+        bsf_map_params_default(&p);
+        p.quant_step = 0.0001f;
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&fine, &p));
+        pose.x = 1000.0f;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_fuse(&fine, &res, &pose));
+        pose.x = 100.0f;
+        TEST_ASSERT_EQUAL_INT((int)res.n_features, bsf_map_fuse(&fine, &res, &pose));
+        pose.x = 0.0f;
+    }
+    TEST_ASSERT_EQUAL_UINT(0u, bsf_map_feature_count(&map));
+    {
+        size_t len = 1;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_BUFFER, bsf_map_encode(&map, NULL, buf, 16u, &len));
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_encode(&map, &pose, NULL, sizeof buf, &len));
+        pose.y = NAN;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_encode(&map, &pose, buf, sizeof buf, &len));
+    }
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_rx_apply(NULL, buf, 4u));
+    buf[0] = 0x21u; /* a features frame is not a map frame */
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_VERSION, bsf_map_rx_apply(&rx, buf, 4u));
+}
+
+/* The receiver, fed every frame through the stream decoder, holds the
+ * robot's sent values after every frame. */
+static void test_map_receiver_equals_robot_sent_copy(void)
+{
+    long k;
+    uint32_t bytes = 0;
+    start(NULL);
+    for (k = 0; k < N_SCANS; ++k) {
+        bsf_pose_t pose;
+        size_t len = 0;
+        scan_k(k, N_SCANS, 7u, &pose);
+        TEST_ASSERT_EQUAL_INT((int)res.n_features, bsf_map_fuse(&map, &res, &pose));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, &pose, buf, sizeof buf, &len));
+        bytes += (uint32_t)len;
+        if (len > 0u) {
+            TEST_ASSERT_EQUAL_INT(1, deliver(buf, len));
+        }
+        assert_rx_equals_sent();
+        TEST_ASSERT_EQUAL_INT(0, bsf_map_pending(&map));
+    }
+    TEST_ASSERT_EQUAL_UINT32(bytes, map.stats.map_bytes + map.stats.pose_bytes);
+    TEST_ASSERT_EQUAL_UINT32(map.stats.n_frames, rx.stats.frames);
+    TEST_ASSERT_EQUAL_UINT32(0u, rx.stats.records_skipped);
+    TEST_ASSERT_EQUAL_UINT32(0u, rx.stats.frames_missed);
+    TEST_ASSERT_TRUE(map.stats.n_new > 0u);
+    TEST_ASSERT_TRUE(map.stats.n_refined > 0u);
+    TEST_ASSERT_TRUE(rx.has_pose);
+}
+
+/* Every curve of the receiver's map lies near the true surfaces. */
+static void test_map_curves_lie_on_true_surfaces(void)
+{
+    long k;
+    uint32_t id;
+    uint32_t n_samples = 0;
+    uint32_t n_far = 0;
+    double worst = 0.0;
+    start(NULL);
+    for (k = 0; k < N_SCANS; ++k) {
+        bsf_pose_t pose;
+        size_t len = 0;
+        scan_k(k, N_SCANS, 11u, &pose);
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        (void)deliver(buf, len);
+    }
+    for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+        static bsf_point_t c[BSF_MAX_CTRL_PER_FEATURE];
+        static bsf_point_t all[4096];
+        const int n = bsf_map_rx_feature_ctrl(&rx, id, all, NULL, 4096u, NULL);
+        int first;
+        TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
+        /* evaluate in windows the evaluator accepts; spans overlap by 2 */
+        for (first = 0; first + 2 < n; first += BSF_MAX_CTRL_PER_FEATURE - 2) {
+            const int m =
+                n - first < BSF_MAX_CTRL_PER_FEATURE ? n - first : BSF_MAX_CTRL_PER_FEATURE;
+            int j;
+            memcpy(c, all + first, (size_t)m * sizeof c[0]);
+            for (j = 0; j <= 40; ++j) {
+                bsf_point_t pt;
+                double d;
+                if (bsf_bspline_eval(c, (size_t)m, (float)j / 40.0f, &pt, NULL, NULL) != BSF_OK) {
+                    continue;
+                }
+                d = bsf_scene_distance_to_surface(&scene, (double)pt.x, (double)pt.y, NULL);
+                worst = d > worst ? d : worst;
+                n_far += d > 0.05 ? 1u : 0u;
+                ++n_samples;
+            }
+        }
+    }
+    TEST_ASSERT_TRUE(n_samples > 100u);
+    /* at most 5 % of the curve farther than 5 cm from the truth */
+    TEST_ASSERT_TRUE_MESSAGE(n_far * 20u <= n_samples, "curves far from the true surfaces");
+    TEST_ASSERT_TRUE(worst < 0.5);
+}
+
+/* Corners the loop sees in at least 5 scans become exactly one map vertex
+ * within 3 cm each, in at least 90 % of cases; no corner gets two. */
+#define MAX_CORNERS 64
+static double corner_x[MAX_CORNERS];
+static double corner_y[MAX_CORNERS];
+static uint32_t corner_seen[MAX_CORNERS];
+
+static void test_map_corners_become_one_vertex_each(void)
+{
+    size_t n_corners = 0;
+    size_t c;
+    long k;
+    uint32_t n_judged = 0;
+    uint32_t n_one = 0;
+    start(NULL);
+    memset(corner_seen, 0, sizeof corner_seen);
+    for (k = 0; k < N_SCANS; ++k) {
+        static bsf_scene_corner_t corners[MAX_CORNERS];
+        bsf_pose_t pose;
+        bsf_lidar_t l;
+        double x;
+        double y;
+        double th;
+        size_t n = 0;
+        size_t len = 0;
+        bsf_scene_demo_pose(k, N_SCANS, &x, &y, &th);
+        l = bsf_lidar_default(x, y, th, 361u, 1.5 * 3.14159265358979);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&scene, &l, corners, MAX_CORNERS, &n));
+        n_corners = n;
+        for (c = 0; c < n; ++c) {
+            corner_x[c] = corners[c].wx;
+            corner_y[c] = corners[c].wy;
+            corner_seen[c] += corners[c].visible ? 1u : 0u;
+        }
+        scan_k(k, N_SCANS, 21u, &pose);
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        (void)deliver(buf, len);
+    }
+    for (c = 0; c < n_corners; ++c) {
+        uint32_t near = 0;
+        uint32_t id;
+        for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+            static bsf_point_t pts[4096];
+            static uint8_t vtx[4096];
+            const int n = bsf_map_rx_feature_ctrl(&rx, id, pts, vtx, 4096u, NULL);
+            int j;
+            TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
+            for (j = 0; j + 1 < n; ++j) {
+                if (vtx[j] && vtx[j + 1]) {
+                    const double dx = (double)pts[j].x - corner_x[c];
+                    const double dy = (double)pts[j].y - corner_y[c];
+                    near += dx * dx + dy * dy <= 0.03 * 0.03 ? 1u : 0u;
+                    ++j;
+                }
+            }
+        }
+        TEST_ASSERT_TRUE_MESSAGE(near <= 1u, "a corner became two map vertices");
+        if (corner_seen[c] >= 5u) {
+            ++n_judged;
+            n_one += near;
+        }
+    }
+    TEST_ASSERT_TRUE(n_judged >= 4u);
+    TEST_ASSERT_TRUE_MESSAGE(n_one * 10u >= n_judged * 9u, "corners without their vertex");
+}
+
+/* Seeing the same thing again and again sends nothing after it settles. */
+static void test_map_revisit_sends_nothing(void)
+{
+    bsf_pose_t pose;
+    int i;
+    size_t len = 0;
+    start(NULL);
+    scan_k(10, N_SCANS, 3u, &pose);
+    for (i = 0; i < 40; ++i) {
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        (void)deliver(buf, len);
+    }
+    TEST_ASSERT_EQUAL_UINT(0u, len);
+    TEST_ASSERT_EQUAL_UINT32(0u, map.stats.n_new - (uint32_t)bsf_map_feature_count(&map) -
+                                     map.stats.n_merged - map.stats.n_forgotten -
+                                     map.stats.n_transient);
+    assert_rx_equals_sent();
+}
+
+/* A lost frame leaves the features it carried stale at the receiver;
+ * snapshots bring them back; a damaged frame is dropped whole. */
+static void test_map_loss_then_snapshots_recover(void)
+{
+    bsf_map_params_t p;
+    long k;
+    uint32_t id;
+    int stale_seen = 0;
+    bsf_map_params_default(&p);
+    p.snapshot_budget = 40u;
+    p.frame_interval = 1u;
+    start(&p);
+    for (k = 0; k < 3 * N_SCANS; ++k) {
+        bsf_pose_t pose;
+        size_t len = 0;
+        scan_k(k % N_SCANS, N_SCANS, 5u, &pose);
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        if (k == 0 || k == 4 || k == 9) {
+            continue; /* lost */
+        }
+        if (k == 6 && len > 8u) {
+            const uint32_t frames = rx.stats.frames;
+            buf[len / 2u] ^= 0x10u; /* damaged */
+            if (buf[len / 2u] == 0u) {
+                buf[len / 2u] = 0x33u;
+            }
+            (void)deliver(buf, len);
+            TEST_ASSERT_EQUAL_UINT32(frames, rx.stats.frames);
+            continue;
+        }
+        (void)deliver(buf, len);
+        {
+            for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+                uint8_t stale = 0;
+                TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
+                stale_seen |= stale;
+            }
+        }
+    }
+    /* with nothing new, one round of snapshots (the map's sent bytes over
+     * the budget) restores every feature */
+    for (k = 0; k < 200; ++k) {
+        size_t len = 0;
+        int any_stale = 0;
+        bsf_pose_t still = {1.0f, 1.0f, 0.0f};
+        res.n_features = 0u; /* a scan that sees nothing: time passes */
+        res.n_ctrl = 0u;
+        TEST_ASSERT_EQUAL_INT(0, bsf_map_fuse(&map, &res, &still));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        TEST_ASSERT_TRUE(len <= 40u + 16u);
+        (void)deliver(buf, len);
+        for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+            uint8_t stale = 0;
+            TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
+            any_stale |= stale;
+        }
+        if (!any_stale) {
+            break;
+        }
+    }
+    TEST_ASSERT_TRUE(k < 200);
+    TEST_ASSERT_TRUE(dec.stats.bad_crc + dec.stats.malformed >= 1u);
+    TEST_ASSERT_EQUAL_UINT32(3u, rx.stats.frames_missed); /* the first loss is unseen */
+    /* the lost frames' features were reported stale, then healed */
+    TEST_ASSERT_TRUE(rx.stats.records_skipped > 0u);
+    TEST_ASSERT_TRUE(stale_seen);
+    TEST_ASSERT_TRUE(map.stats.n_snapshots > 0u);
+    assert_rx_equals_sent();
+}
+
+/* A map frame travels through bsf_frame_decode like any other, and a
+ * decoder that predates it would skip it as an unknown type. */
+static void test_map_frame_through_frame_decode(void)
+{
+    bsf_pose_t pose;
+    size_t len = 0;
+    static uint8_t body[BSF_MAP_FRAME_MAX_SIZE];
+    size_t body_len = 0;
+    start(NULL);
+    scan_k(0, N_SCANS, 2u, &pose);
+    TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, &pose, buf, sizeof buf, &len));
+    TEST_ASSERT_TRUE(len > 8u);
+    TEST_ASSERT_EQUAL_UINT8(0u, buf[len - 1u]);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_cobs_decode(buf, len - 1u, body, sizeof body, &body_len));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_frame_decode(body, body_len, &frame));
+    TEST_ASSERT_EQUAL_UINT8(BSF_FRAME_TYPE_MAP, frame.type);
+    TEST_ASSERT_EQUAL_UINT32(0u, frame.seq);
+    TEST_ASSERT_EQUAL_PTR(body, frame.payload);
+    TEST_ASSERT_EQUAL_UINT(body_len - 4u, frame.payload_len);
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, frame.payload, frame.payload_len));
+    assert_rx_equals_sent();
+    /* a payload cut short is malformed and changes nothing */
+    bsf_map_rx_init(&rx);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_map_rx_apply(&rx, body, body_len - 6u));
+    TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
+}
+
+/* A small frame budget: the changes go out over several frames, in order,
+ * and the receiver still ends equal to the robot's sent copy. */
+static void test_map_small_frames_carry_everything(void)
+{
+    long k;
+    start(NULL);
+    for (k = 0; k < 30; ++k) {
+        bsf_pose_t pose;
+        size_t len = 0;
+        int guard = 0;
+        scan_k(k, N_SCANS, 9u, &pose);
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        do {
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, 64u, &len));
+            TEST_ASSERT_TRUE(len <= 64u);
+            (void)deliver(buf, len);
+            assert_rx_equals_sent();
+        } while (len > 0u && ++guard < 1000);
+        TEST_ASSERT_EQUAL_INT(0, bsf_map_pending(&map));
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, rx.stats.records_skipped);
+}
+
+/* With frame_interval n, map changes go out once per n fuse calls, and the
+ * receiver still ends equal to the robot's sent copy. */
+static void test_map_frame_interval_batches_changes(void)
+{
+    bsf_map_params_t p;
+    long k;
+    uint32_t frames_with_map = 0;
+    bsf_map_params_default(&p);
+    TEST_ASSERT_EQUAL_UINT16(5u, p.frame_interval);
+    start(&p);
+    for (k = 0; k < N_SCANS; ++k) {
+        bsf_pose_t pose;
+        size_t len = 0;
+        const uint32_t before = map.stats.map_bytes;
+        scan_k(k, N_SCANS, 7u, &pose);
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, &pose, buf, sizeof buf, &len));
+        /* a pose record goes in every call, map records every 5th */
+        TEST_ASSERT_TRUE(len > 0u);
+        (void)deliver(buf, len);
+        if (map.stats.map_bytes != before) {
+            TEST_ASSERT_EQUAL_INT(0, (int)(map.stats.n_fused % 5u));
+            ++frames_with_map;
+            /* between map frames a queued merge is the robot's alone */
+            assert_rx_equals_sent();
+        }
+    }
+    TEST_ASSERT_TRUE(frames_with_map > 0u && frames_with_map <= N_SCANS / 5);
+    TEST_ASSERT_EQUAL_UINT32(N_SCANS, rx.stats.poses);
+    p.frame_interval = 0u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_map_rejects_bad_input);
+    RUN_TEST(test_map_receiver_equals_robot_sent_copy);
+    RUN_TEST(test_map_curves_lie_on_true_surfaces);
+    RUN_TEST(test_map_corners_become_one_vertex_each);
+    RUN_TEST(test_map_revisit_sends_nothing);
+    RUN_TEST(test_map_loss_then_snapshots_recover);
+    RUN_TEST(test_map_frame_through_frame_decode);
+    RUN_TEST(test_map_small_frames_carry_everything);
+    RUN_TEST(test_map_frame_interval_batches_changes);
+    return UNITY_END();
+}
