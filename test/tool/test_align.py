@@ -284,6 +284,12 @@ res = run(["extract", "drift.log", "--map", "--prior-path", "p.csv", "-o", "x.bs
 check(res.returncode == 2 and "--prior-path goes with --align" in res.stderr, "--prior-path needs --align")
 res = run(["extract", "drift.log", "--map", "--align", "--prior-path", "-", "-o", "x.bsf"])
 check(res.returncode == 2 and "a file of its own" in res.stderr, "--prior-path needs a file of its own")
+res = run(["extract", "drift.log", "--map", "--align", "--prior-path", "no_dir/p.csv", "-o", "untouched.bsf"])
+check(res.returncode == 1 and "cannot create no_dir/p.csv" in res.stderr and
+      not os.path.exists(os.path.join(WORK, "untouched.bsf")), "an unwritable --prior-path leaves no stream behind")
+res = run(["extract", "drift.log", "--map", "--align", "--prior-path", "lone.csv", "-o", "no_dir/x.bsf"])
+check(res.returncode == 1 and not os.path.exists(os.path.join(WORK, "lone.csv")),
+      "an unwritable stream leaves no prior path behind")
 
 # Errors.
 res = run(["extract", "drift.log", "--align", "-o", "x.bsf"])

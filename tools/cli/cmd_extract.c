@@ -346,12 +346,7 @@ static int run_extract(const extract_opts_t *o)
         odo_edges_free(&g_as.edges);
         return EXIT_FAIL;
     }
-    out = open_out(o->out, 1);
-    if (out == NULL) {
-        carmen_close(rd);
-        odo_edges_free(&g_as.edges);
-        return EXIT_FAIL;
-    }
+    /* the side file first: when it cannot be written, the stream is not touched */
     if (o->prior_path != NULL) {
         prior_csv = open_out(o->prior_path, 0);
         if (prior_csv == NULL || fputs(prior_csv_header, prior_csv) == EOF) {
@@ -360,10 +355,19 @@ static int run_extract(const extract_opts_t *o)
                 (void)close_out(prior_csv, o->prior_path);
             }
             carmen_close(rd);
-            (void)close_out(out, o->out);
             odo_edges_free(&g_as.edges);
             return EXIT_FAIL;
         }
+    }
+    out = open_out(o->out, 1);
+    if (out == NULL) {
+        carmen_close(rd);
+        if (prior_csv != NULL) {
+            (void)close_out(prior_csv, o->prior_path);
+            (void)remove(o->prior_path); /* created just now, holds only its header */
+        }
+        odo_edges_free(&g_as.edges);
+        return EXIT_FAIL;
     }
     memset(&ms, 0, sizeof ms);
     memset(&cut, 0, sizeof cut);
