@@ -147,6 +147,17 @@ void bsf_svg_path_end(bsf_svg_t *svg, const char *stroke, double w)
     }
 }
 
+void bsf_svg_path_end_dashed(bsf_svg_t *svg, const char *stroke, double w, const char *dash)
+{
+    if (svg->open_path) {
+        fprintf(svg->f,
+                "\" fill=\"none\" stroke=\"%s\" stroke-width=\"%.2f\" "
+                "stroke-dasharray=\"%s\" stroke-linejoin=\"round\"/>\n",
+                stroke, w, dash);
+        svg->open_path = 0;
+    }
+}
+
 /* Curves per <path> element. */
 #define SVG_CURVES_PER_PATH 2000u
 

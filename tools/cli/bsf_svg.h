@@ -43,6 +43,9 @@ int bsf_svg_begin(bsf_svg_t *svg, FILE *f, const bsf_bounds_t *bounds, double wi
 void bsf_svg_path_begin(bsf_svg_t *svg);
 void bsf_svg_path_point(bsf_svg_t *svg, double x, double y);
 void bsf_svg_path_end(bsf_svg_t *svg, const char *stroke, double width_px);
+/** As bsf_svg_path_end, the stroke dashed: `dash` is an SVG stroke-dasharray
+ *  in pixels, such as "6,4". */
+void bsf_svg_path_end_dashed(bsf_svg_t *svg, const char *stroke, double width_px, const char *dash);
 
 /**
  * Quadratic B-spline curves (clamped, uniform knots: bsf_bspline.h), drawn

@@ -133,8 +133,8 @@ int cmd_demo(int argc, char **argv)
     printf("bsf demo: %ld synthetic scans (361 beams, 1 cm noise) with %s\n", n_scans,
            bsf_method_name(method));
     print_metrics(stdout, stream_path, &sum, &dm);
-    rc = write_map_svg(svg_path, in, stream_path, 0, -1, NULL, &scene, "bsf demo: synthetic office",
-                       1600.0);
+    rc = write_map_svg(svg_path, in, stream_path, 0, -1, NULL, &scene, NULL,
+                       "bsf demo: synthetic office", 1600.0);
     close_in(in);
     if (rc != 0) {
         return EXIT_FAIL;

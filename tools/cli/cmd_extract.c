@@ -41,6 +41,9 @@ static const char extract_help[] =
     "  --odometry SRC   with --align: 'log' (default) the motion between the log's\n"
     "                   odometry poses (ROBOTLASER1 robot pose, FLASER odom pose);\n"
     "                   'edges' the '#SEQUENTIAL' EDGE2 edges of the log's pose graph\n"
+    "  --prior-path CSV with --align: per fused scan, its laser poses as CSV\n"
+    "                   (docs/TOOL.md): the odometry alone, the prior, the aligned pose;\n"
+    "                   bsf map/render --prior draw the odometry path dashed\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
     "  -h, --help       this help\n"
     "\n"
@@ -97,11 +100,12 @@ typedef struct {
     double quant;
     long meta_every;
     int reproducible;
-    int map;              /* write map-update frames */
-    long pose_every;      /* with map: a pose record every K scans, 0 none */
-    long snapshot_budget; /* with map: snapshot bytes per frame */
-    int align;            /* with map: align each scan before fusing it */
-    int odo_edges;        /* with align: odometry from the sequential edges */
+    int map;                /* write map-update frames */
+    long pose_every;        /* with map: a pose record every K scans, 0 none */
+    long snapshot_budget;   /* with map: snapshot bytes per frame */
+    int align;              /* with map: align each scan before fusing it */
+    int odo_edges;          /* with align: odometry from the sequential edges */
+    const char *prior_path; /* with align: CSV of prior and aligned poses */
     const char *out;
 } extract_opts_t;
 
@@ -116,6 +120,7 @@ typedef struct {
     unsigned long prev_index; /* its index in the log */
     odo_pose_t prev_odo;      /* its odometry pose (log source) */
     bsf_pose_t prev_pose;     /* its aligned laser pose */
+    odo_pose_t dead;          /* the odometry alone, chained from the first pose */
     unsigned long n_aligned, n_free;
     unsigned long declined[BSF_ALIGN_DECLINE_COUNT];
 } align_state_t;
@@ -123,9 +128,12 @@ static align_state_t g_as;
 
 /* The laser pose scan `index` is fused at: the log's for the first scan,
  * then the previous aligned pose moved by the odometry and aligned to the
- * map. 0, or -1 with a message when the odometry lacks the motion. */
+ * map. *prior_out gets the pose alignment started from, *dead_out the
+ * odometry alone chained from the first scan's pose (both the log's for the
+ * first scan). 0, or -1 with a message when the odometry lacks the motion. */
 static int aligned_pose(const char *log, unsigned long line, unsigned long index,
-                        const carmen_scan_t *rec, bsf_pose_t *pose)
+                        const carmen_scan_t *rec, bsf_pose_t *pose, odo_pose_t *prior_out,
+                        odo_pose_t *dead_out)
 {
     const odo_pose_t odo = {rec->robot_pose.x, rec->robot_pose.y, rec->robot_pose.theta};
     if (g_as.have_prev) {
@@ -150,9 +158,13 @@ static int aligned_pose(const char *log, unsigned long line, unsigned long index
             m = odo_between(g_as.prev_odo, odo);
         }
         prior = odo_compose(prev, m);
+        prior.t = remainder(prior.t, 2.0 * M_PI);
+        *prior_out = prior;
+        *dead_out = odo_compose(g_as.dead, m);
+        dead_out->t = remainder(dead_out->t, 2.0 * M_PI);
         p.x = (float)prior.x;
         p.y = (float)prior.y;
-        p.theta = (float)remainder(prior.t, 2.0 * M_PI);
+        p.theta = (float)prior.t;
         st = bsf_align_points(&g_align_work, NULL, &g_map, &g_ex.points, &g_res, &p, &ar);
         if (st != BSF_OK) {
             fprintf(stderr, "%s:%lu: scan %lu not aligned: %s\n", log, line, index,
@@ -168,7 +180,12 @@ static int aligned_pose(const char *log, unsigned long line, unsigned long index
         pose->x = (float)rec->laser_pose.x;
         pose->y = (float)rec->laser_pose.y;
         pose->theta = (float)remainder(rec->laser_pose.theta, 2.0 * M_PI);
+        prior_out->x = (double)pose->x;
+        prior_out->y = (double)pose->y;
+        prior_out->t = (double)pose->theta;
+        *dead_out = *prior_out;
     }
+    g_as.dead = *dead_out;
     g_as.have_prev = 1;
     g_as.prev_index = index;
     g_as.prev_odo = odo;
@@ -273,6 +290,11 @@ static int write_metadata(meta_state_t *ms, FILE *out, const char *out_name,
     return 0;
 }
 
+/* Header of the --prior-path CSV (bsf map --prior and bsf render --prior read it). */
+static const char prior_csv_header[] =
+    "scan,time_s,odometry_x,odometry_y,odometry_theta,prior_x,prior_y,prior_theta,aligned_x,"
+    "aligned_y,aligned_theta\n";
+
 static int run_extract(const extract_opts_t *o)
 {
     static meta_state_t ms;
@@ -290,6 +312,7 @@ static int run_extract(const extract_opts_t *o)
     bsf_frame_info_t info;
     int r;
     int write_failed = 0;
+    FILE *prior_csv = NULL;
 
     {
         bsf_params_t p = bsf_params_default(o->method);
@@ -323,9 +346,27 @@ static int run_extract(const extract_opts_t *o)
         odo_edges_free(&g_as.edges);
         return EXIT_FAIL;
     }
+    /* the side file first: when it cannot be written, the stream is not touched */
+    if (o->prior_path != NULL) {
+        prior_csv = open_out(o->prior_path, 0);
+        if (prior_csv == NULL || fputs(prior_csv_header, prior_csv) == EOF) {
+            if (prior_csv != NULL) {
+                fail_msg("write error on %s", o->prior_path);
+                (void)close_out(prior_csv, o->prior_path);
+            }
+            carmen_close(rd);
+            odo_edges_free(&g_as.edges);
+            return EXIT_FAIL;
+        }
+    }
     out = open_out(o->out, 1);
     if (out == NULL) {
         carmen_close(rd);
+        if (prior_csv != NULL) {
+            (void)close_out(prior_csv, o->prior_path);
+            (void)remove(o->prior_path); /* created just now, holds only its header */
+        }
+        odo_edges_free(&g_as.edges);
         return EXIT_FAIL;
     }
     memset(&ms, 0, sizeof ms);
@@ -438,11 +479,13 @@ static int run_extract(const extract_opts_t *o)
         info.pose.theta = (float)remainder(rec.laser_pose.theta, 2.0 * M_PI);
         if (o->map) {
             bsf_pose_t pose;
+            odo_pose_t prior = {0.0, 0.0, 0.0}, dead = {0.0, 0.0, 0.0};
             int fused;
             pose.x = info.pose.x;
             pose.y = info.pose.y;
             pose.theta = info.pose.theta;
-            if (o->align && aligned_pose(o->log, rec.line, index, &rec, &pose) != 0) {
+            if (o->align &&
+                aligned_pose(o->log, rec.line, index, &rec, &pose, &prior, &dead) != 0) {
                 ++failed;
                 ++index;
                 continue;
@@ -454,6 +497,14 @@ static int run_extract(const extract_opts_t *o)
                 ++failed;
                 ++index;
                 continue;
+            }
+            if (prior_csv != NULL &&
+                fprintf(prior_csv, "%lu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", index,
+                        rec.timestamp, dead.x, dead.y, dead.t, prior.x, prior.y, prior.t,
+                        (double)pose.x, (double)pose.y, (double)pose.theta) < 0) {
+                fail_msg("write error on %s", o->prior_path);
+                write_failed = 1;
+                break;
             }
             if (write_map_frames(
                     out, o->out,
@@ -499,7 +550,11 @@ static int run_extract(const extract_opts_t *o)
     malformed = carmen_malformed_count(rd);
     overlong = carmen_overlong_count(rd);
     carmen_close(rd);
+    if (prior_csv != NULL && close_out(prior_csv, o->prior_path) != 0) {
+        write_failed = 1;
+    }
     if (close_out(out, o->out) != 0 || r < 0 || write_failed) {
+        odo_edges_free(&g_as.edges);
         return EXIT_FAIL;
     }
     if (index == 0u) {
@@ -624,6 +679,8 @@ int cmd_extract(int argc, char **argv)
                 return usage_error("--odometry takes 'log' or 'edges', got '%s'", v);
             }
             odometry_set = 1;
+        } else if ((v = opt_value(argc, argv, &i, "--prior-path", &err)) != NULL) {
+            o.prior_path = v;
         } else if ((v = opt_value(argc, argv, &i, "--pose-every", &err)) != NULL) {
             if (parse_long(v, 0, 1000000000L, &o.pose_every) != 0) {
                 return usage_error("--pose-every needs a count >= 0, got '%s'", v);
@@ -661,6 +718,14 @@ int cmd_extract(int argc, char **argv)
     }
     if (odometry_set && !o.align) {
         return usage_error("--odometry goes with --align");
+    }
+    if (o.prior_path != NULL && !o.align) {
+        return usage_error(
+            "--prior-path goes with --align (without it the prior is the log's pose)");
+    }
+    if (o.prior_path != NULL &&
+        (strcmp(o.prior_path, "-") == 0 || strcmp(o.prior_path, o.out) == 0)) {
+        return usage_error("--prior-path needs a file of its own, not '%s'", o.prior_path);
     }
     return run_extract(&o);
 }

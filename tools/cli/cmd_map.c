@@ -6,7 +6,7 @@
 #include "tool.h"
 
 static const char map_help[] =
-    "Usage: bsf map IN [--json] [-o MAP.svg] [--points LOG] [--width PX]\n"
+    "Usage: bsf map IN [--json] [-o MAP.svg] [--points LOG] [--prior CSV] [--width PX]\n"
     "Rebuild the fused map a map stream carries (bsf extract --map; '-' reads\n"
     "standard input) with the library's receiver, frame by frame, and print it.\n"
     "\n"
@@ -21,6 +21,9 @@ static const char map_help[] =
     "  --points LOG  with -o: draw the raw points of a CARMEN log underneath (every\n"
     "                scan through its laser pose, thinned as bsf render thins them),\n"
     "                to judge the map against what the robot saw\n"
+    "  --prior CSV   with -o: draw the odometry (prior) path that bsf extract --align\n"
+    "                --prior-path wrote, dashed, beside the corrected path of the\n"
+    "                stream's pose records\n"
     "  --width PX    drawing width in pixels (default 1600)\n"
     "  -h, --help    this help\n"
     "\n"
@@ -156,7 +159,8 @@ static map_totals_t totals_of(const map_view_t *v, bsf_point_t *ctrl, uint8_t *v
 }
 
 static int write_svg(const char *out_path, const char *title, const map_view_t *v, double width,
-                     const char *points_log, bsf_point_t *ctrl, uint8_t *vtx, const map_totals_t *t)
+                     const char *points_log, const char *prior_csv, bsf_point_t *ctrl, uint8_t *vtx,
+                     const map_totals_t *t)
 {
     const uint32_t limit = bsf_map_rx_id_limit(v->rx);
     bsf_bounds_t b;
@@ -168,7 +172,7 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
     uint32_t id;
     size_t i;
     int rc;
-    unsigned long pts_read = 0, pts_drawn = 0;
+    unsigned long pts_read = 0, pts_drawn = 0, prior_poses = 0;
     double cell_m = 0.0;
     bsf_bounds_init(&b);
     for (id = 0; id < limit; ++id) {
@@ -180,6 +184,10 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
     }
     for (i = 0; i < v->n_path; ++i) {
         bsf_bounds_add(&b, v->path[3u * i], v->path[3u * i + 1u]);
+    }
+    /* the whole prior path is in the picture, however far it drifted */
+    if (prior_csv != NULL && render_prior_path(NULL, prior_csv, 0, -1, &b, NULL) != 0) {
+        return -1;
     }
     if (b.empty && points_log != NULL &&
         render_log_points(NULL, points_log, &b, NULL, NULL, NULL) != 0) {
@@ -226,6 +234,13 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
         bsf_svg_curve_bspline2(&svg, xy, (size_t)n);
     }
     bsf_svg_curves_end(&svg);
+    if (prior_csv != NULL && render_prior_path(&svg, prior_csv, 0, -1, NULL, &prior_poses) != 0) {
+        if (out != stdout) {
+            fclose(out);
+        }
+        free(xy);
+        return -1;
+    }
     memset(&path, 0, sizeof path);
     for (i = 0; i < v->n_path; ++i) {
         render_path_point(&svg, &path, v->path[3u * i], v->path[3u * i + 1u], v->path[3u * i + 2u]);
@@ -242,10 +257,14 @@ static int write_svg(const char *out_path, const char *title, const map_view_t *
             }
         }
     }
-    render_legend(&svg, v->n_path > 0u, points_log != NULL, 0);
+    render_legend(&svg, v->n_path > 0u, points_log != NULL, 0, prior_csv != NULL);
     snprintf(caption, sizeof caption,
              "map: %lu features, %lu vertices, %.1f m of curve; %lu frames", t->features,
              t->vertices, t->length, v->frames);
+    if (prior_csv != NULL) {
+        const size_t len = strlen(caption);
+        snprintf(caption + len, sizeof caption - len, "; %lu prior poses", prior_poses);
+    }
     if (points_log != NULL) {
         const size_t len = strlen(caption);
         snprintf(caption + len, sizeof caption - len, "; %lu raw points, %lu drawn (%.0f cm grid)",
@@ -261,7 +280,7 @@ int cmd_map(int argc, char **argv)
     static map_ctx_t ctx;
     static bsf_point_t ctrl[MAP_MAX_POINTS];
     static uint8_t vtx[MAP_MAX_POINTS];
-    const char *in_path = NULL, *out_path = NULL, *points = NULL;
+    const char *in_path = NULL, *out_path = NULL, *points = NULL, *prior = NULL;
     double width = 1600.0;
     int json = 0, i, err = 0, rc = 0;
     stream_summary_t sum;
@@ -278,6 +297,8 @@ int cmd_map(int argc, char **argv)
             out_path = v;
         } else if ((v = opt_value(argc, argv, &i, "--points", &err)) != NULL) {
             points = v;
+        } else if ((v = opt_value(argc, argv, &i, "--prior", &err)) != NULL) {
+            prior = v;
         } else if ((v = opt_value(argc, argv, &i, "--width", &err)) != NULL) {
             if (parse_float(v, 100.0, 20000.0, &width) != 0) {
                 return usage_error("--width needs pixels in [100, 20000], got '%s'", v);
@@ -300,6 +321,9 @@ int cmd_map(int argc, char **argv)
     }
     if (points != NULL && out_path == NULL) {
         return usage_error("--points goes with -o MAP.svg");
+    }
+    if (prior != NULL && out_path == NULL) {
+        return usage_error("--prior goes with -o MAP.svg");
     }
     if (json && out_path != NULL && strcmp(out_path, "-") == 0) {
         return usage_error("--json and -o - would both write to stdout");
@@ -336,7 +360,7 @@ int cmd_map(int argc, char **argv)
         print_json(&ctx.view, ctrl, vtx);
     }
     if (out_path != NULL &&
-        write_svg(out_path, in_path, &ctx.view, width, points, ctrl, vtx, &t) != 0) {
+        write_svg(out_path, in_path, &ctx.view, width, points, prior, ctrl, vtx, &t) != 0) {
         rc = -1;
     }
     info = (json || (out_path != NULL && strcmp(out_path, "-") == 0)) ? stderr : stdout;

@@ -5,7 +5,7 @@
 #include "tool.h"
 
 static const char render_help[] =
-    "Usage: bsf render IN -o MAP.svg [--scans K..L] [--points LOG] [--width PX]\n"
+    "Usage: bsf render IN -o MAP.svg [--scans K..L] [--points LOG] [--prior CSV] [--width PX]\n"
     "Draw the stream's B-spline features (exact quadratic curves) in the world\n"
     "frame (poses from the stream) over a grid labelled in metres, with the robot's\n"
     "path and last pose, vertices as red squares, a legend and a scale bar.\n"
@@ -13,6 +13,9 @@ static const char render_help[] =
     "--points draws those scans' raw points from LOG underneath (same numbering:\n"
     "the n-th laser scan of the log), thinned to one per pixel-sized cell, so a\n"
     "whole log stays a few megabytes.\n"
+    "--prior draws the odometry (prior) path of a CSV that bsf extract --align\n"
+    "--prior-path wrote as a dashed line beside the stream's (corrected) path\n"
+    "(its rows of the scans --scans keeps).\n"
     "--width sets the drawing's width in pixels (default 1600). The stream is read\n"
     "several times (a pipe is spooled to a temporary file), so memory does not grow\n"
     "with its length. Exits 1 when a non-empty input holds no valid frame.\n";
@@ -297,6 +300,137 @@ void render_path_end(bsf_svg_t *svg, const render_path_t *p)
     }
 }
 
+/* Longest line of a prior-path CSV: eleven numbers of at most ~25 characters. */
+#define PRIOR_LINE_MAX 512
+/* Largest coordinate accepted, metres: beyond it the file is not a robot's path. */
+#define PRIOR_COORD_MAX 1e7
+
+/* Columns of a prior-path CSV. */
+#define PRIOR_COLUMNS 11
+
+/* One row of a prior-path CSV: its scan index and odometry pose (x, y,
+ * theta). 0, or -1. */
+static int parse_prior_row(const char *line, double *scan, double *x, double *y, double *theta)
+{
+    double v[PRIOR_COLUMNS];
+    const char *p = line;
+    int k;
+    for (k = 0; k < PRIOR_COLUMNS; ++k) {
+        char *end = NULL;
+        errno = 0;
+        v[k] = strtod(p, &end);
+        if (end == p || errno != 0 || !isfinite(v[k])) {
+            return -1;
+        }
+        p = end;
+        if (k + 1 < PRIOR_COLUMNS) {
+            if (*p != ',') {
+                return -1;
+            }
+            ++p;
+        }
+    }
+    for (k = 2; k < PRIOR_COLUMNS; ++k) {
+        if (k % 3 != 1 && fabs(v[k]) > PRIOR_COORD_MAX) { /* x and y; theta is k % 3 == 1 */
+            return -1;
+        }
+    }
+    if (*p != '\0' || !(v[0] >= 0.0 && v[0] <= 4294967295.0) || v[0] != floor(v[0])) {
+        return -1;
+    }
+    *scan = v[0];
+    *x = v[2];
+    *y = v[3];
+    *theta = v[4];
+    return 0;
+}
+
+int render_prior_path(bsf_svg_t *svg, const char *csv, long lo, long hi, bsf_bounds_t *bounds,
+                      unsigned long *n)
+{
+    static const char header[] =
+        "scan,time_s,odometry_x,odometry_y,odometry_theta,prior_x,prior_y,prior_theta,aligned_x,"
+        "aligned_y,aligned_theta";
+    char line[PRIOR_LINE_MAX];
+    unsigned long lineno = 0, poses = 0;
+    double last_x = 0.0, last_y = 0.0;
+    int rc = 0;
+    FILE *f = fopen(csv, "r");
+    if (f == NULL) {
+        fail_msg("cannot open %s: %s", csv, strerror(errno));
+        return -1;
+    }
+    while (fgets(line, sizeof line, f) != NULL) {
+        size_t len = strlen(line);
+        double scan, x, y, th;
+        ++lineno;
+        if (len > 0u && line[len - 1u] == '\n') {
+            line[--len] = '\0';
+        } else if (!feof(f)) {
+            fail_msg("%s:%lu: line longer than %d bytes: not a prior path (bsf extract "
+                     "--prior-path writes one)",
+                     csv, lineno, PRIOR_LINE_MAX - 2);
+            rc = -1;
+            break;
+        }
+        if (len > 0u && line[len - 1u] == '\r') {
+            line[--len] = '\0';
+        }
+        if (lineno == 1u) {
+            if (strcmp(line, header) != 0) {
+                fail_msg("%s:1: not a prior path: the header must be %s (bsf extract "
+                         "--prior-path writes it)",
+                         csv, header);
+                rc = -1;
+                break;
+            }
+            continue;
+        }
+        if (parse_prior_row(line, &scan, &x, &y, &th) != 0) {
+            fail_msg("%s:%lu: malformed row (%d finite numbers, coordinates within %g m)", csv,
+                     lineno, PRIOR_COLUMNS, PRIOR_COORD_MAX);
+            rc = -1;
+            break;
+        }
+        if (!in_range((uint32_t)scan, lo, hi)) {
+            continue;
+        }
+        if (bounds != NULL) {
+            bsf_bounds_add(bounds, x, y);
+        }
+        if (svg != NULL) {
+            if (poses == 0u || hypot(x - last_x, y - last_y) > 5.0) {
+                bsf_svg_path_end_dashed(svg, RENDER_PRIOR_COLOUR, 1.4, "6,4");
+                bsf_svg_path_begin(svg);
+            }
+            bsf_svg_path_point(svg, x, y);
+        }
+        last_x = x;
+        last_y = y;
+        ++poses;
+    }
+    if (rc == 0 && ferror(f)) {
+        fail_msg("read error on %s", csv);
+        rc = -1;
+    }
+    if (rc == 0 && lineno == 0u) {
+        fail_msg("%s is empty: not a prior path (bsf extract --prior-path writes one)", csv);
+        rc = -1;
+    }
+    if (rc == 0 && poses == 0u) {
+        fail_msg("%s holds no pose%s", csv, lo > 0 || hi >= 0 ? " of the scans drawn" : "");
+        rc = -1;
+    }
+    if (svg != NULL) {
+        bsf_svg_path_end_dashed(svg, RENDER_PRIOR_COLOUR, 1.4, "6,4");
+    }
+    fclose(f);
+    if (n != NULL) {
+        *n = poses;
+    }
+    return rc;
+}
+
 /* A frame's vertices (pairs of flagged control points) as markers; returns
  * how many. */
 static unsigned long draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
@@ -317,9 +451,9 @@ static unsigned long draw_vertices(bsf_svg_t *svg, const bsf_frame_t *fr)
 }
 
 /* The legend row: the layers that are in the picture. */
-void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene)
+void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene, int have_prior)
 {
-    bsf_svg_legend_item_t key[5];
+    bsf_svg_legend_item_t key[6];
     size_t n = 0;
     key[n].key = BSF_SVG_KEY_LINE;
     key[n].colour = RENDER_CURVE_COLOUR;
@@ -330,7 +464,13 @@ void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scen
     if (have_path) {
         key[n].key = BSF_SVG_KEY_LINE;
         key[n].colour = RENDER_PATH_COLOUR;
-        key[n++].text = "robot path and last pose";
+        key[n++].text =
+            have_prior ? "corrected path (aligned) and last pose" : "robot path and last pose";
+    }
+    if (have_prior) {
+        key[n].key = BSF_SVG_KEY_DASH;
+        key[n].colour = RENDER_PRIOR_COLOUR;
+        key[n++].text = "prior path (odometry)";
     }
     if (have_points) {
         key[n].key = BSF_SVG_KEY_DOT;
@@ -461,8 +601,8 @@ static int render_pass(FILE *in, const char *in_name, render_ctx_t *rc, render_p
 }
 
 int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, long hi,
-                  const char *points_log, const bsf_scene_t *scene, const char *title,
-                  double width_px)
+                  const char *points_log, const bsf_scene_t *scene, const char *prior_csv,
+                  const char *title, double width_px)
 {
     static bounds_ctx_t bc;
     bsf_bounds_t b;
@@ -472,6 +612,7 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     FILE *out;
     char caption[200];
     int failed;
+    unsigned long prior_poses = 0;
 
     memset(&bc, 0, sizeof bc);
     bc.lo = lo;
@@ -515,6 +656,10 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     if (scene != NULL) {
         draw_scene(NULL, scene, &b);
     }
+    /* the whole prior path is in the picture, however far it drifted */
+    if (prior_csv != NULL && render_prior_path(NULL, prior_csv, lo, hi, &b, NULL) != 0) {
+        return -1;
+    }
     out = open_out(out_path, 0);
     if (out == NULL) {
         return -1;
@@ -553,6 +698,9 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     bsf_svg_curves_begin(&svg, RENDER_CURVE_COLOUR, 1.6);
     failed = render_pass(in, in_name, &rc, PASS_CURVES) != 0;
     bsf_svg_curves_end(&svg);
+    if (!failed && prior_csv != NULL) {
+        failed = render_prior_path(&svg, prior_csv, lo, hi, NULL, &prior_poses) != 0;
+    }
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_PATH) != 0;
         render_path_end(&svg, &rc.path);
@@ -561,8 +709,12 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
     if (!failed) {
         failed = render_pass(in, in_name, &rc, PASS_VERTICES) != 0;
     }
-    render_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL);
+    render_legend(&svg, rc.path.n > 0, points_log != NULL, scene != NULL, prior_csv != NULL);
     snprintf(caption, sizeof caption, "%lu scans, %lu vertices", bc.frames, rc.vertices);
+    if (prior_csv != NULL) {
+        size_t len = strlen(caption);
+        snprintf(caption + len, sizeof caption - len, "; %lu prior poses", prior_poses);
+    }
     if (points_log != NULL) {
         size_t len = strlen(caption);
         snprintf(caption + len, sizeof caption - len, "; %lu raw points, %lu drawn (%.0f cm grid)",
@@ -580,7 +732,7 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
 
 int cmd_render(int argc, char **argv)
 {
-    const char *in_path = NULL, *out_path = NULL, *points = NULL;
+    const char *in_path = NULL, *out_path = NULL, *points = NULL, *prior = NULL;
     long lo = 0, hi = -1;
     double width = 1600.0;
     FILE *in;
@@ -598,6 +750,8 @@ int cmd_render(int argc, char **argv)
             }
         } else if ((v = opt_value(argc, argv, &i, "--points", &err)) != NULL) {
             points = v;
+        } else if ((v = opt_value(argc, argv, &i, "--prior", &err)) != NULL) {
+            prior = v;
         } else if ((v = opt_value(argc, argv, &i, "--width", &err)) != NULL) {
             if (parse_float(v, 100.0, 20000.0, &width) != 0) {
                 return usage_error("--width needs pixels in [100, 20000], got '%s'", v);
@@ -622,7 +776,7 @@ int cmd_render(int argc, char **argv)
     if (in == NULL) {
         return EXIT_FAIL;
     }
-    rc = write_map_svg(out_path, in, in_path, lo, hi, points, NULL, in_path, width);
+    rc = write_map_svg(out_path, in, in_path, lo, hi, points, NULL, prior, in_path, width);
     close_in(in);
     if (rc == 0) {
         fprintf(stderr, "%s: wrote %s\n", g_cmd, out_path);

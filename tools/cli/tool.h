@@ -184,6 +184,7 @@ int cmd_map(int argc, char **argv);
 #define RENDER_CURVE_COLOUR "#1f5fbf"
 #define RENDER_VERTEX_COLOUR "#d62728"
 #define RENDER_PATH_COLOUR "#2ca02c"
+#define RENDER_PRIOR_COLOUR "#ff7f0e"
 #define RENDER_POINT_COLOUR "#9a9a9a"
 #define RENDER_WALL_COLOUR "#c8c8c8"
 
@@ -203,8 +204,18 @@ void render_path_end(bsf_svg_t *svg, const render_path_t *p);
  *  0, or -1 with a message. */
 int render_log_points(bsf_svg_t *svg, const char *log, bsf_bounds_t *bounds, unsigned long *read,
                       unsigned long *drawn, double *cell_m);
-/** The legend row of bsf render: curves, vertices, and the optional layers. */
-void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene);
+/** The odometry (prior) path of a CSV that bsf extract --align --prior-path
+ *  wrote (columns scan,time_s, then x,y,theta of the odometry alone, of the
+ *  prior and of the aligned pose): its odometry poses into bounds when svg is
+ *  NULL, else drawn as a dashed line (a jump over 5 m starts a new line).
+ *  *n gets the number of poses drawn: the rows whose scan is in lo..hi
+ *  (hi < 0: no upper bound).
+ *  0, or -1 with a message (FILE:LINE for a malformed line). */
+int render_prior_path(bsf_svg_t *svg, const char *csv, long lo, long hi, bsf_bounds_t *bounds,
+                      unsigned long *n);
+/** The legend row of bsf render: curves, vertices, and the optional layers;
+ *  with a prior path, the robot's path is named the corrected one. */
+void render_legend(bsf_svg_t *svg, int have_path, int have_points, int have_scene, int have_prior);
 
 /* ---- map_view.c: the receiver's map of a map stream (bsf map, listen, metrics) */
 
@@ -249,7 +260,7 @@ void print_metrics(FILE *f, const char *name, const stream_summary_t *s,
  *  raw points and scene (cmd_render.c). in must come from open_seekable (it
  *  is read several times, so memory does not grow with the stream). */
 int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, long hi,
-                  const char *points_log, const bsf_scene_t *scene, const char *title,
-                  double width_px);
+                  const char *points_log, const bsf_scene_t *scene, const char *prior_csv,
+                  const char *title, double width_px);
 
 #endif /* BSF_TOOL_H */

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from typing import List, Optional
@@ -161,13 +162,33 @@ def cmd_export(a: argparse.Namespace) -> int:
     if a.samples < 2:
         print(f"bsf: --samples must be at least 2, got {a.samples}", file=sys.stderr)
         return 2
+    for bad, msg in (
+        (not (math.isfinite(a.map_rate) and 0.001 <= a.map_rate <= 1e6), f"--map-rate must be 0.001 .. 1e6 Hz, got {a.map_rate}"),
+        (a.map_every < 1, f"--map-every must be at least 1, got {a.map_every}"),
+        (not 1 <= a.map_per_span <= 64, f"--map-per-span must be 1 .. 64, got {a.map_per_span}"),
+    ):
+        if bad:
+            print(f"bsf: {msg}", file=sys.stderr)
+            return 2
     try:
-        res = export(a.input, a.output, a.format, frame_id=a.frame_id, laser_frame=a.laser_frame, samples=a.samples, prefix=a.prefix)
+        res = export(
+            a.input,
+            a.output,
+            a.format,
+            frame_id=a.frame_id,
+            laser_frame=a.laser_frame,
+            samples=a.samples,
+            prefix=a.prefix,
+            map_rate=a.map_rate,
+            map_every=a.map_every,
+            map_per_span=a.map_per_span,
+        )
     except (ExportError, BsfError, OSError) as e:
         print(f"bsf: {e}", file=sys.stderr)
         return 1
     counts = ", ".join(f"{n} on {t}" for t, n in sorted(res.messages.items()))
-    print(f"{a.output}: {res.frames} frames exported ({counts})", file=sys.stderr)
+    what = f"{res.frames} frames" + (f", {res.map_frames} map frames" if res.map_frames else "")
+    print(f"{a.output}: {what} exported ({counts})", file=sys.stderr)
     return 0
 
 
@@ -202,7 +223,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     x = sub.add_parser(
         "export",
         help="write a bsf stream as ROS 2 markers (MCAP for Foxglove, or a ROS 2 bag for RViz 2; needs the rosbag extra)",
-        description="Features as visualization_msgs/MarkerArray (line strips, vertex spheres), the laser pose and path.",
+        description="Features as visualization_msgs/MarkerArray (line strips, vertex spheres), the laser pose and path; "
+        "a map stream (bsf extract --map) as the receiver's whole map on /bsf/map, with the pose records' path.",
     )
     x.add_argument("input", metavar="IN", help="bsf stream ('-': stdin)")
     x.add_argument("-o", dest="output", required=True, help="OUT.mcap, or a new directory with --format ros2bag")
@@ -211,6 +233,16 @@ def main(argv: Optional[List[str]] = None) -> int:
     x.add_argument("--laser-frame", default="laser", help="frame of frames without a pose (laser)")
     x.add_argument("--samples", type=int, default=32, help="points per feature's line strip (32)")
     x.add_argument("--prefix", default="/bsf", help="topic prefix (/bsf: /bsf/features, /bsf/pose, /bsf/path)")
+    x.add_argument(
+        "--map-rate",
+        type=float,
+        default=10.0,
+        metavar="HZ",
+        help="map streams: map frames per second, for their stamps (a map frame carries no time): "
+        "the metadata's time origin + (seq - first seq) / HZ (10)",
+    )
+    x.add_argument("--map-every", type=int, default=10, metavar="N", help="map streams: the whole map every N map frames and after the last (10)")
+    x.add_argument("--map-per-span", type=int, default=4, metavar="K", help="map streams: line strip points per curve span (4)")
     x.set_defaults(func=cmd_export)
     a = p.parse_args(argv)
     try:

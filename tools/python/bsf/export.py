@@ -17,6 +17,25 @@ stamped at each scan's time from the stream:
 - ``/bsf/path``: ``nav_msgs/msg/Path`` of every pose, once, at the first
   posed scan's time (offered transient-local, so a late subscriber gets it).
 
+A map stream (``bsf extract --map``) gives, from the receiver's map
+(:class:`bsf.Map`) rebuilt frame by frame:
+
+- ``/bsf/map``: ``visualization_msgs/msg/MarkerArray`` of the whole map every
+  ``map_every`` map frames and after the last one: a DELETEALL, a LINE_STRIP
+  per map feature (namespace ``map``, id = the feature's id; the curve through
+  ``map_per_span`` samples per span of its world-frame control points, a
+  feature of two control points as their segment; stale features in grey)
+  and one SPHERE_LIST of the map's vertices (namespace ``vertices``),
+  offered transient-local;
+- ``/bsf/pose`` at each map frame that carries a pose record, and ``/bsf/path``
+  of those poses, as for scans.
+
+A map frame carries no time (docs/FORMAT.md section 11), so its stamp is
+derived: the time origin of the stream's metadata plus its sequence number
+(counted from the first map frame's) divided by ``map_rate`` (Hz; 10 by
+default, one frame per scan for a 10 Hz scanner with ``--pose-every 1``). A
+lost frame (a gap in the sequence numbers) keeps the later stamps in place.
+
 Frames with a pose are drawn in the fixed frame (``frame_id``), frames
 without one in the laser frame (``laser_frame``). Anything else that is a
 set of curves and points in the fixed frame (the fused map) goes through
@@ -37,7 +56,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import Frame, Metadata, read
+from . import Frame, Map, MapFeature, MapFrame, Metadata, read
 
 FORMATS = ("mcap", "ros2bag")
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
@@ -56,6 +75,7 @@ COLORS = {
     "auxiliary": (1.0, 0.5, 0.05, 1.0),
     "vertices": (0.84, 0.15, 0.16, 1.0),
     "map": (0.17, 0.63, 0.17, 1.0),
+    "stale": (0.6, 0.6, 0.6, 1.0),
 }
 LINE_WIDTH = 0.02  #: metres
 SPHERE_SIZE = 0.06  #: metres
@@ -73,6 +93,20 @@ def frame_stamp_ns(frame: Frame) -> int:
     return int(frame.timestamp_ms) * 1_000_000
 
 
+def map_lines(features: Sequence[MapFeature], per_span: int) -> List[np.ndarray]:
+    """The polylines the export draws for map features: ``per_span`` samples per
+    span of each curve (:meth:`MapFeature.sample`), the segment itself for a
+    feature of two control points (no quadratic span yet)."""
+    return [f.sample(per_span) if len(f.ctrl) >= 3 else np.asarray(f.ctrl, dtype=np.float64) for f in features]
+
+
+def map_vertices(features: Sequence[MapFeature]) -> np.ndarray:
+    """Every vertex of the map features, shape (k, 2), float64."""
+    if not features:
+        return np.zeros((0, 2))
+    return np.concatenate([np.asarray(f.vertices, dtype=np.float64).reshape(-1, 2) for f in features])
+
+
 def _typestore():
     try:
         from rosbags.typesys import Stores, get_typestore
@@ -84,6 +118,7 @@ def _typestore():
 @dataclass
 class ExportResult:
     frames: int = 0  #: scan frames exported
+    map_frames: int = 0  #: map frames applied to the exported map
     messages: Dict[str, int] = field(default_factory=dict)  #: messages per topic
 
 
@@ -104,6 +139,9 @@ class Exporter:
         laser_frame: str = "laser",
         samples: int = 32,
         prefix: str = "/bsf",
+        map_rate: float = 10.0,
+        map_every: int = 10,
+        map_per_span: int = 4,
     ):
         if fmt not in FORMATS:
             raise ExportError(f"unknown format {fmt!r}; one of {', '.join(FORMATS)}")
@@ -113,6 +151,21 @@ class Exporter:
             raise ExportError("frame names must not be empty")
         if not prefix.startswith("/") or any(c.isspace() for c in prefix):
             raise ExportError(f"the topic prefix must start with '/' and hold no spaces, got {prefix!r}")
+        if not (isinstance(map_rate, (int, float)) and math.isfinite(map_rate) and 0.001 <= map_rate <= 1e6):
+            raise ExportError(f"the map frame rate must be 0.001 .. 1e6 Hz, got {map_rate}")
+        if int(map_every) < 1:
+            raise ExportError(f"map_every must be at least 1, got {map_every}")
+        if not 1 <= int(map_per_span) <= 64:
+            raise ExportError(f"map_per_span must be 1 .. 64, got {map_per_span}")
+        self.map_rate = float(map_rate)
+        self.map_every = int(map_every)
+        self.map_per_span = int(map_per_span)
+        self._map: Optional[Map] = None
+        self._map_seq = 0  # sequence number of the last map frame applied
+        self._map_tick = 0  # frame periods since the first map frame
+        self._map_origin_ns = 0
+        self._map_stamp_ns = 0  # stamp of the last map frame applied
+        self._map_published = True  # the map as it is now was published
         self.fmt = fmt
         self.frame_id = frame_id
         self.laser_frame = laser_frame
@@ -219,13 +272,16 @@ class Exporter:
         frame_id: Optional[str] = None,
         ns: str = "curves",
         colors: Optional[Sequence[Tuple[float, float, float, float]]] = None,
+        ids: Optional[Sequence[int]] = None,
         replace: bool = True,
+        latched: bool = False,
     ) -> None:
         """One MarkerArray on ``topic``: a LINE_STRIP per polyline in ``lines``
         (each (k, 2), k >= 2, namespace ``ns``, id = its index) and the
         ``points`` ((m, 2)) as one SPHERE_LIST (namespace ``vertices``), in
-        ``frame_id`` (default: the fixed frame). ``replace`` first deletes
-        every marker this topic drew before. The fused map goes here too."""
+        ``frame_id`` (default: the fixed frame). ``ids`` replaces the indices
+        as marker ids (int32). ``replace`` first deletes every marker this
+        topic drew before; ``latched`` offers the topic transient-local."""
         if stamp_ns < 0:
             raise ExportError(f"a stamp before 1970 cannot be written ({stamp_ns} ns)")
         fid = frame_id or self.frame_id
@@ -237,13 +293,16 @@ class Exporter:
             if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 2 or not np.all(np.isfinite(pts)):
                 raise ExportError(f"{topic}: line {i} is not two or more finite (x, y) points")
             color = colors[i] if colors is not None else COLORS["map"]
-            ms.append(self._marker(stamp_ns, fid, ns, i, LINE_STRIP, ADD, pts, color, LINE_WIDTH))
+            mid = i if ids is None else int(ids[i])
+            if not -(2**31) <= mid < 2**31:
+                raise ExportError(f"{topic}: marker id {mid} does not fit a ROS marker id (int32)")
+            ms.append(self._marker(stamp_ns, fid, ns, mid, LINE_STRIP, ADD, pts, color, LINE_WIDTH))
         if points is not None and len(points):
             pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
             if not np.all(np.isfinite(pts)):
                 raise ExportError(f"{topic}: points are not finite")
             ms.append(self._marker(stamp_ns, fid, "vertices", 0, SPHERE_LIST, ADD, pts, COLORS["vertices"], SPHERE_SIZE))
-        self._write(topic, MARKER_ARRAY, stamp_ns, self._T[MARKER_ARRAY](markers=ms))
+        self._write(topic, MARKER_ARRAY, stamp_ns, self._T[MARKER_ARRAY](markers=ms), latched=latched)
 
     def add_frame(self, frame: Frame) -> None:
         """One scan: its features and vertices on ``<prefix>/features``, its pose on ``<prefix>/pose``."""
@@ -255,22 +314,81 @@ class Exporter:
             self.prefix + "/features", ns, lines, frame.vertices(world=True), frame_id=fid, ns="features", colors=colors
         )
         if frame.pose is not None:
-            x, y, th = frame.pose
-            self._write(
-                self.prefix + "/pose",
-                POSE_STAMPED,
-                ns,
-                self._T[POSE_STAMPED](header=self._header(ns, self.frame_id), pose=self._pose(x, y, th)),
-            )
-            self._path.append((ns, (x, y, th)))
+            self._pose_message(ns, frame.pose)
         self.result.frames += 1
 
+    def _pose_message(self, ns: int, pose: Tuple[float, float, float]) -> None:
+        self._write(
+            self.prefix + "/pose",
+            POSE_STAMPED,
+            ns,
+            self._T[POSE_STAMPED](header=self._header(ns, self.frame_id), pose=self._pose(*pose)),
+        )
+        self._path.append((ns, pose))
+
+    def _map_tick_of(self, frame: MapFrame) -> int:
+        """Frame periods from the first map frame to this one: the sequence
+        number's step, a step back (a new stream) counting as one."""
+        if self._map is None:
+            return 0
+        step = (int(frame.seq) - self._map_seq) % 2**32
+        return self._map_tick + (step if 0 < step < 2**31 else 1)
+
+    def add_map_frame(self, frame: MapFrame, metadata: Optional[Metadata] = None) -> None:
+        """One map frame: applied to the export's receiver map (BsfError when
+        the receiver refuses it), its pose record on ``<prefix>/pose``, and
+        the whole map on ``<prefix>/map`` every ``map_every`` map frames.
+        Its stamp is the time origin of ``metadata`` (the one in force at the
+        first map frame; 0 without one) plus the frame periods since the
+        first map frame (see the module's description)."""
+        if not isinstance(frame, MapFrame):
+            raise TypeError(f"add_map_frame needs a MapFrame, got {type(frame).__name__}")
+        tick = self._map_tick_of(frame)
+        if self._map is None:
+            if metadata is not None and metadata.time_origin_us is not None:
+                self._map_origin_ns = int(metadata.time_origin_us) * 1000
+            self._map = Map()
+        ns = self._map_origin_ns + round(tick * 1e9 / self.map_rate)
+        poses = len(self._map.path)
+        self._map.apply(frame)
+        self._map_seq, self._map_tick, self._map_stamp_ns = int(frame.seq), tick, ns
+        self._map_published = False
+        self.result.map_frames += 1
+        if len(self._map.path) > poses:
+            self._pose_message(ns, self._map.path[-1])
+        if self.result.map_frames % self.map_every == 0:
+            self.publish_map()
+
+    def publish_map(self) -> None:
+        """The receiver's whole map on ``<prefix>/map`` at the last map frame's stamp."""
+        if self._map is None:
+            raise ExportError("no map frame was added")
+        feats = self._map.features
+        self.add_markers(
+            self.prefix + "/map",
+            self._map_stamp_ns,
+            map_lines(feats, self.map_per_span),
+            map_vertices(feats),
+            ns="map",
+            ids=[f.id for f in feats],
+            colors=[COLORS["stale"] if f.stale else COLORS["map"] for f in feats],
+            latched=True,
+        )
+        self._map_published = True
+
+    @property
+    def map(self) -> Optional[Map]:
+        """The receiver's map of the map frames added so far (None before the first)."""
+        return self._map
+
     def close(self) -> ExportResult:
-        """Write the path and finish the file (idempotent)."""
+        """Publish the final map, write the path and finish the file (idempotent)."""
         if self._closed:
             return self.result
         self._closed = True
         try:
+            if self._map is not None and not self._map_published:
+                self.publish_map()
             if self._path:
                 first = min(ns for ns, _ in self._path)
                 poses = [self._T[POSE_STAMPED](header=self._header(ns, self.frame_id), pose=self._pose(*p)) for ns, p in self._path]
@@ -320,7 +438,8 @@ def export(
 ) -> ExportResult:
     """Export a bsf stream (a path, or frames) to ``out``: see the module's
     description. ``fmt`` defaults to "mcap" for a name ending in .mcap;
-    ``options`` go to :class:`Exporter` (frame_id, laser_frame, samples, prefix).
+    ``options`` go to :class:`Exporter` (frame_id, laser_frame, samples, prefix,
+    map_rate, map_every, map_per_span).
     Raises ExportError, BsfError (a bad stream) or OSError."""
     if fmt is None:
         if not os.fspath(out).endswith(".mcap"):
@@ -330,11 +449,16 @@ def export(
     ex = Exporter(out, fmt, **options)
     try:
         with ex:
+            meta: Optional[Metadata] = None
             for f in frames:
-                if isinstance(f, Frame):
+                if isinstance(f, Metadata):
+                    meta = f
+                elif isinstance(f, Frame):
                     ex.add_frame(f)
-        if ex.result.frames == 0:
-            raise ExportError(f"{os.fspath(source) if isinstance(source, (str, os.PathLike)) else 'the stream'} holds no scan frame")
+                elif isinstance(f, MapFrame):
+                    ex.add_map_frame(f, meta)
+        if ex.result.frames == 0 and ex.result.map_frames == 0:
+            raise ExportError(f"{os.fspath(source) if isinstance(source, (str, os.PathLike)) else 'the stream'} holds no scan frame and no map frame")
     except BaseException:
         # no half-written output is left behind for a viewer to open
         target = Path(out)
