@@ -81,7 +81,7 @@ def number(cell, path):
 
 
 def triple(cell, path):
-    parts = [p for p in cell.split("/")]
+    parts = cell.split("/")
     if len(parts) != 3:
         raise InputError(f"{path}: {cell!r} is not 'a / b / c'")
     return [number(p, path) for p in parts]
