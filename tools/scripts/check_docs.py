@@ -152,19 +152,33 @@ def bench_rows(exe, extra):
     for line in out.splitlines():
         c = [x.strip() for x in line.split("|")]
         if len(c) > 17 and c[3] == "1cm":
-            rows.append({"beams": int(c[2].split("/")[0]), "recall": float(c[5].rstrip("%")),
+            rows.append({"scene": c[1], "beams": int(c[2].split("/")[0]), "recall": float(c[5].rstrip("%")),
                          "verr_median": float(c[10].split("/")[0])})
     if not rows:
         raise SystemExit(f"check_docs: {' '.join(cmd)} printed no 1 cm rows")
     return rows
 
 
+# The scenes the README's "synthetic offices" sentence covers; the corridor and
+# the cluttered room have a sentence of their own.
+OFFICE_SCENES = ("office", "angles", "curved")
+
+
 def check_truth(exe, errors):
-    rows = bench_rows(exe, [])
+    all_rows = bench_rows(exe, [])
+    rows = [r for r in all_rows if r["scene"] in OFFICE_SCENES]
     recall = (min(r["recall"] for r in rows), max(r["recall"] for r in rows))
     verr = (min(r["verr_median"] for r in rows), max(r["verr_median"] for r in rows))
     paper = bench_rows(exe, ["--paper"])
-    sparse = [r["recall"] for r in paper if r["beams"] <= 541]
+    sparse = [r["recall"] for r in paper if r["beams"] <= 541 and r["scene"] in OFFICE_SCENES]
+    for scene, lead in (("corridor", "a long corridor with door recesses"),
+                        ("clutter", "a cluttered room of shelves, posts and boxes")):
+        got = [r["recall"] for r in all_rows if r["scene"] == scene]
+        if not got:
+            errors.append(f"bench_truth printed no 1 cm rows for the {scene} scene")
+            continue
+        expect_range("README.md", re.escape(lead) + r"[^%]*? ([\d.]+)–([\d.]+) %", min(got), max(got),
+                     f"{scene} recall", errors)
     paper_range = (round(min(sparse)), round(max(sparse)))
     for rel in ("README.md", "CHANGELOG.md"):
         expect_range(rel, r"finds ([\d.]+)–([\d.]+) % of the visible corners", *recall, "corner recall", errors)
