@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
+#include "bsf_grazing.h"
 #include "bsf_math.h"
 
 #include <float.h>
@@ -38,6 +39,7 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * side within max_side of the apex, so the beam spacing, not the range,
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
+    p.join_grazing = 0u;
     return p;
 }
 
@@ -55,7 +57,7 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
         !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
         !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
         !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
-        p->min_side_points < 2u || p->min_side_points > 64u) {
+        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -1100,7 +1102,9 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            close_run = !within_jump(pts, p, work->run[m - 1u], i);
+            close_run = !within_jump(pts, p, work->run[m - 1u], i) &&
+                        !(p->join_grazing && work->run[m - 1u] + 1u == i &&
+                          bsf_grazing_join(pts, i - 1u, p->max_side));
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i) {
