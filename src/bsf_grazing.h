@@ -67,6 +67,14 @@ static inline int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
     return s2 > 0.0f && along > 0.0f && along <= 1.5f * s2 && off * off <= 0.25f * s2 * s2;
 }
 
+/* |q - p| <= cap */
+static inline int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
+{
+    const float dx = q.x - p.x;
+    const float dy = q.y - p.y;
+    return dx * dx + dy * dy <= cap * cap;
+}
+
 static inline int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
 {
     return i < pts->count && pts->valid[i] != 0u;
@@ -106,10 +114,12 @@ static inline int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap)
     }
     /* a corner turning onto the wall that starts at b, or off the one that
      * ends at a */
-    if (bsf_grazing_run4(pts, b) && bsf_grazing_entry(p[a], p[b], p[b + 1u])) {
+    if (bsf_grazing_run4(pts, b) && bsf_grazing_entry(p[a], p[b], p[b + 1u]) &&
+        bsf_grazing_within(p[a], p[b + 2u], cap)) {
         return 1;
     }
-    return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]);
+    return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]) &&
+           bsf_grazing_within(p[b], p[a - 2u], cap);
 }
 
 #endif

@@ -700,6 +700,17 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
+    /* A wall seen at grazing incidence has a return every half metre or
+     * more: with grazing joins, a side short of points may reach twice as
+     * far (the fits and the straightness test still judge it). */
+    if (p->join_grazing) {
+        if (apex - a0 < need) {
+            a0 = walk_side(c, a0, 0u, -1, 4.0f * side2);
+        }
+        if (b1 - apex < need) {
+            b1 = walk_side(c, b1, m - 1u, 1, 4.0f * side2);
+        }
+    }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
     if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
@@ -1104,7 +1115,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
         if (!close_run && m > 0u) {
             close_run = !within_jump(pts, p, work->run[m - 1u], i) &&
                         !(p->join_grazing && work->run[m - 1u] + 1u == i &&
-                          bsf_grazing_join(pts, i - 1u, p->max_side));
+                          bsf_grazing_join(pts, i - 1u, 1.0f));
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i) {
