@@ -30,6 +30,10 @@
 /* Largest ratio of two successive steps along one line (on a plane the step
  * grows with 1 / cos^2 of the incidence: about 1.4 per beam at 85 deg). */
 #define BSF_GRAZING_STEP_RATIO 2.0f
+/* Smallest sine of the angle between a wide step and the ray (incidence at
+ * most 80 deg): nearer edge-on, a door or recess in the wall hides between
+ * two returns that still line up, and the feature would close it. */
+#define BSF_GRAZING_MIN_SIN 0.17f
 
 /* Points p0, p1, p2 in that order on a line: p1 between the two, within
  * BSF_GRAZING_LINE_TOL of their chord, the two steps within the ratio. */
@@ -66,6 +70,10 @@ static inline int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
     const float off = ex * uy - ey * ux;   /* times |q - p| */
     return s2 > 0.0f && along > 0.0f && along <= 1.5f * s2 && off * off <= 0.25f * s2 * s2;
 }
+
+/* Largest step LC's runs join this way, metres: SVED's default radius cap,
+ * so runs and segments go on across the same steps. */
+#define BSF_GRAZING_LC_CAP 1.0f
 
 /* |q - p| <= cap */
 static inline int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
@@ -107,6 +115,15 @@ static inline int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap)
     dy = p[b].y - p[a].y;
     if (!(dx * dx + dy * dy <= cap * cap)) {
         return 0;
+    }
+    {
+        /* sin of the angle between the step and beam b's ray (the sensor
+         * is at the origin) */
+        const float cr = dx * p[b].y - dy * p[b].x;
+        const float rb2 = p[b].x * p[b].x + p[b].y * p[b].y;
+        if (!(cr * cr >= BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN * (dx * dx + dy * dy) * rb2)) {
+            return 0;
+        }
     }
     if ((a >= 2u && bsf_grazing_run4(pts, a - 2u)) || (a >= 1u && bsf_grazing_run4(pts, a - 1u)) ||
         bsf_grazing_run4(pts, a)) {

@@ -1115,7 +1115,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
         if (!close_run && m > 0u) {
             close_run = !within_jump(pts, p, work->run[m - 1u], i) &&
                         !(p->join_grazing && work->run[m - 1u] + 1u == i &&
-                          bsf_grazing_join(pts, i - 1u, 1.0f));
+                          bsf_grazing_join(pts, i - 1u, BSF_GRAZING_LC_CAP));
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i) {
