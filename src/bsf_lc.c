@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
+#include "bsf_grazing.h"
 #include "bsf_math.h"
 
 #include <float.h>
@@ -38,6 +39,7 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * side within max_side of the apex, so the beam spacing, not the range,
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
+    p.join_grazing = 0u;
     return p;
 }
 
@@ -55,7 +57,7 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
         !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
         !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
         !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
-        p->min_side_points < 2u || p->min_side_points > 64u) {
+        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -698,6 +700,17 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
+    /* A wall seen at grazing incidence has a return every half metre or
+     * more: with grazing joins, a side short of points may reach twice as
+     * far (the fits and the straightness test still judge it). */
+    if (p->join_grazing) {
+        if (apex - a0 < need) {
+            a0 = walk_side(c, a0, 0u, -1, 4.0f * side2);
+        }
+        if (b1 - apex < need) {
+            b1 = walk_side(c, b1, m - 1u, 1, 4.0f * side2);
+        }
+    }
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
     if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
@@ -1100,7 +1113,9 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            close_run = !within_jump(pts, p, work->run[m - 1u], i);
+            close_run = !within_jump(pts, p, work->run[m - 1u], i) &&
+                        !(p->join_grazing && work->run[m - 1u] + 1u == i &&
+                          bsf_grazing_join(pts, i - 1u, BSF_GRAZING_LC_CAP));
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i) {

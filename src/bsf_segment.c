@@ -3,6 +3,7 @@
 
 #include <math.h>
 
+#include "bsf_grazing.h"
 #include "bsf_math.h"
 
 #define BSF_SEG_PI_F 3.14159265f
@@ -22,6 +23,7 @@ bsf_sved_params_t bsf_sved_params_paper(void)
     p.radius_max = 0.0f;
     p.lookback = 0u;
     p.reject_mixed = 0u;
+    p.join_grazing = 0u;
     return p;
 }
 
@@ -32,6 +34,7 @@ bsf_sved_params_t bsf_sved_params_default(void)
     p.max_gap_beams = 16u;
     p.radius_max = 1.0f;
     p.reject_mixed = 1u;
+    p.join_grazing = 0u;
     return p;
 }
 
@@ -58,7 +61,7 @@ bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p)
         !min_points_ok(p->min_segment_points) || p->max_gap_beams < 1u ||
         p->max_gap_beams > (uint16_t)BSF_MAX_POINTS || !is_finite_f(p->radius_max) ||
         !(p->radius_max == 0.0f || p->radius_max >= p->a) || p->lookback > BSF_SVED_MAX_LOOKBACK ||
-        p->reject_mixed > 1u) {
+        p->reject_mixed > 1u || p->join_grazing > 1u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -402,6 +405,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     float cap2;
     beam_radius_t rad;
     int reject_mixed;
+    int grazing;
     int ring;
 
     st = begin(pts, out, cap, n_out, n_wasted_points, &sink);
@@ -418,6 +422,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
     slots = extensions ? 1u + (size_t)p->lookback : 1u;
     reject_mixed = extensions && p->reject_mixed;
+    grazing = extensions && p->join_grazing && p->radius_max > 0.0f;
     ring = extensions && bsf_points_full_circle(pts);
     rad.a2 = a2;
     rad.two_b = two_b;
@@ -501,6 +506,12 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
          * the nearest passing end would be, or none passes. NaN never does. */
         if (best < slots && !beam_within(&rad, best_d2)) {
             best = slots;
+        }
+        /* A wide step from the beam before may still continue a wall seen
+         * at grazing incidence (bsf_grazing.h). */
+        if (best == slots && grazing && n_open > 0u && b > 0u && open[0].last + 1u == b &&
+            bsf_grazing_join(pts, b - 1u, p->radius_max)) {
+            best = 0u;
         }
         if (best == 0u) {
             open[0].last = (uint32_t)b; /* the current segment goes on (most beams) */

@@ -39,7 +39,7 @@ typedef struct {
 #define BSF_SEG_NONE 0xFFFFu
 
 /**
- * SVED parameters. The first three are the paper's rule; the last four
+ * SVED parameters. The first three are the paper's rule; the last five
  * extend it and are all off in bsf_sved_params_paper():
  *  - lookback: besides the current segment, a point may join one of the
  *    `lookback` most recently extended open segments whose last point lies
@@ -54,6 +54,10 @@ typedef struct {
  *  - reject_mixed: a mixed pixel (a lone reading between a foreground and a
  *    background surface at a depth jump, see bsf_segment_sved_labelled)
  *    joins no segment, so it cannot bend or bridge either surface.
+ *  - join_grazing: a wall seen at grazing incidence returns one point every
+ *    half metre or more at 7 m, farther apart than the radius, yet on a line
+ *    to millimetres; such steps join the current segment (off by default:
+ *    it finds more corners but lets curves stray farther, docs/GROUND_TRUTH.md).
  */
 typedef struct {
     float a;                     /**< distance threshold at range 0, metres, finite, > 0 */
@@ -66,6 +70,11 @@ typedef struct {
     uint8_t lookback;     /**< older open segments a point may rejoin, 0..BSF_SVED_MAX_LOOKBACK;
                                0 = the paper's rule (the current segment only) */
     uint8_t reject_mixed; /**< 1: mixed pixels join no segment; 0: the paper */
+    uint8_t join_grazing; /**< 1: a point also joins the current segment across a step wider
+                               than the radius (at most radius_max, used when radius_max > 0)
+                               where four consecutive returns through the step lie on one line,
+                               a wall seen at grazing incidence, or where such a wall starts at
+                               a corner; 0 (default and the paper): it does not */
 } bsf_sved_params_t;
 
 /** Largest lookback of bsf_sved_params_t. */
@@ -81,13 +90,13 @@ typedef struct {
 /**
  * SVED defaults (what the extractor uses unless told otherwise): the paper's
  * a = 0.2 m, b = 0.07 /m, min_segment_points = 5, plus lookback 4,
- * max_gap_beams 16, radius_max 1.0 m and reject_mixed 1 (docs/TABLE1.md has
+ * max_gap_beams 16, radius_max 1.0 m, reject_mixed 1 and join_grazing 0 (docs/TABLE1.md has
  * the measurements behind each value).
  */
 bsf_sved_params_t bsf_sved_params_default(void);
 
 /** The paper's SVED rule exactly: a = 0.2 m, b = 0.07 /m, min_segment_points
- *  = 5, lookback 0, radius_max 0 (none), reject_mixed 0. */
+ *  = 5, lookback 0, radius_max 0 (none), reject_mixed 0, join_grazing 0. */
 bsf_sved_params_t bsf_sved_params_paper(void);
 
 /** RPOS defaults of the paper: alpha_max = pi/4, eta = 1.5, min_segment_points = 5. */

@@ -20,12 +20,14 @@ static bsf_lc_work_t work;
 static bsf_keypoint_t kps[BSF_MAX_KEYPOINTS];
 static bsf_scene_t scene;
 static double range_max = 30.0; /* of the simulated sensor */
+static int join_grazing = 0;    /* LC's join_grazing for detect() */
 
 void setUp(void)
 {
     bsf_scene_init(&scene);
     memset(kps, 0, sizeof kps);
     range_max = 30.0;
+    join_grazing = 0;
 }
 
 void tearDown(void)
@@ -39,8 +41,9 @@ static size_t detect(double x, double y, double heading, size_t n, double fov, d
     bsf_lidar_t lid = bsf_lidar_default(x, y, heading, n, fov);
     bsf_scene_rng_t rng;
     bsf_scan_t scan;
-    const bsf_lc_params_t p = bsf_lc_params_default();
+    bsf_lc_params_t p = bsf_lc_params_default();
     size_t n_out = 0;
+    p.join_grazing = (uint8_t)join_grazing;
     lid.noise_sigma = sigma;
     lid.range_max = range_max;
     lid.no_return = (float)(range_max + 1.0);
@@ -118,6 +121,55 @@ static void test_a_corner_behind_a_thin_post_is_found(void)
     n = detect(0.0, 0.0, 0.0, 541u, 1.5 * PI, 0.01);
     TEST_ASSERT_EQUAL_size_t(1u, n);
     TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
+}
+
+/* A room corner 7 m away whose second wall is seen at 77 deg incidence:
+ * its returns near the corner are 0.4 m apart at 0.75 deg beams, wider
+ * than the jump radius there (0.33 m), so without grazing joins the run
+ * ends at the corner and no corner is found; with them the wall's
+ * collinear returns continue the run and the corner is found where the
+ * walls meet. */
+static void test_a_corner_onto_a_wall_seen_at_grazing_incidence_is_found_with_grazing_joins(void)
+{
+    size_t n;
+    size_t k;
+    int seed_found = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 7.0, 1.6, -0.5 * PI, 4.0, PI, 4.0));
+    n = detect(0.0, 0.0, 0.0, 361u, 1.5 * PI, 0.01);
+    for (k = 0; k < n; ++k) {
+        TEST_ASSERT_TRUE_MESSAGE(dist_to(k, 0.0, 0.0, 0.0, 7.0, 1.6) > 0.1,
+                                 "no corner expected without grazing joins");
+    }
+    join_grazing = 1;
+    n = detect(0.0, 0.0, 0.0, 361u, 1.5 * PI, 0.01);
+    for (k = 0; k < n; ++k) {
+        if (dist_to(k, 0.0, 0.0, 0.0, 7.0, 1.6) < 0.03) {
+            seed_found = 1;
+        }
+    }
+    TEST_ASSERT_TRUE_MESSAGE(seed_found, "the corner within 3 cm");
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+}
+
+/* With grazing joins a straight wall seen from 1 m to nearly edge-on, with
+ * a door in it, the free end of a wall in front of it and a box in front of
+ * another wall (depth jumps) give no corner but the box's own. */
+static void test_grazing_joins_add_no_corner_on_straight_walls_or_at_depth_jumps(void)
+{
+    size_t n;
+    size_t k;
+    join_grazing = 1;
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 0.0, 1.0, 9.0, 1.0) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 10.0, 1.0, 20.0, 1.0) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 8.0, -6.0, 8.0, 0.0) >= 0);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_box(&scene, 3.5, -2.5, 4.5, -1.5));
+    n = detect(0.0, 0.0, 0.0, 361u, 1.5 * PI, 0.01);
+    for (k = 0; k < n; ++k) {
+        const double d =
+            fmin(fmin(dist_to(k, 0.0, 0.0, 0.0, 3.5, -1.5), dist_to(k, 0.0, 0.0, 0.0, 3.5, -2.5)),
+                 fmin(dist_to(k, 0.0, 0.0, 0.0, 4.5, -1.5), dist_to(k, 0.0, 0.0, 0.0, 4.5, -2.5)));
+        TEST_ASSERT_TRUE_MESSAGE(d < 0.05, "only the box's corners");
+    }
 }
 
 static void test_noisy_room_gives_its_four_corners_and_nothing_else(void)
@@ -207,6 +259,8 @@ int main(void)
     RUN_TEST(test_a_lone_far_corner_is_found_at_one_degree_beams);
     RUN_TEST(test_a_corner_beyond_30_m_is_found);
     RUN_TEST(test_a_corner_behind_a_thin_post_is_found);
+    RUN_TEST(test_a_corner_onto_a_wall_seen_at_grazing_incidence_is_found_with_grazing_joins);
+    RUN_TEST(test_grazing_joins_add_no_corner_on_straight_walls_or_at_depth_jumps);
     RUN_TEST(test_noisy_room_gives_its_four_corners_and_nothing_else);
     RUN_TEST(test_straight_walls_pillars_and_curved_walls_give_no_corner);
     RUN_TEST(test_refused_calls);

@@ -699,6 +699,64 @@ static void test_null_arguments_are_refused(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_rpos_params_check(NULL));
 }
 
+/* SVED with every extension on a room corner 7 m away whose second wall is
+ * seen at 77 deg incidence (returns 0.4 m apart near the corner, wider than
+ * the radius there): with grazing joins both walls are one segment that
+ * holds every return; without, the wall's first returns break off. */
+static size_t corner_onto_grazing_wall(int join_grazing, size_t *n_valid)
+{
+    bsf_lidar_t l = bsf_lidar_default(0.0, 0.0, 0.0, 361u, 1.5 * 3.14159265358979);
+    bsf_scene_rng_t rng;
+    bsf_sved_params_t p = bsf_sved_params_default();
+    p.join_grazing = (uint8_t)join_grazing;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 7.0, 1.6, -0.5 * 3.14159265358979,
+                                                       4.0, 3.14159265358979, 4.0));
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&rng, 11u);
+    shoot(&l, &rng);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
+                                                            NULL, &n_segs, &n_wasted));
+    check_partition();
+    *n_valid = points.n_valid;
+    return n_segs;
+}
+
+static void test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segment(void)
+{
+    size_t n_valid = 0;
+    TEST_ASSERT_EQUAL_size_t(1u, corner_onto_grazing_wall(1, &n_valid));
+    TEST_ASSERT_EQUAL_size_t(0u, n_wasted);
+    TEST_ASSERT_EQUAL_size_t(n_valid, segs[0].n_points);
+    TEST_ASSERT_TRUE(n_valid > 20u);
+    TEST_ASSERT_TRUE(corner_onto_grazing_wall(0, &n_valid) > 1u || n_wasted > 0u);
+}
+
+/* A lone reading halfway across a depth jump lies on the chord of its two
+ * neighbours, but the surfaces either side do not go on along that line:
+ * grazing joins do not bridge it (mixed-pixel rejection off, so only the
+ * grazing rule could). */
+static void test_sved_grazing_joins_do_not_bridge_a_depth_jump_through_a_mixed_reading(void)
+{
+    bsf_sved_params_t p = bsf_sved_params_default();
+    size_t i;
+    p.join_grazing = 1u;
+    p.reject_mixed = 0u;
+    for (i = 0; i < 40u; ++i) {
+        ranges[i] = i < 20u ? 3.0f : 5.0f;
+    }
+    ranges[20] = 4.0f; /* between the near and the far surface */
+    points_from_ranges(40u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
+                                                            NULL, &n_segs, &n_wasted));
+    check_partition();
+    TEST_ASSERT_EQUAL_size_t(2u, n_segs);
+    TEST_ASSERT_EQUAL_size_t(0u, segs[0].first);
+    TEST_ASSERT_EQUAL_size_t(19u, segs[0].last);
+    TEST_ASSERT_EQUAL_size_t(21u, segs[1].first);
+    TEST_ASSERT_EQUAL_size_t(1u, n_wasted);
+}
+
 static void test_bad_parameters_are_refused(void)
 {
     const bsf_sved_params_t sd = bsf_sved_params_default();
@@ -731,6 +789,11 @@ static void test_bad_parameters_are_refused(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
     sp = sd;
     sp.min_segment_points = 0u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
+    TEST_ASSERT_EQUAL_UINT8(0u, sd.join_grazing);
+    TEST_ASSERT_EQUAL_UINT8(0u, bsf_sved_params_paper().join_grazing);
+    sp = sd;
+    sp.join_grazing = 2u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
 
     rp = rd;
@@ -865,6 +928,8 @@ int main(void)
     RUN_TEST(test_empty_and_all_invalid_scans_give_no_segments);
     RUN_TEST(test_single_valid_beam_is_wasted_or_kept_with_min_one);
     RUN_TEST(test_null_arguments_are_refused);
+    RUN_TEST(test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segment);
+    RUN_TEST(test_sved_grazing_joins_do_not_bridge_a_depth_jump_through_a_mixed_reading);
     RUN_TEST(test_bad_parameters_are_refused);
     RUN_TEST(test_nan_coordinates_in_hand_made_points_do_not_join);
     RUN_TEST(test_more_kept_segments_than_cap_is_a_capacity_error);

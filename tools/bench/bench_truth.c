@@ -6,7 +6,8 @@
  *
  *   bench_truth                  full table (docs/GROUND_TRUTH.md)
  *   bench_truth --quick --check  small run that fails (exit 1) when a target is missed (ctest)
- *   options: --poses N, --paper (paper-faithful configuration), --datasets DIR
+ *   options: --poses N, --paper (paper-faithful configuration), --grazing (SVED and
+ *            LC join walls seen at grazing incidence), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
@@ -66,10 +67,17 @@ static int16_t hits[BSF_MAX_POINTS];
 static bsf_truth_acc_t acc;
 
 static int paper_mode = 0;
+static int grazing_mode = 0; /* --grazing: join walls seen at grazing incidence */
 
 static bsf_params_t make_params(void)
 {
-    return bsf_params_default(paper_mode ? BSF_METHOD_FALKO_SVED_PDM : BSF_METHOD_DEFAULT);
+    bsf_params_t p =
+        bsf_params_default(paper_mode ? BSF_METHOD_FALKO_SVED_PDM : BSF_METHOD_DEFAULT);
+    if (grazing_mode) {
+        p.sved.join_grazing = 1u;
+        p.lc.join_grazing = 1u;
+    }
+    return p;
 }
 
 static double now_ns(void)
@@ -389,6 +397,8 @@ int main(int argc, char **argv)
             bsf_truth_verbose = 1;
         } else if (strcmp(argv[a], "--paper") == 0) {
             paper_mode = 1;
+        } else if (strcmp(argv[a], "--grazing") == 0) {
+            grazing_mode = 1;
         } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
             n_poses = strtol(argv[++a], NULL, 10);
         } else if (strcmp(argv[a], "--datasets") == 0 && a + 1 < argc) {
@@ -400,11 +410,11 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[a], "--noise") == 0 && a + 1 < argc) {
             only_noise = strtod(argv[++a], NULL) / 1000.0;
         } else {
-            fprintf(
-                stderr,
-                "usage: %s [--quick] [--check] [--verbose] [--paper] [--poses N] [--scene NAME] "
-                "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
-                argv[0]);
+            fprintf(stderr,
+                    "usage: %s [--quick] [--check] [--verbose] [--paper] [--grazing] [--poses N] "
+                    "[--scene NAME] "
+                    "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
+                    argv[0]);
             return 2;
         }
     }
@@ -415,8 +425,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_truth: --poses must be >= 1\n");
         return 2;
     }
-    printf("bench_truth: %s configuration, %ld poses per row\n",
-           paper_mode ? "paper-faithful" : "default", n_poses);
+    printf("bench_truth: %s configuration%s, %ld poses per row\n",
+           paper_mode ? "paper-faithful" : "default", grazing_mode ? " with grazing joins" : "",
+           n_poses);
     print_header();
     for (w = 0; w < N_SCENES; ++w) {
         if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {
