@@ -28,6 +28,9 @@
  *    through the scan's pose;
  *  - distance to the map: to the nearest point of any map curve (curves
  *    sampled 16 times per span; resolved up to 0.5 m);
+ *  - previous scan's features: each scan's valid points against the features
+ *    of the scan extracted before it (world frame); with the own-scan rows it
+ *    bounds what a single map can reach when poses disagree;
  *  - per-scan stream: what `bsf extract --reproducible` writes (a features
  *    frame per scan with its pose, a metadata frame every 64 scans); its
  *    coverage is each point's distance to its own scan's features;
@@ -75,6 +78,7 @@ typedef struct {
     /* per-scan stream */
     size_t stream_bytes, stream_gz_bytes;
     mg_hist_t own_dist;  /* raw point to its own scan's features */
+    mg_hist_t prev_dist; /* raw point to the previous scan's features: how well poses agree */
     mg_hist_t own_truth; /* per-scan feature samples to the true surface */
     /* grid */
     mg_grid_result_t grid;
@@ -269,6 +273,10 @@ static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t 
         if (mg_points_add(pts, wx, wy) != 0) {
             return -1;
         }
+    }
+    /* scratch still holds the previous extracted scan's curves (none for the first) */
+    if (scratch->n_seg > 0u) {
+        own_scan_distances(pts, first, scratch, &col->prev_dist);
     }
     if (result_curves(scratch, px, py, pth) != 0) {
         return -1;
@@ -861,6 +869,11 @@ static void print_table(void)
         printf(" %.1f |", 1000.0 * mg_hist_quantile(&col->map_dist, 0.5)));
     ROW("**map: points within 5 cm**",
         printf(" %.1f %% |", 100.0 * mg_hist_share_below(&col->map_dist, 0.05)));
+    ROW("map: points within 1 / 2 / 10 / 50 cm (where the misses lie)",
+        printf(" %.1f / %.1f / %.1f / %.1f %% |", 100.0 * mg_hist_share_below(&col->map_dist, 0.01),
+               100.0 * mg_hist_share_below(&col->map_dist, 0.02),
+               100.0 * mg_hist_share_below(&col->map_dist, 0.10),
+               100.0 * mg_hist_share_below(&col->map_dist, 0.50)));
     ROW("**map: curve to true surface p99 / max mm**",
         col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->map_truth, 0.99),
                                 1000.0 * col->map_truth.max)
@@ -891,6 +904,15 @@ static void print_table(void)
         printf(" %.1f |", 1000.0 * mg_hist_quantile(&col->own_dist, 0.5)));
     ROW("per-scan features: points within 5 cm",
         printf(" %.1f %% |", 100.0 * mg_hist_share_below(&col->own_dist, 0.05)));
+    ROW("previous scan's features: points within 1 / 2 / 5 cm (how well consecutive poses agree)",
+        printf(" %.1f / %.1f / %.1f %% |", 100.0 * mg_hist_share_below(&col->prev_dist, 0.01),
+               100.0 * mg_hist_share_below(&col->prev_dist, 0.02),
+               100.0 * mg_hist_share_below(&col->prev_dist, 0.05)));
+    ROW("per-scan features: points within 1 / 2 / 10 / 50 cm",
+        printf(" %.1f / %.1f / %.1f / %.1f %% |", 100.0 * mg_hist_share_below(&col->own_dist, 0.01),
+               100.0 * mg_hist_share_below(&col->own_dist, 0.02),
+               100.0 * mg_hist_share_below(&col->own_dist, 0.10),
+               100.0 * mg_hist_share_below(&col->own_dist, 0.50)));
     ROW("per-scan features to true surface p99 / max mm",
         col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->own_truth, 0.99),
                                 1000.0 * col->own_truth.max)
