@@ -434,6 +434,42 @@ static void test_map_frame_through_frame_decode(void)
     TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
 }
 
+/* Points on the wire: a long form, two short ones (one at the edge of the
+ * short range, one a vertex) decode to the points written; a long form that
+ * the short one could hold is malformed. */
+static void test_map_point_forms(void)
+{
+    /* header (version 2, type 3), seq 0, step 50 (5 mm); a new-feature
+     * record: tag 0, id +1 (svar 2), 3 points */
+    static const uint8_t ok[] = {0x23u, 0x00u, 0x32u, 0x00u, 0x02u, 0x03u,
+                                 /* (+100, 0): long, uvar(200 * 4) = A0 06, uvar(0) */
+                                 0xA0u, 0x06u, 0x00u,
+                                 /* (+10, -3), vertex: short, zx 20, zy 5 */
+                                 0x53u, 0x05u,
+                                 /* (-64, 0): short, zx 127, zy 0 */
+                                 0xFDu, 0x80u};
+    /* the second point as a long form: (20 * 4, vertex 1), 5 */
+    static const uint8_t bad[] = {0x23u, 0x00u, 0x32u, 0x00u, 0x02u, 0x03u, 0xA0u,
+                                  0x06u, 0x00u, 0x52u, 0x05u, 0xFDu, 0x80u};
+    int32_t q[6];
+    uint8_t v[3];
+    bsf_map_rx_init(&rx);
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, ok, sizeof ok));
+    TEST_ASSERT_EQUAL_INT(3, bsf_map_rx_feature_q(&rx, 1u, q, v, 3u));
+    TEST_ASSERT_EQUAL_INT32(100, q[0]);
+    TEST_ASSERT_EQUAL_INT32(0, q[1]);
+    TEST_ASSERT_EQUAL_INT32(110, q[2]);
+    TEST_ASSERT_EQUAL_INT32(-3, q[3]);
+    TEST_ASSERT_EQUAL_INT32(46, q[4]);
+    TEST_ASSERT_EQUAL_INT32(-3, q[5]);
+    TEST_ASSERT_EQUAL_UINT8(0u, v[0]);
+    TEST_ASSERT_EQUAL_UINT8(1u, v[1]);
+    TEST_ASSERT_EQUAL_UINT8(0u, v[2]);
+    bsf_map_rx_init(&rx);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_map_rx_apply(&rx, bad, sizeof bad));
+    TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
+}
+
 /* A small frame budget: the changes go out over several frames, in order,
  * and the receiver still ends equal to the robot's sent copy. */
 static void test_map_small_frames_carry_everything(void)
@@ -500,6 +536,7 @@ int main(void)
     RUN_TEST(test_map_revisit_sends_nothing);
     RUN_TEST(test_map_loss_then_snapshots_recover);
     RUN_TEST(test_map_frame_through_frame_decode);
+    RUN_TEST(test_map_point_forms);
     RUN_TEST(test_map_small_frames_carry_everything);
     RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();
