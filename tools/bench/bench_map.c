@@ -370,58 +370,76 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* The bytes of the final map sent once: the snapshot records of one round
- * of the round robin from id 0 over every feature the robot still holds, on
- * a copy of the map (the library has no call that writes the whole map at
- * once), in frames of a small snapshot budget so that the round's end is
- * seen within SNAP_BUDGET bytes (counted twice at most); frame headers
- * are left out. Features the
- * robot forgot are not in it: the table scales the bytes by the receiver's
- * control points over the robot's. */
+ * of the round robin over every feature the robot still holds, on a copy of
+ * the map (the library has no call that writes the whole map at once), in
+ * frames of SNAP_BUDGET snapshot bytes; frame headers are left out.
+ * Features the robot forgot are not in it: the table scales the bytes by
+ * the receiver's control points over the robot's. */
 #define SNAP_BUDGET 128u
+#define SNAP_WARMUP 8
+#define SNAP_STATES 8192
 static int map_once_bytes(column_t *col)
 {
-    const size_t n = bsf_map_feature_count(&g_map);
-    uint32_t bytes0, max_id = 0, last_next;
-    size_t i;
+    /* after the robot's pending changes are out, the snapshot round robin of
+     * a map that no longer changes is periodic in its state (next id, next
+     * point), recorded after each frame until one repeats. Within a round
+     * the state only grows (ids, then points); a state not above the one
+     * before means the round wrapped in that frame. One period holds as many
+     * whole rounds as it wraps, every feature once per round (a map smaller
+     * than one frame's budget, sent more than once per frame, reads high). */
+    static uint32_t st_next[SNAP_STATES], st_bytes[SNAP_STATES];
+    static uint16_t st_pos[SNAP_STATES], st_wraps[SNAP_STATES];
+    size_t n_st = 0;
+    unsigned wraps = 0;
     int guard = 0;
-    if (n == 0u) {
+    if (bsf_map_feature_count(&g_map) == 0u) {
         return 0;
-    }
-    for (i = 0; i < n; ++i) {
-        uint32_t id = 0;
-        if (bsf_map_feature_q(&g_map, i, NULL, NULL, 0u, &id) >= 0 && id > max_id) {
-            max_id = id;
-        }
     }
     memcpy(&g_map_copy, &g_map, sizeof g_map);
     g_map_copy.params.snapshot_budget = SNAP_BUDGET;
     g_map_copy.snapshot_next = 0u;
     g_map_copy.snapshot_pos = 0u;
-    last_next = 0u;
-    bytes0 = g_map_copy.stats.record_bytes[4];
     g_map_copy.params.frame_interval = 1u;
     memset(&g_empty, 0, sizeof g_empty);
     while (guard++ < 100000) {
         size_t len = 0;
+        size_t k;
         /* a scan without features lets the frame interval pass */
         if (bsf_map_fuse(&g_map_copy, &g_empty, &g_last_pose) < 0 ||
-            bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
+            bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK ||
+            len == 0u) {
             return -1;
         }
-        if (len == 0u) {
+        if (guard < SNAP_WARMUP || bsf_map_pending(&g_map_copy)) {
+            continue;
+        }
+        if (n_st > 0u && (g_map_copy.snapshot_next < st_next[n_st - 1u] ||
+                          (g_map_copy.snapshot_next == st_next[n_st - 1u] &&
+                           g_map_copy.snapshot_pos <= st_pos[n_st - 1u]))) {
+            ++wraps;
+        }
+        for (k = 0; k < n_st; ++k) {
+            if (st_next[k] == g_map_copy.snapshot_next && st_pos[k] == g_map_copy.snapshot_pos) {
+                const unsigned rounds = wraps - st_wraps[k];
+                if (rounds == 0u) {
+                    return -1;
+                }
+                col->map_once_bytes =
+                    (size_t)(g_map_copy.stats.record_bytes[4] - st_bytes[k]) / rounds;
+                col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
+                return 0;
+            }
+        }
+        if (n_st == SNAP_STATES) {
             return -1;
         }
-        /* the round ends at the last id or where the next round starts
-         * (within this frame: at most SNAP_BUDGET bytes counted twice) */
-        if ((g_map_copy.snapshot_pos == 0u && g_map_copy.snapshot_next > max_id) ||
-            g_map_copy.snapshot_next < last_next) {
-            break;
-        }
-        last_next = g_map_copy.snapshot_next;
+        st_next[n_st] = g_map_copy.snapshot_next;
+        st_pos[n_st] = g_map_copy.snapshot_pos;
+        st_bytes[n_st] = g_map_copy.stats.record_bytes[4];
+        st_wraps[n_st] = (uint16_t)wraps;
+        ++n_st;
     }
-    col->map_once_bytes = (size_t)(g_map_copy.stats.record_bytes[4] - bytes0);
-    col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
-    return guard < 100000 ? 0 : -1;
+    return -1;
 }
 
 /* The receiver's final map as curves; robot and receiver compared value for value. */
