@@ -34,6 +34,7 @@
 typedef struct {
     float x, y;   /* world position */
     float dx, dy; /* unit tangent */
+    float gate;   /* match distance at this sample's range, metres */
     uint8_t vertex;
 } sample_t;
 
@@ -83,6 +84,8 @@ static void gather_near(const bsf_map_t *m, near_t *nr)
 void bsf_map_params_default(bsf_map_params_t *p)
 {
     p->match_dist = 0.10f;
+    p->match_dist_near = 0.10f;
+    p->match_dist_per_m = 0.0f;
     p->match_angle = 0.5f;
     p->vertex_dist = 0.05f;
     p->ctrl_spacing = 0.25f;
@@ -103,7 +106,8 @@ static bsf_status_t check_params(const bsf_map_params_t *p, int32_t *step_code)
 {
     float code;
     if (!finite_f(p->match_dist) || !finite_f(p->match_angle) || !finite_f(p->vertex_dist) ||
-        !finite_f(p->ctrl_spacing) || !finite_f(p->send_tol) || !finite_f(p->quant_step)) {
+        !finite_f(p->ctrl_spacing) || !finite_f(p->send_tol) || !finite_f(p->quant_step) ||
+        !finite_f(p->match_dist_near) || !finite_f(p->match_dist_per_m)) {
         return BSF_ERR_PARAM;
     }
     if (p->match_dist <= 0.0f || p->match_dist > 1.0f || p->match_angle <= 0.0f ||
@@ -111,7 +115,8 @@ static bsf_status_t check_params(const bsf_map_params_t *p, int32_t *step_code)
         p->ctrl_spacing < 0.02f || p->ctrl_spacing > 2.0f || p->send_tol < 0.0f ||
         p->send_tol > 1.0f || p->quant_step < BSF_QUANT_STEP_MIN ||
         p->quant_step > BSF_QUANT_STEP_MAX || p->weight_cap < 1u || p->weight_cap > 255u ||
-        p->frame_interval < 1u || p->frame_interval > 1000u) {
+        p->frame_interval < 1u || p->frame_interval > 1000u || p->match_dist_near <= 0.0f ||
+        p->match_dist_near > 1.0f || p->match_dist_per_m < 0.0f || p->match_dist_per_m > 1.0f) {
         return BSF_ERR_PARAM;
     }
     code = floorf(p->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
@@ -556,7 +561,7 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
             near[n_near++] = g;
         }
         for (k = k0; k < k1; ++k) {
-            float best = md * md;
+            float best = s[k].gate * s[k].gate;
             size_t j;
             lab[k].feature = BSF_MAP_NONE;
             lab[k].seg = 0u;
@@ -1038,8 +1043,8 @@ static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
     }
 }
 
-static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
-                         near_t *nr)
+static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n, float sx,
+                         float sy, near_t *nr)
 {
     sample_t s[MAX_SAMPLES];
     label_t lab[MAX_SAMPLES];
@@ -1057,6 +1062,14 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     ns = sample_curve(w, vtx, n, s);
     if (ns == 0u) {
         return;
+    }
+    /* the gate grows with range: pose and range errors move far samples more */
+    for (k = 0; k < ns; ++k) {
+        const float ex = s[k].x - sx;
+        const float ey = s[k].y - sy;
+        const float g =
+            m->params.match_dist_near + m->params.match_dist_per_m * sqrtf(ex * ex + ey * ey);
+        s[k].gate = g < m->params.match_dist ? g : m->params.match_dist;
     }
     box[0] = box[1] = 3.0e38f;
     box[2] = box[3] = -3.0e38f;
@@ -1292,7 +1305,8 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
             w[j].x = pose->x + c * p->x - sn * p->y;
             w[j].y = pose->y + sn * p->x + c * p->y;
         }
-        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, &nr);
+        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, pose->x, pose->y,
+                     &nr);
     }
     return (int)scan->n_features;
 }

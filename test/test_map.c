@@ -123,6 +123,12 @@ static void test_map_rejects_bad_input(void)
     bsf_map_params_default(&p);
     p.quant_step = 0.0f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+    bsf_map_params_default(&p);
+    p.match_dist_near = 0.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+    bsf_map_params_default(&p);
+    p.match_dist_per_m = -0.01f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_init(NULL, NULL));
     start(NULL);
     scan_k(0, N_SCANS, 1u, &pose);
@@ -470,6 +476,53 @@ static void test_map_point_forms(void)
     TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
 }
 
+/* One straight piece, sensor frame: y = wall_y for x in -1 .. 1. */
+static void one_piece(float wall_y)
+{
+    unsigned k;
+    memset(&res, 0, sizeof res);
+    res.n_features = 1u;
+    res.n_ctrl = 3u;
+    res.features[0].ctrl_first = 0u;
+    res.features[0].n_ctrl = 3u;
+    for (k = 0; k < 3u; ++k) {
+        res.ctrl[k].x = -1.0f + (float)k;
+        res.ctrl[k].y = wall_y;
+    }
+}
+
+/* Map features after a wall seen three times, then a parallel surface 7 cm
+ * in front of it, both `range` metres from the sensor. */
+static size_t features_after_close_surface(const bsf_map_params_t *p, float range)
+{
+    const bsf_pose_t pose = {0.0f, 1.0f - range, 0.0f};
+    int k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, p));
+    one_piece(range);
+    for (k = 0; k < 3; ++k) {
+        TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    }
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    one_piece(range - 0.07f);
+    TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    return bsf_map_feature_count(&map);
+}
+
+/* The gate by range: near the sensor a surface 7 cm from a wall is its own
+ * feature, far away (where poses and ranges err more) the same offset is
+ * the wall's; a fixed gate of 10 cm takes it into the wall at any range. */
+static void test_map_gate_grows_with_range(void)
+{
+    bsf_map_params_t p;
+    bsf_map_params_default(&p);
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 1.0f));
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
+    p.match_dist_near = 0.04f;
+    p.match_dist_per_m = 0.005f;
+    TEST_ASSERT_EQUAL_size_t(2u, features_after_close_surface(&p, 1.0f));
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
+}
+
 /* A small frame budget: the changes go out over several frames, in order,
  * and the receiver still ends equal to the robot's sent copy. */
 static void test_map_small_frames_carry_everything(void)
@@ -537,6 +590,7 @@ int main(void)
     RUN_TEST(test_map_loss_then_snapshots_recover);
     RUN_TEST(test_map_frame_through_frame_decode);
     RUN_TEST(test_map_point_forms);
+    RUN_TEST(test_map_gate_grows_with_range);
     RUN_TEST(test_map_small_frames_carry_everything);
     RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();

@@ -50,7 +50,13 @@ BSF_BEGIN_DECLS
 /** Runtime parameters of a map (bsf_map_params_default gives the defaults). */
 typedef struct {
     float match_dist;         /**< metres, (0, 1]: a scan curve sample within this distance
-                                   of a map curve belongs to it (default 0.10) */
+                                   of a map curve belongs to it (default 0.10); the
+                                   largest gate when it depends on range (below) */
+    float match_dist_near;    /**< metres, (0, 1]: the gate of a sample at the sensor; it
+                                   grows by match_dist_per_m per metre of the sample's
+                                   range, up to match_dist (default 0.10) */
+    float match_dist_per_m;   /**< [0, 1]: that growth, metres per metre (default 0: a
+                                   fixed gate of match_dist) */
     float match_angle;        /**< radians, (0, pi/2]: largest direction difference for
                                    that (default 0.5) */
     float vertex_dist;        /**< metres, [0, match_dist]: a scan vertex this close to a map

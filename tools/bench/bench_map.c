@@ -17,7 +17,8 @@
  * every K scans (default 1; 0: none), counted apart from the map.
  * --map-param NAME=VALUE: a field of bsf_map_params_t other than the default
  * (match_dist, match_angle, vertex_dist, ctrl_spacing, send_tol, weight_cap,
- * forget_after, frame_interval), to measure a trade-off. --check: exit 1 unless every
+ * forget_after, frame_interval, match_dist_near, match_dist_per_m), to
+ * measure a trade-off. --check: exit 1 unless every
  * scan was extracted and fused, the receiver's map equals the robot's sent
  * copy feature for feature, and every figure was measured (ctest runs it on
  * a short scene).
@@ -516,9 +517,9 @@ static bsf_map_params_t g_map_params;
  * (the range is checked by bsf_map_init). */
 static int set_map_param(const char *arg)
 {
-    static const char *const names[] = {"match_dist",   "match_angle",   "vertex_dist",
-                                        "ctrl_spacing", "send_tol",      "weight_cap",
-                                        "forget_after", "frame_interval"};
+    static const char *const names[] = {
+        "match_dist", "match_angle",  "vertex_dist",    "ctrl_spacing",    "send_tol",
+        "weight_cap", "forget_after", "frame_interval", "match_dist_near", "match_dist_per_m"};
     const char *eq = strchr(arg, '=');
     char *end = NULL;
     double v;
@@ -545,6 +546,8 @@ static int set_map_param(const char *arg)
     case 5: g_map_params.weight_cap = (uint16_t)v; break;
     case 6: g_map_params.forget_after = (uint32_t)v; break;
     case 7: g_map_params.frame_interval = (uint16_t)v; break;
+    case 8: g_map_params.match_dist_near = (float)v; break;
+    case 9: g_map_params.match_dist_per_m = (float)v; break;
     default: return -1;
     }
     return 0;
