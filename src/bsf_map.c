@@ -1065,10 +1065,12 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     }
     /* the gate grows with range: pose and range errors move far samples more */
     for (k = 0; k < ns; ++k) {
-        const float ex = s[k].x - sx;
-        const float ey = s[k].y - sy;
-        const float g =
-            m->params.match_dist_near + m->params.match_dist_per_m * sqrtf(ex * ex + ey * ey);
+        float g = m->params.match_dist_near;
+        if (m->params.match_dist_per_m > 0.0f) {
+            const float ex = s[k].x - sx;
+            const float ey = s[k].y - sy;
+            g += m->params.match_dist_per_m * sqrtf(ex * ex + ey * ey);
+        }
         s[k].gate = g < m->params.match_dist ? g : m->params.match_dist;
     }
     box[0] = box[1] = 3.0e38f;
