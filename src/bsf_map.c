@@ -577,7 +577,9 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
 
 /* Refine the control points that the samples matched to map feature fs
  * cover: per point, the basis-weighted mean of the samples' normal
- * residuals, folded into its running mean (weight = observations, capped). */
+ * residuals, folded into its running mean (weight = observations, capped).
+ * Vertices too: the residuals of the two walls that meet there pull a
+ * corner placed off them (a scan's corner fit on a grazing view) onto both. */
 static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *lab, size_t ns)
 {
     acc_t acc[MAX_ACC];
@@ -643,7 +645,7 @@ static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *
     for (a = 0; a < n_acc; ++a) {
         bsf_map_ctrl_t *c = &m->ctrl[acc[a].idx];
         float w;
-        if (acc[a].a < MIN_SUPPORT || (c->flags & BSF_MAP_CF_VERTEX)) {
+        if (acc[a].a < MIN_SUPPORT) {
             continue;
         }
         w = (float)c->weight + 1.0f;
