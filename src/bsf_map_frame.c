@@ -588,6 +588,8 @@ static int put_append(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_t
     if (run == 0u) {
         return 1;
     }
+    run = bsf_map_simplify(m, f, edge, dir, run);
+    first = at_head ? m->ctrl[edge].prev : m->ctrl[edge].next;
     qx = m->ctrl[edge].qx;
     qy = m->ctrl[edge].qy;
     n = span_points(m, first, dir, run, room_of(w), NULL, &qx, &qy);
@@ -619,6 +621,7 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
         if (ripe_run(m, f, f->head, 0) < f->n_ctrl) {
             return 1; /* held back */
         }
+        (void)bsf_map_simplify(m, f, f->head, 0, (uint32_t)f->n_ctrl - 1u);
         n = span_points(m, f->head, 0, BSF_MAP_REC_MAX_POINTS, room_of(w), NULL, &qx, &qy);
         if (n < 2u) {
             return 0;

@@ -523,6 +523,60 @@ static void test_map_gate_grows_with_range(void)
     TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
 }
 
+/* Control points of the only map feature, as the receiver holds them,
+ * after a straight wall of 17 points 25 cm apart is seen three times (its
+ * points ripe) and sent. */
+static int wall_points_sent(float simplify_tol, bsf_point_t *pts, size_t cap)
+{
+    bsf_map_params_t p;
+    const bsf_pose_t pose = {0.0f, 0.0f, 0.0f};
+    size_t len = 0;
+    unsigned k;
+    int i;
+    bsf_map_params_default(&p);
+    p.frame_interval = 1u;
+    p.simplify_tol = simplify_tol;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, &p));
+    bsf_map_rx_init(&rx);
+    bsf_decoder_init(&dec);
+    memset(&res, 0, sizeof res);
+    res.n_features = 1u;
+    res.n_ctrl = 17u;
+    res.features[0].n_ctrl = 17u;
+    for (k = 0; k < 17u; ++k) {
+        res.ctrl[k].x = -2.0f + 0.25f * (float)k;
+        /* a wall a few mm from straight */
+        res.ctrl[k].y = 1.0f + ((k & 1u) ? 0.002f : -0.002f);
+    }
+    for (i = 0; i < 3; ++i) {
+        TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        (void)deliver(buf, len);
+    }
+    assert_rx_equals_sent();
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    return bsf_map_feature_ctrl(&map, 0u, 1, pts, NULL, cap, NULL);
+}
+
+/* Before points go out, a straight run keeps its ends (and one point: a
+ * feature keeps three), all on the wall; with simplify_tol 0 every point
+ * goes out. The receiver holds exactly what the robot sent either way. */
+static void test_map_straight_run_sends_its_ends(void)
+{
+    static bsf_point_t pts[64];
+    int n;
+    int k;
+    n = wall_points_sent(0.0f, pts, 64u);
+    TEST_ASSERT_EQUAL_INT(17, n);
+    n = wall_points_sent(0.01f, pts, 64u);
+    TEST_ASSERT_EQUAL_INT(3, n);
+    TEST_ASSERT_FLOAT_WITHIN(0.01f, -2.0f, pts[0].x);
+    TEST_ASSERT_FLOAT_WITHIN(0.01f, 2.0f, pts[2].x);
+    for (k = 0; k < n; ++k) {
+        TEST_ASSERT_FLOAT_WITHIN(0.01f, 1.0f, pts[k].y);
+    }
+}
+
 /* A small frame budget: the changes go out over several frames, in order,
  * and the receiver still ends equal to the robot's sent copy. */
 static void test_map_small_frames_carry_everything(void)
@@ -591,6 +645,7 @@ int main(void)
     RUN_TEST(test_map_frame_through_frame_decode);
     RUN_TEST(test_map_point_forms);
     RUN_TEST(test_map_gate_grows_with_range);
+    RUN_TEST(test_map_straight_run_sends_its_ends);
     RUN_TEST(test_map_small_frames_carry_everything);
     RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();
