@@ -17,7 +17,8 @@
  * every K scans (default 1; 0: none), counted apart from the map.
  * --map-param NAME=VALUE: a field of bsf_map_params_t other than the default
  * (match_dist, match_angle, vertex_dist, ctrl_spacing, send_tol, weight_cap,
- * forget_after, frame_interval, match_dist_near, match_dist_per_m), to
+ * forget_after, frame_interval, match_dist_near, match_dist_per_m,
+ * simplify_tol), to
  * measure a trade-off. --check: exit 1 unless every
  * scan was extracted and fused, the receiver's map equals the robot's sent
  * copy feature for feature, and every figure was measured (ctest runs it on
@@ -38,11 +39,10 @@
  *  - grid: 5 cm cells, every valid point ray-cast from its scan's sensor
  *    position (map_geom.h), gmapping's occupancy threshold, PGM gzip'd and PNG;
  *  - synthetic scenes (361 beams over 270 degrees, 1 cm range noise, true
- *    poses on a loop, tools/scene): curve to true surface over the map's
- *    curve samples; "surface seen" is the true surface hit by a valid return
- *    (2 cm bins along each shape); a corner counts as seen in a scan when
- *    bsf_truth_corner_seen says so, and as one map vertex when exactly one
- *    map vertex lies within 3 cm of it.
+ *    poses on a loop, tools/scene): curve to true surface every 1 cm along
+ *    the curves (quantiles per length of curve); "surface seen" is the true surface hit by a valid
+ * return (2 cm bins along each shape); a corner counts as seen in a scan when bsf_truth_corner_seen
+ * says so, and as one map vertex when exactly one map vertex lies within 3 cm of it.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -517,9 +517,10 @@ static bsf_map_params_t g_map_params;
  * (the range is checked by bsf_map_init). */
 static int set_map_param(const char *arg)
 {
-    static const char *const names[] = {
-        "match_dist", "match_angle",  "vertex_dist",    "ctrl_spacing",    "send_tol",
-        "weight_cap", "forget_after", "frame_interval", "match_dist_near", "match_dist_per_m"};
+    static const char *const names[] = {"match_dist",       "match_angle",    "vertex_dist",
+                                        "ctrl_spacing",     "send_tol",       "weight_cap",
+                                        "forget_after",     "frame_interval", "match_dist_near",
+                                        "match_dist_per_m", "simplify_tol"};
     const char *eq = strchr(arg, '=');
     char *end = NULL;
     double v;
@@ -548,6 +549,7 @@ static int set_map_param(const char *arg)
     case 7: g_map_params.frame_interval = (uint16_t)v; break;
     case 8: g_map_params.match_dist_near = (float)v; break;
     case 9: g_map_params.match_dist_per_m = (float)v; break;
+    case 10: g_map_params.simplify_tol = (float)v; break;
     default: return -1;
     }
     return 0;
@@ -726,6 +728,24 @@ static unsigned long g_corner_scans[MAX_CORNERS];
 static bsf_scene_corner_t g_corners[MAX_CORNERS];
 static size_t g_n_corners;
 
+/* Distances from a curve segment (x0, y0, x1, y1) to the true surface,
+ * every TRUTH_STEP along it: the quantiles are per length of curve, however
+ * many control points (and so samples) a piece has. */
+#define TRUTH_STEP 0.01
+static void add_truth(mg_hist_t *h, const bsf_scene_t *scene, const float *seg)
+{
+    const double x0 = (double)seg[0];
+    const double y0 = (double)seg[1];
+    const double dx = (double)seg[2] - x0;
+    const double dy = (double)seg[3] - y0;
+    const size_t n = (size_t)(sqrt(dx * dx + dy * dy) / TRUTH_STEP) + 1u;
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        const double t = (double)k / (double)n;
+        mg_hist_add(h, bsf_scene_distance_to_surface(scene, x0 + t * dx, y0 + t * dy, NULL));
+    }
+}
+
 static int run_scene(column_t *col, int which, long n_poses)
 {
     static bsf_scene_t scene;
@@ -792,9 +812,7 @@ static int run_scene(column_t *col, int which, long n_poses)
         } else if (t == 0) {
             size_t s;
             for (s = 0; s < scratch.n_seg; ++s) {
-                mg_hist_add(&col->own_truth,
-                            bsf_scene_distance_to_surface(&scene, (double)scratch.seg[4u * s],
-                                                          (double)scratch.seg[4u * s + 1u], NULL));
+                add_truth(&col->own_truth, &scene, &scratch.seg[4u * s]);
             }
         }
     }
@@ -807,9 +825,7 @@ static int run_scene(column_t *col, int which, long n_poses)
     }
     if (rc == 0) {
         for (m = 0; m < map.n_seg; ++m) {
-            mg_hist_add(&col->map_truth,
-                        bsf_scene_distance_to_surface(&scene, (double)map.seg[4u * m],
-                                                      (double)map.seg[4u * m + 1u], NULL));
+            add_truth(&col->map_truth, &scene, &map.seg[4u * m]);
         }
         for (m = 0; m < g_n_corners; ++m) {
             size_t v, near = 0;
