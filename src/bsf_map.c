@@ -84,13 +84,13 @@ static void gather_near(const bsf_map_t *m, near_t *nr)
 void bsf_map_params_default(bsf_map_params_t *p)
 {
     p->match_dist = 0.10f;
-    p->match_dist_near = 0.10f;
-    p->match_dist_per_m = 0.0f;
+    p->match_dist_near = 0.03f;
+    p->match_dist_per_m = 0.01f;
     p->match_angle = 0.5f;
     p->vertex_dist = 0.05f;
     p->ctrl_spacing = 0.25f;
     p->send_tol = 0.02f;
-    p->simplify_tol = 0.01f;
+    p->simplify_tol = 0.015f;
     p->quant_step = BSF_QUANT_STEP_DEFAULT;
     p->weight_cap = 32u;
     p->forget_after = 50u;
@@ -1164,6 +1164,56 @@ static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
     }
 }
 
+/* A scan corner left unmatched between samples matched to one map feature
+ * (the map's curve rounds that corner off by more than the gate): the
+ * feature's control point nearest to it, if not a chain end or a vertex and
+ * within ctrl_spacing, becomes a vertex there, as make_vertex does. */
+#define CORNER_REACH 8
+static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *lab, size_t ns,
+                                size_t k)
+{
+    const float sp = m->params.ctrl_spacing;
+    float best = sp * sp;
+    uint16_t pick = BSF_MAP_NONE;
+    uint16_t f = BSF_MAP_NONE;
+    uint16_t i;
+    long a;
+    long b;
+    for (a = (long)k - 1; a >= 0 && a >= (long)k - CORNER_REACH; --a) {
+        if (lab[a].feature != BSF_MAP_NONE) {
+            f = lab[a].feature;
+            break;
+        }
+    }
+    for (b = (long)k + 1; b < (long)ns && b <= (long)k + CORNER_REACH; ++b) {
+        if (lab[b].feature != BSF_MAP_NONE) {
+            break;
+        }
+    }
+    if (f == BSF_MAP_NONE || b >= (long)ns || b > (long)k + CORNER_REACH || lab[b].feature != f) {
+        return;
+    }
+    for (i = m->features[f].head; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
+        const bsf_map_ctrl_t *c = &m->ctrl[i];
+        const float d2 = (c->x - s[k].x) * (c->x - s[k].x) + (c->y - s[k].y) * (c->y - s[k].y);
+        if (d2 < best && (c->flags & BSF_MAP_CF_VERTEX)) {
+            return; /* the map has a corner there */
+        }
+        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && d2 < best) {
+            best = d2;
+            pick = i;
+        }
+    }
+    if (pick != BSF_MAP_NONE) {
+        bsf_map_ctrl_t *c = &m->ctrl[pick];
+        c->x = s[k].x;
+        c->y = s[k].y;
+        c->flags |= BSF_MAP_CF_VERTEX;
+        c->weight = 1u;
+        ++m->stats.n_vertex_made;
+    }
+}
+
 static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n, float sx,
                          float sy, near_t *nr)
 {
@@ -1251,6 +1301,8 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     for (k = 0; k < ns; ++k) {
         if (s[k].vertex && lab[k].feature != BSF_MAP_NONE) {
             make_vertex(m, &lab[k], &s[k]);
+        } else if (s[k].vertex) {
+            make_vertex_between(m, s, lab, ns, k);
         }
     }
     /* refine every feature the samples matched, once each */

@@ -508,18 +508,19 @@ static size_t features_after_close_surface(const bsf_map_params_t *p, float rang
     return bsf_map_feature_count(&map);
 }
 
-/* The gate by range: near the sensor a surface 7 cm from a wall is its own
- * feature, far away (where poses and ranges err more) the same offset is
- * the wall's; a fixed gate of 10 cm takes it into the wall at any range. */
+/* The gate by range (the defaults: 3 cm + 1 cm per metre): near the sensor
+ * a surface 7 cm from a wall is its own feature, far away (where poses and
+ * ranges err more) the same offset is the wall's; a fixed gate of 10 cm
+ * takes it into the wall at any range. */
 static void test_map_gate_grows_with_range(void)
 {
     bsf_map_params_t p;
     bsf_map_params_default(&p);
-    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 1.0f));
-    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
-    p.match_dist_near = 0.04f;
-    p.match_dist_per_m = 0.005f;
     TEST_ASSERT_EQUAL_size_t(2u, features_after_close_surface(&p, 1.0f));
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
+    p.match_dist_near = 0.10f;
+    p.match_dist_per_m = 0.0f;
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 1.0f));
     TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
 }
 
