@@ -34,6 +34,7 @@
 typedef struct {
     float x, y;   /* world position */
     float dx, dy; /* unit tangent */
+    float gate;   /* match distance at this sample's range, metres */
     uint8_t vertex;
 } sample_t;
 
@@ -83,10 +84,13 @@ static void gather_near(const bsf_map_t *m, near_t *nr)
 void bsf_map_params_default(bsf_map_params_t *p)
 {
     p->match_dist = 0.10f;
+    p->match_dist_near = 0.03f;
+    p->match_dist_per_m = 0.01f;
     p->match_angle = 0.5f;
     p->vertex_dist = 0.05f;
     p->ctrl_spacing = 0.25f;
     p->send_tol = 0.02f;
+    p->simplify_tol = 0.015f;
     p->quant_step = BSF_QUANT_STEP_DEFAULT;
     p->weight_cap = 32u;
     p->forget_after = 50u;
@@ -103,7 +107,9 @@ static bsf_status_t check_params(const bsf_map_params_t *p, int32_t *step_code)
 {
     float code;
     if (!finite_f(p->match_dist) || !finite_f(p->match_angle) || !finite_f(p->vertex_dist) ||
-        !finite_f(p->ctrl_spacing) || !finite_f(p->send_tol) || !finite_f(p->quant_step)) {
+        !finite_f(p->ctrl_spacing) || !finite_f(p->send_tol) || !finite_f(p->quant_step) ||
+        !finite_f(p->match_dist_near) || !finite_f(p->match_dist_per_m) ||
+        !finite_f(p->simplify_tol)) {
         return BSF_ERR_PARAM;
     }
     if (p->match_dist <= 0.0f || p->match_dist > 1.0f || p->match_angle <= 0.0f ||
@@ -111,7 +117,9 @@ static bsf_status_t check_params(const bsf_map_params_t *p, int32_t *step_code)
         p->ctrl_spacing < 0.02f || p->ctrl_spacing > 2.0f || p->send_tol < 0.0f ||
         p->send_tol > 1.0f || p->quant_step < BSF_QUANT_STEP_MIN ||
         p->quant_step > BSF_QUANT_STEP_MAX || p->weight_cap < 1u || p->weight_cap > 255u ||
-        p->frame_interval < 1u || p->frame_interval > 1000u) {
+        p->frame_interval < 1u || p->frame_interval > 1000u || p->match_dist_near <= 0.0f ||
+        p->match_dist_near > 1.0f || p->match_dist_per_m < 0.0f || p->match_dist_per_m > 1.0f ||
+        p->simplify_tol < 0.0f || p->simplify_tol > 0.5f) {
         return BSF_ERR_PARAM;
     }
     code = floorf(p->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
@@ -230,6 +238,122 @@ static size_t chain_expanded(const bsf_map_t *m, const bsf_map_feature_t *f)
 }
 
 /* 1 when every point is sent and within the tolerance of its sent value. */
+/* Points of one run bsf_map_simplify looks at, and how many points one
+ * chord may replace (bounds the work: SIMPLIFY_RUN x SIMPLIFY_SPAN). */
+#define SIMPLIFY_RUN 128u
+#define SIMPLIFY_SPAN 32u
+
+static float seg_dist2(const bsf_map_ctrl_t *p, const bsf_map_ctrl_t *a, const bsf_map_ctrl_t *b)
+{
+    const float dx = b->x - a->x;
+    const float dy = b->y - a->y;
+    const float l2 = dx * dx + dy * dy;
+    float t = 0.0f;
+    float ex;
+    float ey;
+    if (l2 > 1e-12f) {
+        t = ((p->x - a->x) * dx + (p->y - a->y) * dy) / l2;
+        t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    }
+    ex = a->x + t * dx - p->x;
+    ey = a->y + t * dy - p->y;
+    return ex * ex + ey * ey;
+}
+
+/* How far the curve passes from control point p between its neighbours a
+ * and b: a quadratic B-spline misses an interior point by about a quarter
+ * of its distance from the line through the neighbours (0 at a vertex or a
+ * chain end, which the curve goes through). */
+static float curve_gap(const bsf_map_t *m, uint16_t a, uint16_t p, uint16_t b)
+{
+    const bsf_map_ctrl_t *ca;
+    const bsf_map_ctrl_t *cp = &m->ctrl[p];
+    const bsf_map_ctrl_t *cb;
+    float dx;
+    float dy;
+    float l;
+    if (a == BSF_MAP_NONE || b == BSF_MAP_NONE || (cp->flags & BSF_MAP_CF_VERTEX)) {
+        return 0.0f;
+    }
+    ca = &m->ctrl[a];
+    cb = &m->ctrl[b];
+    dx = cb->x - ca->x;
+    dy = cb->y - ca->y;
+    l = sqrtf(dx * dx + dy * dy);
+    if (l < 1e-6f) {
+        return 0.0f;
+    }
+    return 0.25f * fabsf(dx * (cp->y - ca->y) - dy * (cp->x - ca->x)) / l;
+}
+
+uint32_t bsf_map_simplify(bsf_map_t *m, bsf_map_feature_t *f, uint16_t anchor, int dir, uint32_t n)
+{
+    const float tol2 = m->params.simplify_tol * m->params.simplify_tol;
+    uint16_t run[SIMPLIFY_RUN + 1u];
+    uint8_t keep[SIMPLIFY_RUN + 1u];
+    uint32_t len = 0;
+    uint32_t removed = 0;
+    uint32_t a = 0;
+    uint32_t k;
+    uint16_t i = anchor;
+    if (tol2 <= 0.0f || (f->flags & BSF_MAP_FF_OP) || n < 2u) {
+        return n;
+    }
+    run[len++] = anchor;
+    while (len <= n && len <= SIMPLIFY_RUN) {
+        i = dir ? m->ctrl[i].prev : m->ctrl[i].next;
+        if (i == BSF_MAP_NONE) {
+            return n; /* cannot happen: the caller counted the run */
+        }
+        run[len++] = i;
+    }
+    memset(keep, 1, len);
+    /* greedy: from the kept point a, the farthest b whose chord holds every
+     * point between within the tolerance, and leaves the curve near the
+     * chord's ends (where it turns into the neighbouring legs) within it */
+    while (a + 1u < len) {
+        uint32_t b = a + 1u;
+        /* the point kept before a (chain order), fixed by now */
+        const uint16_t before = dir ? m->ctrl[run[a]].next : m->ctrl[run[a]].prev;
+        while (b + 1u < len && b - a < SIMPLIFY_SPAN) {
+            const bsf_map_ctrl_t *cb = &m->ctrl[run[b]];
+            const uint16_t e = run[b + 1u];
+            const bsf_map_ctrl_t *ce = &m->ctrl[e];
+            const uint16_t after = dir ? ce->prev : ce->next;
+            int ok = !(cb->flags & (BSF_MAP_CF_VERTEX | BSF_MAP_CF_SENT)) &&
+                     cb->prev != BSF_MAP_NONE && cb->next != BSF_MAP_NONE &&
+                     curve_gap(m, before, run[a], e) <= m->params.simplify_tol &&
+                     curve_gap(m, run[a], e, after) <= m->params.simplify_tol;
+            for (k = a + 1u; ok && k <= b; ++k) {
+                ok = seg_dist2(&m->ctrl[run[k]], &m->ctrl[run[a]], ce) <= tol2;
+            }
+            if (!ok) {
+                break;
+            }
+            ++b;
+        }
+        for (k = a + 1u; k < b; ++k) {
+            keep[k] = 0u;
+        }
+        a = b;
+    }
+    /* never below 3 points */
+    for (k = 1; k < len && f->n_ctrl - removed > 3u; ++k) {
+        if (!keep[k]) {
+            bsf_map_ctrl_t *c = &m->ctrl[run[k]];
+            m->ctrl[c->prev].next = c->next;
+            m->ctrl[c->next].prev = c->prev;
+            c->next = m->free_ctrl;
+            c->prev = BSF_MAP_NONE;
+            m->free_ctrl = run[k];
+            ++m->n_free_ctrl;
+            ++removed;
+        }
+    }
+    f->n_ctrl = (uint16_t)(f->n_ctrl - removed);
+    return n - removed;
+}
+
 int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f)
 {
     const float tol = m->params.send_tol;
@@ -556,7 +680,7 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
             near[n_near++] = g;
         }
         for (k = k0; k < k1; ++k) {
-            float best = md * md;
+            float best = s[k].gate * s[k].gate;
             size_t j;
             lab[k].feature = BSF_MAP_NONE;
             lab[k].seg = 0u;
@@ -572,7 +696,9 @@ static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, labe
 
 /* Refine the control points that the samples matched to map feature fs
  * cover: per point, the basis-weighted mean of the samples' normal
- * residuals, folded into its running mean (weight = observations, capped). */
+ * residuals, folded into its running mean (weight = observations, capped).
+ * Vertices too: the residuals of the two walls that meet there pull a
+ * corner placed off them (a scan's corner fit on a grazing view) onto both. */
 static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *lab, size_t ns)
 {
     acc_t acc[MAX_ACC];
@@ -638,7 +764,7 @@ static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *
     for (a = 0; a < n_acc; ++a) {
         bsf_map_ctrl_t *c = &m->ctrl[acc[a].idx];
         float w;
-        if (acc[a].a < MIN_SUPPORT || (c->flags & BSF_MAP_CF_VERTEX)) {
+        if (acc[a].a < MIN_SUPPORT) {
             continue;
         }
         w = (float)c->weight + 1.0f;
@@ -1038,8 +1164,58 @@ static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
     }
 }
 
-static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
-                         near_t *nr)
+/* A scan corner left unmatched between samples matched to one map feature
+ * (the map's curve rounds that corner off by more than the gate): the
+ * feature's control point nearest to it, if not a chain end or a vertex and
+ * within ctrl_spacing, becomes a vertex there, as make_vertex does. */
+#define CORNER_REACH 8
+static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *lab, size_t ns,
+                                size_t k)
+{
+    const float sp = m->params.ctrl_spacing;
+    float best = sp * sp;
+    uint16_t pick = BSF_MAP_NONE;
+    uint16_t f = BSF_MAP_NONE;
+    uint16_t i;
+    long a;
+    long b;
+    for (a = (long)k - 1; a >= 0 && a >= (long)k - CORNER_REACH; --a) {
+        if (lab[a].feature != BSF_MAP_NONE) {
+            f = lab[a].feature;
+            break;
+        }
+    }
+    for (b = (long)k + 1; b < (long)ns && b <= (long)k + CORNER_REACH; ++b) {
+        if (lab[b].feature != BSF_MAP_NONE) {
+            break;
+        }
+    }
+    if (f == BSF_MAP_NONE || b >= (long)ns || b > (long)k + CORNER_REACH || lab[b].feature != f) {
+        return;
+    }
+    for (i = m->features[f].head; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
+        const bsf_map_ctrl_t *c = &m->ctrl[i];
+        const float d2 = (c->x - s[k].x) * (c->x - s[k].x) + (c->y - s[k].y) * (c->y - s[k].y);
+        if (d2 < best && (c->flags & BSF_MAP_CF_VERTEX)) {
+            return; /* the map has a corner there */
+        }
+        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && d2 < best) {
+            best = d2;
+            pick = i;
+        }
+    }
+    if (pick != BSF_MAP_NONE) {
+        bsf_map_ctrl_t *c = &m->ctrl[pick];
+        c->x = s[k].x;
+        c->y = s[k].y;
+        c->flags |= BSF_MAP_CF_VERTEX;
+        c->weight = 1u;
+        ++m->stats.n_vertex_made;
+    }
+}
+
+static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n, float sx,
+                         float sy, near_t *nr)
 {
     sample_t s[MAX_SAMPLES];
     label_t lab[MAX_SAMPLES];
@@ -1057,6 +1233,16 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     ns = sample_curve(w, vtx, n, s);
     if (ns == 0u) {
         return;
+    }
+    /* the gate grows with range: pose and range errors move far samples more */
+    for (k = 0; k < ns; ++k) {
+        float g = m->params.match_dist_near;
+        if (m->params.match_dist_per_m > 0.0f) {
+            const float ex = s[k].x - sx;
+            const float ey = s[k].y - sy;
+            g += m->params.match_dist_per_m * sqrtf(ex * ex + ey * ey);
+        }
+        s[k].gate = g < m->params.match_dist ? g : m->params.match_dist;
     }
     box[0] = box[1] = 3.0e38f;
     box[2] = box[3] = -3.0e38f;
@@ -1115,6 +1301,8 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     for (k = 0; k < ns; ++k) {
         if (s[k].vertex && lab[k].feature != BSF_MAP_NONE) {
             make_vertex(m, &lab[k], &s[k]);
+        } else if (s[k].vertex) {
+            make_vertex_between(m, s, lab, ns, k);
         }
     }
     /* refine every feature the samples matched, once each */
@@ -1292,7 +1480,8 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
             w[j].x = pose->x + c * p->x - sn * p->y;
             w[j].y = pose->y + sn * p->x + c * p->y;
         }
-        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, &nr);
+        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, pose->x, pose->y,
+                     &nr);
     }
     return (int)scan->n_features;
 }

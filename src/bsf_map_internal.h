@@ -72,6 +72,14 @@ static inline int bsf_map_ctrl_moved(const bsf_map_ctrl_t *c, float step, float 
  * from its sent value: nothing of it waits for a frame. */
 int bsf_map_chain_clean(const bsf_map_t *m, const bsf_map_feature_t *f);
 
+/* Before points go out for the first time: of the n points that follow
+ * `anchor` (along next, or prev when dir is 1), drop those strictly inside
+ * the run that are unsent, not vertices, and within params.simplify_tol of
+ * the chord between the points kept on either side (the last of the n is
+ * kept). A straight wall then costs its ends, not a point every
+ * ctrl_spacing. Returns how many of the n remain. */
+uint32_t bsf_map_simplify(bsf_map_t *m, bsf_map_feature_t *f, uint16_t anchor, int dir, uint32_t n);
+
 /* Syntax of a map payload (no receiver state): every record well formed,
  * nothing left over. Sets *seq. Returns BSF_OK or BSF_ERR_FORMAT. */
 bsf_status_t bsf_map_frame_check(const uint8_t *payload, size_t len, uint32_t *seq);

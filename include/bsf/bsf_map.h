@@ -48,7 +48,13 @@ BSF_BEGIN_DECLS
 /** Runtime parameters of a map (bsf_map_params_default gives the defaults). */
 typedef struct {
     float match_dist;         /**< metres, (0, 1]: a scan curve sample within this distance
-                                   of a map curve belongs to it (default 0.10) */
+                                   of a map curve belongs to it (default 0.10); the
+                                   largest gate when it depends on range (below) */
+    float match_dist_near;    /**< metres, (0, 1]: the gate of a sample at the sensor; it
+                                   grows by match_dist_per_m per metre of the sample's
+                                   range, up to match_dist (default 0.03) */
+    float match_dist_per_m;   /**< [0, 1]: that growth, metres per metre (default 0.01;
+                                   0: a fixed gate) */
     float match_angle;        /**< radians, (0, pi/2]: largest direction difference for
                                    that (default 0.5) */
     float vertex_dist;        /**< metres, [0, match_dist]: a scan vertex this close to a map
@@ -58,6 +64,10 @@ typedef struct {
     float send_tol;           /**< metres, [0, 1]: a control point is re-sent when its fused
                                    position is farther than this from the value the receiver
                                    holds (default 0.02) */
+    float simplify_tol;       /**< metres, [0, 0.5]: before points are first sent, those
+                                   within this of the chord of their kept neighbours are
+                                   dropped (not vertices, not chain ends; 0: keep all;
+                                   default 0.015) */
     float quant_step;         /**< metres, [BSF_QUANT_STEP_MIN, BSF_QUANT_STEP_MAX], rounded
                                    to 0.1 mm: the wire's unit of control points (default 0.005) */
     uint16_t weight_cap;      /**< 1..255: observation weight at which a control point's

@@ -123,6 +123,12 @@ static void test_map_rejects_bad_input(void)
     bsf_map_params_default(&p);
     p.quant_step = 0.0f;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+    bsf_map_params_default(&p);
+    p.match_dist_near = 0.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
+    bsf_map_params_default(&p);
+    p.match_dist_per_m = -0.01f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_map_init(&map, &p));
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_init(NULL, NULL));
     start(NULL);
     scan_k(0, N_SCANS, 1u, &pose);
@@ -434,6 +440,144 @@ static void test_map_frame_through_frame_decode(void)
     TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
 }
 
+/* Points on the wire: a long form, two short ones (one at the edge of the
+ * short range, one a vertex) decode to the points written; a long form that
+ * the short one could hold is malformed. */
+static void test_map_point_forms(void)
+{
+    /* header (version 2, type 3), seq 0, step 50 (5 mm); a new-feature
+     * record: tag 0, id +1 (svar 2), 3 points */
+    static const uint8_t ok[] = {0x23u, 0x00u, 0x32u, 0x00u, 0x02u, 0x03u,
+                                 /* (+100, 0): long, uvar(200 * 4) = A0 06, uvar(0) */
+                                 0xA0u, 0x06u, 0x00u,
+                                 /* (+10, -3), vertex: short, zx 20, zy 5 */
+                                 0x53u, 0x05u,
+                                 /* (-64, 0): short, zx 127, zy 0 */
+                                 0xFDu, 0x80u};
+    /* the second point as a long form: (20 * 4, vertex 1), 5 */
+    static const uint8_t bad[] = {0x23u, 0x00u, 0x32u, 0x00u, 0x02u, 0x03u, 0xA0u,
+                                  0x06u, 0x00u, 0x52u, 0x05u, 0xFDu, 0x80u};
+    int32_t q[6];
+    uint8_t v[3];
+    bsf_map_rx_init(&rx);
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, ok, sizeof ok));
+    TEST_ASSERT_EQUAL_INT(3, bsf_map_rx_feature_q(&rx, 1u, q, v, 3u));
+    TEST_ASSERT_EQUAL_INT32(100, q[0]);
+    TEST_ASSERT_EQUAL_INT32(0, q[1]);
+    TEST_ASSERT_EQUAL_INT32(110, q[2]);
+    TEST_ASSERT_EQUAL_INT32(-3, q[3]);
+    TEST_ASSERT_EQUAL_INT32(46, q[4]);
+    TEST_ASSERT_EQUAL_INT32(-3, q[5]);
+    TEST_ASSERT_EQUAL_UINT8(0u, v[0]);
+    TEST_ASSERT_EQUAL_UINT8(1u, v[1]);
+    TEST_ASSERT_EQUAL_UINT8(0u, v[2]);
+    bsf_map_rx_init(&rx);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_map_rx_apply(&rx, bad, sizeof bad));
+    TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
+}
+
+/* One straight piece, sensor frame: y = wall_y for x in -1 .. 1. */
+static void one_piece(float wall_y)
+{
+    unsigned k;
+    memset(&res, 0, sizeof res);
+    res.n_features = 1u;
+    res.n_ctrl = 3u;
+    res.features[0].ctrl_first = 0u;
+    res.features[0].n_ctrl = 3u;
+    for (k = 0; k < 3u; ++k) {
+        res.ctrl[k].x = -1.0f + (float)k;
+        res.ctrl[k].y = wall_y;
+    }
+}
+
+/* Map features after a wall seen three times, then a parallel surface 7 cm
+ * in front of it, both `range` metres from the sensor. */
+static size_t features_after_close_surface(const bsf_map_params_t *p, float range)
+{
+    const bsf_pose_t pose = {0.0f, 1.0f - range, 0.0f};
+    int k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, p));
+    one_piece(range);
+    for (k = 0; k < 3; ++k) {
+        TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    }
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    one_piece(range - 0.07f);
+    TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    return bsf_map_feature_count(&map);
+}
+
+/* The gate by range (the defaults: 3 cm + 1 cm per metre): near the sensor
+ * a surface 7 cm from a wall is its own feature, far away (where poses and
+ * ranges err more) the same offset is the wall's; a fixed gate of 10 cm
+ * takes it into the wall at any range. */
+static void test_map_gate_grows_with_range(void)
+{
+    bsf_map_params_t p;
+    bsf_map_params_default(&p);
+    TEST_ASSERT_EQUAL_size_t(2u, features_after_close_surface(&p, 1.0f));
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
+    p.match_dist_near = 0.10f;
+    p.match_dist_per_m = 0.0f;
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 1.0f));
+    TEST_ASSERT_EQUAL_size_t(1u, features_after_close_surface(&p, 9.0f));
+}
+
+/* Control points of the only map feature, as the receiver holds them,
+ * after a straight wall of 17 points 25 cm apart is seen three times (its
+ * points ripe) and sent. */
+static int wall_points_sent(float simplify_tol, bsf_point_t *pts, size_t cap)
+{
+    bsf_map_params_t p;
+    const bsf_pose_t pose = {0.0f, 0.0f, 0.0f};
+    size_t len = 0;
+    unsigned k;
+    int i;
+    bsf_map_params_default(&p);
+    p.frame_interval = 1u;
+    p.simplify_tol = simplify_tol;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, &p));
+    bsf_map_rx_init(&rx);
+    bsf_decoder_init(&dec);
+    memset(&res, 0, sizeof res);
+    res.n_features = 1u;
+    res.n_ctrl = 17u;
+    res.features[0].n_ctrl = 17u;
+    for (k = 0; k < 17u; ++k) {
+        res.ctrl[k].x = -2.0f + 0.25f * (float)k;
+        /* a wall a few mm from straight */
+        res.ctrl[k].y = 1.0f + ((k & 1u) ? 0.002f : -0.002f);
+    }
+    for (i = 0; i < 3; ++i) {
+        TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
+        (void)deliver(buf, len);
+    }
+    assert_rx_equals_sent();
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    return bsf_map_feature_ctrl(&map, 0u, 1, pts, NULL, cap, NULL);
+}
+
+/* Before points go out, a straight run keeps its ends (and one point: a
+ * feature keeps three), all on the wall; with simplify_tol 0 every point
+ * goes out. The receiver holds exactly what the robot sent either way. */
+static void test_map_straight_run_sends_its_ends(void)
+{
+    static bsf_point_t pts[64];
+    int n;
+    int k;
+    n = wall_points_sent(0.0f, pts, 64u);
+    TEST_ASSERT_EQUAL_INT(17, n);
+    n = wall_points_sent(0.01f, pts, 64u);
+    TEST_ASSERT_EQUAL_INT(3, n);
+    TEST_ASSERT_FLOAT_WITHIN(0.01f, -2.0f, pts[0].x);
+    TEST_ASSERT_FLOAT_WITHIN(0.01f, 2.0f, pts[2].x);
+    for (k = 0; k < n; ++k) {
+        TEST_ASSERT_FLOAT_WITHIN(0.01f, 1.0f, pts[k].y);
+    }
+}
+
 /* A small frame budget: the changes go out over several frames, in order,
  * and the receiver still ends equal to the robot's sent copy. */
 static void test_map_small_frames_carry_everything(void)
@@ -500,6 +644,9 @@ int main(void)
     RUN_TEST(test_map_revisit_sends_nothing);
     RUN_TEST(test_map_loss_then_snapshots_recover);
     RUN_TEST(test_map_frame_through_frame_decode);
+    RUN_TEST(test_map_point_forms);
+    RUN_TEST(test_map_gate_grows_with_range);
+    RUN_TEST(test_map_straight_run_sends_its_ends);
     RUN_TEST(test_map_small_frames_carry_everything);
     RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();

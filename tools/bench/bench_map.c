@@ -17,7 +17,9 @@
  * every K scans (default 1; 0: none), counted apart from the map.
  * --map-param NAME=VALUE: a field of bsf_map_params_t other than the default
  * (match_dist, match_angle, vertex_dist, ctrl_spacing, send_tol, weight_cap,
- * forget_after, frame_interval), to measure a trade-off. --check: exit 1 unless every
+ * forget_after, frame_interval, match_dist_near, match_dist_per_m,
+ * simplify_tol), to
+ * measure a trade-off. --check: exit 1 unless every
  * scan was extracted and fused, the receiver's map equals the robot's sent
  * copy feature for feature, and every figure was measured (ctest runs it on
  * a short scene).
@@ -28,17 +30,19 @@
  *    through the scan's pose;
  *  - distance to the map: to the nearest point of any map curve (curves
  *    sampled 16 times per span; resolved up to 0.5 m);
+ *  - previous scan's features: each scan's valid points against the features
+ *    of the scan extracted before it (world frame); with the own-scan rows it
+ *    bounds what a single map can reach when poses disagree;
  *  - per-scan stream: what `bsf extract --reproducible` writes (a features
  *    frame per scan with its pose, a metadata frame every 64 scans); its
  *    coverage is each point's distance to its own scan's features;
  *  - grid: 5 cm cells, every valid point ray-cast from its scan's sensor
  *    position (map_geom.h), gmapping's occupancy threshold, PGM gzip'd and PNG;
  *  - synthetic scenes (361 beams over 270 degrees, 1 cm range noise, true
- *    poses on a loop, tools/scene): curve to true surface over the map's
- *    curve samples; "surface seen" is the true surface hit by a valid return
- *    (2 cm bins along each shape); a corner counts as seen in a scan when
- *    bsf_truth_corner_seen says so, and as one map vertex when exactly one
- *    map vertex lies within 3 cm of it.
+ *    poses on a loop, tools/scene): curve to true surface every 1 cm along
+ *    the curves (quantiles per length of curve); "surface seen" is the true surface hit by a valid
+ * return (2 cm bins along each shape); a corner counts as seen in a scan when bsf_truth_corner_seen
+ * says so, and as one map vertex when exactly one map vertex lies within 3 cm of it.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -75,6 +79,7 @@ typedef struct {
     /* per-scan stream */
     size_t stream_bytes, stream_gz_bytes;
     mg_hist_t own_dist;  /* raw point to its own scan's features */
+    mg_hist_t prev_dist; /* raw point to the previous scan's features: how well poses agree */
     mg_hist_t own_truth; /* per-scan feature samples to the true surface */
     /* grid */
     mg_grid_result_t grid;
@@ -270,6 +275,10 @@ static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t 
             return -1;
         }
     }
+    /* scratch still holds the previous extracted scan's curves (none for the first) */
+    if (scratch->n_seg > 0u) {
+        own_scan_distances(pts, first, scratch, &col->prev_dist);
+    }
     if (result_curves(scratch, px, py, pth) != 0) {
         return -1;
     }
@@ -362,58 +371,76 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* The bytes of the final map sent once: the snapshot records of one round
- * of the round robin from id 0 over every feature the robot still holds, on
- * a copy of the map (the library has no call that writes the whole map at
- * once), in frames of a small snapshot budget so that the round's end is
- * seen within SNAP_BUDGET bytes (counted twice at most); frame headers
- * are left out. Features the
- * robot forgot are not in it: the table scales the bytes by the receiver's
- * control points over the robot's. */
+ * of the round robin over every feature the robot still holds, on a copy of
+ * the map (the library has no call that writes the whole map at once), in
+ * frames of SNAP_BUDGET snapshot bytes; frame headers are left out.
+ * Features the robot forgot are not in it: the table scales the bytes by
+ * the receiver's control points over the robot's. */
 #define SNAP_BUDGET 128u
+#define SNAP_WARMUP 8
+#define SNAP_STATES 8192
 static int map_once_bytes(column_t *col)
 {
-    const size_t n = bsf_map_feature_count(&g_map);
-    uint32_t bytes0, max_id = 0, last_next;
-    size_t i;
+    /* after the robot's pending changes are out, the snapshot round robin of
+     * a map that no longer changes is periodic in its state (next id, next
+     * point), recorded after each frame until one repeats. Within a round
+     * the state only grows (ids, then points); a state not above the one
+     * before means the round wrapped in that frame. One period holds as many
+     * whole rounds as it wraps, every feature once per round (a map smaller
+     * than one frame's budget, sent more than once per frame, reads high). */
+    static uint32_t st_next[SNAP_STATES], st_bytes[SNAP_STATES];
+    static uint16_t st_pos[SNAP_STATES], st_wraps[SNAP_STATES];
+    size_t n_st = 0;
+    unsigned wraps = 0;
     int guard = 0;
-    if (n == 0u) {
+    if (bsf_map_feature_count(&g_map) == 0u) {
         return 0;
-    }
-    for (i = 0; i < n; ++i) {
-        uint32_t id = 0;
-        if (bsf_map_feature_q(&g_map, i, NULL, NULL, 0u, &id) >= 0 && id > max_id) {
-            max_id = id;
-        }
     }
     memcpy(&g_map_copy, &g_map, sizeof g_map);
     g_map_copy.params.snapshot_budget = SNAP_BUDGET;
     g_map_copy.snapshot_next = 0u;
     g_map_copy.snapshot_pos = 0u;
-    last_next = 0u;
-    bytes0 = g_map_copy.stats.record_bytes[4];
     g_map_copy.params.frame_interval = 1u;
     memset(&g_empty, 0, sizeof g_empty);
     while (guard++ < 100000) {
         size_t len = 0;
+        size_t k;
         /* a scan without features lets the frame interval pass */
         if (bsf_map_fuse(&g_map_copy, &g_empty, &g_last_pose) < 0 ||
-            bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK) {
+            bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK ||
+            len == 0u) {
             return -1;
         }
-        if (len == 0u) {
+        if (guard < SNAP_WARMUP || bsf_map_pending(&g_map_copy)) {
+            continue;
+        }
+        if (n_st > 0u && (g_map_copy.snapshot_next < st_next[n_st - 1u] ||
+                          (g_map_copy.snapshot_next == st_next[n_st - 1u] &&
+                           g_map_copy.snapshot_pos <= st_pos[n_st - 1u]))) {
+            ++wraps;
+        }
+        for (k = 0; k < n_st; ++k) {
+            if (st_next[k] == g_map_copy.snapshot_next && st_pos[k] == g_map_copy.snapshot_pos) {
+                const unsigned rounds = wraps - st_wraps[k];
+                if (rounds == 0u) {
+                    return -1;
+                }
+                col->map_once_bytes =
+                    (size_t)(g_map_copy.stats.record_bytes[4] - st_bytes[k]) / rounds;
+                col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
+                return 0;
+            }
+        }
+        if (n_st == SNAP_STATES) {
             return -1;
         }
-        /* the round ends at the last id or where the next round starts
-         * (within this frame: at most SNAP_BUDGET bytes counted twice) */
-        if ((g_map_copy.snapshot_pos == 0u && g_map_copy.snapshot_next > max_id) ||
-            g_map_copy.snapshot_next < last_next) {
-            break;
-        }
-        last_next = g_map_copy.snapshot_next;
+        st_next[n_st] = g_map_copy.snapshot_next;
+        st_pos[n_st] = g_map_copy.snapshot_pos;
+        st_bytes[n_st] = g_map_copy.stats.record_bytes[4];
+        st_wraps[n_st] = (uint16_t)wraps;
+        ++n_st;
     }
-    col->map_once_bytes = (size_t)(g_map_copy.stats.record_bytes[4] - bytes0);
-    col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
-    return guard < 100000 ? 0 : -1;
+    return -1;
 }
 
 /* The receiver's final map as curves; robot and receiver compared value for value. */
@@ -490,9 +517,10 @@ static bsf_map_params_t g_map_params;
  * (the range is checked by bsf_map_init). */
 static int set_map_param(const char *arg)
 {
-    static const char *const names[] = {"match_dist",   "match_angle",   "vertex_dist",
-                                        "ctrl_spacing", "send_tol",      "weight_cap",
-                                        "forget_after", "frame_interval"};
+    static const char *const names[] = {"match_dist",       "match_angle",    "vertex_dist",
+                                        "ctrl_spacing",     "send_tol",       "weight_cap",
+                                        "forget_after",     "frame_interval", "match_dist_near",
+                                        "match_dist_per_m", "simplify_tol"};
     const char *eq = strchr(arg, '=');
     char *end = NULL;
     double v;
@@ -519,6 +547,9 @@ static int set_map_param(const char *arg)
     case 5: g_map_params.weight_cap = (uint16_t)v; break;
     case 6: g_map_params.forget_after = (uint32_t)v; break;
     case 7: g_map_params.frame_interval = (uint16_t)v; break;
+    case 8: g_map_params.match_dist_near = (float)v; break;
+    case 9: g_map_params.match_dist_per_m = (float)v; break;
+    case 10: g_map_params.simplify_tol = (float)v; break;
     default: return -1;
     }
     return 0;
@@ -697,6 +728,24 @@ static unsigned long g_corner_scans[MAX_CORNERS];
 static bsf_scene_corner_t g_corners[MAX_CORNERS];
 static size_t g_n_corners;
 
+/* Distances from a curve segment (x0, y0, x1, y1) to the true surface,
+ * every TRUTH_STEP along it: the quantiles are per length of curve, however
+ * many control points (and so samples) a piece has. */
+#define TRUTH_STEP 0.01
+static void add_truth(mg_hist_t *h, const bsf_scene_t *scene, const float *seg)
+{
+    const double x0 = (double)seg[0];
+    const double y0 = (double)seg[1];
+    const double dx = (double)seg[2] - x0;
+    const double dy = (double)seg[3] - y0;
+    const size_t n = (size_t)(sqrt(dx * dx + dy * dy) / TRUTH_STEP) + 1u;
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        const double t = (double)k / (double)n;
+        mg_hist_add(h, bsf_scene_distance_to_surface(scene, x0 + t * dx, y0 + t * dy, NULL));
+    }
+}
+
 static int run_scene(column_t *col, int which, long n_poses)
 {
     static bsf_scene_t scene;
@@ -763,9 +812,7 @@ static int run_scene(column_t *col, int which, long n_poses)
         } else if (t == 0) {
             size_t s;
             for (s = 0; s < scratch.n_seg; ++s) {
-                mg_hist_add(&col->own_truth,
-                            bsf_scene_distance_to_surface(&scene, (double)scratch.seg[4u * s],
-                                                          (double)scratch.seg[4u * s + 1u], NULL));
+                add_truth(&col->own_truth, &scene, &scratch.seg[4u * s]);
             }
         }
     }
@@ -778,9 +825,7 @@ static int run_scene(column_t *col, int which, long n_poses)
     }
     if (rc == 0) {
         for (m = 0; m < map.n_seg; ++m) {
-            mg_hist_add(&col->map_truth,
-                        bsf_scene_distance_to_surface(&scene, (double)map.seg[4u * m],
-                                                      (double)map.seg[4u * m + 1u], NULL));
+            add_truth(&col->map_truth, &scene, &map.seg[4u * m]);
         }
         for (m = 0; m < g_n_corners; ++m) {
             size_t v, near = 0;
@@ -861,6 +906,11 @@ static void print_table(void)
         printf(" %.1f |", 1000.0 * mg_hist_quantile(&col->map_dist, 0.5)));
     ROW("**map: points within 5 cm**",
         printf(" %.1f %% |", 100.0 * mg_hist_share_below(&col->map_dist, 0.05)));
+    ROW("map: points within 1 / 2 / 10 / 50 cm (where the misses lie)",
+        printf(" %.1f / %.1f / %.1f / %.1f %% |", 100.0 * mg_hist_share_below(&col->map_dist, 0.01),
+               100.0 * mg_hist_share_below(&col->map_dist, 0.02),
+               100.0 * mg_hist_share_below(&col->map_dist, 0.10),
+               100.0 * mg_hist_share_below(&col->map_dist, 0.50)));
     ROW("**map: curve to true surface p99 / max mm**",
         col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->map_truth, 0.99),
                                 1000.0 * col->map_truth.max)
@@ -891,6 +941,15 @@ static void print_table(void)
         printf(" %.1f |", 1000.0 * mg_hist_quantile(&col->own_dist, 0.5)));
     ROW("per-scan features: points within 5 cm",
         printf(" %.1f %% |", 100.0 * mg_hist_share_below(&col->own_dist, 0.05)));
+    ROW("previous scan's features: points within 1 / 2 / 5 cm (how well consecutive poses agree)",
+        printf(" %.1f / %.1f / %.1f %% |", 100.0 * mg_hist_share_below(&col->prev_dist, 0.01),
+               100.0 * mg_hist_share_below(&col->prev_dist, 0.02),
+               100.0 * mg_hist_share_below(&col->prev_dist, 0.05)));
+    ROW("per-scan features: points within 1 / 2 / 10 / 50 cm",
+        printf(" %.1f / %.1f / %.1f / %.1f %% |", 100.0 * mg_hist_share_below(&col->own_dist, 0.01),
+               100.0 * mg_hist_share_below(&col->own_dist, 0.02),
+               100.0 * mg_hist_share_below(&col->own_dist, 0.10),
+               100.0 * mg_hist_share_below(&col->own_dist, 0.50)));
     ROW("per-scan features to true surface p99 / max mm",
         col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->own_truth, 0.99),
                                 1000.0 * col->own_truth.max)
