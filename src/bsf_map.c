@@ -2,7 +2,7 @@
 /*
  * bsf_map.c - the robot's fused map: association of a scan's features with
  * map curves, refinement, extension, merging, vertex fusion and the
- * forgetting policy (docs/MAP-notes.md says why each works as it does).
+ * forgetting policy (docs/MAP.md says why each works as it does).
  */
 #include "bsf/bsf_map.h"
 

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * bsf_align.h - align one scan to the fused map before fusing it, so that
- * odometry drift does not bend the map (docs/ALIGN-notes.md explains the
+ * odometry drift does not bend the map (docs/ALIGN.md explains the
  * method and its measurements).
  *
  * Given a scan (its valid points, or its features sampled along their

@@ -2,7 +2,7 @@
 /*
  * bsf_map.h - a fused feature map on the robot and its reconstruction on the
  * receiver (docs/FORMAT.md section 11 is the normative wire format of the
- * map frames; docs/MAP-notes.md explains the design).
+ * map frames; docs/MAP.md explains the design).
  *
  * Robot: bsf_map_fuse() folds one scan's features (bsf_result_t, sensor
  * frame) into a map of world-frame clamped quadratic B-spline control-point

@@ -4,7 +4,7 @@
  * drifting odometry. For every drift source three maps are fused from the
  * same scans: with the corrected (or true) poses, with the odometry prior
  * alone, and with each prior aligned to the map (bsf_align_points). One
- * column per source; docs/ALIGN-notes.md pastes the output.
+ * column per source; docs/ALIGN.md pastes the output.
  *
  *   bench_align [--data DIR] [--scans N] [--poses N] [--only NAME] [--seed S] [--check]
  *
