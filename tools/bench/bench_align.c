@@ -213,7 +213,7 @@ static int load_log(run_t *r, const char *path, long max_scans, int edges)
         r->s[r->n - 1].mount.t = wrap(r->s[r->n - 1].mount.t);
         /* the corrected motion (perturbed later), or NaN until an edge gives it */
         if (edges || r->n == 1u) {
-            r->s[r->n - 1].motion.t = NAN;
+            r->s[r->n - 1].motion.t = (double)NAN;
         } else {
             r->s[r->n - 1].motion = compose(inverse(robot[r->n - 2]), rb);
             r->s[r->n - 1].motion.t = wrap(r->s[r->n - 1].motion.t);
