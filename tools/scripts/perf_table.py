@@ -357,7 +357,7 @@ def table(rows):
                           "QEMU icount"))
     if "size_default" in rows:
         t.append(("`.text`+`.rodata` of libbsf linked by an extract + encode firmware, -Os, default method only",
-                  nbytes(rows['size_default']), "<= 24 576 B", "-", "-", status(rows["size_default"] <= 24576),
+                  nbytes(rows['size_default']), "<= 32 768 B", "-", "-", status(rows["size_default"] <= 32768),
                   "size_report.py on extract_encode.elf.map, `-DBSF_METHODS=lc-sved-pdm`"))
         if rows.get("mem_extractor_1081") is not None:
             t.append(("`sizeof(bsf_extractor_t)`, 1081 beams, M4F", nbytes(rows['mem_extractor_1081']), "<= 49 152 B",
