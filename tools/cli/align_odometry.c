@@ -40,6 +40,7 @@ odo_pose_t odo_between(odo_pose_t a, odo_pose_t b)
     return r;
 }
 
+#ifdef BSF_HAVE_ZLIB /* only the gzip edge reader stores edges */
 static int edges_put(odo_edges_t *e, unsigned long b, double dx, double dy, double dt)
 {
     if (b >= e->n) {
@@ -68,6 +69,7 @@ static int edges_put(odo_edges_t *e, unsigned long b, double dx, double dy, doub
     e->have[b] = 1u;
     return 0;
 }
+#endif
 
 int odo_edges_load(const char *path, odo_edges_t *e)
 {
