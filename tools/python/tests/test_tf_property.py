@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Property-based tests of bsf.tf: random transform trees (loops, missing
+"""Property-based tests of bsf.tf (hypothesis; no example database is written): random transform trees (loops, missing
 frames, two parents, non-finite and huge values, stamps at the ends of the
 integer range, chains deeper than MAX_CHAIN) never make a lookup hang or
 raise anything but PoseError; a pose it returns is finite, its heading within
@@ -56,7 +56,7 @@ def _build(edges, max_gap_ns=1_000_000_000):
     return tree
 
 
-@settings(max_examples=400, deadline=2000)
+@settings(max_examples=400, deadline=2000, database=None)
 @given(
     edges=st.lists(edge, max_size=30),
     lookups=st.lists(st.tuples(st.sampled_from(NAMES + ["nowhere"]), st.sampled_from(NAMES + ["nowhere"]), stamp), min_size=1, max_size=10),
@@ -68,7 +68,7 @@ def test_random_trees_give_a_finite_pose_or_a_pose_error(edges, lookups, max_gap
         _check_lookup(tree, target, source, t)
 
 
-@settings(max_examples=100, deadline=5000)
+@settings(max_examples=100, deadline=5000, database=None)
 @given(
     depth=st.integers(min_value=1, max_value=3 * MAX_CHAIN),
     close_loop=st.booleans(),
@@ -89,7 +89,7 @@ def test_deep_chains_and_loops_end_in_a_pose_or_a_pose_error(depth, close_loop, 
         assert pose is None  # too deep, or a loop: refused
 
 
-@settings(max_examples=200, deadline=2000)
+@settings(max_examples=200, deadline=2000, database=None)
 @given(
     samples=st.lists(st.tuples(stamp, coord, coord, coord), min_size=1, max_size=12),
     t=stamp,
