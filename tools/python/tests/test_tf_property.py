@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: MIT
-"""Property-based tests of bsf.tf (hypothesis; no example database is written): random transform trees (loops, missing
-frames, two parents, non-finite and huge values, stamps at the ends of the
-integer range, chains deeper than MAX_CHAIN) never make a lookup hang or
-raise anything but PoseError; a pose it returns is finite, its heading within
-[-pi, pi]; what add() refuses it counts."""
+"""Property-based tests of bsf.tf (hypothesis, no example database): random
+transform trees (loops, missing frames, two parents, non-finite and huge
+values, stamps at the ends of the integer range, chains deeper than
+MAX_CHAIN) never make a lookup hang or raise anything but PoseError; a pose
+it returns is finite, its heading within [-pi, pi]; what add() refuses it
+counts."""
 import math
 
 from hypothesis import given, settings, strategies as st
