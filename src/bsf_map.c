@@ -11,6 +11,7 @@
 
 #include "bsf/bsf_stream.h"
 #include "bsf_map_internal.h"
+#include "bsf_math.h"
 
 /* Spacing of scan curve samples along the control polygon, metres, and the
  * bounds of their count. */
@@ -649,7 +650,7 @@ static void seg_test(const bsf_map_t *m, uint16_t g, const sample_t *q, float cm
 static void label_samples(const bsf_map_t *m, const sample_t *s, size_t ns, label_t *lab)
 {
     const float md = m->params.match_dist;
-    const float cmin = cosf(m->params.match_angle);
+    const float cmin = bsf_cosf(m->params.match_angle);
     uint16_t near[BSF_MAP_SEG_WINDOW];
     size_t k0;
     for (k0 = 0; k0 < ns; k0 += LABEL_RUN) {
@@ -1447,8 +1448,9 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
         map->features[fs].flags &= (uint8_t)~BSF_MAP_FF_FRESH;
     }
     drop_transients(map);
-    c = cosf(pose->theta);
-    sn = sinf(pose->theta);
+    /* the library's own sine and cosine: the C library's differ in the last
+     * bits between targets, and the map must be the same on every one */
+    bsf_sincosf(pose->theta, &sn, &c);
     nr.valid = 0;
     nr.n = 0u;
     nr.removed = 0u;

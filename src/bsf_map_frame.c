@@ -1059,9 +1059,13 @@ static int rx_link(bsf_map_rx_t *rx, bsf_map_rx_feature_t *f, const uint8_t *pts
     return 1;
 }
 
+/* A record that cannot apply: the receiver no longer holds what the robot
+ * believes. A feature never received (its first frame lost, or a receiver
+ * that joined late) is flagged too, so that a missing feature is reported
+ * like a wrong one, until a snapshot brings it. */
 static void rx_stale(bsf_map_rx_feature_t *f)
 {
-    if (f->state == RX_PRESENT) {
+    if (f->state == RX_PRESENT || f->state == RX_ABSENT) {
         f->state = RX_STALE;
     }
 }
@@ -1110,6 +1114,9 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         if (rec->start == 0u) {
             rx_free_chain(rx, f);
         } else if (f->state != RX_SNAP || f->n_ctrl != rec->start || f->upd != rec->upd) {
+            if (f->state == RX_ABSENT) {
+                f->state = RX_STALE; /* a part of a feature never received */
+            }
             return 0;
         }
         if (!rx_link(rx, f, rec->pts, end, rec->n, 0, 0, 0)) {

@@ -312,10 +312,12 @@ uint32_t bsf_map_rx_id_limit(const bsf_map_rx_t *rx);
  * Control points of receiver feature `id`, in metres (quantised values times
  * the stream's step), vertices given twice (two consecutive flagged slots);
  * ctrl and is_vertex (either may be NULL) take up to cap entries; *stale (may
- * be NULL) is 1 when the feature missed an update. Returns the number of
- * stored control points (may exceed cap), 0 when the id holds no feature
- * (never sent, merged into another, removed), or a negative bsf_status_t on
- * failure: BSF_ERR_ARG for NULL rx.
+ * be NULL) is 1 when the feature missed an update (also when the receiver
+ * never got the feature itself, only later records of it: it then holds no
+ * points but is reported). Returns the number of stored control points (may
+ * exceed cap), 0 when the id holds no feature (never sent, merged into
+ * another, removed, or missed), or a negative bsf_status_t on failure:
+ * BSF_ERR_ARG for NULL rx.
  */
 BSF_NODISCARD int bsf_map_rx_feature_ctrl(const bsf_map_rx_t *rx, uint32_t id, bsf_point_t *ctrl,
                                           uint8_t *is_vertex, size_t cap, uint8_t *stale);

@@ -224,3 +224,173 @@ bsf_status_t det_run_log(const det_log_scan_t *scans, size_t n, const uint32_t *
     }
     return BSF_OK;
 }
+
+/* ---- the fused map and alignment ---------------------------------------------- */
+
+static bsf_map_t det_map;
+static bsf_map_rx_t det_rx;
+static bsf_align_work_t det_align_work;
+static bsf_points_t det_points;
+static uint8_t map_wire[BSF_MAP_FRAME_MAX_SIZE];
+
+static bsf_status_t map_start(det_map_summary_t *out)
+{
+    bsf_map_params_t p;
+    memset(out, 0, sizeof *out);
+    out->stream_hash = DET_FNV_INIT;
+    out->align_hash = DET_FNV_INIT;
+    out->rx_hash = DET_FNV_INIT;
+    bsf_map_params_default(&p);
+    p.frame_interval = 1u;
+    p.snapshot_budget = 32u;
+    bsf_map_rx_init(&det_rx);
+    bsf_decoder_init(&dec);
+    return bsf_map_init(&det_map, &p);
+}
+
+/* One scan: extract (default method), align from a prior off `pose` once the
+ * map holds something, fuse at the aligned pose, write a frame, apply it. */
+static bsf_status_t map_step(const bsf_scan_t *scan, const bsf_pose_t *pose, unsigned k,
+                             det_map_summary_t *out)
+{
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_pose_t at = *pose;
+    size_t len = 0u;
+    size_t off = 0u;
+    int r;
+    bsf_status_t st = bsf_extractor_init(&ex, &p);
+    if (st == BSF_OK) {
+        st = bsf_extract(&ex, scan, &res);
+    }
+    if (st < 0) {
+        return st;
+    }
+    if (bsf_map_feature_count(&det_map) > 0u) {
+        bsf_align_result_t ar;
+        bsf_pose_t prior = *pose;
+        prior.x += (k % 2u) ? 0.04f : -0.03f;
+        prior.y += 0.02f;
+        prior.theta += (k % 3u) ? 0.01f : -0.015f;
+        st = bsf_scan_to_points(scan, &det_points);
+        if (st != BSF_OK) {
+            return st;
+        }
+        st = bsf_align_points(&det_align_work, NULL, &det_map, &det_points, &res, &prior, &ar);
+        if (st != BSF_OK) {
+            return st;
+        }
+        out->align_hash = det_hash_floats(out->align_hash, &ar.pose.x, 1u);
+        out->align_hash = det_hash_floats(out->align_hash, &ar.pose.y, 1u);
+        out->align_hash = det_hash_floats(out->align_hash, &ar.pose.theta, 1u);
+        out->align_hash =
+            det_hash_u32(out->align_hash, ((uint32_t)ar.declined << 16) | ar.n_matches);
+        out->align_hash = det_hash_floats(out->align_hash, &ar.rms, 1u);
+        if (ar.declined == BSF_ALIGN_ACCEPTED) {
+            ++out->n_accepted;
+            at = ar.pose;
+        }
+    }
+    r = bsf_map_fuse(&det_map, &res, &at);
+    if (r < 0) {
+        return (bsf_status_t)r;
+    }
+    st = bsf_map_encode(&det_map, &at, map_wire, sizeof map_wire, &len);
+    if (st != BSF_OK) {
+        return st;
+    }
+    if (len > 0u) {
+        out->stream_hash = det_fnv1a(out->stream_hash, map_wire, len);
+        out->stream_bytes += (uint32_t)len;
+        ++out->frames;
+    }
+    while (off < len) {
+        size_t used = 0u;
+        const int got = bsf_decoder_feed(&dec, map_wire + off, len - off, &used, &decoded);
+        off += used;
+        if (got == (int)BSF_FRAME_TYPE_MAP &&
+            bsf_map_rx_apply(&det_rx, decoded.payload, decoded.payload_len) < 0) {
+            return BSF_ERR_FORMAT;
+        }
+    }
+    return BSF_OK;
+}
+
+static void map_finish(det_map_summary_t *out)
+{
+    uint32_t id;
+    for (id = 0; id < bsf_map_rx_id_limit(&det_rx); ++id) {
+        static int32_t q[2u * BSF_MAP_MAX_CTRL];
+        static uint8_t v[BSF_MAP_MAX_CTRL];
+        const int n = bsf_map_rx_feature_q(&det_rx, id, q, v, BSF_MAP_MAX_CTRL);
+        int i;
+        out->rx_hash = det_hash_u32(out->rx_hash, id);
+        out->rx_hash = det_hash_u32(out->rx_hash, (uint32_t)n);
+        for (i = 0; i < n && i < (int)BSF_MAP_MAX_CTRL; ++i) {
+            out->rx_hash = det_hash_u32(out->rx_hash, (uint32_t)q[2 * i]);
+            out->rx_hash = det_hash_u32(out->rx_hash, (uint32_t)q[2 * i + 1]);
+            out->rx_hash = det_hash_u32(out->rx_hash, v[i]);
+        }
+        out->rx_points += n > 0 ? (uint32_t)n : 0u;
+    }
+}
+
+bsf_status_t det_run_map(const float *ranges_in, det_map_summary_t *out)
+{
+    unsigned j;
+    bsf_status_t st = map_start(out);
+    /* three rounds of the demo scans: features seen again are sent */
+    for (j = 0; j < 3u * DET_SCANS && st == BSF_OK; ++j) {
+        const unsigned k = j % DET_SCANS;
+        bsf_scan_t scan;
+        const bsf_lidar_t lid = det_lidar(k);
+        bsf_pose_t pose;
+        st = det_simulate(k, ranges, &scan);
+        if (st != BSF_OK) {
+            break;
+        }
+        if (ranges_in != NULL) {
+            memcpy(ranges, ranges_in + (size_t)k * DET_BEAMS, DET_BEAMS * sizeof ranges[0]);
+        }
+        pose.x = (float)lid.pose.x;
+        pose.y = (float)lid.pose.y;
+        pose.theta = (float)lid.pose.theta;
+        st = map_step(&scan, &pose, j, out);
+    }
+    if (st == BSF_OK) {
+        map_finish(out);
+    }
+    return st;
+}
+
+bsf_status_t det_run_map_log(const det_log_scan_t *scans, size_t n, const uint32_t *range_bits,
+                             det_map_summary_t *out)
+{
+    size_t k, i, at = 0u;
+    bsf_status_t st = map_start(out);
+    for (k = 0; k < n && st == BSF_OK; ++k) {
+        const det_log_scan_t *s = &scans[k];
+        bsf_scan_t scan;
+        bsf_pose_t pose;
+        if (s->count > BSF_MAX_POINTS) {
+            return BSF_ERR_CAPACITY;
+        }
+        for (i = 0; i < s->count; ++i) {
+            ranges[i] = float_of_bits(range_bits[at + i]);
+        }
+        at += s->count;
+        scan.ranges = ranges;
+        scan.count = s->count;
+        scan.angle_min = float_of_bits(s->angle_min);
+        scan.angle_increment = float_of_bits(s->angle_increment);
+        scan.range_min = 0.0f;
+        scan.range_max = float_of_bits(s->range_max);
+        pose.x = float_of_bits(s->pose_x);
+        pose.y = float_of_bits(s->pose_y);
+        pose.theta = float_of_bits(s->pose_theta);
+        st = map_step(&scan, &pose, (unsigned)k, out);
+    }
+    if (st == BSF_OK) {
+        map_finish(out);
+    }
+    return st;
+}

@@ -75,4 +75,28 @@ typedef struct {
 bsf_status_t det_run_log(const det_log_scan_t *scans, size_t n, const uint32_t *range_bits,
                          det_summary_t *out);
 
+/** Results of the map workload (det_run_map, det_run_map_log). */
+typedef struct {
+    uint32_t stream_hash;  /**< FNV-1a of every map frame byte, in order */
+    uint32_t stream_bytes; /**< map frame bytes */
+    uint32_t frames;       /**< map frames written */
+    uint32_t align_hash;   /**< FNV-1a of each alignment's pose bits, decline reason, matches */
+    uint32_t rx_hash;      /**< FNV-1a of the receiver's quantised points, by feature id */
+    uint32_t rx_points;    /**< points the receiver holds at the end */
+    uint32_t n_accepted;   /**< alignments accepted */
+} det_map_summary_t;
+
+/**
+ * The map workload on the demo scans, three rounds (ranges_in as for det_run; NULL:
+ * simulate): each scan extracted with the default method, aligned to the map
+ * from a prior off its true pose, fused at the aligned pose, a map frame
+ * written (snapshots on) and applied to a receiver.
+ * @return BSF_OK or the first failing status.
+ */
+bsf_status_t det_run_map(const float *ranges_in, det_map_summary_t *out);
+
+/** The map workload on n recorded scans (as det_run_log), poses from the log. */
+bsf_status_t det_run_map_log(const det_log_scan_t *scans, size_t n, const uint32_t *range_bits,
+                             det_map_summary_t *out);
+
 #endif /* BSF_DET_CORE_H */

@@ -83,10 +83,24 @@ static void write_u32_array(FILE *f, const char *name, const uint32_t *v, size_t
     fprintf(f, "%s};\n", n > 0u ? "" : "0u");
 }
 
+/* The map workload's results as NAME_* macros. */
+static void write_map(FILE *f, const char *name, const det_map_summary_t *m)
+{
+    fprintf(f, "#define %s_STREAM_HASH 0x%08lxu\n", name, (unsigned long)m->stream_hash);
+    fprintf(f, "#define %s_STREAM_BYTES %luu\n", name, (unsigned long)m->stream_bytes);
+    fprintf(f, "#define %s_FRAMES %luu\n", name, (unsigned long)m->frames);
+    fprintf(f, "#define %s_ALIGN_HASH 0x%08lxu\n", name, (unsigned long)m->align_hash);
+    fprintf(f, "#define %s_ACCEPTED %luu\n", name, (unsigned long)m->n_accepted);
+    fprintf(f, "#define %s_RX_HASH 0x%08lxu\n", name, (unsigned long)m->rx_hash);
+    fprintf(f, "#define %s_RX_POINTS %luu\n", name, (unsigned long)m->rx_points);
+}
+
 int main(int argc, char **argv)
 {
     det_summary_t s;
     det_summary_t ls;
+    det_map_summary_t ms;
+    det_map_summary_t lms;
     bsf_status_t st = BSF_OK;
     FILE *f;
     unsigned k;
@@ -103,11 +117,18 @@ int main(int argc, char **argv)
     if (st == BSF_OK) {
         st = det_run(NULL, &s, NULL, NULL);
     }
+    if (st == BSF_OK) {
+        st = det_run_map(NULL, &ms);
+    }
     memset(&ls, 0, sizeof ls);
+    memset(&lms, 0, sizeof lms);
     if (st == BSF_OK && argc == 3) {
         n_log = read_log(argv[2], &n_log_ranges);
         if (n_log > 0u) {
             st = det_run_log(log_scans, n_log, log_range_bits, &ls);
+            if (st == BSF_OK) {
+                st = det_run_map_log(log_scans, n_log, log_range_bits, &lms);
+            }
         } else {
             printf("det_expect: %s not readable: no log scans in the reference\n", argv[2]);
         }
@@ -128,6 +149,8 @@ int main(int argc, char **argv)
     fprintf(f, "#define DET_EXPECT_STREAM_BYTES %luu\n", (unsigned long)s.stream_bytes);
     fprintf(f, "#define DET_EXPECT_FEATURES %luu\n", (unsigned long)s.n_features);
     fprintf(f, "#define DET_EXPECT_CTRL %luu\n", (unsigned long)s.n_ctrl);
+    write_map(f, "DET_EXPECT_MAP", &ms);
+    write_map(f, "DET_EXPECT_LOG_MAP", &lms);
     for (i = 0; i < (size_t)DET_SCANS * DET_BEAMS; ++i) {
         bits[i] = bits_of(all_ranges[i]);
     }
@@ -157,5 +180,12 @@ int main(int argc, char **argv)
            (unsigned long)s.decoded_hash, (unsigned long)s.stream_bytes,
            (unsigned long)s.n_features, (unsigned long)s.n_ctrl, (unsigned long)n_log,
            (unsigned long)ls.stream_hash, (unsigned long)ls.stream_bytes);
+    printf("det_expect: map (demo): %lu frames, %lu bytes, stream 0x%08lx, %lu alignments "
+           "accepted, receiver %lu points 0x%08lx; map (log): %lu frames, %lu bytes, stream "
+           "0x%08lx, %lu accepted\n",
+           (unsigned long)ms.frames, (unsigned long)ms.stream_bytes, (unsigned long)ms.stream_hash,
+           (unsigned long)ms.n_accepted, (unsigned long)ms.rx_points, (unsigned long)ms.rx_hash,
+           (unsigned long)lms.frames, (unsigned long)lms.stream_bytes,
+           (unsigned long)lms.stream_hash, (unsigned long)lms.n_accepted);
     return fclose(f) == 0 ? 0 : 1;
 }

@@ -94,6 +94,43 @@ static void test_frames_of_recorded_intel_scans_equal_the_host_byte_for_byte(voi
     TEST_ASSERT_TRUE(s.n_features > 0u);
 }
 
+/* The fused map's update frames, the alignments and the receiver's map, from
+ * the host's demo ranges: byte for byte and bit for bit as on the host. */
+static void test_map_stream_of_the_host_ranges_equals_the_host_byte_for_byte(void)
+{
+    det_map_summary_t m;
+    memcpy(host_ranges, det_host_range_bits, sizeof host_ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, det_run_map(host_ranges, &m));
+    TEST_ASSERT_TRUE(m.frames > 0u && m.rx_points > 0u);
+    TEST_ASSERT_EQUAL_UINT32(DET_EXPECT_MAP_FRAMES, m.frames);
+    TEST_ASSERT_EQUAL_UINT32(DET_EXPECT_MAP_STREAM_BYTES, m.stream_bytes);
+    TEST_ASSERT_EQUAL_HEX32_MESSAGE(DET_EXPECT_MAP_STREAM_HASH, m.stream_hash,
+                                    "map frame bytes differ from the host's");
+    TEST_ASSERT_EQUAL_UINT32(DET_EXPECT_MAP_ACCEPTED, m.n_accepted);
+    TEST_ASSERT_EQUAL_HEX32_MESSAGE(DET_EXPECT_MAP_ALIGN_HASH, m.align_hash,
+                                    "aligned poses differ from the host's");
+    TEST_ASSERT_EQUAL_UINT32(DET_EXPECT_MAP_RX_POINTS, m.rx_points);
+    TEST_ASSERT_EQUAL_HEX32_MESSAGE(DET_EXPECT_MAP_RX_HASH, m.rx_hash,
+                                    "the receiver's map differs from the host's");
+}
+
+static void test_map_stream_of_recorded_intel_scans_equals_the_host_byte_for_byte(void)
+{
+    det_map_summary_t m;
+    if (DET_LOG_SCANS_USED == 0u) {
+        TEST_IGNORE_MESSAGE("intel.log.gz was not found when the reference was made");
+    }
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, det_run_map_log(det_log_scans, DET_LOG_SCANS_USED, det_log_range_bits, &m));
+    TEST_ASSERT_TRUE(m.frames > 0u);
+    TEST_ASSERT_EQUAL_UINT32(DET_EXPECT_LOG_MAP_FRAMES, m.frames);
+    TEST_ASSERT_EQUAL_UINT32(DET_EXPECT_LOG_MAP_STREAM_BYTES, m.stream_bytes);
+    TEST_ASSERT_EQUAL_HEX32_MESSAGE(DET_EXPECT_LOG_MAP_STREAM_HASH, m.stream_hash,
+                                    "map frame bytes of the Intel scans differ from the host's");
+    TEST_ASSERT_EQUAL_HEX32(DET_EXPECT_LOG_MAP_ALIGN_HASH, m.align_hash);
+    TEST_ASSERT_EQUAL_HEX32(DET_EXPECT_LOG_MAP_RX_HASH, m.rx_hash);
+}
+
 static void test_hashes_do_not_depend_on_byte_order(void)
 {
     /* FNV-1a of the bytes 00 00 80 3f (1.0f little-endian), whatever the
@@ -114,5 +151,7 @@ int main(void)
     RUN_TEST(test_hashes_do_not_depend_on_byte_order);
     RUN_TEST(test_frames_of_the_host_ranges_equal_the_host_byte_for_byte);
     RUN_TEST(test_frames_of_recorded_intel_scans_equal_the_host_byte_for_byte);
+    RUN_TEST(test_map_stream_of_the_host_ranges_equals_the_host_byte_for_byte);
+    RUN_TEST(test_map_stream_of_recorded_intel_scans_equals_the_host_byte_for_byte);
     return UNITY_END();
 }

@@ -8,6 +8,7 @@ corrected one by bsf map and bsf render; errors on bad option combinations.
 
 Usage: test_align.py BSF_EXE SYNTH_LOG_EXE WORK_DIR
 """
+import gzip
 import json
 import math
 import os
@@ -172,6 +173,22 @@ res = run(["extract", "edges.log", "--map", "--align", "--odometry", "edges", "-
 check(res.returncode == 0, "extract --align --odometry edges succeeds")
 check("odometry: sequential edges" in res.stderr, "the summary names the edges")
 check(share_far("edges.bsf", segs, 0.05) < 0.05, "the map aligned with edge odometry lies on the walls")
+# The same log gzip-compressed (zlib, or the system's gzip in a build
+# without zlib): the same map; a cut gzip file is a read error.
+with open(os.path.join(WORK, "edges.log"), "rb") as f_in:
+    packed = gzip.compress(f_in.read(), mtime=0)
+with open(os.path.join(WORK, "edges.log.gz"), "wb") as f_out:
+    f_out.write(packed)
+with open(os.path.join(WORK, "cut.log.gz"), "wb") as f_out:
+    f_out.write(packed[: len(packed) // 2])
+res = run(["extract", "edges.log.gz", "--map", "--align", "--odometry", "edges", "--reproducible",
+           "-o", "edges_gz.bsf"])
+m1 = run(["map", "edges.bsf", "--json"])
+m2 = run(["map", "edges_gz.bsf", "--json"])
+check(res.returncode == 0 and m1.returncode == 0 and m2.returncode == 0 and m1.stdout == m2.stdout,
+      "edges from a gzip log give the same map")
+res = run(["extract", "cut.log.gz", "--map", "--align", "--odometry", "edges", "-o", "x.bsf"])
+check(res.returncode == 1 and "cut.log.gz" in res.stderr, "a cut gzip log is refused with its name")
 
 # The prior path beside the corrected one: --prior-path writes both per
 # fused scan, bsf map --prior and bsf render --prior draw the prior dashed.

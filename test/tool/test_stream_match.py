@@ -4,7 +4,10 @@
 for example s390x big-endian under qemu-user) writes the same
 `bsf extract --reproducible` stream, byte for byte, as the host's `bsf` on the
 same logs, for both methods, and reads the host's stream into the same
-`bsf metrics` text.
+`bsf metrics` text. The same for the fused map's stream (`bsf extract --map`,
+with and without `--align`, with snapshots), read back by `bsf map --json`,
+on the synthetic log and the first scans of a corrected log (true poses)
+when the shared data has one.
 
 Usage: test_stream_match.py HOST_BSF TARGET_BSF TARGET_SYNTH_LOG WORK_DIR [SHARED_DIR]
 """
@@ -28,6 +31,23 @@ def check(cond, what):
 
 def run(exe, args):
     return subprocess.run([exe] + args, cwd=WORK, capture_output=True, timeout=240)
+
+
+def corrected_log():
+    """alt/intel-corrected.log.gz from the shared data, when present."""
+    for cand in (os.path.join(SHARED, "data", "alt", "intel-corrected.log.gz"),
+                 os.path.join(SHARED, "alt", "intel-corrected.log.gz")):
+        if SHARED and os.path.isfile(cand):
+            return cand
+    return None
+
+
+def same_files(a, b):
+    with open(a, "rb") as f:
+        x = f.read()
+    with open(b, "rb") as f:
+        y = f.read()
+    return x == y, len(x)
 
 
 def intel_log():
@@ -88,6 +108,39 @@ for log, extra in logs:
             mt = run(TARGET, ["metrics", outs["host"]])
             check(mh.returncode == 0 and mt.returncode == 0 and metrics_text(mh.stdout) == metrics_text(mt.stdout),
                   "%s --method %s: target's bsf metrics of the host stream equal the host's" % (name, method))
+
+# The fused map: extract --map (and --align) streams byte for byte, and the
+# target's `bsf map --json` of the host's stream equal to the host's.
+map_logs = [("synth.log", [])]
+corrected = corrected_log()
+if corrected:
+    map_logs.append((corrected, ["--count", "400"]))
+else:
+    print("note    intel-corrected.log.gz not found: the map on the synthetic log only")
+MAP_VARIANTS = [("map", ["--map"]), ("map-align", ["--map", "--align"]),
+                ("map-snap", ["--map", "--align", "--snapshot-budget", "48"])]
+for log, extra in map_logs:
+    name = os.path.basename(log)
+    for tag, opts in MAP_VARIANTS:
+        outs = {}
+        for side, exe in (("host", HOST), ("target", TARGET)):
+            out = os.path.join(WORK, "%s.%s.%s.bsf" % (name, tag, side))
+            r = run(exe, ["extract", log] + opts + ["--reproducible", "-o", out] + extra)
+            ok = r.returncode == 0 and os.path.isfile(out) and os.path.getsize(out) > 0
+            check(ok, "%s bsf extract %s %s exits 0 with a stream" % (side, name, " ".join(opts)))
+            if not ok:
+                sys.stderr.write(r.stderr.decode(errors="replace"))
+            outs[side] = out
+        if all(os.path.isfile(p) for p in outs.values()):
+            same, size = same_files(outs["host"], outs["target"])
+            check(same and size > 0, "%s %s: target map stream identical to the host's (%d bytes)"
+                  % (name, " ".join(opts), size))
+            jh = run(HOST, ["map", outs["host"], "--json"])
+            jt = run(TARGET, ["map", outs["host"], "--json"])
+            check(jh.returncode == 0 and jt.returncode == 0 and len(jh.stdout) > 0
+                  and jh.stdout == jt.stdout,
+                  "%s %s: target's bsf map --json of the host stream equals the host's"
+                  % (name, " ".join(opts)))
 
 if failures:
     print("%d check(s) failed" % len(failures))

@@ -2,6 +2,10 @@
 /*
  * align_odometry.c - odometry sources for `bsf extract --map --align`.
  */
+/* popen/pclose for the gzip fallback without zlib */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
 #include "align_odometry.h"
 
 #include <math.h>
@@ -69,20 +73,83 @@ static int edges_put(odo_edges_t *e, unsigned long b, double dx, double dy, doub
     return 0;
 }
 
-int odo_edges_load(const char *path, odo_edges_t *e)
+/* Lines of a log, gzip or plain: zlib when the build has it, else the
+ * system's `gzip -dcf` (which passes plain text through), as the CARMEN
+ * reader does. */
+typedef struct {
+#ifdef BSF_HAVE_ZLIB
+    gzFile gz;
+#else
+    FILE *pipe;
+#endif
+} line_src_t;
+
+static int src_open(line_src_t *src, const char *path)
 {
 #ifdef BSF_HAVE_ZLIB
+    src->gz = gzopen(path, "rb");
+    return src->gz != NULL ? 0 : -1;
+#else
+    FILE *probe = fopen(path, "rb");
+    size_t i, n = 0;
+    char *cmd;
+    if (probe == NULL) {
+        return -1; /* a clear "cannot open" rather than gzip's complaint */
+    }
+    fclose(probe);
+    cmd = malloc(4u * strlen(path) + 48u);
+    if (cmd == NULL) {
+        return -1;
+    }
+    n += (size_t)sprintf(cmd, "gzip -dcf -- '");
+    for (i = 0; path[i] != '\0'; ++i) {
+        if (path[i] == '\'') {
+            memcpy(cmd + n, "'\\''", 4u);
+            n += 4u;
+        } else {
+            cmd[n++] = path[i];
+        }
+    }
+    memcpy(cmd + n, "' 2>/dev/null", 14u);
+    src->pipe = popen(cmd, "r");
+    free(cmd);
+    return src->pipe != NULL ? 0 : -1;
+#endif
+}
+
+static char *src_gets(line_src_t *src, char *line, int cap)
+{
+#ifdef BSF_HAVE_ZLIB
+    return gzgets(src->gz, line, cap);
+#else
+    return fgets(line, cap, src->pipe);
+#endif
+}
+
+/* 0 when the whole input was read without error. */
+static int src_close(line_src_t *src)
+{
+#ifdef BSF_HAVE_ZLIB
+    int err = 0;
+    (void)gzerror(src->gz, &err);
+    return (gzclose(src->gz) == Z_OK && (err == Z_OK || err == Z_STREAM_END)) ? 0 : -1;
+#else
+    return pclose(src->pipe) == 0 ? 0 : -1;
+#endif
+}
+
+int odo_edges_load(const char *path, odo_edges_t *e)
+{
     char line[4096];
     int seq = 0;
     unsigned long n_edges = 0;
-    gzFile gz;
+    line_src_t src;
     memset(e, 0, sizeof *e);
-    gz = gzopen(path, "rb");
-    if (gz == NULL) {
+    if (src_open(&src, path) != 0) {
         fail_msg("%s: cannot open for its pose-graph edges", path);
         return -1;
     }
-    while (gzgets(gz, line, (int)sizeof line) != NULL) {
+    while (src_gets(&src, line, (int)sizeof line) != NULL) {
         unsigned long a, b;
         double dx, dy, dt;
         if (strncmp(line, "#SEQUENTIAL", 11) == 0) {
@@ -93,7 +160,7 @@ int odo_edges_load(const char *path, odo_edges_t *e)
                    b == a + 1u && b < ODO_MAX_INDEX && isfinite(dx) && isfinite(dy) &&
                    isfinite(dt) && fabs(dx) < 1e6 && fabs(dy) < 1e6 && fabs(dt) < 1e3) {
             if (edges_put(e, b, dx, dy, dt) != 0) {
-                gzclose(gz);
+                (void)src_close(&src);
                 odo_edges_free(e);
                 fail_msg("out of memory reading the edges of %s", path);
                 return -1;
@@ -101,7 +168,11 @@ int odo_edges_load(const char *path, odo_edges_t *e)
             ++n_edges;
         }
     }
-    gzclose(gz);
+    if (src_close(&src) != 0) {
+        odo_edges_free(e);
+        fail_msg("%s: read error (a damaged gzip file?) while reading its pose-graph edges", path);
+        return -1;
+    }
     if (n_edges == 0u) {
         odo_edges_free(e);
         fail_msg("%s: no sequential EDGE2 edges (a '#SEQUENTIAL' section of 'EDGE2 k k+1 dx dy "
@@ -110,11 +181,6 @@ int odo_edges_load(const char *path, odo_edges_t *e)
         return -1;
     }
     return 0;
-#else
-    memset(e, 0, sizeof *e);
-    fail_msg("%s: --odometry edges needs a build with zlib", path);
-    return -1;
-#endif
 }
 
 void odo_edges_free(odo_edges_t *e)

@@ -13,7 +13,8 @@ upside down (a mirrored scan) is refused (:meth:`TransformTree.add_3d`).
 A lookup never extrapolates: a time before a transform's first sample, after
 its last, or between two samples further apart than ``max_gap_ns`` raises
 :class:`PoseError`, as do frames that are not connected, a loop, a chain of
-more than :data:`MAX_CHAIN` transforms, and a frame published with two parents.
+more than :data:`MAX_CHAIN` transforms, a frame published with two parents,
+and transforms so large that composing them overflows.
 """
 from __future__ import annotations
 
@@ -33,6 +34,9 @@ MAX_CHAIN = 64
 MAX_GAP_NS_DEFAULT = 1_000_000_000
 
 _IDENTITY: Pose = (0.0, 0.0, 0.0)
+
+#: Stamps are held as signed 64-bit nanoseconds; a stamp outside is refused.
+_STAMP_MIN, _STAMP_MAX = -(2**63), 2**63 - 1
 
 
 class PoseError(Exception):
@@ -97,7 +101,8 @@ class TransformTree:
         """Add parent -> child (the child's origin and heading in the parent).
 
         Returns False (and counts it in :attr:`rejected`) for values that are
-        not finite, a missing yaw, empty names or a frame its own parent.
+        not finite, a missing yaw, empty names, a frame its own parent or a
+        timed transform's stamp outside signed 64-bit nanoseconds.
         A later static transform of the same child replaces an earlier one.
         """
         parent, child = strip_frame(parent), strip_frame(child)
@@ -107,6 +112,7 @@ class TransformTree:
             or parent == child
             or yaw is None
             or not all(math.isfinite(v) for v in (x, y, yaw))
+            or (not static and not _STAMP_MIN <= int(stamp_ns) <= _STAMP_MAX)
         ):
             self.rejected += 1
             return False
@@ -114,7 +120,8 @@ class TransformTree:
         if static:
             self._static[child] = (float(x), float(y), math.remainder(float(yaw), 2.0 * math.pi))
         else:
-            self._samples.setdefault(child, []).append((int(stamp_ns), float(x), float(y), float(yaw)))
+            # the heading reduced to [-pi, pi]: differences of huge headings overflow
+            self._samples.setdefault(child, []).append((int(stamp_ns), float(x), float(y), math.remainder(float(yaw), 2.0 * math.pi)))
             self._arrays.pop(child, None)
         return True
 
@@ -173,19 +180,19 @@ class TransformTree:
                 if child in self._static:  # also latched: tf2 would use the static one
                     return self._static[child]
                 raise PoseError(f"after the last transform {name}", f"{_sec(t[-1])} s")
-            gap = int(t[i] - t[i - 1])
+            gap = int(t[i]) - int(t[i - 1])  # in Python ints: int64 would wrap
             if gap > self.max_gap_ns:
                 raise PoseError(
                     f"in a gap of the transform {name} longer than {self.max_gap_ns / 1e9:g} s",
                     f"{_sec(t[i - 1])} s to {_sec(t[i])} s",
                 )
             f = (stamp_ns - int(t[i - 1])) / gap
-            a, b = v[i - 1], v[i]
-            dyaw = math.remainder(float(b[2] - a[2]), 2.0 * math.pi)
+            a, b = [float(c) for c in v[i - 1]], [float(c) for c in v[i]]
+            dyaw = math.remainder(b[2] - a[2], 2.0 * math.pi)
             return (
-                float(a[0] + f * (b[0] - a[0])),
-                float(a[1] + f * (b[1] - a[1])),
-                math.remainder(float(a[2]) + f * dyaw, 2.0 * math.pi),
+                a[0] + f * (b[0] - a[0]),
+                a[1] + f * (b[1] - a[1]),
+                math.remainder(a[2] + f * dyaw, 2.0 * math.pi),
             )
         return self._static[child]
 
@@ -206,6 +213,8 @@ class TransformTree:
         Raises PoseError when there is none (see the module's description).
         """
         target, source = strip_frame(target), strip_frame(source)
+        if not _STAMP_MIN <= int(stamp_ns) <= _STAMP_MAX:
+            raise PoseError("a time outside signed 64-bit nanoseconds", f"{stamp_ns} ns")
         known = self.frames
         for name, what in ((source, "frame"), (target, "fixed frame")):
             if name not in known:
@@ -224,7 +233,11 @@ class TransformTree:
                 pose = compose(self._edge(child, stamp_ns), pose)
             return pose
 
-        return compose(inverse(to_common(up_t)), to_common(up_s))
+        pose = compose(inverse(to_common(up_t)), to_common(up_s))
+        # finite transforms can still overflow when composed (1e308 + 1e308)
+        if not all(math.isfinite(v) for v in pose):
+            raise PoseError(f"the transforms from {target} to {source} give a pose that is not finite")
+        return pose
 
 
 def _sec(ns: int) -> str:

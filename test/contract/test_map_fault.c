@@ -1,0 +1,528 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Fault injection on the map stream: the map-update frames of a synthetic
+ * drive (the demo office, three loops, then a quiet tail in which snapshots
+ * go round) through a channel that flips bits (1e-4 .. 1e-2 per byte),
+ * inserts or deletes bytes, or replaces bursts, and to a receiver that joins
+ * late. A lossless receiver fed the same frames is the reference (it holds
+ * the robot's sent copy, checked). Judged at the end, feature by feature:
+ * the damaged receiver holds exactly the reference's points, or flags the
+ * feature stale; a feature that differs without the flag is wrong (must be
+ * 0). Every frame the decoder delivers must be one the robot sent, byte for
+ * byte (damaged frames accepted: must be 0), and every frame the channel did
+ * not touch must be delivered.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "bsf/bsf.h"
+#include "bsf_scene.h"
+#include "unity.h"
+
+#define N_LOOP 90
+#define N_DRIVE (3 * N_LOOP)
+#define N_TAIL 400
+#define MAX_FRAMES (N_DRIVE + N_TAIL)
+#define STREAM_CAP (MAX_FRAMES * 600)
+#define MAX_Q 4096
+
+static bsf_extractor_t ex;
+static bsf_result_t res;
+static bsf_map_t map;
+static bsf_map_rx_t ref;
+static bsf_map_rx_t rx;
+static bsf_decoder_t dec;
+static bsf_frame_t frame;
+static bsf_scene_t scene;
+static float ranges[BSF_MAX_POINTS];
+static uint8_t stream[STREAM_CAP];
+static size_t frame_start[MAX_FRAMES + 1];
+static uint32_t frame_seq[MAX_FRAMES];
+static size_t n_frames;
+static size_t stream_len;
+static uint8_t channel[2 * STREAM_CAP];
+static uint8_t damaged[MAX_FRAMES + 1];
+static uint8_t delivered[MAX_FRAMES];
+static int32_t q_a[2 * MAX_Q];
+static int32_t q_b[2 * MAX_Q];
+static uint8_t v_a[MAX_Q];
+static uint8_t v_b[MAX_Q];
+
+typedef struct {
+    unsigned frames_untouched; /* frames the channel did not touch (nor their delimiter) */
+    unsigned frames_recovered; /* of those, delivered */
+    unsigned frames_delivered;
+    unsigned damaged_accepted; /* delivered but not a frame the robot sent: must be 0 */
+    unsigned features;         /* features the reference holds */
+    unsigned intact;           /* equal to the reference, never flagged */
+    unsigned repaired;         /* equal, after being flagged stale on the way */
+    unsigned reported;         /* flagged stale at the end */
+    unsigned unflagged;        /* different and not flagged, but the receiver counted a
+                                  frame loss (see judge_features), of which: */
+    unsigned missing;          /*   the receiver holds none of it */
+    unsigned ghost;            /*   the robot merged it away; the receiver still has it */
+    unsigned wrong;            /* different, not flagged, no loss counted: must be 0 */
+    unsigned ref_partial;      /* the reference mid-snapshot at the end: not judged */
+} tally_t;
+
+static int first_seen;     /* the damaged receiver got a frame */
+static uint32_t first_seq; /* the sequence number of its first */
+static uint64_t rng_state;
+
+static uint32_t rng_next(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (uint32_t)(rng_state >> 11);
+}
+
+static uint32_t rng_below(uint32_t n)
+{
+    return rng_next() % n;
+}
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+/* Scan k of the demo office's loop, extracted; its true pose in *pose. */
+static void scan_k(long k, bsf_pose_t *pose)
+{
+    bsf_scene_rng_t srng;
+    bsf_scan_t s;
+    bsf_lidar_t l;
+    double x, y, th;
+    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scene_demo_pose(k % N_LOOP, N_LOOP, &x, &y, &th);
+    l = bsf_lidar_default(x, y, th, 361u, 1.5 * 3.14159265358979);
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&srng, 77u + (uint64_t)k);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &srng, ranges, NULL, BSF_MAX_POINTS));
+    s = bsf_scene_lidar_scan(&l, ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
+    pose->x = (float)x;
+    pose->y = (float)y;
+    pose->theta = (float)th;
+}
+
+/* The sequence number of a map payload (a uvar after the type byte). */
+static uint32_t payload_seq(const uint8_t *p, size_t len)
+{
+    uint32_t v = 0u;
+    size_t i;
+    for (i = 1u; i < len && i < 6u; ++i) {
+        v |= (uint32_t)(p[i] & 0x7Fu) << (7u * (i - 1u));
+        if (!(p[i] & 0x80u)) {
+            break;
+        }
+    }
+    return v;
+}
+
+/* Feed bytes to the decoder into rx; judge every delivered frame. */
+static void feed(bsf_map_rx_t *to, const uint8_t *data, size_t len, tally_t *t)
+{
+    size_t off = 0u;
+    while (off < len) {
+        size_t used = 0u;
+        const int got = bsf_decoder_feed(&dec, data + off, len - off, &used, &frame);
+        TEST_ASSERT_TRUE(got >= 0);
+        off += used;
+        if (got == (int)BSF_FRAME_TYPE_MAP) {
+            const uint32_t seq = payload_seq(frame.payload, frame.payload_len);
+            size_t k = n_frames;
+            size_t j;
+            for (j = 0; j < n_frames; ++j) {
+                if (frame_seq[j] == seq) {
+                    k = j;
+                    break;
+                }
+            }
+            if (t != NULL) {
+                ++t->frames_delivered;
+            }
+            /* genuine: the payload the robot sent under this sequence
+             * number, byte for byte, delivered once */
+            if (k == n_frames || delivered[k]) {
+                if (t != NULL) {
+                    ++t->damaged_accepted;
+                }
+                continue;
+            }
+            {
+                static bsf_decoder_t d2;
+                static bsf_frame_t f2;
+                size_t used2 = 0u;
+                bsf_decoder_init(&d2);
+                TEST_ASSERT_EQUAL_INT((int)BSF_FRAME_TYPE_MAP,
+                                      bsf_decoder_feed(&d2, stream + frame_start[k],
+                                                       frame_start[k + 1u] - frame_start[k], &used2,
+                                                       &f2));
+                if (f2.payload_len != frame.payload_len ||
+                    memcmp(f2.payload, frame.payload, f2.payload_len) != 0) {
+                    if (t != NULL) {
+                        ++t->damaged_accepted;
+                    }
+                    continue;
+                }
+            }
+            delivered[k] = 1u;
+            if (!first_seen) {
+                first_seen = 1;
+                first_seq = seq;
+            }
+            TEST_ASSERT_TRUE(bsf_map_rx_apply(to, frame.payload, frame.payload_len) >= 0);
+        }
+    }
+}
+
+/* The robot's drive with the given snapshot budget: every frame into
+ * stream[], frame boundaries kept; the reference receiver fed all of it. */
+static uint16_t stream_budget = 0xFFFFu;
+
+static void make_stream(uint16_t budget)
+{
+    bsf_map_params_t p;
+    long k;
+    if (stream_budget == budget) {
+        return;
+    }
+    stream_budget = budget;
+    n_frames = 0u;
+    stream_len = 0u;
+    bsf_scene_demo_office(&scene);
+    bsf_map_params_default(&p);
+    p.frame_interval = 1u;
+    p.snapshot_budget = budget;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, &p));
+    for (k = 0; k < N_DRIVE + N_TAIL; ++k) {
+        bsf_pose_t pose = {1.0f, 1.0f, 0.0f};
+        size_t len = 0u;
+        if (k < N_DRIVE) {
+            scan_k(k, &pose);
+        } else {
+            res.n_features = 0u; /* the robot stands still: snapshots go round */
+            res.n_ctrl = 0u;
+        }
+        TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
+        TEST_ASSERT_TRUE(stream_len + BSF_MAP_FRAME_MAX_SIZE <= STREAM_CAP);
+        TEST_ASSERT_EQUAL_INT(
+            BSF_OK, bsf_map_encode(&map, NULL, stream + stream_len, BSF_MAP_FRAME_MAX_SIZE, &len));
+        if (len > 0u) {
+            TEST_ASSERT_TRUE(n_frames < MAX_FRAMES);
+            frame_start[n_frames] = stream_len;
+            frame_seq[n_frames] = map.frame_seq - 1u;
+            ++n_frames;
+            stream_len += len;
+        }
+    }
+    frame_start[n_frames] = stream_len;
+    bsf_map_rx_init(&ref);
+    bsf_decoder_init(&dec);
+    memset(delivered, 0, sizeof delivered);
+    feed(&ref, stream, stream_len, NULL);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n_frames, ref.stats.frames);
+    printf("map stream, snapshot budget %u: %zu frames, %zu bytes, %u features in the robot's "
+           "RAM; lossless receiver: %u records skipped\n",
+           (unsigned)budget, n_frames, stream_len, (unsigned)bsf_map_feature_count(&map),
+           (unsigned)ref.stats.records_skipped);
+    if (budget == 0u) {
+        /* without snapshots a receiver that lost nothing applies everything
+         * (with snapshots, a merge of a feature whose snapshot is half sent
+         * is skipped and the feature flagged until its next snapshot) */
+        TEST_ASSERT_EQUAL_UINT32(0u, ref.stats.records_skipped);
+    }
+    /* the reference holds the robot's sent copy of every feature in its RAM,
+     * healed by the quiet tail where snapshots are on */
+    for (k = 0; k < (long)bsf_map_feature_count(&map); ++k) {
+        uint32_t id = 0u;
+        uint8_t stale = 1u;
+        const int n = bsf_map_feature_q(&map, (size_t)k, q_a, v_a, MAX_Q, &id);
+        TEST_ASSERT_TRUE(n >= 0 && n <= MAX_Q);
+        TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&ref, id, NULL, NULL, 0u, &stale) >= 0);
+        if (stale) {
+            continue; /* its snapshot in parts is under way */
+        }
+        TEST_ASSERT_EQUAL_INT(n, bsf_map_rx_feature_q(&ref, id, q_b, v_b, MAX_Q));
+        TEST_ASSERT_EQUAL_MEMORY(q_a, q_b, (size_t)n * 2u * sizeof q_a[0]);
+        TEST_ASSERT_EQUAL_MEMORY(v_a, v_b, (size_t)n);
+    }
+}
+
+/* The receiver knows it lost frames: a gap in the sequence numbers, a first
+ * frame other than the stream's first, or a damaged frame dropped. */
+static int loss_counted(void)
+{
+    const bsf_decoder_stats_t *d = &dec.stats;
+    return rx.stats.frames_missed > 0u || (first_seen && first_seq != 0u) ||
+           d->bad_crc + d->malformed + d->oversize + d->unsupported_version + d->unknown_type > 0u;
+}
+
+/* Feature by feature, the damaged receiver against the reference. */
+static void judge_features(tally_t *t, const uint8_t *was_stale)
+{
+    uint32_t id;
+    const uint32_t lim = bsf_map_rx_id_limit(&ref) > bsf_map_rx_id_limit(&rx)
+                             ? bsf_map_rx_id_limit(&ref)
+                             : bsf_map_rx_id_limit(&rx);
+    for (id = 0; id < lim; ++id) {
+        uint8_t stale_ref = 0u;
+        uint8_t stale = 0u;
+        const int n = bsf_map_rx_feature_q(&ref, id, q_a, v_a, MAX_Q);
+        const int m = bsf_map_rx_feature_q(&rx, id, q_b, v_b, MAX_Q);
+        int same;
+        TEST_ASSERT_TRUE(n >= 0 && n <= MAX_Q && m >= 0 && m <= MAX_Q);
+        TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&ref, id, NULL, NULL, 0u, &stale_ref) >= 0);
+        TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
+        if (stale_ref) {
+            ++t->ref_partial; /* a snapshot in parts is under way: not judged */
+            continue;
+        }
+        same = n == m && memcmp(q_a, q_b, (size_t)n * 2u * sizeof q_a[0]) == 0 &&
+               memcmp(v_a, v_b, (size_t)n) == 0;
+        if (n == 0 && m == 0) {
+            continue; /* neither holds it (merged away, never sent) */
+        }
+        ++t->features;
+        if (stale) {
+            ++t->reported;
+        } else if (!same && loss_counted()) {
+            /* A lost frame's records for a feature that gets no record
+             * since (no skip flags it); its creation lost (m == 0); or a
+             * merge lost, the robot's feature gone (n == 0; snapshots name
+             * only features the robot holds). The format has no
+             * per-feature word for these; the frame-level loss counters
+             * are the receiver's only word. */
+            ++t->unflagged;
+            t->missing += m == 0;
+            t->ghost += n == 0;
+        } else if (!same) {
+            ++t->wrong;
+            printf("  feature %u: reference %d points, receiver %d, not flagged\n", (unsigned)id, n,
+                   m);
+        } else if (was_stale[id]) {
+            ++t->repaired;
+        } else {
+            ++t->intact;
+        }
+    }
+}
+
+static uint8_t was_stale[BSF_MAP_RX_MAX_FEATURES];
+
+static void note_stale(void)
+{
+    uint32_t id;
+    for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+        uint8_t st = 0u;
+        TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &st) >= 0);
+        was_stale[id] |= st;
+    }
+}
+
+enum { FLIPS, INSERTS, DELETES, BURSTS, LATE_JOIN };
+static const char *const model_name[] = {"bit flips", "insertions", "deletions", "bursts",
+                                         "late join"};
+
+/* One run through the channel: rate is per byte (bit flips: per bit of a
+ * byte hit), or the number of bursts, or the frame the late receiver joins
+ * at. The stream goes out frame by frame; the receiver is judged at the end. */
+static tally_t run(int model, double rate, uint64_t seed)
+{
+    tally_t t;
+    size_t k;
+    memset(&t, 0, sizeof t);
+    rng_state = seed * 0x9E3779B97F4A7C15ull + 1u;
+    memset(damaged, 0, sizeof damaged);
+    memset(delivered, 0, sizeof delivered);
+    memset(was_stale, 0, sizeof was_stale);
+    first_seen = 0;
+    bsf_map_rx_init(&rx);
+    bsf_decoder_init(&dec);
+    for (k = 0; k < n_frames; ++k) {
+        const uint8_t *f = stream + frame_start[k];
+        const size_t n = frame_start[k + 1u] - frame_start[k];
+        size_t out = 0u;
+        size_t j;
+        if (model == LATE_JOIN) {
+            if (k < (size_t)rate) {
+                damaged[k] = 1u; /* never heard */
+                continue;
+            }
+            memcpy(channel, f, n);
+            out = n;
+        } else if (model == BURSTS) {
+            /* rate bursts over the stream: each frame hit with probability
+             * rate / n_frames; a burst of 2..64 random bytes replaces as many */
+            memcpy(channel, f, n);
+            out = n;
+            if (rng_below(1000000u) < (uint32_t)(rate * 1e6 / (double)n_frames)) {
+                const size_t at = rng_below((uint32_t)n);
+                size_t len = 2u + rng_below(63u);
+                if (at + len > n) {
+                    len = n - at;
+                }
+                for (j = 0; j < len; ++j) {
+                    channel[at + j] = (uint8_t)rng_next();
+                }
+                damaged[k] = 1u;
+                if (at + len == n) {
+                    damaged[k + 1u] = 1u; /* its delimiter: the next frame merges in */
+                }
+            }
+        } else {
+            const uint32_t per_million = (uint32_t)(rate * 1e6);
+            for (j = 0; j < n; ++j) {
+                if (rng_below(1000000u) >= per_million) {
+                    channel[out++] = f[j];
+                    continue;
+                }
+                damaged[k] = 1u;
+                if (j == n - 1u) {
+                    damaged[k + 1u] = 1u;
+                }
+                if (model == FLIPS) {
+                    channel[out++] = (uint8_t)(f[j] ^ (1u << rng_below(8u)));
+                } else if (model == INSERTS) {
+                    channel[out++] = (uint8_t)rng_next();
+                    channel[out++] = f[j];
+                } /* DELETES: the byte is dropped */
+            }
+        }
+        feed(&rx, channel, out, &t);
+        note_stale();
+    }
+    for (k = 0; k < n_frames; ++k) {
+        if (!damaged[k]) {
+            ++t.frames_untouched;
+            t.frames_recovered += delivered[k];
+        }
+    }
+    judge_features(&t, was_stale);
+    printf("budget %-3u %-10s %-6g seed %-4u: frames %zu, untouched %u, recovered %u, delivered "
+           "%u, damaged "
+           "accepted %u; features %u: intact %u, repaired %u, reported stale %u, unflagged after a "
+           "counted loss %u (missing %u, "
+           "ghost %u), wrong %u\n",
+           (unsigned)stream_budget, model_name[model], rate, (unsigned)seed, n_frames,
+           t.frames_untouched, t.frames_recovered, t.frames_delivered, t.damaged_accepted,
+           t.features, t.intact, t.repaired, t.reported, t.unflagged, t.missing, t.ghost, t.wrong);
+    return t;
+}
+
+static tally_t total;
+
+static void add(const tally_t *t)
+{
+    total.frames_untouched += t->frames_untouched;
+    total.frames_recovered += t->frames_recovered;
+    total.frames_delivered += t->frames_delivered;
+    total.damaged_accepted += t->damaged_accepted;
+    total.features += t->features;
+    total.intact += t->intact;
+    total.repaired += t->repaired;
+    total.reported += t->reported;
+    total.unflagged += t->unflagged;
+    total.missing += t->missing;
+    total.ghost += t->ghost;
+    total.wrong += t->wrong;
+}
+
+static void check(const tally_t *t)
+{
+    TEST_ASSERT_EQUAL_UINT(0u, t->damaged_accepted);
+    TEST_ASSERT_EQUAL_UINT(0u, t->wrong);
+    TEST_ASSERT_EQUAL_UINT(t->frames_untouched, t->frames_recovered);
+    add(t);
+}
+
+static void channel_runs(uint16_t budget)
+{
+    static const double rates[] = {1e-4, 3e-4, 1e-3, 3e-3, 1e-2};
+    int model;
+    size_t r;
+    uint64_t seed;
+    make_stream(budget);
+    for (model = FLIPS; model <= DELETES; ++model) {
+        for (r = 0; r < sizeof rates / sizeof rates[0]; ++r) {
+            for (seed = 1u; seed <= 2u; ++seed) {
+                const tally_t t = run(model, rates[r], seed + 10u * r + 100u * (uint64_t)model);
+                check(&t);
+                if (budget > 0u) {
+                    /* snapshots repair or flag all but features merged away */
+                    TEST_ASSERT_EQUAL_UINT(t.ghost, t.unflagged);
+                }
+            }
+        }
+    }
+    for (seed = 1u; seed <= 4u; ++seed) {
+        const tally_t t = run(BURSTS, 4.0 * (double)seed, 500u + seed);
+        check(&t);
+    }
+}
+
+/* The default: no snapshots. What damage hits is reported, never repaired. */
+static void test_map_fault_channel_no_snapshots(void)
+{
+    channel_runs(0u);
+}
+
+/* Snapshots of 40 bytes per frame repair what damage hit. */
+static void test_map_fault_channel_snapshots(void)
+{
+    channel_runs(40u);
+}
+
+/* A receiver that joins late: everything before its first frame is missing;
+ * without snapshots the features it never got are reported, with them they
+ * come back. */
+static void test_map_fault_late_join(void)
+{
+    static const double joins[] = {0.05, 0.3, 0.6};
+    size_t j;
+    make_stream(0u);
+    for (j = 0; j < sizeof joins / sizeof joins[0]; ++j) {
+        const tally_t t = run(LATE_JOIN, (double)(size_t)(joins[j] * (double)n_frames), 900u + j);
+        check(&t);
+        TEST_ASSERT_TRUE(t.frames_delivered > 0u);
+    }
+    make_stream(40u);
+    for (j = 0; j < sizeof joins / sizeof joins[0]; ++j) {
+        const tally_t t = run(LATE_JOIN, (double)(size_t)(joins[j] * (double)n_frames), 950u + j);
+        check(&t);
+        /* snapshots bring back every feature the robot holds */
+        TEST_ASSERT_TRUE(t.features > 0u && t.repaired + t.intact > 0u);
+        TEST_ASSERT_EQUAL_UINT(0u, t.missing);
+    }
+}
+
+static void test_map_fault_totals(void)
+{
+    printf("TOTAL: frames untouched %u, recovered %u, delivered %u, damaged accepted %u; "
+           "features %u: intact %u, repaired %u, reported stale %u, unflagged after a counted loss "
+           "%u (missing %u, ghost %u), "
+           "wrong %u\n",
+           total.frames_untouched, total.frames_recovered, total.frames_delivered,
+           total.damaged_accepted, total.features, total.intact, total.repaired, total.reported,
+           total.unflagged, total.missing, total.ghost, total.wrong);
+    TEST_ASSERT_TRUE(total.frames_recovered > 0u);
+    TEST_ASSERT_TRUE(total.repaired > 0u); /* the resync design was exercised */
+    TEST_ASSERT_EQUAL_UINT(0u, total.damaged_accepted);
+    TEST_ASSERT_EQUAL_UINT(0u, total.wrong);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_map_fault_channel_no_snapshots);
+    RUN_TEST(test_map_fault_channel_snapshots);
+    RUN_TEST(test_map_fault_late_join);
+    RUN_TEST(test_map_fault_totals);
+    return UNITY_END();
+}
