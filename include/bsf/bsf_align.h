@@ -17,7 +17,7 @@
  *
  * The result reports the 3x3 information matrix of the final
  * correspondences and its smallest eigenvalue and eigenvector. A direction
- * the geometry leaves free (the axis of a long featureless corridor) is not
+ * the geometry leaves undetermined (the axis of a long featureless corridor) is not
  * solved: the pose keeps the prior along it and BSF_ALIGN_FLAG_FREE is set.
  * When alignment cannot be trusted (too few points or correspondences, a
  * correction larger than the bounds, divergence) the call succeeds but
@@ -53,7 +53,7 @@ typedef struct {
     float theta_scale;    /**< metres per radian, (0, 100]: how heading counts against
                                translation in the eigenvalues (default 1) */
     float free_ratio;     /**< [0, 1): a direction whose eigenvalue is below this share of
-                               the largest is left free (default 0.005) */
+                               the largest is left free, default 0.005 */
     float free_min;       /**< >= 0: ... or below this absolute information (default 3,
                                about three points seen squarely) */
     uint16_t max_iter;    /**< 1..50 Gauss-Newton iterations (default 10) */

@@ -22,15 +22,8 @@
 
 #include "bench_map_scans.h"
 #include "bsf/bsf.h"
+#include "m4_counter.h"
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
-#define SYST_MASK 0x00FFFFFFu
-#define SCB_ICSR (*(volatile uint32_t *)0xE000ED04u)
-#define SCB_VTOR (*(volatile uint32_t *)0xE000ED08u)
-#define ICSR_PENDSTSET (1u << 26)
-#define N_VECTORS 16u
 #define MAX_SCANS 4096u
 
 static bsf_extractor_t g_ex;
@@ -39,111 +32,9 @@ static bsf_map_t g_map;
 static bsf_align_work_t g_work;
 static uint32_t g_align[MAX_SCANS];
 static uint32_t g_sorted[MAX_SCANS];
-static double g_ticks_per_instr;
-
-typedef void (*vector_t)(void);
-static vector_t g_vectors[N_VECTORS] __attribute__((aligned(128)));
-static volatile uint32_t g_wraps;
-
-static void systick_isr(void)
-{
-    ++g_wraps;
-}
-
-/* SysTick through a vector table of our own in RAM; its interrupt counts
- * the 24-bit wraps, so long calls are counted exactly. */
-static void systick_start(void)
-{
-    const vector_t *boot = (const vector_t *)(uintptr_t)SCB_VTOR;
-    uint32_t i;
-    for (i = 0; i < N_VECTORS; ++i) {
-        g_vectors[i] = boot[i];
-    }
-    g_vectors[15] = systick_isr;
-    SCB_VTOR = (uint32_t)(uintptr_t)g_vectors;
-    __asm volatile("dsb\n\tisb" ::: "memory");
-    g_wraps = 0u;
-    SYST_RVR = SYST_MASK;
-    SYST_CVR = 0u;
-    SYST_CSR = 7u;
-}
-
-static uint32_t ticks_now(void)
-{
-    uint32_t w, v, pend;
-    do {
-        w = g_wraps;
-        v = SYST_CVR & SYST_MASK;
-        pend = SCB_ICSR & ICSR_PENDSTSET;
-    } while (w != g_wraps);
-    if (pend != 0u && v > SYST_MASK / 2u) {
-        ++w;
-    }
-    return (w << 24) + (SYST_MASK - v);
-}
-
-/* Exactly 2 instructions per iteration (subs, bne). */
-static void spin(uint32_t n)
-{
-    __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
-}
-
-static uint32_t ticks_of_spin(uint32_t n)
-{
-    const uint32_t t0 = ticks_now();
-    spin(n);
-    return ticks_now() - t0;
-}
-
-static uint32_t to_instr(uint32_t ticks)
-{
-    return (uint32_t)((double)ticks / g_ticks_per_instr + 0.5);
-}
 
 /* Stack high-water mark: paint below the caller's frame, run, find the
  * deepest word overwritten. */
-#define PAINT_BYTES 16384u
-#define PAINT_WORD 0xDEADBEEFu
-
-static uint32_t *paint_base(void)
-{
-    uint32_t sp;
-    __asm volatile("mov %0, sp" : "=r"(sp));
-    return (uint32_t *)(uintptr_t)((sp - PAINT_BYTES - 256u) & ~7u);
-}
-
-static void __attribute__((noinline)) stack_paint(void)
-{
-    volatile uint32_t *p = paint_base();
-    uint32_t i;
-    for (i = 0; i < PAINT_BYTES / 4u; ++i) {
-        p[i] = PAINT_WORD;
-    }
-}
-
-static uint32_t __attribute__((noinline)) stack_used(uint32_t *base)
-{
-    uint32_t i = 0;
-    while (i < PAINT_BYTES / 4u && base[i] == PAINT_WORD) {
-        ++i;
-    }
-    return PAINT_BYTES - 4u * i;
-}
-
-static int cmp_u32(const void *a, const void *b)
-{
-    const uint32_t x = *(const uint32_t *)a;
-    const uint32_t y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint32_t median_of(const uint32_t *v, size_t n, uint32_t *max_out)
-{
-    memcpy(g_sorted, v, n * sizeof *v);
-    qsort(g_sorted, n, sizeof *g_sorted, cmp_u32);
-    *max_out = g_sorted[n - 1u];
-    return g_sorted[n / 2u];
-}
 
 /* b in the frame of a (the motion from a to b). */
 static bsf_pose_t relative(const bsf_pose_t *a, const bsf_pose_t *b)
@@ -183,13 +74,7 @@ int main(void)
     float err_sum = 0.0f;
     size_t k;
     size_t n_timed = 0;
-    systick_start();
-    {
-        const uint32_t a = ticks_of_spin(100000u);
-        const uint32_t b = ticks_of_spin(300000u);
-        g_ticks_per_instr = (double)(b - a) / 400000.0;
-    }
-    if (!(g_ticks_per_instr > 0.5)) {
+    if (!(m4_counter_start() > 0.5)) {
         printf("no usable instruction clock (run QEMU with -icount shift=10)\n");
         return 1;
     }
@@ -223,20 +108,19 @@ int main(void)
             m.y *= 1.02f;
             m.theta += d * 0.0174533f;
             prior = moved(&bench_map_scans[k - 1].pose, &m);
-            stack_paint();
-            base = paint_base();
-            t0 = ticks_now();
+            base = m4_stack_paint();
+            t0 = m4_ticks();
             st = bsf_align_points(&g_work, NULL, &g_map, &g_ex.points, &g_res, &prior, &ar);
-            t1 = ticks_now();
+            t1 = m4_ticks();
             if (st != BSF_OK) {
                 printf("scan %u: alignment failed\n", (unsigned)k);
                 return 1;
             }
             {
-                const uint32_t used = stack_used(base);
+                const uint32_t used = m4_stack_used(base);
                 stack_max = used > stack_max ? used : stack_max;
             }
-            g_align[n_timed++] = to_instr(t1 - t0);
+            g_align[n_timed++] = m4_instr(t1 - t0);
             ++declined[ar.declined];
             n_free += ar.n_free > 0u;
             err_sum += sqrtf((ar.pose.x - sc->pose.x) * (ar.pose.x - sc->pose.x) +
@@ -251,7 +135,7 @@ int main(void)
         printf("no scans\n");
         return 1;
     }
-    med = median_of(g_align, n_timed, &max);
+    med = m4_median(g_align, n_timed, g_sorted, &max);
     printf("bench_m4_align: %s\n", bench_map_description);
     printf("bsf_align_points instructions per scan: median %lu, max %lu (%lu scans)\n",
            (unsigned long)med, (unsigned long)max, (unsigned long)n_timed);

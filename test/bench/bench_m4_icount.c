@@ -36,16 +36,12 @@
 
 #include "bench_scenes.h"
 #include "bsf/bsf.h"
+#include "m4_counter.h"
 #include "bsf_scene.h"
 
 #ifdef BSF_BENCH_HAVE_LOG
 #include "bench_log_scans.h"
 #endif
-
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
-#define SYST_MASK 0x00FFFFFFu
 
 #define MAX_SCANS 4096
 #define N_SYNTH_SCENES 3
@@ -61,141 +57,15 @@ static uint32_t g_sorted[MAX_SCANS];
 static uint32_t g_encode[MAX_SCANS];
 static uint8_t g_frame[BSF_FRAME_MAX_SIZE];
 
-static double g_ticks_per_instr;
 static uint32_t g_stack_bytes;
 
 /* SysTick counts down through 24 bits; its interrupt counts the wraps, so a
  * count of any length is exact. The interrupt runs through a vector table of
  * our own in RAM (VTOR), leaving the shared startup code alone. */
-#define SCB_ICSR (*(volatile uint32_t *)0xE000ED04u)
-#define SCB_VTOR (*(volatile uint32_t *)0xE000ED08u)
-#define ICSR_PENDSTSET (1u << 26)
-#define N_VECTORS 16u
-
-typedef void (*vector_t)(void);
-static vector_t g_vectors[N_VECTORS] __attribute__((aligned(128)));
-static volatile uint32_t g_wraps;
-
-static void systick_isr(void)
-{
-    ++g_wraps;
-}
-
-static void systick_start(void)
-{
-    const vector_t *boot = (const vector_t *)(uintptr_t)SCB_VTOR;
-    uint32_t i;
-    for (i = 0; i < N_VECTORS; ++i) {
-        g_vectors[i] = boot[i];
-    }
-    g_vectors[15] = systick_isr;
-    SCB_VTOR = (uint32_t)(uintptr_t)g_vectors;
-    __asm volatile("dsb\n\tisb" ::: "memory");
-    g_wraps = 0u;
-    SYST_RVR = SYST_MASK;
-    SYST_CVR = 0u;
-    SYST_CSR = 7u; /* enable, interrupt on wrap, core clock */
-}
-
-/* Up-counting SysTick ticks since systick_start, 32 bits (wraps harmlessly:
- * only differences are used). A reload whose interrupt is still pending is
- * counted from the pending bit. */
-static uint32_t ticks_now(void)
-{
-    uint32_t w, v, pend;
-    do {
-        w = g_wraps;
-        v = SYST_CVR & SYST_MASK;
-        pend = SCB_ICSR & ICSR_PENDSTSET;
-    } while (w != g_wraps);
-    if (pend != 0u && v > SYST_MASK / 2u) {
-        ++w;
-    }
-    return (w << 24) + (SYST_MASK - v);
-}
-
-/* Clock hook for the per-stage split (clock_hz 1e9: stage_ns holds raw ticks). */
-static uint32_t hook_ticks(void *user)
-{
-    (void)user;
-    return ticks_now();
-}
-
-/* Exactly 2 instructions per iteration (subs, bne). */
-static void spin(uint32_t n)
-{
-    __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
-}
-
-static uint32_t ticks_of_spin(uint32_t n)
-{
-    const uint32_t t0 = ticks_now();
-    spin(n);
-    return ticks_now() - t0;
-}
-
-/* Ticks per instruction from two loops differing by 2 * 200000 instructions
- * (the call and reading overhead cancels). */
-static void calibrate(void)
-{
-    const uint32_t a = ticks_of_spin(100000u);
-    const uint32_t b = ticks_of_spin(300000u);
-    g_ticks_per_instr = (double)(b - a) / 400000.0;
-}
-
-static uint32_t to_instr(uint32_t ticks)
-{
-    return (uint32_t)((double)ticks / g_ticks_per_instr + 0.5);
-}
 
 /* Stack high-water mark: paint the free stack below the caller's frame,
  * run, then find the deepest word overwritten. Counts everything bsf_extract
  * uses, libm included. */
-#define PAINT_BYTES 8192u
-#define PAINT_WORD 0xDEADBEEFu
-
-static uint32_t *paint_base(void)
-{
-    uint32_t sp;
-    __asm volatile("mov %0, sp" : "=r"(sp));
-    return (uint32_t *)(uintptr_t)((sp - PAINT_BYTES - 256u) & ~7u);
-}
-
-static void __attribute__((noinline)) stack_paint(void)
-{
-    volatile uint32_t *p = paint_base();
-    uint32_t i;
-    for (i = 0; i < PAINT_BYTES / 4u; ++i) {
-        p[i] = PAINT_WORD;
-    }
-}
-
-/* Bytes used below the paint top (the painting function's own frame is above it). */
-static uint32_t __attribute__((noinline)) stack_used(uint32_t *base)
-{
-    uint32_t i = 0;
-    while (i < PAINT_BYTES / 4u && base[i] == PAINT_WORD) {
-        ++i;
-    }
-    return PAINT_BYTES - 4u * i;
-}
-
-static int cmp_u32(const void *a, const void *b)
-{
-    const uint32_t x = *(const uint32_t *)a;
-    const uint32_t y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint32_t median_of(const uint32_t *v, size_t n, uint32_t *max_out)
-{
-    memcpy(g_sorted, v, n * sizeof *v);
-    qsort(g_sorted, n, sizeof *g_sorted, cmp_u32);
-    if (max_out != NULL) {
-        *max_out = g_sorted[n - 1u];
-    }
-    return g_sorted[n / 2u];
-}
 
 typedef struct {
     const bsf_scan_t *(*get)(size_t i, bsf_scan_t *tmp);
@@ -223,11 +93,10 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
         printf("  %-15s SKIPPED: not available in this build\n", bsf_method_name(method));
         return 0;
     }
-    uint32_t *painted = paint_base();
+    uint32_t *painted = m4_stack_paint();
     uint32_t stack_top_used;
-    stack_paint();
     /* What the measuring itself leaves below the paint top (subtracted). */
-    stack_top_used = stack_used(painted);
+    stack_top_used = m4_stack_used(painted);
     for (i = 0; i < src->n; ++i) {
         bsf_scan_t tmp;
         const bsf_scan_t *scan = src->get(i, &tmp);
@@ -235,20 +104,20 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
         bsf_status_t st;
 
         /* Whole call, no clock hook: what firmware without timing pays. */
-        t0 = ticks_now();
+        t0 = m4_ticks();
         st = bsf_extract(&g_ex, scan, &g_res);
-        t1 = ticks_now();
+        t1 = m4_ticks();
         if (st < 0) { /* BSF_OK_CUT is a result like any other */
             printf("  %s: scan %u: %s\n", bsf_method_name(method), (unsigned)i, bsf_status_str(st));
             return 1;
         }
-        g_whole[i] = to_instr(t1 - t0);
+        g_whole[i] = m4_instr(t1 - t0);
         mean += (double)g_whole[i];
         feats += g_res.stats.n_features;
     }
-    g_stack_bytes = stack_used(painted) - stack_top_used;
+    g_stack_bytes = m4_stack_used(painted) - stack_top_used;
     /* Per-stage split with the hook (a few instructions more per stage). */
-    p.clock = hook_ticks;
+    p.clock = m4_clock_hook;
     p.clock_user = NULL;
     p.clock_hz = 1000000000u;
     if (bsf_extractor_init(&g_ex, &p) != BSF_OK) {
@@ -266,23 +135,23 @@ static int run_method(const scan_source_t *src, bsf_method_t method)
         /* The scan's frame, as firmware sends it after extracting. */
         bsf_frame_info_init(&info);
         info.seq = (uint32_t)i;
-        t0 = ticks_now();
+        t0 = m4_ticks();
         if (bsf_frame_encode(&info, &g_res, g_frame, sizeof g_frame, &len) != BSF_OK) {
             printf("  %s: scan %u: frame not encoded\n", bsf_method_name(method), (unsigned)i);
             return 1;
         }
-        g_encode[i] = to_instr(ticks_now() - t0);
+        g_encode[i] = m4_instr(m4_ticks() - t0);
         for (s = 0; s < BSF_STAGE_COUNT; ++s) {
-            g_stage[s][i] = to_instr(g_res.stats.stage_ns[s]);
+            g_stage[s][i] = m4_instr(g_res.stats.stage_ns[s]);
         }
     }
-    med_whole = median_of(g_whole, src->n, &max_whole);
+    med_whole = m4_median(g_whole, src->n, g_sorted, &max_whole);
     printf("  %-15s %9lu %9lu %9lu |", bsf_method_name(method), (unsigned long)med_whole,
            (unsigned long)(mean / (double)src->n + 0.5), (unsigned long)max_whole);
     for (s = 0; s < BSF_STAGE_COUNT; ++s) {
-        printf(" %8lu", (unsigned long)median_of(g_stage[s], src->n, NULL));
+        printf(" %8lu", (unsigned long)m4_median(g_stage[s], src->n, g_sorted, NULL));
     }
-    printf(" | %8lu", (unsigned long)median_of(g_encode, src->n, NULL));
+    printf(" | %8lu", (unsigned long)m4_median(g_encode, src->n, g_sorted, NULL));
     printf(" | %5.2f | %5lu\n", (double)feats / (double)src->n, (unsigned long)g_stack_bytes);
     return 0;
 }
@@ -557,13 +426,12 @@ int main(void)
 #endif
     int rc = 0;
 
-    systick_start();
-    calibrate();
+    const double ticks_per_instr = m4_counter_start();
     printf("bench_m4_icount: Cortex-M4F under QEMU -icount; %.4f SysTick ticks per "
            "instruction (calibrated; 25.6 expected at shift=10)\n",
-           g_ticks_per_instr);
+           ticks_per_instr);
     printf("counts are instructions executed, not cycles; BSF_MAX_POINTS %d\n", BSF_MAX_POINTS);
-    if (g_ticks_per_instr < 0.5) {
+    if (ticks_per_instr < 0.5) {
         printf("no usable instruction clock (run QEMU with -icount shift=10)\n");
         return 1;
     }

@@ -18,15 +18,8 @@
 
 #include "bench_map_scans.h"
 #include "bsf/bsf.h"
+#include "m4_counter.h"
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
-#define SYST_MASK 0x00FFFFFFu
-#define SCB_ICSR (*(volatile uint32_t *)0xE000ED04u)
-#define SCB_VTOR (*(volatile uint32_t *)0xE000ED08u)
-#define ICSR_PENDSTSET (1u << 26)
-#define N_VECTORS 16u
 #define MAX_SCANS 4096u
 
 static bsf_extractor_t g_ex;
@@ -36,111 +29,9 @@ static uint8_t g_frame[BSF_MAP_FRAME_MAX_SIZE];
 static uint32_t g_fuse[MAX_SCANS];
 static uint32_t g_encode[MAX_SCANS];
 static uint32_t g_sorted[MAX_SCANS];
-static double g_ticks_per_instr;
-
-typedef void (*vector_t)(void);
-static vector_t g_vectors[N_VECTORS] __attribute__((aligned(128)));
-static volatile uint32_t g_wraps;
-
-static void systick_isr(void)
-{
-    ++g_wraps;
-}
-
-/* SysTick through a vector table of our own in RAM; its interrupt counts
- * the 24-bit wraps, so long calls are counted exactly. */
-static void systick_start(void)
-{
-    const vector_t *boot = (const vector_t *)(uintptr_t)SCB_VTOR;
-    uint32_t i;
-    for (i = 0; i < N_VECTORS; ++i) {
-        g_vectors[i] = boot[i];
-    }
-    g_vectors[15] = systick_isr;
-    SCB_VTOR = (uint32_t)(uintptr_t)g_vectors;
-    __asm volatile("dsb\n\tisb" ::: "memory");
-    g_wraps = 0u;
-    SYST_RVR = SYST_MASK;
-    SYST_CVR = 0u;
-    SYST_CSR = 7u;
-}
-
-static uint32_t ticks_now(void)
-{
-    uint32_t w, v, pend;
-    do {
-        w = g_wraps;
-        v = SYST_CVR & SYST_MASK;
-        pend = SCB_ICSR & ICSR_PENDSTSET;
-    } while (w != g_wraps);
-    if (pend != 0u && v > SYST_MASK / 2u) {
-        ++w;
-    }
-    return (w << 24) + (SYST_MASK - v);
-}
-
-/* Exactly 2 instructions per iteration (subs, bne). */
-static void spin(uint32_t n)
-{
-    __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
-}
-
-static uint32_t ticks_of_spin(uint32_t n)
-{
-    const uint32_t t0 = ticks_now();
-    spin(n);
-    return ticks_now() - t0;
-}
-
-static uint32_t to_instr(uint32_t ticks)
-{
-    return (uint32_t)((double)ticks / g_ticks_per_instr + 0.5);
-}
 
 /* Stack high-water mark: paint below the caller's frame, run, find the
  * deepest word overwritten. */
-#define PAINT_BYTES 16384u
-#define PAINT_WORD 0xDEADBEEFu
-
-static uint32_t *paint_base(void)
-{
-    uint32_t sp;
-    __asm volatile("mov %0, sp" : "=r"(sp));
-    return (uint32_t *)(uintptr_t)((sp - PAINT_BYTES - 256u) & ~7u);
-}
-
-static void __attribute__((noinline)) stack_paint(void)
-{
-    volatile uint32_t *p = paint_base();
-    uint32_t i;
-    for (i = 0; i < PAINT_BYTES / 4u; ++i) {
-        p[i] = PAINT_WORD;
-    }
-}
-
-static uint32_t __attribute__((noinline)) stack_used(uint32_t *base)
-{
-    uint32_t i = 0;
-    while (i < PAINT_BYTES / 4u && base[i] == PAINT_WORD) {
-        ++i;
-    }
-    return PAINT_BYTES - 4u * i;
-}
-
-static int cmp_u32(const void *a, const void *b)
-{
-    const uint32_t x = *(const uint32_t *)a;
-    const uint32_t y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint32_t median_of(const uint32_t *v, size_t n, uint32_t *max_out)
-{
-    memcpy(g_sorted, v, n * sizeof *v);
-    qsort(g_sorted, n, sizeof *g_sorted, cmp_u32);
-    *max_out = g_sorted[n - 1u];
-    return g_sorted[n / 2u];
-}
 
 int main(void)
 {
@@ -153,13 +44,7 @@ int main(void)
     uint32_t fuse_med;
     uint32_t enc_med;
     size_t k;
-    systick_start();
-    {
-        const uint32_t a = ticks_of_spin(100000u);
-        const uint32_t b = ticks_of_spin(300000u);
-        g_ticks_per_instr = (double)(b - a) / 400000.0;
-    }
-    if (!(g_ticks_per_instr > 0.5)) {
+    if (!(m4_counter_start() > 0.5)) {
         printf("no usable instruction clock (run QEMU with -icount shift=10)\n");
         return 1;
     }
@@ -186,26 +71,25 @@ int main(void)
             printf("scan %u: extraction failed\n", (unsigned)k);
             return 1;
         }
-        stack_paint();
-        base = paint_base();
-        t0 = ticks_now();
+        base = m4_stack_paint();
+        t0 = m4_ticks();
         st = bsf_map_fuse(&g_map, &g_res, &sc->pose);
-        t1 = ticks_now();
+        t1 = m4_ticks();
         if (st < 0 || bsf_map_encode(&g_map, NULL, g_frame, sizeof g_frame, &len) != BSF_OK) {
             printf("scan %u: fuse or encode failed\n", (unsigned)k);
             return 1;
         }
-        t2 = ticks_now();
+        t2 = m4_ticks();
         {
-            const uint32_t used = stack_used(base);
+            const uint32_t used = m4_stack_used(base);
             stack_max = used > stack_max ? used : stack_max;
         }
-        g_fuse[k] = to_instr(t1 - t0);
-        g_encode[k] = to_instr(t2 - t1);
+        g_fuse[k] = m4_instr(t1 - t0);
+        g_encode[k] = m4_instr(t2 - t1);
         bytes += (uint32_t)len;
     }
-    fuse_med = median_of(g_fuse, n, &fuse_max);
-    enc_med = median_of(g_encode, n, &enc_max);
+    fuse_med = m4_median(g_fuse, n, g_sorted, &fuse_max);
+    enc_med = m4_median(g_encode, n, g_sorted, &enc_max);
     printf("bench_m4_map: %s\n", bench_map_description);
     printf("bsf_map_fuse   instructions per scan: median %lu, max %lu\n", (unsigned long)fuse_med,
            (unsigned long)fuse_max);
