@@ -191,6 +191,22 @@ def _add_tf(tree: TransformTree, msg: object, static: bool) -> int:
     return added
 
 
+def add_pose_message(tree: TransformTree, kind: str, msg: object, static: bool = False) -> int:
+    """Add one decoded pose message to ``tree``: a ``tf2_msgs/TFMessage``
+    (``kind`` "tf") or a ``nav_msgs/Odometry`` ("odometry"). Returns how many
+    transforms were taken; the tree counts what it refused (non-finite values,
+    bad frame names, a child turned upside down). Raises what reading a
+    malformed message's fields raises; :func:`load_poses` counts those as bad
+    messages."""
+    if kind == "tf":
+        return _add_tf(tree, msg, static)
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation  # type: ignore[attr-defined]
+    quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+    frame = str(msg.header.frame_id)  # type: ignore[attr-defined]
+    child = str(msg.child_frame_id)  # type: ignore[attr-defined]
+    return int(tree.add_3d(frame, child, _stamp_ns(msg), float(p.x), float(p.y), quat, static))
+
+
 def _names(frames: "set[str]", most: int = 20) -> str:
     """Frame names for a message, at most ``most`` of them (a bag may name thousands)."""
     names = sorted(frames)
@@ -241,15 +257,12 @@ def load_poses(
                 try:
                     m = reader.deserialize(raw, conn.msgtype)
                     if conn.topic == TF_STATIC and conn in static:
-                        _add_tf(tree, m, True)
-                    elif kind == "tf":
-                        usable += _add_tf(tree, m, pose_from == TF_STATIC)
+                        add_pose_message(tree, "tf", m, True)
                     else:
-                        p, q = m.pose.pose.position, m.pose.pose.orientation
-                        quat = (float(q.x), float(q.y), float(q.z), float(q.w))
-                        if tree.add_3d(str(m.header.frame_id), str(m.child_frame_id), _stamp_ns(m), float(p.x), float(p.y), quat):
+                        n = add_pose_message(tree, kind, m, pose_from == TF_STATIC)
+                        if n and kind == "odometry":
                             odom_frame = odom_frame or str(m.header.frame_id).lstrip("/")
-                            usable += 1
+                        usable += n
                     src.messages += 1
                 except (GeneratorExit, KeyboardInterrupt):
                     raise
