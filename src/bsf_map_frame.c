@@ -1146,6 +1146,14 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         f->lost_at = rx->lost;
         return 1;
     case BSF_MAP_REC_SNAPSHOT:
+        if (f->state == RX_PRESENT && f->upd == rec->upd &&
+            rx_lost_since(rx, f) < RX_CONFIRM_LOST) {
+            /* the count shows no record of it was lost: the receiver holds
+             * what the snapshot carries, and keeps it whole */
+            f->lost_at = rx->lost;
+            ++rx->stats.snapshots;
+            return 1;
+        }
         /* a first part restarts the feature; a later part continues it only
          * when every part before it arrived */
         if (rec->start == 0u) {
