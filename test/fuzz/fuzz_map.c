@@ -18,7 +18,8 @@
  * Properties: fuse returns a count <= the scan's features or a documented
  * error, and an error leaves the map byte for byte unchanged; encode returns
  * a documented status and a frame within its cap; every frame goes through
- * the stream decoder and applies with no record skipped; after every call
+ * the stream decoder and applies with no record skipped, advancing no
+ * feature's update count by more than 4; after every call
  * the map's fused control points are finite and within the caps, and the
  * receiver holds exactly the robot's sent copy of every feature, none
  * flagged (snapshots on or off: a snapshot of a feature the receiver can
@@ -168,8 +169,25 @@ static void deliver(size_t len)
         off += used;
         FUZZ_CHECK(got == 0 || got == (int)BSF_FRAME_TYPE_MAP);
         if (got == (int)BSF_FRAME_TYPE_MAP) {
-            const int skipped = bsf_map_rx_apply(&rx, frame.payload, frame.payload_len);
+            /* a frame advances a feature's update count by at most 4 (what
+             * lets a receiver confirm a feature by its count after a short
+             * loss): counted here through the receiver's counts */
+            static uint8_t upd[BSF_MAP_RX_MAX_FEATURES];
+            static uint8_t held[BSF_MAP_RX_MAX_FEATURES];
+            const uint32_t limit = bsf_map_rx_id_limit(&rx);
+            uint32_t id;
+            int skipped;
+            for (id = 0; id < limit; ++id) {
+                upd[id] = rx.features[id].upd;
+                held[id] = bsf_map_rx_feature_state(&rx, id) == BSF_MAP_RX_CONFIRMED;
+            }
+            skipped = bsf_map_rx_apply(&rx, frame.payload, frame.payload_len);
             FUZZ_CHECK(skipped == 0); /* lost nothing: every record applies */
+            for (id = 0; id < limit; ++id) {
+                if (held[id] && bsf_map_rx_feature_state(&rx, id) == BSF_MAP_RX_CONFIRMED) {
+                    FUZZ_CHECK((((unsigned)rx.features[id].upd - upd[id]) & 15u) <= 4u);
+                }
+            }
             ++maps;
         }
     }
