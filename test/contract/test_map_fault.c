@@ -3,17 +3,15 @@
  * Fault injection on the map stream: the map-update frames of a synthetic
  * drive (the demo office, three loops, then a quiet tail in which snapshots
  * go round) through a channel that flips bits (1e-4 .. 1e-2 per byte),
- * inserts or deletes bytes, or replaces bursts, and to a receiver that joins
- * late. A lossless receiver fed the same frames is the reference (it holds
- * the robot's sent copy, checked). Judged at the end, feature by feature:
- * the damaged receiver holds exactly the reference's points, or flags the
- * feature (stale output of bsf_map_rx_feature_ctrl: unconfirmed, stale or
- * missing); a feature that differs without the flag must not exist, whether
- * the receiver counted a loss or not. A feature flagged but equal is a false
- * alarm (counted, kept low by confirmation through update counts). Every
- * frame the decoder delivers must be one the robot sent, byte for byte
- * (damaged frames accepted: must be 0), and every frame the channel did not
- * touch must be delivered.
+ * inserts or deletes bytes, replaces bursts, or goes silent for 1 .. 6 whole
+ * frames, and to a receiver that joins late. A lossless receiver fed the same frames is the
+ * reference (it holds the robot's sent copy, checked). Judged at the end, feature by feature: the
+ * damaged receiver holds exactly the reference's points, or flags the feature (stale output of
+ * bsf_map_rx_feature_ctrl: unconfirmed, stale or missing); a feature that differs without the flag
+ * must not exist, whether the receiver counted a loss or not. A feature flagged but equal is a
+ * false alarm (counted, kept low by confirmation through update counts). Every frame the decoder
+ * delivers must be one the robot sent, byte for byte (damaged frames accepted: must be 0), and
+ * every frame the channel did not touch must be delivered.
  */
 #include <stdio.h>
 #include <string.h>
@@ -352,9 +350,9 @@ static void note_stale(void)
     }
 }
 
-enum { FLIPS, INSERTS, DELETES, BURSTS, LATE_JOIN };
-static const char *const model_name[] = {"bit flips", "insertions", "deletions", "bursts",
-                                         "late join"};
+enum { FLIPS, INSERTS, DELETES, BURSTS, LATE_JOIN, SILENCES };
+static const char *const model_name[] = {"bit flips", "insertions", "deletions",
+                                         "bursts",    "late join",  "silences"};
 
 /* One run through the channel: rate is per byte (bit flips: per bit of a
  * byte hit), or the number of bursts, or the frame the late receiver joins
@@ -363,6 +361,7 @@ static tally_t run(int model, double rate, uint64_t seed)
 {
     tally_t t;
     size_t k;
+    size_t silent_left = 0u; /* SILENCES: frames still to lose */
     memset(&t, 0, sizeof t);
     rng_state = seed * 0x9E3779B97F4A7C15ull + 1u;
     memset(damaged, 0, sizeof damaged);
@@ -376,7 +375,21 @@ static tally_t run(int model, double rate, uint64_t seed)
         const size_t n = frame_start[k + 1u] - frame_start[k];
         size_t out = 0u;
         size_t j;
-        if (model == LATE_JOIN) {
+        if (model == SILENCES) {
+            /* the link goes silent for `rate` whole frames, from a frame in
+             * 8: losses of 1 .. 3 frames end in count confirmations, 4 or
+             * more must not */
+            if (silent_left == 0u && rng_below(8u) == 0u) {
+                silent_left = (size_t)rate;
+            }
+            if (silent_left > 0u) {
+                --silent_left;
+                damaged[k] = 1u;
+                continue;
+            }
+            memcpy(channel, f, n);
+            out = n;
+        } else if (model == LATE_JOIN) {
             if (k < (size_t)rate) {
                 damaged[k] = 1u; /* never heard */
                 continue;
@@ -497,6 +510,12 @@ static void channel_runs(uint16_t budget)
     for (seed = 1u; seed <= 4u; ++seed) {
         const tally_t t = run(BURSTS, 4.0 * (double)seed, 500u + seed);
         check(&t);
+    }
+    for (r = 1u; r <= 6u; ++r) {
+        for (seed = 1u; seed <= 2u; ++seed) {
+            const tally_t t = run(SILENCES, (double)r, 600u + 10u * r + seed);
+            check(&t);
+        }
     }
 }
 
