@@ -877,7 +877,7 @@ static int feature_new(bsf_map_t *m, const newpt_t *p, size_t n)
     }
     f = &m->features[m->n_features++];
     memset(f, 0, sizeof *f);
-    f->id = m->next_id++;
+    f->id = BSF_MAP_ID_UNSENT; /* given at its first record (dense ids on the wire) */
     f->last_seen = m->stats.n_fused;
     f->flags = BSF_MAP_FF_FRESH;
     f->head = ctrl_alloc(m, p[0].x, p[0].y, p[0].vertex);

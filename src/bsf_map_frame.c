@@ -629,6 +629,9 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
         }
         qx = 0;
         qy = 0;
+        /* ids are given in the order features first go out, so that every id
+         * below the largest a receiver saw is one the robot sent */
+        f->id = m->next_id++;
         put_tag(w, BSF_MAP_REC_NEW, 0u, 0u);
         put_id(w, prev_id, f->id);
         put_u(w, n);
@@ -746,6 +749,9 @@ static void put_snapshots(bsf_map_t *m, wr_t *w, int64_t *prev_id)
             uint16_t s;
             for (s = 0; s < m->n_features; ++s) {
                 const uint32_t id = m->features[s].id;
+                if (!(m->features[s].flags & BSF_MAP_FF_SENT)) {
+                    continue; /* no id yet */
+                }
                 if (id >= m->snapshot_next && (slot == BSF_MAP_NONE || id < m->features[slot].id)) {
                     slot = s;
                 }
@@ -950,6 +956,15 @@ bsf_status_t bsf_map_encode(bsf_map_t *map, const bsf_pose_t *pose, uint8_t *buf
 #define RX_GONE 3u
 #define RX_SNAP 4u /* a snapshot in parts is arriving */
 
+/* A frame advances one feature's update count by at most RX_ADVANCE_MAX
+ * (a merge, an append at each end, a move): after fewer than
+ * RX_CONFIRM_LOST lost frames a count that matches cannot have wrapped, so
+ * no record of the feature was lost. A gap adds at most RX_GAP_MAX to
+ * rx->lost, enough to say "too many to tell". */
+#define RX_ADVANCE_MAX 4u
+#define RX_CONFIRM_LOST (16u / RX_ADVANCE_MAX)
+#define RX_GAP_MAX 16u
+
 void bsf_map_rx_init(bsf_map_rx_t *rx)
 {
     size_t i;
@@ -964,6 +979,22 @@ void bsf_map_rx_init(bsf_map_rx_t *rx)
     }
     rx->free_ctrl = 0u;
     rx->n_free_ctrl = BSF_MAP_RX_MAX_CTRL;
+    rx->ids_known = 1u;
+}
+
+/* Map frames lost since f was last confirmed (or its snapshot started). */
+static uint32_t rx_lost_since(const bsf_map_rx_t *rx, const bsf_map_rx_feature_t *f)
+{
+    return rx->lost - f->lost_at;
+}
+
+/* A record of f applied with the count it expected: when too few frames
+ * were lost for the count to have wrapped, f missed nothing. */
+static void rx_confirm_by_count(bsf_map_rx_t *rx, bsf_map_rx_feature_t *f)
+{
+    if (rx_lost_since(rx, f) < RX_CONFIRM_LOST) {
+        f->lost_at = rx->lost;
+    }
 }
 
 static void rx_free_chain(bsf_map_rx_t *rx, bsf_map_rx_feature_t *f)
@@ -1083,11 +1114,16 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         ++rx->stats.poses;
         return 1;
     }
+    if (rec->op == BSF_MAP_REC_NEW) {
+        /* ids go out in order: every id the lost frames gave is below this */
+        rx->ids_known = 1u;
+    }
     if (rec->id >= BSF_MAP_RX_MAX_FEATURES ||
         (rec->op == BSF_MAP_REC_MERGE && rec->id_b >= BSF_MAP_RX_MAX_FEATURES)) {
         if (rec->id_b < BSF_MAP_RX_MAX_FEATURES && rec->op == BSF_MAP_REC_MERGE) {
             rx_stale(&rx->features[rec->id_b]);
         }
+        rx->over_cap = 1u;
         return 0;
     }
     if (rec->id >= rx->id_limit) {
@@ -1107,12 +1143,22 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         }
         f->state = RX_PRESENT;
         f->upd = 1u;
+        f->lost_at = rx->lost;
         return 1;
     case BSF_MAP_REC_SNAPSHOT:
+        if (f->state == RX_PRESENT && f->upd == rec->upd &&
+            rx_lost_since(rx, f) < RX_CONFIRM_LOST) {
+            /* the count shows no record of it was lost: the receiver holds
+             * what the snapshot carries, and keeps it whole */
+            f->lost_at = rx->lost;
+            ++rx->stats.snapshots;
+            return 1;
+        }
         /* a first part restarts the feature; a later part continues it only
          * when every part before it arrived */
         if (rec->start == 0u) {
             rx_free_chain(rx, f);
+            f->lost_at = rx->lost;
         } else if (f->state != RX_SNAP || f->n_ctrl != rec->start || f->upd != rec->upd) {
             if (f->state == RX_ABSENT) {
                 f->state = RX_STALE; /* a part of a feature never received */
@@ -1126,6 +1172,11 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         }
         f->state = rec->high ? RX_PRESENT : RX_SNAP;
         f->upd = (uint8_t)rec->upd;
+        if (rec->high) {
+            /* the parts agree with each other when their counts matched
+             * over few enough lost frames */
+            rx_confirm_by_count(rx, f);
+        }
         ++rx->stats.snapshots;
         return 1;
     case BSF_MAP_REC_APPEND: {
@@ -1143,6 +1194,7 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             return 0;
         }
         f->upd = (uint8_t)((f->upd + 1u) & 15u);
+        rx_confirm_by_count(rx, f);
         return 1;
     }
     case BSF_MAP_REC_MOVE: {
@@ -1204,6 +1256,9 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
             rx->ctrl[c].vertex ^= (uint8_t)(gap & 1u);
         }
         f->upd = (uint8_t)((f->upd + 1u) & 15u);
+        if (f->state == RX_PRESENT) {
+            rx_confirm_by_count(rx, f);
+        }
         return 1;
     }
     case BSF_MAP_REC_MERGE: {
@@ -1240,6 +1295,13 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
         b->n_ctrl = 0u;
         b->state = RX_GONE;
         f->upd = (uint8_t)((f->upd + 1u) & 15u);
+        if (rx_lost_since(rx, b) >= RX_CONFIRM_LOST) {
+            /* b's points may be wrong and a's count cannot tell: only a
+             * snapshot confirms a now */
+            f->lost_at = rx->lost - RX_GAP_MAX;
+        } else {
+            rx_confirm_by_count(rx, f);
+        }
         return 1;
     }
     default: return 0;
@@ -1269,9 +1331,18 @@ int bsf_map_rx_apply(bsf_map_rx_t *rx, const uint8_t *payload, size_t len)
     if (rx->seen_frame && rx->quant_step != (float)step_code * BSF_QUANT_STEP_UNIT) {
         return BSF_ERR_FORMAT; /* one step per stream: the held values would change meaning */
     }
-    if (rx->seen_frame && seq != rx->next_seq) {
-        rx->stats.frames_missed += seq - rx->next_seq;
+    {
+        /* a receiver's first frame expects the stream's first, seq 0 */
+        const uint32_t gap = seq - (rx->seen_frame ? rx->next_seq : 0u);
+        if (gap != 0u) {
+            rx->lost += gap < RX_GAP_MAX ? gap : RX_GAP_MAX;
+            rx->ids_known = 0u;
+            if (rx->seen_frame) {
+                rx->stats.frames_missed += gap;
+            }
+        }
     }
+    rx->loss_noted = 0u;
     rx->seen_frame = 1u;
     rx->next_seq = seq + 1u;
     rx->quant_step = (float)step_code * BSF_QUANT_STEP_UNIT;
@@ -1286,6 +1357,38 @@ int bsf_map_rx_apply(bsf_map_rx_t *rx, const uint8_t *payload, size_t len)
     }
     ++rx->stats.frames;
     return skipped;
+}
+
+void bsf_map_rx_note_loss(bsf_map_rx_t *rx)
+{
+    if (rx != NULL) {
+        rx->loss_noted = 1u;
+    }
+}
+
+int bsf_map_rx_feature_state(const bsf_map_rx_t *rx, uint32_t id)
+{
+    const bsf_map_rx_feature_t *f;
+    if (rx == NULL) {
+        return BSF_ERR_ARG;
+    }
+    if (id >= BSF_MAP_RX_MAX_FEATURES) {
+        return rx->over_cap ? BSF_MAP_RX_MISSING : BSF_MAP_RX_NONE;
+    }
+    f = &rx->features[id];
+    switch (f->state) {
+    case RX_PRESENT:
+        return rx->loss_noted || f->lost_at != rx->lost ? BSF_MAP_RX_UNCONFIRMED
+                                                        : BSF_MAP_RX_CONFIRMED;
+    case RX_STALE:
+    case RX_SNAP: return f->head != BSF_MAP_NONE ? BSF_MAP_RX_STALE : BSF_MAP_RX_MISSING;
+    case RX_ABSENT:
+        /* every id below the largest seen was sent; above it, after a loss,
+         * any id may have been */
+        return id < rx->id_limit || !rx->ids_known || rx->loss_noted ? BSF_MAP_RX_MISSING
+                                                                     : BSF_MAP_RX_NONE;
+    default: return BSF_MAP_RX_NONE;
+    }
 }
 
 uint32_t bsf_map_rx_id_limit(const bsf_map_rx_t *rx)
@@ -1303,15 +1406,12 @@ int bsf_map_rx_feature_ctrl(const bsf_map_rx_t *rx, uint32_t id, bsf_point_t *ct
         return BSF_ERR_ARG;
     }
     if (stale != NULL) {
-        *stale = 0u;
+        *stale = bsf_map_rx_feature_state(rx, id) >= BSF_MAP_RX_UNCONFIRMED ? 1u : 0u;
     }
     if (id >= BSF_MAP_RX_MAX_FEATURES) {
         return 0;
     }
     f = &rx->features[id];
-    if (stale != NULL) {
-        *stale = (f->state == RX_STALE || f->state == RX_SNAP) ? 1u : 0u;
-    }
     for (i = f->head; i != BSF_MAP_NONE; i = rx->ctrl[i].next) {
         const bsf_map_rx_ctrl_t *c = &rx->ctrl[i];
         const unsigned reps = c->vertex ? 2u : 1u;

@@ -116,6 +116,8 @@
 #define bsf_map_rx_id_limit BSF_MAP_CAPS_NAME(bsf_map_rx_id_limit)
 #define bsf_map_rx_feature_ctrl BSF_MAP_CAPS_NAME(bsf_map_rx_feature_ctrl)
 #define bsf_map_rx_feature_q BSF_MAP_CAPS_NAME(bsf_map_rx_feature_q)
+#define bsf_map_rx_note_loss BSF_MAP_CAPS_NAME(bsf_map_rx_note_loss)
+#define bsf_map_rx_feature_state BSF_MAP_CAPS_NAME(bsf_map_rx_feature_state)
 
 /* Alignment's work area also follows the alignment caps (A: BSF_ALIGN_MAX_POINTS,
  * V: BSF_ALIGN_MAX_VERTICES, S: BSF_ALIGN_MAX_SEGS, G: BSF_ALIGN_GRID, E:

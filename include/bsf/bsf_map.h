@@ -38,6 +38,11 @@ BSF_BEGIN_DECLS
 
 /** Smallest frame buffer bsf_map_encode() accepts, bytes. */
 #define BSF_MAP_FRAME_MIN_SIZE 64u
+/** Id of a robot feature whose new-feature record has not gone out yet
+ *  (bsf_map_feature_ctrl, bsf_map_feature_q): ids are given at the first
+ *  send, 0, 1, 2, ..., so a receiver knows every id below the largest it saw
+ *  was sent. */
+#define BSF_MAP_ID_UNSENT 0xFFFFFFFFu
 /** Largest map-update frame on the wire (COBS body + delimiter), bytes;
  *  bsf_map_encode also keeps frames within BSF_FRAME_MAX_SIZE, what a stream
  *  decoder of the same caps holds. */
@@ -127,7 +132,8 @@ typedef struct {
 typedef struct {
     float min_x, min_y; /**< bounding box of the control points, metres */
     float max_x, max_y;
-    uint32_t id;        /**< feature id on the wire, unique for the stream */
+    uint32_t id;        /**< feature id on the wire, unique for the stream, given when its
+                             new-feature record goes out (BSF_MAP_ID_UNSENT before) */
     uint32_t last_seen; /**< n_fused when last observed */
     uint16_t head;      /**< pool index of the first control point */
     uint16_t tail;      /**< pool index of the last control point */
@@ -168,7 +174,8 @@ typedef struct {
     uint16_t n_features;                    /**< used slots of features[] (packed) */
     uint16_t free_ctrl;                     /**< head of the free list of ctrl[] */
     uint16_t n_free_ctrl;                   /**< points on that list */
-    uint32_t next_id;                       /**< id of the next new feature */
+    uint32_t next_id;                       /**< id of the next feature sent (ids: 0, 1, ... in
+                                                 the order of their new-feature records) */
     uint32_t frame_seq;                     /**< sequence number of the next frame */
     uint32_t snapshot_next;                 /**< round-robin position of snapshots (feature id) */
     uint16_t snapshot_pos;                  /**< next point of a snapshot sent in parts */
@@ -236,8 +243,8 @@ size_t bsf_map_feature_count(const bsf_map_t *map);
  * consecutive flagged slots). sent = 0: fused positions; sent = 1: the values
  * the receiver holds (quantised; points not yet sent are left out). ctrl and
  * is_vertex (either may be NULL) take up to cap entries; *id (may be NULL)
- * receives the feature's id. Returns the number of stored control points
- * (may exceed cap: then only cap were written), or a negative bsf_status_t on
+ * receives the feature's id (BSF_MAP_ID_UNSENT before it is sent). Returns the number of stored
+ * control points (may exceed cap: then only cap were written), or a negative bsf_status_t on
  * failure: BSF_ERR_ARG for NULL map or index out of range.
  */
 BSF_NODISCARD int bsf_map_feature_ctrl(const bsf_map_t *map, size_t index, int sent,
@@ -269,8 +276,10 @@ typedef struct {
 typedef struct {
     uint16_t head, tail; /**< point indices, 0xFFFF when empty */
     uint16_t n_ctrl;     /**< distinct points */
-    uint8_t state;       /**< absent, present, stale, removed */
+    uint8_t state;       /**< absent, present, stale, removed, snapshot arriving */
     uint8_t upd;         /**< update count mod 16 */
+    uint32_t lost_at;    /**< bsf_map_rx_t.lost when the feature was last confirmed (or its
+                              snapshot started) */
 } bsf_map_rx_feature_t;
 
 /** The receiver's map: every feature the robot ever sent, by id. */
@@ -281,7 +290,12 @@ typedef struct {
     uint32_t n_free_ctrl;
     uint32_t id_limit;  /**< one past the largest id seen */
     uint32_t next_seq;  /**< expected frame sequence number */
+    uint32_t lost;      /**< map frames lost so far, each gap counted up to 16 (more
+                             cannot be told apart by the 4-bit update counts) */
     uint8_t seen_frame; /**< 1 once a frame was applied */
+    uint8_t loss_noted; /**< 1: the link dropped a frame since the last map frame */
+    uint8_t ids_known;  /**< 1: no feature id at or above id_limit can have been missed */
+    uint8_t over_cap;   /**< 1: a record named an id at or above BSF_MAP_RX_MAX_FEATURES */
     float quant_step;   /**< metres, from the last frame */
     uint8_t has_pose;   /**< 1 once a pose record arrived */
     bsf_pose_t pose;    /**< last pose received */
@@ -297,12 +311,47 @@ void bsf_map_rx_init(bsf_map_rx_t *rx);
  * CRC). The whole payload is checked first; a malformed one changes nothing.
  * A record for a feature the receiver does not hold in the state the record
  * expects (a frame before it was lost) is skipped and the feature marked
- * stale until a snapshot of it arrives. Returns the number of records
+ * stale until a snapshot of it arrives; a gap in the frame sequence numbers
+ * leaves every feature unconfirmed (bsf_map_rx_feature_state). Returns the number of records
  * skipped (>= 0), or a negative bsf_status_t on failure: BSF_ERR_ARG for NULL
  * pointers, BSF_ERR_VERSION when it is not a map frame, BSF_ERR_FORMAT when
  * malformed.
  */
 BSF_NODISCARD int bsf_map_rx_apply(bsf_map_rx_t *rx, const uint8_t *payload, size_t len);
+
+/**
+ * Tell the receiver that the link dropped a frame (the stream decoder counted
+ * a bad CRC, a malformed, oversized or unknown frame): it may have been a map
+ * frame, so every feature is unconfirmed until the next map frame's sequence
+ * number tells how many map frames were lost (none: the flags clear). Nothing
+ * for NULL.
+ */
+void bsf_map_rx_note_loss(bsf_map_rx_t *rx);
+
+/** What the receiver can say of one feature id (bsf_map_rx_feature_state). */
+typedef enum {
+    BSF_MAP_RX_NONE = 0,        /**< holds nothing and misses nothing: never sent, merged away */
+    BSF_MAP_RX_CONFIRMED = 1,   /**< equal to the robot's sent copy as far as the stream can
+                                     tell: no frame lost since it was last confirmed */
+    BSF_MAP_RX_UNCONFIRMED = 2, /**< map frames were lost since it was last confirmed: it may
+                                     have missed records (or been merged away on the robot) */
+    BSF_MAP_RX_STALE = 3,       /**< a record of it could not apply, or its snapshot is still
+                                     arriving in parts: it differs from the robot's */
+    BSF_MAP_RX_MISSING = 4      /**< sent by the robot (or it may have been: ids past the
+                                     largest seen after a loss) but never received: no points */
+} bsf_map_rx_state_t;
+
+/**
+ * State of receiver feature `id` (a bsf_map_rx_state_t, >= 0). After a loss
+ * every feature held is unconfirmed; a complete snapshot confirms it, and so
+ * does a record that applies when at most 3 map frames were lost since the
+ * feature was last confirmed (a frame advances a feature's 4-bit update
+ * count by at most 4, docs/FORMAT.md section 11.3). Ids are given in send
+ * order, so an id below bsf_map_rx_id_limit() never received is missing; so
+ * is any id at or above it after a loss, until a new-feature record shows
+ * which ids exist. Returns BSF_ERR_ARG for NULL rx.
+ */
+BSF_NODISCARD int bsf_map_rx_feature_state(const bsf_map_rx_t *rx, uint32_t id);
 
 /** One past the largest feature id the receiver has seen (ids are 0 .. this - 1;
  *  some of them may be absent, merged away or removed). 0 for NULL. */
@@ -312,9 +361,9 @@ uint32_t bsf_map_rx_id_limit(const bsf_map_rx_t *rx);
  * Control points of receiver feature `id`, in metres (quantised values times
  * the stream's step), vertices given twice (two consecutive flagged slots);
  * ctrl and is_vertex (either may be NULL) take up to cap entries; *stale (may
- * be NULL) is 1 when the feature missed an update (also when the receiver
- * never got the feature itself, only later records of it: it then holds no
- * points but is reported). Returns the number of stored control points (may
+ * be NULL) is 1 when the receiver cannot vouch for the feature: its state
+ * (bsf_map_rx_feature_state) is unconfirmed, stale or missing (a missing
+ * feature holds no points but is reported). Returns the number of stored control points (may
  * exceed cap), 0 when the id holds no feature (never sent, merged into
  * another, removed, or missed), or a negative bsf_status_t on failure:
  * BSF_ERR_ARG for NULL rx.
@@ -335,8 +384,8 @@ BSF_NODISCARD int bsf_map_rx_feature_q(const bsf_map_rx_t *rx, uint32_t id, int3
 /**
  * Quantised control points (quant steps) of robot feature `index` as sent,
  * in the same form as bsf_map_rx_feature_q(), and its id in *id (may be
- * NULL). Returns the number of distinct points, or a negative bsf_status_t on
- * failure: BSF_ERR_ARG for NULL map or index out of range.
+ * NULL; BSF_MAP_ID_UNSENT before it is sent). Returns the number of distinct points, or a negative
+ * bsf_status_t on failure: BSF_ERR_ARG for NULL map or index out of range.
  */
 BSF_NODISCARD int bsf_map_feature_q(const bsf_map_t *map, size_t index, int32_t *q,
                                     uint8_t *is_vertex, size_t cap, uint32_t *id);

@@ -15,8 +15,11 @@
  * held control point is within the wire's range (|q| <= 2^23 - 1) and finite
  * in metres; the id limit and the points held stay within the caps, and the
  * held points plus the free list add up to the pool; a feature that turns
- * stale does so only in a frame that reported skipped records or carried a
- * snapshot in parts (never wrong without a word).
+ * flagged (unconfirmed, stale or missing) does so only in a frame that
+ * reported skipped records, carried a snapshot in parts, followed a gap in
+ * the sequence numbers, or named a larger id than any before (ids below it
+ * that never arrived are missing); after the robot's frames, lost nothing,
+ * every feature is confirmed.
  */
 #include <string.h>
 
@@ -116,14 +119,20 @@ static void check_rx(int r)
         FUZZ_CHECK(m >= (int)n && m <= 2 * (int)n);
         held += n;
         if (st && (id >= bsf_map_rx_id_limit(&before) || !stale_before[id])) {
-            newly_stale = 1;
+            const int state = bsf_map_rx_feature_state(&rx, id);
+            FUZZ_CHECK(state >= BSF_MAP_RX_UNCONFIRMED && state <= BSF_MAP_RX_MISSING);
+            if (!(state == BSF_MAP_RX_MISSING && n == 0u &&
+                  bsf_map_rx_id_limit(&rx) > bsf_map_rx_id_limit(&before))) {
+                newly_stale = 1;
+            }
         }
     }
     FUZZ_CHECK(held + rx.n_free_ctrl == BSF_MAP_RX_MAX_CTRL);
     /* a feature marked stale by this frame: the frame reported a skip, or
      * carried the first parts of a snapshot (the feature is incomplete and
      * flagged until its last part) */
-    FUZZ_CHECK(!newly_stale || r > 0 || rx.stats.snapshots > before.stats.snapshots);
+    FUZZ_CHECK(!newly_stale || r > 0 || rx.stats.snapshots > before.stats.snapshots ||
+               rx.lost != before.lost);
 }
 
 static void apply_direct(const uint8_t *p, size_t n)
@@ -198,6 +207,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             }
         }
         FUZZ_CHECK(rx.stats.records_skipped == 0u && rx.stats.frames == n_prelude);
+        {
+            uint32_t id;
+            for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+                const int state = bsf_map_rx_feature_state(&rx, id);
+                FUZZ_CHECK(state == BSF_MAP_RX_CONFIRMED || state == BSF_MAP_RX_NONE);
+            }
+        }
     }
     while (pos + 2u <= size) {
         size_t n = (size_t)data[pos] | ((size_t)data[pos + 1u] << 8);

@@ -150,6 +150,42 @@ check(len(found) >= 2, f"true corners are map vertices within 5 cm ({len(found)}
 # 3. the text summary and the SVG.
 r = run(["map", "room.map"])
 check(r.returncode == 0 and b"features" in r.stdout and b"map frames" in r.stdout, "bsf map prints a summary")
+# 2b. A lost map frame: every feature that differs from the lossless map is
+# flagged (stale in --json) or missing (counted in the summary), never wrong
+# without a word; a damaged last frame leaves every feature flagged.
+with open(os.path.join(WORK, "room.map"), "rb") as f:
+    pieces = f.read().split(b"\x00")
+frames_idx = [i for i, p in enumerate(pieces) if p]
+# the longest map frame (COBS keeps the version/type byte 0x23 second): it carries map records
+lost = max((i for i in frames_idx if len(pieces[i]) > 1 and pieces[i][1] == 0x23), key=lambda i: len(pieces[i]))
+lossy = [p for i, p in enumerate(pieces) if i != lost]
+with open(os.path.join(WORK, "lossy.map"), "wb") as f:
+    f.write(b"\x00".join(lossy))
+r = run(["map", "lossy.map", "--json"])
+lossy_feats = {f["id"]: f for f in (json.loads(l) for l in r.stdout.decode().splitlines())}
+summary = re.search(rb"(\d+) features, .* (\d+) stale, (\d+) missing;", r.stderr)
+check(r.returncode == 0 and summary is not None, "bsf map --json of a stream with a lost frame: exit 0, summary")
+unflagged = [fid for fid, f in ((f["id"], f) for f in feats)
+             if fid in lossy_feats and not lossy_feats[fid]["stale"]
+             and (lossy_feats[fid]["ctrl"] != f["ctrl"] or lossy_feats[fid]["vertex"] != f["vertex"])]
+absent = [f["id"] for f in feats if f["id"] not in lossy_feats]
+check(not unflagged, f"a lost frame: every feature that differs is flagged stale (unflagged: {unflagged})")
+check(summary is not None and len(absent) <= int(summary.group(3)),
+      f"a lost frame: features never received are counted missing ({len(absent)} absent)")
+check(any(f["stale"] for f in lossy_feats.values()) or (summary is not None and int(summary.group(3)) > 0),
+      "losing the longest map frame leaves features flagged or missing")
+damaged = list(pieces)
+last = bytearray(damaged[frames_idx[-1]])
+last[len(last) // 2] ^= 0x01
+damaged[frames_idx[-1]] = bytes(last) if 0 not in last else damaged[frames_idx[-1]]
+with open(os.path.join(WORK, "damaged_last.map"), "wb") as f:
+    f.write(b"\x00".join(damaged))
+r = run(["map", "damaged_last.map"])
+summary = re.search(rb"(\d+) features, .* (\d+) stale, (\d+) missing;", r.stdout)
+check(r.returncode == 0 and summary is not None and int(summary.group(1)) > 0
+      and summary.group(1) == summary.group(2),
+      "a damaged last frame: the receiver cannot vouch for any feature (all stale)")
+
 r = run(["map", "room.map", "-o", "room.svg"])
 check(r.returncode == 0, "bsf map -o room.svg exits 0")
 try:

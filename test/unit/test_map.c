@@ -405,8 +405,8 @@ static void test_map_loss_then_snapshots_recover(void)
     TEST_ASSERT_TRUE(k < 200);
     TEST_ASSERT_TRUE(dec.stats.bad_crc + dec.stats.malformed >= 1u);
     TEST_ASSERT_EQUAL_UINT32(3u, rx.stats.frames_missed); /* the first loss is unseen */
-    /* the lost frames' features were reported stale, then healed */
-    TEST_ASSERT_TRUE(rx.stats.records_skipped > 0u);
+    /* the lost frames left features flagged (unconfirmed, or stale where a
+     * record could not apply), then snapshots healed them */
     TEST_ASSERT_TRUE(stale_seen);
     TEST_ASSERT_TRUE(map.stats.n_snapshots > 0u);
     assert_rx_equals_sent();
@@ -474,6 +474,85 @@ static void test_map_point_forms(void)
     bsf_map_rx_init(&rx);
     TEST_ASSERT_EQUAL_INT(BSF_ERR_FORMAT, bsf_map_rx_apply(&rx, bad, sizeof bad));
     TEST_ASSERT_EQUAL_UINT32(0u, bsf_map_rx_id_limit(&rx));
+}
+
+/* State of receiver feature id, with the stale flag of the point accessor
+ * checked against it. */
+static int rx_state(uint32_t id)
+{
+    uint8_t stale = 9u;
+    const int st = bsf_map_rx_feature_state(&rx, id);
+    TEST_ASSERT_TRUE(bsf_map_rx_feature_ctrl(&rx, id, NULL, NULL, 0u, &stale) >= 0);
+    TEST_ASSERT_EQUAL_UINT8(st >= BSF_MAP_RX_UNCONFIRMED ? 1u : 0u, stale);
+    return st;
+}
+
+/* After lost frames every feature is unconfirmed until something vouches
+ * for it: a record whose update count matches when fewer than 4 frames were
+ * lost (a frame advances a count by at most 4, so 16 records cannot hide in
+ * them), or a snapshot. Ids are given in send order, so an id below the
+ * largest seen that never arrived is missing, and so is any id above it
+ * until a new-feature record shows where the ids end. */
+static void test_map_rx_flags_what_a_loss_may_have_touched(void)
+{
+    /* header 0x23, seq, step 50; each point (+1, 0) in its short form 09 00 */
+    static const uint8_t f0[] = {0x23u, 0x00u, 0x32u, /* new 0 and new 1 */
+                                 0x00u, 0x00u, 0x02u, 0x09u, 0x00u, 0x09u, 0x00u,
+                                 0x00u, 0x02u, 0x02u, 0x09u, 0x00u, 0x09u, 0x00u};
+    static const uint8_t f2[] = {0x23u, 0x02u, 0x32u, /* append to 0, count 1 */
+                                 0x09u, 0x00u, 0x01u, 0x09u, 0x00u};
+    static const uint8_t f3[] = {0x23u, 0x03u, 0x32u, /* new 3 */
+                                 0x00u, 0x06u, 0x02u, 0x09u, 0x00u, 0x09u, 0x00u};
+    static const uint8_t f8[] = {0x23u, 0x08u, 0x32u, /* append to 0 (count 2), to 1 (count 1) */
+                                 0x11u, 0x00u, 0x01u, 0x09u, 0x00u,
+                                 0x09u, 0x02u, 0x01u, 0x09u, 0x00u};
+    static const uint8_t f9[] = {0x23u, 0x09u, 0x32u, /* snapshots of 0 (count 3) and 1 (2) */
+                                 0x9Cu, 0x00u, 0x00u, 0x02u, 0x09u, 0x00u, 0x09u, 0x00u,
+                                 0x94u, 0x02u, 0x00u, 0x02u, 0x09u, 0x00u, 0x09u, 0x00u};
+    static const uint8_t f10[] = {0x23u, 0x0Au, 0x32u, 0x05u, 0x00u, 0x00u, 0x00u}; /* a pose */
+    bsf_map_rx_init(&rx);
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_map_rx_feature_state(NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_NONE, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, f0, sizeof f0));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(1u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_NONE, rx_state(2u));
+    /* frame 1 lost: 0's append has the count it expects over 1 lost frame */
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, f2, sizeof f2));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_UNCONFIRMED, rx_state(1u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_MISSING, rx_state(2u)); /* frame 1 may have made it */
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_MISSING, rx_state(BSF_MAP_RX_MAX_FEATURES - 1u));
+    /* new 3: ids 0 .. 3 were sent, 2 never arrived; nothing above 3 yet */
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, f3, sizeof f3));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_MISSING, rx_state(2u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(3u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_NONE, rx_state(4u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_feature_q(&rx, 2u, NULL, NULL, 0u));
+    /* frames 4 .. 7 lost: the counts match, but 16 records could hide in 4
+     * frames, so the records apply and the features stay unconfirmed */
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, f8, sizeof f8));
+    TEST_ASSERT_EQUAL_INT(3, bsf_map_rx_feature_q(&rx, 1u, NULL, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_UNCONFIRMED, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_UNCONFIRMED, rx_state(1u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_UNCONFIRMED, rx_state(3u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_MISSING, rx_state(4u));
+    /* snapshots confirm (and replace) */
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, f9, sizeof f9));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(1u));
+    TEST_ASSERT_EQUAL_INT(2, bsf_map_rx_feature_q(&rx, 1u, NULL, NULL, 0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_UNCONFIRMED, rx_state(3u));
+    /* a frame the link dropped may have been a map frame, until the next
+     * map frame's sequence number shows none was lost */
+    bsf_map_rx_note_loss(&rx);
+    bsf_map_rx_note_loss(NULL);
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_UNCONFIRMED, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_map_rx_apply(&rx, f10, sizeof f10));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(0u));
+    TEST_ASSERT_EQUAL_INT(BSF_MAP_RX_CONFIRMED, rx_state(1u));
+    TEST_ASSERT_EQUAL_UINT32(0u, rx.stats.records_skipped);
+    TEST_ASSERT_EQUAL_UINT32(5u, rx.stats.frames_missed);
 }
 
 /* One straight piece, sensor frame: y = wall_y for x in -1 .. 1. */
@@ -645,6 +724,7 @@ int main(void)
     RUN_TEST(test_map_loss_then_snapshots_recover);
     RUN_TEST(test_map_frame_through_frame_decode);
     RUN_TEST(test_map_point_forms);
+    RUN_TEST(test_map_rx_flags_what_a_loss_may_have_touched);
     RUN_TEST(test_map_gate_grows_with_range);
     RUN_TEST(test_map_straight_run_sends_its_ends);
     RUN_TEST(test_map_small_frames_carry_everything);

@@ -18,7 +18,7 @@
  * --map-param NAME=VALUE: a field of bsf_map_params_t other than the default
  * (match_dist, match_angle, vertex_dist, ctrl_spacing, send_tol, weight_cap,
  * forget_after, frame_interval, match_dist_near, match_dist_per_m,
- * simplify_tol), to
+ * simplify_tol, snapshot_budget), to
  * measure a trade-off. --check: exit 1 unless every
  * scan was extracted and fused, the receiver's map equals the robot's sent
  * copy feature for feature, and every figure was measured (ctest runs it on
@@ -520,7 +520,7 @@ static int set_map_param(const char *arg)
     static const char *const names[] = {"match_dist",       "match_angle",    "vertex_dist",
                                         "ctrl_spacing",     "send_tol",       "weight_cap",
                                         "forget_after",     "frame_interval", "match_dist_near",
-                                        "match_dist_per_m", "simplify_tol"};
+                                        "match_dist_per_m", "simplify_tol",   "snapshot_budget"};
     const char *eq = strchr(arg, '=');
     char *end = NULL;
     double v;
@@ -550,6 +550,7 @@ static int set_map_param(const char *arg)
     case 8: g_map_params.match_dist_near = (float)v; break;
     case 9: g_map_params.match_dist_per_m = (float)v; break;
     case 10: g_map_params.simplify_tol = (float)v; break;
+    case 11: g_map_params.snapshot_budget = (uint16_t)v; break;
     default: return -1;
     }
     return 0;
@@ -994,7 +995,8 @@ int main(int argc, char **argv)
                         "bench_map: --map-param needs NAME=VALUE with a name of "
                         "bsf_map_params_t (match_dist, match_angle, vertex_dist, "
                         "ctrl_spacing, send_tol, weight_cap, forget_after, "
-                        "frame_interval), got '%s'\n",
+                        "frame_interval, match_dist_near, match_dist_per_m, simplify_tol, "
+                        "snapshot_budget), got '%s'\n",
                         argv[i]);
                 return 2;
             }

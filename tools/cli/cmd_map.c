@@ -29,7 +29,9 @@ static const char map_help[] =
     "\n"
     "Without --json or -o, prints a summary: features, control points, vertices,\n"
     "curve length, frames and bytes. The summary goes to stderr otherwise. A feature\n"
-    "is stale when a frame it needed was lost and no snapshot has repaired it yet.\n"
+    "is stale when the receiver cannot vouch for it: frames were lost since it was\n"
+    "last confirmed, or a record of it could not apply, and no snapshot has repaired\n"
+    "it yet. Missing: ids the robot sent that never arrived (no points to draw).\n"
     "Exits 1 when the input holds no map frame or the receiver refuses a frame.\n";
 
 #define MAP_MAX_POINTS BSF_MAP_RX_MAX_CTRL
@@ -111,9 +113,10 @@ static void span_point(const bsf_point_t *c, size_t spans, size_t s, double u, d
 }
 
 /* Totals of the map: features, control points (as given, vertices twice),
- * vertices, stale features, curve length (polyline through 16 samples per span). */
+ * vertices, flagged features (stale output: unconfirmed, stale), ids sent but
+ * never received (missing), curve length (polyline through 16 samples per span). */
 typedef struct {
-    unsigned long features, ctrl, vertices, stale;
+    unsigned long features, ctrl, vertices, stale, missing;
     double length;
 } map_totals_t;
 
@@ -129,6 +132,9 @@ static map_totals_t totals_of(const map_view_t *v, bsf_point_t *ctrl, uint8_t *v
         int k;
         size_t spans, s;
         double prev_x, prev_y;
+        if (n == 0 && bsf_map_rx_feature_state(v->rx, id) == BSF_MAP_RX_MISSING) {
+            ++t.missing;
+        }
         if (n < 3) {
             continue;
         }
@@ -355,6 +361,7 @@ int cmd_map(int argc, char **argv)
         map_view_free(&ctx.view);
         return EXIT_FAIL;
     }
+    note_trailing_loss(ctx.view.rx, &sum);
     t = totals_of(&ctx.view, ctrl, vtx);
     if (json) {
         print_json(&ctx.view, ctrl, vtx);
@@ -368,10 +375,11 @@ int cmd_map(int argc, char **argv)
         fprintf(stderr, "%s: wrote %s\n", g_cmd, out_path);
     }
     fprintf(info,
-            "%s: %lu features, %lu control points, %lu vertices, %.1f m of curve, %lu stale; "
+            "%s: %lu features, %lu control points, %lu vertices, %.1f m of curve, %lu stale, "
+            "%lu missing; "
             "%lu map frames, %llu bytes (%lu pose-only frames, %llu bytes), %lu missing by "
             "sequence, %lu records skipped, %lu frames dropped\n",
-            in_path, t.features, t.ctrl, t.vertices, t.length, t.stale, ctx.view.frames,
+            in_path, t.features, t.ctrl, t.vertices, t.length, t.stale, t.missing, ctx.view.frames,
             ctx.view.bytes, ctx.view.pose_only_frames, ctx.view.pose_only_bytes, sum.map_seq_gaps,
             (unsigned long)ctx.view.rx->stats.records_skipped, frames_dropped(&sum.stats));
     map_view_free(&ctx.view);

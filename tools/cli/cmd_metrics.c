@@ -14,7 +14,7 @@ static const char metrics_help[] =
     "counting histograms over the wire's integer units).\n"
     "A map stream (bsf extract --map) also gets its map's bytes: map frames, of which\n"
     "pose-only frames, the metadata and anything else, and the map the receiver\n"
-    "rebuilds (features, control points, stale features).\n"
+    "rebuilds (features, control points, stale features, missing ids).\n"
     "Exits 1 when a non-empty input holds no valid frame.\n";
 
 void print_metrics(FILE *f, const char *name, const stream_summary_t *s, const dataset_metrics_t *d)
@@ -68,7 +68,7 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
     static metrics_map_ctx_t c;
     stream_summary_t s2;
     const unsigned long long other = s->bytes_in - s->map_frame_bytes - s->metadata_bytes;
-    unsigned long features = 0, ctrl = 0, stale = 0;
+    unsigned long features = 0, ctrl = 0, stale = 0, missing = 0;
     uint32_t id;
     memset(&c, 0, sizeof c);
     if (map_view_init(&c.view, 0) != 0) {
@@ -78,6 +78,7 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
         map_view_free(&c.view);
         return -1;
     }
+    note_trailing_loss(c.view.rx, &s2);
     for (id = 0; id < bsf_map_rx_id_limit(c.view.rx); ++id) {
         uint8_t st = 0;
         const int n = bsf_map_rx_feature_ctrl(c.view.rx, id, NULL, NULL, 0u, &st);
@@ -85,6 +86,8 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
             ++features;
             ctrl += (unsigned long)n;
             stale += st;
+        } else if (bsf_map_rx_feature_state(c.view.rx, id) == BSF_MAP_RX_MISSING) {
+            ++missing;
         }
     }
     {
@@ -96,10 +99,11 @@ static int print_map_metrics(FILE *in, const char *name, const stream_summary_t 
     }
     printf("other bytes       %llu metadata, %llu per-scan frames and unframed bytes\n",
            s->metadata_bytes, other);
-    printf("map               %lu features, %lu control points (vertices twice), %lu stale; "
-           "%lu map frames missing by sequence, %lu records skipped, %lu frames refused\n",
-           features, ctrl, stale, s->map_seq_gaps, (unsigned long)c.view.rx->stats.records_skipped,
-           c.failed ? c.view.frames_bad : 0ul);
+    printf("map               %lu features, %lu control points (vertices twice), %lu stale, "
+           "%lu missing; %lu map frames missing by sequence, %lu records skipped, %lu frames "
+           "refused\n",
+           features, ctrl, stale, missing, s->map_seq_gaps,
+           (unsigned long)c.view.rx->stats.records_skipped, c.failed ? c.view.frames_bad : 0ul);
     map_view_free(&c.view);
     return 0;
 }

@@ -50,6 +50,7 @@ static int deliver(stream_summary_t *sum, frame_cb on_frame, void *ctx, size_t b
         }
         sum->have_map_seq = 1;
         sum->last_map_seq = g_frame.seq;
+        sum->dropped_at_last_map = frames_dropped(&g_dec.stats);
         ++sum->n_map_frames;
         sum->map_frame_bytes += bytes;
     } else {
@@ -196,6 +197,13 @@ void close_in(FILE *in)
 unsigned long frames_dropped(const bsf_decoder_stats_t *s)
 {
     return (unsigned long)s->bad_crc + s->malformed + s->unsupported_version + s->oversize;
+}
+
+void note_trailing_loss(bsf_map_rx_t *rx, const stream_summary_t *sum)
+{
+    if (sum->n_map_frames > 0u && frames_dropped(&sum->stats) != sum->dropped_at_last_map) {
+        bsf_map_rx_note_loss(rx);
+    }
 }
 
 /* ---- metrics ------------------------------------------------------------------ */

@@ -103,6 +103,7 @@ typedef struct {
     unsigned long map_seq_gaps;         /**< map frames missing according to their numbers */
     int have_map_seq;                   /**< internal: a map frame number was seen */
     uint32_t last_map_seq;              /**< internal: the last one */
+    unsigned long dropped_at_last_map;  /**< frames_dropped() when the last map frame came */
 } stream_summary_t;
 
 /** Called for every decoded frame (features and metadata: check f->type)
@@ -125,6 +126,9 @@ int rewind_input(FILE *in, const char *name);
 void close_in(FILE *in);
 /** Frames dropped by the decoder (CRC, malformed, version, oversize). */
 unsigned long frames_dropped(const bsf_decoder_stats_t *s);
+/* Tell the map receiver about frames dropped after the last map frame of a
+ * decoded stream (any of them may have been a map frame); nothing when none. */
+void note_trailing_loss(bsf_map_rx_t *rx, const stream_summary_t *sum);
 /** A result's metric counts (zeros when inconsistent). */
 bsf_scan_counts_t counts_of_result(const bsf_result_t *r);
 

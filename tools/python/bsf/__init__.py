@@ -385,8 +385,10 @@ class MapFeature:
     """One feature of the fused map: a clamped uniform quadratic B-spline in the
     world frame (metres). A vertex (corner) is a control point given twice in a
     row, both copies flagged in ``vertex``, as in a scan's :class:`Feature`.
-    ``stale`` is True when a frame it needed was lost and no snapshot has
-    repaired it yet."""
+    ``stale`` is True when the receiver cannot vouch for it: map frames were
+    lost since it was last confirmed (by a snapshot, or a record whose update
+    count shows it missed nothing), or a record of it could not apply, and no
+    snapshot has repaired it yet."""
 
     id: int
     ctrl: np.ndarray  #: float32, shape (n, 2), world frame
@@ -452,6 +454,25 @@ class Map:
         return out
 
     @property
+    def missing(self) -> List[int]:
+        """Ids the robot sent that never arrived (a lost frame, a late join):
+        the receiver holds no points for them. Ids are given in send order, so
+        every id below the largest seen was sent."""
+        return [int(i) for i in self._rx.missing()]
+
+    @property
+    def more_missing(self) -> bool:
+        """True when, after a loss, features with ids above the largest seen may
+        have been sent and never received (until a new feature arrives)."""
+        return bool(self._rx.more_missing())
+
+    def note_loss(self) -> None:
+        """Tell the map that the link dropped a frame (a damaged one the
+        decoder refused): every feature is unconfirmed (``stale``) until the
+        next map frame's sequence number shows whether a map frame was lost."""
+        self._rx.note_loss()
+
+    @property
     def counters(self) -> Dict[str, int]:
         """frames, frames_missed, records, records_skipped, snapshots, poses."""
         return dict(self._rx.counters)
@@ -463,16 +484,21 @@ class Map:
         return None if p is None else (float(p[0]), float(p[1]), float(p[2]))
 
 
-def read_map(source: "Source", **kwargs: Any) -> Map:
+def read_map(source: "Source", *, baudrate: int = 115200, chunk_size: int = 65536) -> Map:
     """The map of a whole map stream (a path, "-", a file object: as :func:`read`).
 
     Raises BsfError when the stream holds no map frame (a per-scan stream, or
     garbage) or the receiver refuses a frame.
     """
     m = Map()
-    for fr in read(source, **kwargs):
+    dec = Decoder()
+    dropped_at_map = 0
+    for fr in _read(source, dec, baudrate, chunk_size, by_frame=True):
         if isinstance(fr, MapFrame):
             m.apply(fr)
+            dropped_at_map = _dropped(dec)
+    if m.frames > 0 and _dropped(dec) != dropped_at_map:
+        m.note_loss()  # a frame dropped after the last map frame may have been one
     if m.frames == 0:
         raise BsfError("no map frame in the stream (bsf extract --map writes one)")
     return m
@@ -817,16 +843,38 @@ def read(source: Source, *, baudrate: int = 115200, chunk_size: int = 65536) -> 
     stream order among them; each Frame's ``metadata`` is the one in force. Damaged frames are skipped. Raises BsfError at the end when
     the source held bytes but no valid frame.
     """
+    return _read(source, Decoder(), baudrate, chunk_size)
+
+
+def _dropped(dec: "Decoder") -> int:
+    c = dec.counters
+    return c["bad_crc"] + c["malformed"] + c["unsupported_version"] + c["oversize"]
+
+
+def _read(
+    source: Source, dec: "Decoder", baudrate: int, chunk_size: int, by_frame: bool = False
+) -> Iterator[Union[Frame, Metadata]]:
+    """read() with a given decoder; by_frame feeds it one delimited piece at a
+    time, so that its counters at each frame yielded are those of the stream
+    up to that frame."""
     f, close, name = _open_source(source, baudrate)
-    dec = Decoder()
     total = 0
     delivered = 0
     try:
         for chunk in _chunks(f, chunk_size):
             total += len(chunk)
-            for fr in dec.feed(chunk):
-                delivered += 1
-                yield fr
+            pieces = [chunk]
+            if by_frame:
+                pieces, at = [], 0
+                while at < len(chunk):
+                    end = chunk.find(b"\x00", at)
+                    end = len(chunk) if end < 0 else end + 1
+                    pieces.append(chunk[at:end])
+                    at = end
+            for piece in pieces:
+                for fr in dec.feed(piece):
+                    delivered += 1
+                    yield fr
         for fr in dec.finish():
             delivered += 1
             yield fr

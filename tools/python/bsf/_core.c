@@ -1070,6 +1070,56 @@ static PyObject *MapReceiver_features(MapReceiverObject *self, PyObject *unused)
     return out;
 }
 
+/* note_loss(): the link dropped a frame (bsf_map_rx_note_loss). */
+static PyObject *MapReceiver_note_loss(MapReceiverObject *self, PyObject *unused)
+{
+    (void)unused;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    bsf_map_rx_note_loss(self->rx);
+    Py_RETURN_NONE;
+}
+
+/* missing() -> [id]: ids below the id limit that were sent but never received. */
+static PyObject *MapReceiver_missing(MapReceiverObject *self, PyObject *unused)
+{
+    PyObject *out;
+    uint32_t id, limit;
+    (void)unused;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    out = PyList_New(0);
+    if (out == NULL) {
+        return NULL;
+    }
+    limit = bsf_map_rx_id_limit(self->rx);
+    for (id = 0; id < limit; ++id) {
+        if (bsf_map_rx_feature_state(self->rx, id) == BSF_MAP_RX_MISSING) {
+            PyObject *v = PyLong_FromUnsignedLong((unsigned long)id);
+            if (v == NULL || PyList_Append(out, v) != 0) {
+                Py_XDECREF(v);
+                Py_DECREF(out);
+                return NULL;
+            }
+            Py_DECREF(v);
+        }
+    }
+    return out;
+}
+
+/* more_missing() -> bool: ids past the largest seen may have been missed. */
+static PyObject *MapReceiver_more_missing(MapReceiverObject *self, PyObject *unused)
+{
+    (void)unused;
+    if (!map_rx_ready(self)) {
+        return NULL;
+    }
+    return PyBool_FromLong(bsf_map_rx_feature_state(self->rx, bsf_map_rx_id_limit(self->rx)) ==
+                           BSF_MAP_RX_MISSING);
+}
+
 static PyObject *MapReceiver_get_pose(MapReceiverObject *self, void *closure)
 {
     (void)closure;
@@ -1102,6 +1152,13 @@ static PyMethodDef MapReceiver_methods[] = {
      "apply(payload) -> records skipped (a map frame's payload)"},
     {"features", (PyCFunction)MapReceiver_features, METH_NOARGS,
      "features() -> list of (id, float32 x/y bytes, vertex flag bytes, stale)"},
+    {"note_loss", (PyCFunction)MapReceiver_note_loss, METH_NOARGS,
+     "note_loss(): the link dropped a frame; every feature is unconfirmed until the next map "
+     "frame"},
+    {"missing", (PyCFunction)MapReceiver_missing, METH_NOARGS,
+     "missing() -> ids sent by the robot but never received"},
+    {"more_missing", (PyCFunction)MapReceiver_more_missing, METH_NOARGS,
+     "more_missing() -> True when ids past the largest seen may have been missed"},
     {NULL, NULL, 0, NULL}};
 
 static PyGetSetDef MapReceiver_getset[] = {

@@ -203,3 +203,52 @@ def test_snapshots_repair_a_lost_frame(bsf_tool, map_stream, tmp_path):
     for fid, f in want.items():
         assert np.array_equal(got[fid].ctrl, f.ctrl) and np.array_equal(got[fid].vertex, f.vertex)
         assert not got[fid].stale
+
+
+def test_a_lost_frame_leaves_nothing_wrong_without_a_word(map_stream):
+    """Without snapshots, a lost frame: every feature either equals the
+    lossless map's or is stale, and ids never received are listed missing."""
+    _, out = map_stream
+    frames = [f for f in bsf.decode(out.read_bytes()) if isinstance(f, bsf.MapFrame)]
+    full = bsf.Map()
+    for f in frames:
+        full.apply(f)
+    assert full.missing == [] and not any(f.stale for f in full.features)
+    lost = [i for i, f in enumerate(frames) if len(f.payload) > 16][0]
+    lossy = bsf.Map()
+    for i, f in enumerate(frames):
+        if i != lost:
+            lossy.apply(f)
+    got = {f.id: f for f in lossy.features}
+    want = {f.id: f for f in full.features}
+    flagged = 0
+    for fid, f in want.items():
+        if fid not in got:
+            # below the largest id seen: listed; above it: maybe more are missing
+            assert fid in lossy.missing or lossy.more_missing
+            flagged += 1
+        elif not (np.array_equal(got[fid].ctrl, f.ctrl) and np.array_equal(got[fid].vertex, f.vertex)):
+            assert got[fid].stale
+            flagged += 1
+    assert flagged > 0  # the frame that made the map was lost
+
+
+def test_a_damaged_last_frame_flags_every_feature(map_stream, tmp_path):
+    _, out = map_stream
+    data = bytearray(out.read_bytes())
+    assert data[-1] == 0
+    # a byte in the middle of the last frame (after the last delimiter but one)
+    start = data.rindex(0, 0, len(data) - 1) + 1
+    at = (start + len(data) - 1) // 2
+    data[at] = data[at] ^ 0x01 or 0x01
+    bad = tmp_path / "bad_last.map"
+    bad.write_bytes(bytes(data))
+    m = bsf.read_map(bad)
+    assert m.features and all(f.stale for f in m.features)
+    m2 = bsf.Map()
+    for f in bsf.decode(bytes(data)):
+        if isinstance(f, bsf.MapFrame):
+            m2.apply(f)
+    assert not any(f.stale for f in m2.features)  # what the receiver cannot know alone
+    m2.note_loss()
+    assert all(f.stale for f in m2.features)
