@@ -180,6 +180,7 @@ static uint16_t ctrl_alloc(bsf_map_t *m, float x, float y, uint8_t vertex)
     c->prev = BSF_MAP_NONE;
     c->weight = 1u;
     c->flags = vertex ? BSF_MAP_CF_VERTEX : 0u;
+    c->corner_obs = 1u;
     return i;
 }
 
@@ -1090,15 +1091,25 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
     return 1;
 }
 
+/* Gate of a map vertex for a scan corner: a vertex that is the mean of n
+ * corners is uncertain by about ctrl_spacing / n (the first corner may be
+ * anywhere make_vertex reaches), never tighter than vertex_dist. A corner
+ * first placed off by a grazing view is then pulled to the mean of the
+ * corners seen later, and the gate tightens as they agree. */
+static float vertex_gate(const bsf_map_t *m, const bsf_map_ctrl_t *c)
+{
+    const float g = m->params.ctrl_spacing / (float)c->corner_obs;
+    return g > m->params.vertex_dist ? g : m->params.vertex_dist;
+}
+
 /* Scan vertices near a map vertex move it by their running mean. */
 static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
 {
-    const float d2max = m->params.vertex_dist * m->params.vertex_dist;
     size_t k;
     uint16_t g;
     for (k = 0; k < ns; ++k) {
         uint16_t best = BSF_MAP_NONE;
-        float bd = d2max;
+        float bd = 3.0e38f;
         if (!s[k].vertex) {
             continue;
         }
@@ -1107,11 +1118,13 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
             for (j = 0; j < 3u; ++j) {
                 const bsf_map_ctrl_t *c = &m->ctrl[m->segs[g].p[j]];
                 float d2;
+                float gate;
                 if (!(c->flags & BSF_MAP_CF_VERTEX)) {
                     continue;
                 }
                 d2 = (c->x - s[k].x) * (c->x - s[k].x) + (c->y - s[k].y) * (c->y - s[k].y);
-                if (d2 <= bd) {
+                gate = vertex_gate(m, c);
+                if (d2 <= gate * gate && d2 <= bd) {
                     bd = d2;
                     best = m->segs[g].p[j];
                 }
@@ -1119,9 +1132,12 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
         }
         if (best != BSF_MAP_NONE) {
             bsf_map_ctrl_t *c = &m->ctrl[best];
-            const float w = (float)c->weight + 1.0f;
+            const float w = (float)c->corner_obs + 1.0f;
             c->x += (s[k].x - c->x) / w;
             c->y += (s[k].y - c->y) / w;
+            if (c->corner_obs < 255u) {
+                ++c->corner_obs;
+            }
             if (c->weight < m->params.weight_cap) {
                 ++c->weight;
             }
@@ -1161,6 +1177,7 @@ static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
         c->y = q->y;
         c->flags |= BSF_MAP_CF_VERTEX;
         c->weight = 1u;
+        c->corner_obs = 1u;
         ++m->stats.n_vertex_made;
     }
 }
@@ -1211,6 +1228,7 @@ static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *
         c->y = s[k].y;
         c->flags |= BSF_MAP_CF_VERTEX;
         c->weight = 1u;
+        c->corner_obs = 1u;
         ++m->stats.n_vertex_made;
     }
 }
@@ -1392,6 +1410,95 @@ static void drop_transients(bsf_map_t *m)
     }
 }
 
+/* Gate of a point at range r from the sensor (fuse_feature's). */
+static float range_gate(const bsf_map_params_t *p, float r)
+{
+    const float g = p->match_dist_near + p->match_dist_per_m * r;
+    return g < p->match_dist ? g : p->match_dist;
+}
+
+/* A scan sees each bearing once, so its curve runs one way in bearing from
+ * the sensor. A fit whose control polygon turns back in bearing at an end
+ * (a hooked tail fitted to a few returns at grazing incidence) describes
+ * no surface the scan saw: cut the end from the point of greatest bearing
+ * on, when the points after it fall back by more than the association gate
+ * at their range (less is noise the gate absorbs). w and vtx (n slots, a
+ * vertex two flagged slots) are cut in place; returns the slots that
+ * remain, or 0 when fewer than 3 do. */
+static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx, size_t n,
+                         float sx, float sy)
+{
+    float th[BSF_MAX_CTRL_PER_FEATURE];
+    float r[BSF_MAX_CTRL_PER_FEATURE];
+    size_t lo = 0;
+    size_t hi = n - 1u;
+    size_t j;
+    size_t k;
+    size_t m;
+    float dir;
+    th[0] = 0.0f;
+    for (k = 0; k < n; ++k) {
+        const float ax = w[k].x - sx;
+        const float ay = w[k].y - sy;
+        r[k] = sqrtf(ax * ax + ay * ay);
+        if (k > 0u) {
+            const float bx = w[k - 1u].x - sx;
+            const float by = w[k - 1u].y - sy;
+            th[k] = th[k - 1u] + bsf_atan2f(bx * ay - by * ax, bx * ax + by * ay);
+        }
+    }
+    dir = th[n - 1u] >= 0.0f ? 1.0f : -1.0f;
+    /* tail: the last point of greatest bearing, and how far the rest fall back */
+    for (j = 0, k = 1; k < n; ++k) {
+        j = dir * th[k] >= dir * th[j] ? k : j;
+    }
+    for (k = j + 1u; k < n; ++k) {
+        if (dir * (th[j] - th[k]) * r[k] > range_gate(p, r[k])) {
+            hi = j - 1u;
+            break;
+        }
+    }
+    /* head: the first point of least bearing */
+    for (j = 0, k = 1; k < n; ++k) {
+        j = dir * th[k] < dir * th[j] ? k : j;
+    }
+    for (k = 0; k < j; ++k) {
+        if (dir * (th[k] - th[j]) * r[k] > range_gate(p, r[k])) {
+            lo = j + 1u;
+            break;
+        }
+    }
+    if (hi == n - 1u && lo == 0u) {
+        return n;
+    }
+    if (hi + 1u <= lo || hi + 1u - lo < 3u) {
+        return 0u;
+    }
+    /* a vertex left whole at an end becomes a plain end point (one slot), a
+     * vertex cut in two a plain point */
+    for (k = 0; k < n; ++k) {
+        if (vtx[k] && k + 1u < n && vtx[k + 1u]) {
+            if (k == lo) {
+                ++lo;
+            } else if (k + 1u == hi) {
+                --hi;
+            }
+            ++k;
+        }
+    }
+    vtx[lo] = 0u;
+    vtx[hi] = 0u;
+    m = hi + 1u - lo;
+    if (m < 3u) {
+        return 0u;
+    }
+    if (lo > 0u) {
+        memmove(w, w + lo, m * sizeof w[0]);
+        memmove(vtx, vtx + lo, m);
+    }
+    return m;
+}
+
 static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose, float step)
 {
     /* world coordinates stay within what the wire's quantised values hold */
@@ -1476,14 +1583,22 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     for (i = 0; i < scan->n_features; ++i) {
         const bsf_feature_t *f = &scan->features[i];
         bsf_point_t w[BSF_MAX_CTRL_PER_FEATURE];
+        uint8_t vtx[BSF_MAX_CTRL_PER_FEATURE];
         size_t j;
+        size_t n;
         for (j = 0; j < f->n_ctrl; ++j) {
             const bsf_point_t *p = &scan->ctrl[f->ctrl_first + j];
             w[j].x = pose->x + c * p->x - sn * p->y;
             w[j].y = pose->y + sn * p->x + c * p->y;
+            vtx[j] = scan->ctrl_is_vertex[f->ctrl_first + j];
         }
-        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, pose->x, pose->y,
-                     &nr);
+        n = trim_folds(&map->params, w, vtx, f->n_ctrl, pose->x, pose->y);
+        if (n != f->n_ctrl) {
+            ++map->stats.n_folds_cut;
+        }
+        if (n > 0u) {
+            fuse_feature(map, w, vtx, n, pose->x, pose->y, &nr);
+        }
     }
     return (int)scan->n_features;
 }
