@@ -1149,25 +1149,28 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
 }
 
 /* A scan vertex that matched a map curve where the map has no vertex (the
- * curve was first seen without its corner): the span's control point nearest
- * to it, if not a chain end and within ctrl_spacing, becomes a vertex there.
+ * curve was first seen without its corner): the span's control point that
+ * weighs most in the curve at the match, if not a chain end, becomes a
+ * vertex there. That is the point the curve rounds the corner with, however
+ * far from the corner a rounded fit put it (a single span over two faces of
+ * a box puts it well beyond the corner).
  * The receiver gets it as a move with a vertex toggle; later observations of
  * the corner merge into it. */
 static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
 {
     const bsf_map_seg_t *sg = &m->segs[l->seg];
-    const float sp = m->params.ctrl_spacing;
-    float best = sp * sp;
+    float best = 0.0f;
     uint16_t pick = BSF_MAP_NONE;
     unsigned j;
+    float b[3];
+    span_basis(sg->ends, l->u, b);
     for (j = 0; j < 3u; ++j) {
         const bsf_map_ctrl_t *c = &m->ctrl[sg->p[j]];
-        const float d2 = (c->x - q->x) * (c->x - q->x) + (c->y - q->y) * (c->y - q->y);
         if ((c->flags & BSF_MAP_CF_VERTEX) != 0u) {
             return; /* the span already has its corner */
         }
-        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && d2 < best) {
-            best = d2;
+        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && b[j] > best) {
+            best = b[j];
             pick = sg->p[j];
         }
     }
