@@ -779,13 +779,12 @@ static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *
     }
 }
 
-/* Points along samples from..to (step +1 or -1), every ctrl_spacing and at
+/* Points along samples from..to (step +1 or -1), every sp metres and at
  * every vertex, starting after the anchor (ax, ay); the last one ends the
  * run. Returns the count (at most cap). */
-static size_t resample(const bsf_map_t *m, const sample_t *s, long from, long to, int has_anchor,
-                       float ax, float ay, newpt_t *out, size_t cap)
+static size_t resample(float sp, const sample_t *s, long from, long to, int has_anchor, float ax,
+                       float ay, newpt_t *out, size_t cap)
 {
-    const float sp = m->params.ctrl_spacing;
     const long dir = to >= from ? 1 : -1;
     float px = ax;
     float py = ay;
@@ -944,7 +943,7 @@ static void extend(bsf_map_t *m, uint16_t fs, unsigned end, const sample_t *s, l
     if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing * 0.5f) {
         return;
     }
-    n = resample(m, s, from, to, 1, e->x, e->y, p, MAX_SAMPLES);
+    n = resample(m->params.ctrl_spacing, s, from, to, 1, e->x, e->y, p, MAX_SAMPLES);
     if (n > 0u && chain_extend(m, f, p, n, end == 1u)) {
         feature_bbox(m, f);
         ++m->stats.n_extended;
@@ -958,7 +957,7 @@ static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
     if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing) {
         return;
     }
-    n = resample(m, s, from, to, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
+    n = resample(m->params.ctrl_spacing, s, from, to, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
     (void)feature_new(m, p, n);
 }
 
@@ -984,7 +983,8 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
         const bsf_map_ctrl_t *e = &m->ctrl[es == 1u ? a->head : a->tail];
         const bsf_map_ctrl_t *o = &m->ctrl[eu == 1u ? u->head : u->tail];
         const float sp = m->params.ctrl_spacing;
-        n = resample(m, s, down ? hi : lo, down ? lo : hi, 1, e->x, e->y, p, MAX_SAMPLES);
+        n = resample(m->params.ctrl_spacing, s, down ? hi : lo, down ? lo : hi, 1, e->x, e->y, p,
+                     MAX_SAMPLES);
         while (n > 0u && !p[n - 1u].vertex &&
                (p[n - 1u].x - o->x) * (p[n - 1u].x - o->x) +
                        (p[n - 1u].y - o->y) * (p[n - 1u].y - o->y) <
@@ -1053,7 +1053,7 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
         const bsf_map_ctrl_t *at = &m->ctrl[a->tail];
         const bsf_map_ctrl_t *bh = &m->ctrl[b->head];
         const float sp = m->params.ctrl_spacing;
-        n = resample(m, s, from, to, 1, at->x, at->y, p, MAX_SAMPLES);
+        n = resample(m->params.ctrl_spacing, s, from, to, 1, at->x, at->y, p, MAX_SAMPLES);
         /* no bridge point crowding b's head */
         while (n > 0u && !p[n - 1u].vertex &&
                (p[n - 1u].x - bh->x) * (p[n - 1u].x - bh->x) +
@@ -1091,11 +1091,12 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
     return 1;
 }
 
-/* Gate of a map vertex for a scan corner: a vertex that is the mean of n
- * corners is uncertain by about ctrl_spacing / n (the first corner may be
- * anywhere make_vertex reaches), never tighter than vertex_dist. A corner
- * first placed off by a grazing view is then pulled to the mean of the
- * corners seen later, and the gate tightens as they agree. */
+/* Gate of a map vertex for a scan corner: a vertex that n scan corners
+ * merged into is uncertain by about ctrl_spacing / n (the first one may be
+ * a control point a rounded fit put up to a spacing from the corner, made a
+ * vertex by make_vertex), never less than vertex_dist. A corner first placed
+ * off by a grazing view is then pulled toward the corners seen later, and
+ * the gate tightens as they agree. */
 static float vertex_gate(const bsf_map_t *m, const bsf_map_ctrl_t *c)
 {
     const float g = m->params.ctrl_spacing / (float)c->corner_obs;
@@ -1132,7 +1133,7 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
         }
         if (best != BSF_MAP_NONE) {
             bsf_map_ctrl_t *c = &m->ctrl[best];
-            const float w = (float)c->corner_obs + 1.0f;
+            const float w = (float)c->weight + 1.0f;
             c->x += (s[k].x - c->x) / w;
             c->y += (s[k].y - c->y) / w;
             if (c->corner_obs < 255u) {
@@ -1236,6 +1237,53 @@ static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *
     }
 }
 
+/* Points of a new map feature from scan curve w (n slots, vtx) and its
+ * samples s: points on the scan's curve every ctrl_spacing, no farther
+ * apart than the scan's own control points are on average, plus its
+ * vertices. A scan's control points lie off its curve where it bends (a
+ * rounded corner's point, an outlying point of a pillar fit); points on the
+ * curve give refinement points where the surface is, and a long arc at
+ * least as many points as the scan had. When that leaves fewer than 3
+ * points (a short piece), the scan's own control points. Returns the count
+ * written to p (room for max(BSF_MAX_CTRL_PER_FEATURE, MAX_SAMPLES)). */
+static size_t new_points(const bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
+                         const sample_t *s, size_t ns, newpt_t *p)
+{
+    float len = 0.0f;
+    float sp = m->params.ctrl_spacing;
+    size_t distinct = 0;
+    size_t np;
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        const int pair = vtx[k] && k + 1u < n && vtx[k + 1u];
+        ++distinct;
+        if (k > 0u) {
+            const float dx = w[k].x - w[k - 1u].x;
+            const float dy = w[k].y - w[k - 1u].y;
+            len += sqrtf(dx * dx + dy * dy);
+        }
+        k += pair ? 1u : 0u;
+    }
+    if (distinct > 1u && len / (float)(distinct - 1u) < sp) {
+        sp = len / (float)(distinct - 1u);
+    }
+    np = resample(sp, s, 0, (long)ns - 1, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
+    if (np >= 3u) {
+        return np;
+    }
+    np = 0;
+    for (k = 0; k < n; ++k) {
+        p[np].x = w[k].x;
+        p[np].y = w[k].y;
+        p[np].vertex = vtx[k] && k + 1u < n && vtx[k + 1u];
+        ++np;
+        if (p[np - 1u].vertex) {
+            ++k;
+        }
+    }
+    return np;
+}
+
 static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n, float sx,
                          float sy, near_t *nr)
 {
@@ -1304,19 +1352,9 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
         }
     }
     if (first < 0) {
-        /* nothing known: a new feature with the scan's own control points */
-        newpt_t p[BSF_MAX_CTRL_PER_FEATURE];
-        size_t np = 0;
-        for (k = 0; k < n; ++k) {
-            p[np].x = w[k].x;
-            p[np].y = w[k].y;
-            p[np].vertex = vtx[k] && k + 1u < n && vtx[k + 1u];
-            ++np;
-            if (p[np - 1u].vertex) {
-                ++k;
-            }
-        }
-        (void)feature_new(m, p, np);
+        /* nothing known: a new feature */
+        newpt_t p[BSF_MAX_CTRL_PER_FEATURE > MAX_SAMPLES ? BSF_MAX_CTRL_PER_FEATURE : MAX_SAMPLES];
+        (void)feature_new(m, p, new_points(m, w, vtx, n, s, ns, p));
         return;
     }
     /* corners the map has not got yet */
@@ -1420,59 +1458,112 @@ static float range_gate(const bsf_map_params_t *p, float r)
     return g < p->match_dist ? g : p->match_dist;
 }
 
-/* A scan sees each bearing once, so its curve runs one way in bearing from
- * the sensor. A fit whose control polygon turns back in bearing at an end
- * (a hooked tail fitted to a few returns at grazing incidence) describes
- * no surface the scan saw: cut the end from the point of greatest bearing
- * on, when the points after it fall back by more than the association gate
- * at their range (less is noise the gate absorbs). w and vtx (n slots, a
- * vertex two flagged slots) are cut in place; returns the slots that
- * remain, or 0 when fewer than 3 do. */
-static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx, size_t n,
-                         float sx, float sy)
+/* Bearing from (sx, sy) of each of the n points q, unwrapped along them,
+ * and their range; returns the sense (+1 / -1) the points run in. */
+static float bearings(const bsf_point_t *q, size_t n, float sx, float sy, float *th, float *r)
 {
-    float th[BSF_MAX_CTRL_PER_FEATURE];
-    float r[BSF_MAX_CTRL_PER_FEATURE];
-    size_t lo = 0;
-    size_t hi = n - 1u;
-    size_t j;
     size_t k;
-    size_t m;
-    float dir;
     th[0] = 0.0f;
     for (k = 0; k < n; ++k) {
-        const float ax = w[k].x - sx;
-        const float ay = w[k].y - sy;
+        const float ax = q[k].x - sx;
+        const float ay = q[k].y - sy;
         r[k] = sqrtf(ax * ax + ay * ay);
         if (k > 0u) {
-            const float bx = w[k - 1u].x - sx;
-            const float by = w[k - 1u].y - sy;
+            const float bx = q[k - 1u].x - sx;
+            const float by = q[k - 1u].y - sy;
             th[k] = th[k - 1u] + bsf_atan2f(bx * ay - by * ax, bx * ax + by * ay);
         }
     }
-    dir = th[n - 1u] >= 0.0f ? 1.0f : -1.0f;
-    /* tail: the last point of greatest bearing, and how far the rest fall back */
+    return th[n - 1u] >= 0.0f ? 1.0f : -1.0f;
+}
+
+/* Of n points with bearings th (sense dir) and ranges r: *tail is the last
+ * point of greatest bearing when a point after it falls back by more than
+ * the gate at its range, else n; *head the first point of least bearing
+ * when a point before it falls back so, else n. */
+static void folds(const bsf_map_params_t *p, const float *th, const float *r, size_t n, float dir,
+                  size_t *head, size_t *tail)
+{
+    size_t j;
+    size_t k;
+    *head = n;
+    *tail = n;
     for (j = 0, k = 1; k < n; ++k) {
         j = dir * th[k] >= dir * th[j] ? k : j;
     }
     for (k = j + 1u; k < n; ++k) {
         if (dir * (th[j] - th[k]) * r[k] > range_gate(p, r[k])) {
-            hi = j - 1u;
+            *tail = j;
             break;
         }
     }
-    /* head: the first point of least bearing */
     for (j = 0, k = 1; k < n; ++k) {
         j = dir * th[k] < dir * th[j] ? k : j;
     }
     for (k = 0; k < j; ++k) {
         if (dir * (th[k] - th[j]) * r[k] > range_gate(p, r[k])) {
-            lo = j + 1u;
+            *head = j;
             break;
         }
     }
-    if (hi == n - 1u && lo == 0u) {
+}
+
+/* A scan sees each bearing once, so its curve runs one way in bearing from
+ * the sensor. A fit whose curve turns back in bearing at an end (a hooked
+ * tail fitted to a few returns at grazing incidence) describes no surface
+ * the scan saw: when the curve past its point of greatest bearing falls back
+ * by more than the association gate at that range (less is noise the gate
+ * absorbs), the control points from the polygon's point of greatest bearing
+ * on are cut (the curve is judged, not the polygon: a bulging span's middle
+ * point lies off the curve). w and vtx (n slots, a vertex two flagged
+ * slots) are cut in place; returns the slots that remain, or 0 when fewer
+ * than 3 do. */
+static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx, size_t n,
+                         float sx, float sy)
+{
+    bsf_point_t cv[2u * BSF_MAX_CTRL_PER_FEATURE];
+    float th[2u * BSF_MAX_CTRL_PER_FEATURE];
+    float r[2u * BSF_MAX_CTRL_PER_FEATURE];
+    size_t nc = 0;
+    size_t lo = 0;
+    size_t hi = n - 1u;
+    size_t head;
+    size_t tail;
+    size_t k;
+    size_t m;
+    float dir;
+    /* the curve at every knot and mid-span */
+    for (k = 0; k + 2u < n; ++k) {
+        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
+        unsigned h;
+        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
+            float b[3];
+            span_basis(ends, 0.5f * (float)h, b);
+            cv[nc].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
+            cv[nc].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
+            ++nc;
+        }
+    }
+    dir = bearings(cv, nc, sx, sy, th, r);
+    folds(p, th, r, nc, dir, &head, &tail);
+    if (head == nc && tail == nc) {
         return n;
+    }
+    /* the cut: at the control polygon's extremes, in the curve's sense */
+    (void)bearings(w, n, sx, sy, th, r);
+    if (tail < nc) {
+        size_t j = 0;
+        for (k = 1; k < n; ++k) {
+            j = dir * th[k] >= dir * th[j] ? k : j;
+        }
+        hi = j > 0u ? j - 1u : 0u;
+    }
+    if (head < nc) {
+        size_t j = 0;
+        for (k = 1; k < n; ++k) {
+            j = dir * th[k] < dir * th[j] ? k : j;
+        }
+        lo = j + 1u;
     }
     if (hi + 1u <= lo || hi + 1u - lo < 3u) {
         return 0u;
@@ -1494,6 +1585,16 @@ static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx
     m = hi + 1u - lo;
     if (m < 3u) {
         return 0u;
+    }
+    /* a cut end goes where the curve was (the knot between the point and
+     * its inner neighbour), not at an off-curve control point */
+    if (lo > 0u) {
+        w[lo].x = 0.5f * (w[lo].x + w[lo + 1u].x);
+        w[lo].y = 0.5f * (w[lo].y + w[lo + 1u].y);
+    }
+    if (hi + 1u < n) {
+        w[hi].x = 0.5f * (w[hi].x + w[hi - 1u].x);
+        w[hi].y = 0.5f * (w[hi].y + w[hi - 1u].y);
     }
     if (lo > 0u) {
         memmove(w, w + lo, m * sizeof w[0]);

@@ -123,7 +123,7 @@ typedef struct {
     uint16_t prev;      /**< pool index of the previous point, or 0xFFFF */
     uint8_t weight;     /**< observation weight, 1..weight_cap */
     uint8_t flags;      /**< vertex, sent */
-    uint8_t corner_obs; /**< of a vertex: scan corners it is the mean of, 1..255 */
+    uint8_t corner_obs; /**< of a vertex: scan corners merged into it, 1..255 */
 } bsf_map_ctrl_t;
 
 /** One feature of the robot's map (internal layout). */
