@@ -1237,37 +1237,41 @@ static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *
     }
 }
 
-/* Points of a new map feature from scan curve w (n slots, vtx) and its
- * samples s: points on the scan's curve every ctrl_spacing, no farther
- * apart than the scan's own control points are on average, plus its
- * vertices. A scan's control points lie off its curve where it bends (a
- * rounded corner's point, an outlying point of a pillar fit); points on the
- * curve give refinement points where the surface is, and a long arc at
- * least as many points as the scan had. When that leaves fewer than 3
- * points (a short piece), the scan's own control points. Returns the count
- * written to p (room for max(BSF_MAX_CTRL_PER_FEATURE, MAX_SAMPLES)). */
-static size_t new_points(const bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n,
-                         const sample_t *s, size_t ns, newpt_t *p)
+/* Points of a new map feature from scan curve w (n slots, vtx): the
+ * curve at every knot and mid-span of the scan's B-spline, a vertex (two
+ * slots) being the knot between its slots. A scan's control points lie off
+ * its curve where it bends (a rounded corner's point, an outlying point of
+ * a pillar fit); points on the curve give refinement points where the
+ * surface is. Twice the scan's density keeps its bends, and each span of
+ * the scan stays as long, so a point near an end the robot will not see
+ * again is still covered by the basis of the samples that see the rest
+ * (new points go out once observed three times). When that leaves fewer
+ * than 3 points, the scan's own control points. Returns the count written
+ * to p (room for 2 * BSF_MAX_CTRL_PER_FEATURE). */
+static size_t new_points(const bsf_point_t *w, const uint8_t *vtx, size_t n, newpt_t *p)
 {
-    float len = 0.0f;
-    float sp = m->params.ctrl_spacing;
-    size_t distinct = 0;
-    size_t np;
+    uint8_t pair[BSF_MAX_CTRL_PER_FEATURE];
+    size_t np = 0;
     size_t k;
-    for (k = 0; k < n; ++k) {
-        const int pair = vtx[k] && k + 1u < n && vtx[k + 1u];
-        ++distinct;
-        if (k > 0u) {
-            const float dx = w[k].x - w[k - 1u].x;
-            const float dy = w[k].y - w[k - 1u].y;
-            len += sqrtf(dx * dx + dy * dy);
+    memset(pair, 0, sizeof pair);
+    for (k = 0; k + 1u < n; ++k) {
+        if (vtx[k] && vtx[k + 1u]) {
+            pair[k] = 1u;
+            ++k;
         }
-        k += pair ? 1u : 0u;
     }
-    if (distinct > 1u && len / (float)(distinct - 1u) < sp) {
-        sp = len / (float)(distinct - 1u);
+    for (k = 0; k + 2u < n; ++k) {
+        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
+        unsigned h;
+        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
+            float b[3];
+            span_basis(ends, 0.5f * (float)h, b);
+            p[np].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
+            p[np].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
+            p[np].vertex = (uint8_t)(h == 0u && k > 0u && pair[k]);
+            ++np;
+        }
     }
-    np = resample(sp, s, 0, (long)ns - 1, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
     if (np >= 3u) {
         return np;
     }
@@ -1353,8 +1357,8 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     }
     if (first < 0) {
         /* nothing known: a new feature */
-        newpt_t p[BSF_MAX_CTRL_PER_FEATURE > MAX_SAMPLES ? BSF_MAX_CTRL_PER_FEATURE : MAX_SAMPLES];
-        (void)feature_new(m, p, new_points(m, w, vtx, n, s, ns, p));
+        newpt_t p[2u * BSF_MAX_CTRL_PER_FEATURE];
+        (void)feature_new(m, p, new_points(w, vtx, n, p));
         return;
     }
     /* corners the map has not got yet */

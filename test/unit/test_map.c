@@ -561,9 +561,9 @@ static int wall_points_sent(float simplify_tol, bsf_point_t *pts, size_t cap)
 
 /* Before points go out, a straight run keeps its ends (and one point: a
  * feature keeps three), all on the wall; with simplify_tol 0 every point
- * the robot holds goes out (a new feature has a point on the scan's curve
- * at least every ctrl_spacing plus one 8 cm sample step: 13 or more over
- * these 4 m). The receiver holds exactly what the robot sent either way. */
+ * the robot holds goes out (a new feature takes the scan curve at its 16
+ * knots and 15 mid-spans: 31). The receiver holds exactly what the robot
+ * sent either way. */
 static void test_map_straight_run_sends_its_ends(void)
 {
     static bsf_point_t pts[64];
@@ -571,7 +571,7 @@ static void test_map_straight_run_sends_its_ends(void)
     int k;
     n = wall_points_sent(0.0f, pts, 64u);
     TEST_ASSERT_EQUAL_INT(bsf_map_feature_ctrl(&map, 0u, 0, NULL, NULL, 0u, NULL), n);
-    TEST_ASSERT_GREATER_OR_EQUAL_INT(13, n);
+    TEST_ASSERT_EQUAL_INT(31, n);
     n = wall_points_sent(0.01f, pts, 64u);
     TEST_ASSERT_EQUAL_INT(3, n);
     TEST_ASSERT_FLOAT_WITHIN(0.01f, -2.0f, pts[0].x);
