@@ -180,6 +180,7 @@ static uint16_t ctrl_alloc(bsf_map_t *m, float x, float y, uint8_t vertex)
     c->prev = BSF_MAP_NONE;
     c->weight = 1u;
     c->flags = vertex ? BSF_MAP_CF_VERTEX : 0u;
+    c->corner_obs = 1u;
     return i;
 }
 
@@ -778,13 +779,12 @@ static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *
     }
 }
 
-/* Points along samples from..to (step +1 or -1), every ctrl_spacing and at
+/* Points along samples from..to (step +1 or -1), every sp metres and at
  * every vertex, starting after the anchor (ax, ay); the last one ends the
  * run. Returns the count (at most cap). */
-static size_t resample(const bsf_map_t *m, const sample_t *s, long from, long to, int has_anchor,
-                       float ax, float ay, newpt_t *out, size_t cap)
+static size_t resample(float sp, const sample_t *s, long from, long to, int has_anchor, float ax,
+                       float ay, newpt_t *out, size_t cap)
 {
-    const float sp = m->params.ctrl_spacing;
     const long dir = to >= from ? 1 : -1;
     float px = ax;
     float py = ay;
@@ -943,7 +943,7 @@ static void extend(bsf_map_t *m, uint16_t fs, unsigned end, const sample_t *s, l
     if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing * 0.5f) {
         return;
     }
-    n = resample(m, s, from, to, 1, e->x, e->y, p, MAX_SAMPLES);
+    n = resample(m->params.ctrl_spacing, s, from, to, 1, e->x, e->y, p, MAX_SAMPLES);
     if (n > 0u && chain_extend(m, f, p, n, end == 1u)) {
         feature_bbox(m, f);
         ++m->stats.n_extended;
@@ -957,7 +957,7 @@ static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
     if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing) {
         return;
     }
-    n = resample(m, s, from, to, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
+    n = resample(m->params.ctrl_spacing, s, from, to, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
     (void)feature_new(m, p, n);
 }
 
@@ -983,7 +983,8 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
         const bsf_map_ctrl_t *e = &m->ctrl[es == 1u ? a->head : a->tail];
         const bsf_map_ctrl_t *o = &m->ctrl[eu == 1u ? u->head : u->tail];
         const float sp = m->params.ctrl_spacing;
-        n = resample(m, s, down ? hi : lo, down ? lo : hi, 1, e->x, e->y, p, MAX_SAMPLES);
+        n = resample(m->params.ctrl_spacing, s, down ? hi : lo, down ? lo : hi, 1, e->x, e->y, p,
+                     MAX_SAMPLES);
         while (n > 0u && !p[n - 1u].vertex &&
                (p[n - 1u].x - o->x) * (p[n - 1u].x - o->x) +
                        (p[n - 1u].y - o->y) * (p[n - 1u].y - o->y) <
@@ -1052,7 +1053,7 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
         const bsf_map_ctrl_t *at = &m->ctrl[a->tail];
         const bsf_map_ctrl_t *bh = &m->ctrl[b->head];
         const float sp = m->params.ctrl_spacing;
-        n = resample(m, s, from, to, 1, at->x, at->y, p, MAX_SAMPLES);
+        n = resample(m->params.ctrl_spacing, s, from, to, 1, at->x, at->y, p, MAX_SAMPLES);
         /* no bridge point crowding b's head */
         while (n > 0u && !p[n - 1u].vertex &&
                (p[n - 1u].x - bh->x) * (p[n - 1u].x - bh->x) +
@@ -1090,15 +1091,26 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
     return 1;
 }
 
+/* Gate of a map vertex for a scan corner: a vertex that n scan corners
+ * merged into is uncertain by about ctrl_spacing / n (the first one may be
+ * a control point a rounded fit put up to a spacing from the corner, made a
+ * vertex by make_vertex), never less than vertex_dist. A corner first placed
+ * off by a grazing view is then pulled toward the corners seen later, and
+ * the gate tightens as they agree. */
+static float vertex_gate(const bsf_map_t *m, const bsf_map_ctrl_t *c)
+{
+    const float g = m->params.ctrl_spacing / (float)c->corner_obs;
+    return g > m->params.vertex_dist ? g : m->params.vertex_dist;
+}
+
 /* Scan vertices near a map vertex move it by their running mean. */
 static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
 {
-    const float d2max = m->params.vertex_dist * m->params.vertex_dist;
     size_t k;
     uint16_t g;
     for (k = 0; k < ns; ++k) {
         uint16_t best = BSF_MAP_NONE;
-        float bd = d2max;
+        float bd = 3.0e38f;
         if (!s[k].vertex) {
             continue;
         }
@@ -1107,11 +1119,13 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
             for (j = 0; j < 3u; ++j) {
                 const bsf_map_ctrl_t *c = &m->ctrl[m->segs[g].p[j]];
                 float d2;
+                float gate;
                 if (!(c->flags & BSF_MAP_CF_VERTEX)) {
                     continue;
                 }
                 d2 = (c->x - s[k].x) * (c->x - s[k].x) + (c->y - s[k].y) * (c->y - s[k].y);
-                if (d2 <= bd) {
+                gate = vertex_gate(m, c);
+                if (d2 <= gate * gate && d2 <= bd) {
                     bd = d2;
                     best = m->segs[g].p[j];
                 }
@@ -1122,6 +1136,9 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
             const float w = (float)c->weight + 1.0f;
             c->x += (s[k].x - c->x) / w;
             c->y += (s[k].y - c->y) / w;
+            if (c->corner_obs < 255u) {
+                ++c->corner_obs;
+            }
             if (c->weight < m->params.weight_cap) {
                 ++c->weight;
             }
@@ -1133,25 +1150,28 @@ static void fuse_vertices(bsf_map_t *m, sample_t *s, size_t ns)
 }
 
 /* A scan vertex that matched a map curve where the map has no vertex (the
- * curve was first seen without its corner): the span's control point nearest
- * to it, if not a chain end and within ctrl_spacing, becomes a vertex there.
+ * curve was first seen without its corner): the span's control point that
+ * weighs most in the curve at the match, if not a chain end, becomes a
+ * vertex there. That is the point the curve rounds the corner with, however
+ * far from the corner a rounded fit put it (a single span over two faces of
+ * a box puts it well beyond the corner).
  * The receiver gets it as a move with a vertex toggle; later observations of
  * the corner merge into it. */
 static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
 {
     const bsf_map_seg_t *sg = &m->segs[l->seg];
-    const float sp = m->params.ctrl_spacing;
-    float best = sp * sp;
+    float best = 0.0f;
     uint16_t pick = BSF_MAP_NONE;
     unsigned j;
+    float b[3];
+    span_basis(sg->ends, l->u, b);
     for (j = 0; j < 3u; ++j) {
         const bsf_map_ctrl_t *c = &m->ctrl[sg->p[j]];
-        const float d2 = (c->x - q->x) * (c->x - q->x) + (c->y - q->y) * (c->y - q->y);
         if ((c->flags & BSF_MAP_CF_VERTEX) != 0u) {
             return; /* the span already has its corner */
         }
-        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && d2 < best) {
-            best = d2;
+        if (c->prev != BSF_MAP_NONE && c->next != BSF_MAP_NONE && b[j] > best) {
+            best = b[j];
             pick = sg->p[j];
         }
     }
@@ -1161,6 +1181,7 @@ static void make_vertex(bsf_map_t *m, const label_t *l, const sample_t *q)
         c->y = q->y;
         c->flags |= BSF_MAP_CF_VERTEX;
         c->weight = 1u;
+        c->corner_obs = 1u;
         ++m->stats.n_vertex_made;
     }
 }
@@ -1211,8 +1232,60 @@ static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *
         c->y = s[k].y;
         c->flags |= BSF_MAP_CF_VERTEX;
         c->weight = 1u;
+        c->corner_obs = 1u;
         ++m->stats.n_vertex_made;
     }
+}
+
+/* Points of a new map feature from scan curve w (n slots, vtx): the
+ * curve at every knot and mid-span of the scan's B-spline, a vertex (two
+ * slots) being the knot between its slots. A scan's control points lie off
+ * its curve where it bends (a rounded corner's point, an outlying point of
+ * a pillar fit); points on the curve give refinement points where the
+ * surface is. Twice the scan's density keeps its bends, and each span of
+ * the scan stays as long, so a point near an end the robot will not see
+ * again is still covered by the basis of the samples that see the rest
+ * (new points go out once observed three times). When that leaves fewer
+ * than 3 points, the scan's own control points. Returns the count written
+ * to p (room for 2 * BSF_MAX_CTRL_PER_FEATURE). */
+static size_t new_points(const bsf_point_t *w, const uint8_t *vtx, size_t n, newpt_t *p)
+{
+    uint8_t pair[BSF_MAX_CTRL_PER_FEATURE];
+    size_t np = 0;
+    size_t k;
+    memset(pair, 0, sizeof pair);
+    for (k = 0; k + 1u < n; ++k) {
+        if (vtx[k] && vtx[k + 1u]) {
+            pair[k] = 1u;
+            ++k;
+        }
+    }
+    for (k = 0; k + 2u < n; ++k) {
+        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
+        unsigned h;
+        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
+            float b[3];
+            span_basis(ends, 0.5f * (float)h, b);
+            p[np].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
+            p[np].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
+            p[np].vertex = (uint8_t)(h == 0u && k > 0u && pair[k]);
+            ++np;
+        }
+    }
+    if (np >= 3u) {
+        return np;
+    }
+    np = 0;
+    for (k = 0; k < n; ++k) {
+        p[np].x = w[k].x;
+        p[np].y = w[k].y;
+        p[np].vertex = vtx[k] && k + 1u < n && vtx[k + 1u];
+        ++np;
+        if (p[np - 1u].vertex) {
+            ++k;
+        }
+    }
+    return np;
 }
 
 static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx, size_t n, float sx,
@@ -1283,19 +1356,9 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
         }
     }
     if (first < 0) {
-        /* nothing known: a new feature with the scan's own control points */
-        newpt_t p[BSF_MAX_CTRL_PER_FEATURE];
-        size_t np = 0;
-        for (k = 0; k < n; ++k) {
-            p[np].x = w[k].x;
-            p[np].y = w[k].y;
-            p[np].vertex = vtx[k] && k + 1u < n && vtx[k + 1u];
-            ++np;
-            if (p[np - 1u].vertex) {
-                ++k;
-            }
-        }
-        (void)feature_new(m, p, np);
+        /* nothing known: a new feature */
+        newpt_t p[2u * BSF_MAX_CTRL_PER_FEATURE];
+        (void)feature_new(m, p, new_points(w, vtx, n, p));
         return;
     }
     /* corners the map has not got yet */
@@ -1392,6 +1455,158 @@ static void drop_transients(bsf_map_t *m)
     }
 }
 
+/* Gate of a point at range r from the sensor (fuse_feature's). */
+static float range_gate(const bsf_map_params_t *p, float r)
+{
+    const float g = p->match_dist_near + p->match_dist_per_m * r;
+    return g < p->match_dist ? g : p->match_dist;
+}
+
+/* Bearing from (sx, sy) of each of the n points q, unwrapped along them,
+ * and their range; returns the sense (+1 / -1) the points run in. */
+static float bearings(const bsf_point_t *q, size_t n, float sx, float sy, float *th, float *r)
+{
+    size_t k;
+    th[0] = 0.0f;
+    for (k = 0; k < n; ++k) {
+        const float ax = q[k].x - sx;
+        const float ay = q[k].y - sy;
+        r[k] = sqrtf(ax * ax + ay * ay);
+        if (k > 0u) {
+            const float bx = q[k - 1u].x - sx;
+            const float by = q[k - 1u].y - sy;
+            th[k] = th[k - 1u] + bsf_atan2f(bx * ay - by * ax, bx * ax + by * ay);
+        }
+    }
+    return th[n - 1u] >= 0.0f ? 1.0f : -1.0f;
+}
+
+/* Of n points with bearings th (sense dir) and ranges r: *tail is the last
+ * point of greatest bearing when a point after it falls back by more than
+ * the gate at its range, else n; *head the first point of least bearing
+ * when a point before it falls back so, else n. */
+static void folds(const bsf_map_params_t *p, const float *th, const float *r, size_t n, float dir,
+                  size_t *head, size_t *tail)
+{
+    size_t j;
+    size_t k;
+    *head = n;
+    *tail = n;
+    for (j = 0, k = 1; k < n; ++k) {
+        j = dir * th[k] >= dir * th[j] ? k : j;
+    }
+    for (k = j + 1u; k < n; ++k) {
+        if (dir * (th[j] - th[k]) * r[k] > range_gate(p, r[k])) {
+            *tail = j;
+            break;
+        }
+    }
+    for (j = 0, k = 1; k < n; ++k) {
+        j = dir * th[k] < dir * th[j] ? k : j;
+    }
+    for (k = 0; k < j; ++k) {
+        if (dir * (th[k] - th[j]) * r[k] > range_gate(p, r[k])) {
+            *head = j;
+            break;
+        }
+    }
+}
+
+/* A scan sees each bearing once, so its curve runs one way in bearing from
+ * the sensor. A fit whose curve turns back in bearing at an end (a hooked
+ * tail fitted to a few returns at grazing incidence) describes no surface
+ * the scan saw: when the curve past its point of greatest bearing falls back
+ * by more than the association gate at that range (less is noise the gate
+ * absorbs), the control points from the polygon's point of greatest bearing
+ * on are cut (the curve is judged, not the polygon: a bulging span's middle
+ * point lies off the curve). w and vtx (n slots, a vertex two flagged
+ * slots) are cut in place; returns the slots that remain, or 0 when fewer
+ * than 3 do. */
+static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx, size_t n,
+                         float sx, float sy)
+{
+    bsf_point_t cv[2u * BSF_MAX_CTRL_PER_FEATURE];
+    float th[2u * BSF_MAX_CTRL_PER_FEATURE];
+    float r[2u * BSF_MAX_CTRL_PER_FEATURE];
+    size_t nc = 0;
+    size_t lo = 0;
+    size_t hi = n - 1u;
+    size_t head;
+    size_t tail;
+    size_t k;
+    size_t m;
+    float dir;
+    /* the curve at every knot and mid-span */
+    for (k = 0; k + 2u < n; ++k) {
+        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
+        unsigned h;
+        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
+            float b[3];
+            span_basis(ends, 0.5f * (float)h, b);
+            cv[nc].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
+            cv[nc].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
+            ++nc;
+        }
+    }
+    dir = bearings(cv, nc, sx, sy, th, r);
+    folds(p, th, r, nc, dir, &head, &tail);
+    if (head == nc && tail == nc) {
+        return n;
+    }
+    /* the cut: at the control polygon's extremes, in the curve's sense */
+    (void)bearings(w, n, sx, sy, th, r);
+    if (tail < nc) {
+        size_t j = 0;
+        for (k = 1; k < n; ++k) {
+            j = dir * th[k] >= dir * th[j] ? k : j;
+        }
+        hi = j > 0u ? j - 1u : 0u;
+    }
+    if (head < nc) {
+        size_t j = 0;
+        for (k = 1; k < n; ++k) {
+            j = dir * th[k] < dir * th[j] ? k : j;
+        }
+        lo = j + 1u;
+    }
+    if (hi + 1u <= lo || hi + 1u - lo < 3u) {
+        return 0u;
+    }
+    /* a vertex left whole at an end becomes a plain end point (one slot), a
+     * vertex cut in two a plain point */
+    for (k = 0; k < n; ++k) {
+        if (vtx[k] && k + 1u < n && vtx[k + 1u]) {
+            if (k == lo) {
+                ++lo;
+            } else if (k + 1u == hi) {
+                --hi;
+            }
+            ++k;
+        }
+    }
+    vtx[lo] = 0u;
+    vtx[hi] = 0u;
+    m = hi + 1u - lo;
+    if (m < 3u) {
+        return 0u;
+    }
+    /* a cut end goes where the curve was (the knot between the point and
+     * its inner neighbour), not at an off-curve control point */
+    if (lo > 0u) {
+        w[lo].x = 0.5f * (w[lo].x + w[lo + 1u].x);
+        w[lo].y = 0.5f * (w[lo].y + w[lo + 1u].y);
+    }
+    if (hi + 1u < n) {
+        w[hi].x = 0.5f * (w[hi].x + w[hi - 1u].x);
+        w[hi].y = 0.5f * (w[hi].y + w[hi - 1u].y);
+    }
+    if (lo > 0u) {
+        memmove(w, w + lo, m * sizeof w[0]);
+        memmove(vtx, vtx + lo, m);
+    }
+    return m;
+}
+
 static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose, float step)
 {
     /* world coordinates stay within what the wire's quantised values hold */
@@ -1476,14 +1691,22 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
     for (i = 0; i < scan->n_features; ++i) {
         const bsf_feature_t *f = &scan->features[i];
         bsf_point_t w[BSF_MAX_CTRL_PER_FEATURE];
+        uint8_t vtx[BSF_MAX_CTRL_PER_FEATURE];
         size_t j;
+        size_t n;
         for (j = 0; j < f->n_ctrl; ++j) {
             const bsf_point_t *p = &scan->ctrl[f->ctrl_first + j];
             w[j].x = pose->x + c * p->x - sn * p->y;
             w[j].y = pose->y + sn * p->x + c * p->y;
+            vtx[j] = scan->ctrl_is_vertex[f->ctrl_first + j];
         }
-        fuse_feature(map, w, scan->ctrl_is_vertex + f->ctrl_first, f->n_ctrl, pose->x, pose->y,
-                     &nr);
+        n = trim_folds(&map->params, w, vtx, f->n_ctrl, pose->x, pose->y);
+        if (n != f->n_ctrl) {
+            ++map->stats.n_folds_cut;
+        }
+        if (n > 0u) {
+            fuse_feature(map, w, vtx, n, pose->x, pose->y, &nr);
+        }
     }
     return (int)scan->n_features;
 }

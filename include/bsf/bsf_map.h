@@ -106,6 +106,8 @@ typedef struct {
     uint32_t n_forgotten_ctrl; /**< their control points */
     uint32_t n_dropped_obs;    /**< scan features left out: caps full, nothing to forget */
     uint32_t n_transient;      /**< features seen in one scan only, never sent, dropped */
+    uint32_t n_folds_cut;      /**< scan features whose end turned back in bearing (a hooked
+                                    tail): that end cut, or the feature left out */
     uint32_t n_frames;         /**< frames written by bsf_map_encode */
     uint32_t map_bytes;        /**< bytes of those frames, pose records excluded */
     uint32_t pose_bytes;       /**< bytes of pose records (and of pose-only frames) */
@@ -120,12 +122,13 @@ typedef struct {
 /** One control point of the robot's map (internal layout; read it through
  *  the accessors). */
 typedef struct {
-    float x, y;     /**< fused world position, metres */
-    int32_t qx, qy; /**< value the receiver holds, in quant steps (when sent) */
-    uint16_t next;  /**< pool index of the next point of the chain, or 0xFFFF */
-    uint16_t prev;  /**< pool index of the previous point, or 0xFFFF */
-    uint8_t weight; /**< observation weight, 1..weight_cap */
-    uint8_t flags;  /**< vertex, sent */
+    float x, y;         /**< fused world position, metres */
+    int32_t qx, qy;     /**< value the receiver holds, in quant steps (when sent) */
+    uint16_t next;      /**< pool index of the next point of the chain, or 0xFFFF */
+    uint16_t prev;      /**< pool index of the previous point, or 0xFFFF */
+    uint8_t weight;     /**< observation weight, 1..weight_cap */
+    uint8_t flags;      /**< vertex, sent */
+    uint8_t corner_obs; /**< of a vertex: scan corners merged into it, 1..255 */
 } bsf_map_ctrl_t;
 
 /** One feature of the robot's map (internal layout). */

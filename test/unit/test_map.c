@@ -640,14 +640,17 @@ static int wall_points_sent(float simplify_tol, bsf_point_t *pts, size_t cap)
 
 /* Before points go out, a straight run keeps its ends (and one point: a
  * feature keeps three), all on the wall; with simplify_tol 0 every point
- * goes out. The receiver holds exactly what the robot sent either way. */
+ * the robot holds goes out (a new feature takes the scan curve at its 16
+ * knots and 15 mid-spans: 31). The receiver holds exactly what the robot
+ * sent either way. */
 static void test_map_straight_run_sends_its_ends(void)
 {
     static bsf_point_t pts[64];
     int n;
     int k;
     n = wall_points_sent(0.0f, pts, 64u);
-    TEST_ASSERT_EQUAL_INT(17, n);
+    TEST_ASSERT_EQUAL_INT(bsf_map_feature_ctrl(&map, 0u, 0, NULL, NULL, 0u, NULL), n);
+    TEST_ASSERT_EQUAL_INT(31, n);
     n = wall_points_sent(0.01f, pts, 64u);
     TEST_ASSERT_EQUAL_INT(3, n);
     TEST_ASSERT_FLOAT_WITHIN(0.01f, -2.0f, pts[0].x);
@@ -659,6 +662,89 @@ static void test_map_straight_run_sends_its_ends(void)
 
 /* A small frame budget: the changes go out over several frames, in order,
  * and the receiver still ends equal to the robot's sent copy. */
+/* One scan feature (sensor at the origin, heading 0): n points, vertex
+ * flags as given (a vertex two flagged slots). */
+static void one_feature(const float *xy, const uint8_t *vtx, uint8_t n)
+{
+    unsigned k;
+    memset(&res, 0, sizeof res);
+    res.n_features = 1u;
+    res.n_ctrl = (uint16_t)n;
+    res.features[0].n_ctrl = n;
+    for (k = 0; k < n; ++k) {
+        res.ctrl[k].x = xy[2u * k];
+        res.ctrl[k].y = xy[2u * k + 1u];
+        res.ctrl_is_vertex[k] = vtx != NULL ? vtx[k] : 0u;
+    }
+}
+
+/* A wall at x = 5 whose fit ends in a hook: past (5, 1) the curve turns
+ * back toward smaller bearings by about 12 cm at 5 m, more than the gate
+ * there (8 cm). A scan sees each bearing once, so that end is cut: no map
+ * point lies beyond the wall or past its end, and the stats count it. */
+static void test_map_hooked_tail_is_cut(void)
+{
+    static const float hooked[] = {5.0f, -1.0f, 5.0f, -0.5f, 5.0f, 0.0f, 5.0f,
+                                   0.5f, 5.0f,  1.0f, 4.9f,  1.6f, 4.6f, 1.2f};
+    const bsf_pose_t pose = {0.0f, 0.0f, 0.0f};
+    static bsf_point_t pts[64];
+    int n;
+    int k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, NULL));
+    one_feature(hooked, NULL, 7u);
+    TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    TEST_ASSERT_EQUAL_UINT32(1u, map.stats.n_folds_cut);
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    n = bsf_map_feature_ctrl(&map, 0u, 0, pts, NULL, 64u, NULL);
+    TEST_ASSERT_GREATER_OR_EQUAL_INT(3, n);
+    for (k = 0; k < n; ++k) {
+        TEST_ASSERT_FLOAT_WITHIN(0.02f, 5.0f, pts[k].x);
+        TEST_ASSERT_TRUE(pts[k].y <= 1.01f);
+    }
+    /* the same wall without the hook is fused whole */
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, NULL));
+    one_feature(hooked, NULL, 5u);
+    TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    TEST_ASSERT_EQUAL_UINT32(0u, map.stats.n_folds_cut);
+}
+
+/* A corner first seen 15 cm off (a grazing view), then seen where it is
+ * from the same pose: the map's vertex follows the later corners (its gate
+ * starts at ctrl_spacing and tightens as corners merge) and ends within
+ * 3 cm of the corner, one vertex. */
+static void test_map_vertex_follows_later_corners(void)
+{
+    static const float first[] = {2.0f, -1.0f, 2.0f, -0.5f, 2.0f, 0.0f, 2.0f, 0.5f,
+                                  2.0f, 0.85f, 2.0f, 0.85f, 1.5f, 1.0f, 1.0f, 1.0f};
+    static const float later[] = {2.0f, -1.0f, 2.0f, -0.5f, 2.0f, 0.0f, 2.0f, 0.5f,
+                                  2.0f, 1.0f,  2.0f, 1.0f,  1.5f, 1.0f, 1.0f, 1.0f};
+    static const uint8_t vtx[] = {0u, 0u, 0u, 0u, 1u, 1u, 0u, 0u};
+    const bsf_pose_t pose = {0.0f, 0.0f, 0.0f};
+    static bsf_point_t pts[64];
+    static uint8_t is_v[64];
+    int n;
+    int k;
+    int vertices = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, NULL));
+    one_feature(first, vtx, 8u);
+    TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    one_feature(later, vtx, 8u);
+    for (k = 0; k < 30; ++k) {
+        TEST_ASSERT_EQUAL_INT(1, bsf_map_fuse(&map, &res, &pose));
+    }
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    n = bsf_map_feature_ctrl(&map, 0u, 0, pts, is_v, 64u, NULL);
+    for (k = 0; k < n; ++k) {
+        if (is_v[k]) {
+            ++vertices;
+            TEST_ASSERT_FLOAT_WITHIN(0.03f, 2.0f, pts[k].x);
+            TEST_ASSERT_FLOAT_WITHIN(0.03f, 1.0f, pts[k].y);
+            ++k;
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(1, vertices);
+}
+
 static void test_map_small_frames_carry_everything(void)
 {
     long k;
@@ -727,6 +813,8 @@ int main(void)
     RUN_TEST(test_map_rx_flags_what_a_loss_may_have_touched);
     RUN_TEST(test_map_gate_grows_with_range);
     RUN_TEST(test_map_straight_run_sends_its_ends);
+    RUN_TEST(test_map_hooked_tail_is_cut);
+    RUN_TEST(test_map_vertex_follows_later_corners);
     RUN_TEST(test_map_small_frames_carry_everything);
     RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();
