@@ -20,6 +20,14 @@
 /* A circle is only a candidate shape when its radius is below this multiple
  * of the window's extent: a larger one is a line in float arithmetic. */
 #define LC_CIRCLE_MAX_RADIUS 10.0f
+/* Evidence a corner needs against the best smooth curve (corner_test_init):
+ * with many points, the curve's squared residual must exceed the two lines'
+ * by this squared times the noise variance, which chance (two chi-square
+ * degrees of freedom: one more parameter and the apex point) exceeds once
+ * in about 270 000 judgements. */
+#define LC_EVIDENCE_SIGMAS 5.0f
+/* Gauss-Newton steps of the geometric circle fit in the evidence route. */
+#define LC_CIRCLE_STEPS 3u
 
 bsf_lc_params_t bsf_lc_params_default(void)
 {
@@ -79,6 +87,7 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
+    float noise2; /* the current run's noise variance (run_noise squared) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -189,10 +198,65 @@ typedef struct {
     float target;
 } lc_enough_t;
 
+/* One Gauss-Newton step of the geometric circle fit (the sum of squared
+ * distances to the circle) over positions a..b, centre (*cx, *cy) relative
+ * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
+ * or leaves no sensible circle. */
+static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float *cx,
+                        float *cy, float *r)
+{
+    const bsf_point_t *rp = c->rel;
+    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
+    float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
+    float det, du, dv, dr;
+    size_t i;
+    for (i = a; i <= b; ++i) {
+        const float dx = rp[i].x - cx0 - *cx;
+        const float dy = rp[i].y - cy0 - *cy;
+        const float dist = sqrtf(dx * dx + dy * dy);
+        float u, v, g;
+        if (!(dist > 0.0f)) {
+            return;
+        }
+        /* the residual dist - r moves by -(u, v, 1) . (dcx, dcy, dr) */
+        u = dx / dist;
+        v = dy / dist;
+        g = dist - *r;
+        juu += u * u;
+        juv += u * v;
+        jvv += v * v;
+        ju += u;
+        jv += v;
+        n += 1.0f;
+        gu += u * g;
+        gv += v * g;
+        g1 += g;
+    }
+    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1) by Cramer. */
+    det = juu * (jvv * n - jv * jv) - juv * (juv * n - jv * ju) + ju * (juv * jv - jvv * ju);
+    if (!(fabsf(det) > 0.0f)) {
+        return;
+    }
+    du = (gu * (jvv * n - jv * jv) - juv * (gv * n - jv * g1) + ju * (gv * jv - jvv * g1)) / det;
+    dv = (juu * (gv * n - jv * g1) - gu * (juv * n - jv * ju) + ju * (juv * g1 - gv * ju)) / det;
+    dr = (juu * (jvv * g1 - gv * jv) - juv * (juv * g1 - gv * ju) + gu * (juv * jv - jvv * ju)) /
+         det;
+    if (!(*r + dr > 0.0f) || !(fabsf(du) + fabsf(dv) + fabsf(dr) < *r + 1.0f)) {
+        return; /* NaN ends here too */
+    }
+    *cx += du;
+    *cy += dv;
+    *r += dr;
+}
+
 /* Squared residual of the best circle through positions a..b (algebraic fit,
- * then geometric distances), or -1 when no sensible circle exists. */
+ * then geometric distances), or -1 when no sensible circle exists. With
+ * refine > 0, that many Gauss-Newton steps of the geometric fit first: the
+ * algebraic circle's residual exceeds the best circle's by a few noise
+ * variances on short or noisy arcs, which the evidence route would take as
+ * evidence of a corner. */
 static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent,
-                        const lc_enough_t *enough)
+                        const lc_enough_t *enough, unsigned refine)
 {
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
@@ -232,6 +296,9 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         return -1.0f;
     }
     r = sqrtf(r2);
+    for (; refine > 0u; --refine) {
+        circle_step(c, a, b, cx0, cy0, &cx, &cy, &r);
+    }
     for (i = a; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
         const float dy = rp[i].y - cy0 - cy;
@@ -275,7 +342,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
     enough.target = l->rss * (float)(n - 3u); /* straight from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough, 0u);
     if (rss_circle < 0.0f) {
         return 1;
     }
@@ -659,6 +726,115 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
     return 0;
 }
 
+/* LC's corner test on the best smooth curve's squared residual, for two
+ * lines with squared residual rss_lines over n points (apex included). The
+ * ratio route asks the curve for curve_ratio times the lines' residual plus
+ * the floor: the same factor whatever the number of points, so a shallow
+ * corner between long sides fails it by chance (a 35 deg turn between 1.3 m
+ * sides at 1 cm noise scores 10-25) while the curve misses the points by
+ * hundreds of noise variances. The evidence route is a likelihood-ratio
+ * test against the noise: the curve's residual must exceed the lines' by
+ * as many noise variances as chance exceeds once in e^(LC_EVIDENCE_SIGMAS^2
+ * / 2) (about 270 000) judgements, with the variance estimated from the
+ * lines' n - 5 degrees of freedom (n - 1 points, two lines of two
+ * parameters): the F distribution's tail for the one more parameter and the
+ * apex point, nu * (e^(k^2 / nu) - 1) variances for nu degrees of freedom
+ * (k^2 = 25 for many points, more for few). Sides that show curvature at
+ * that level then fail it (side_uncurved): a crease between a wall and a
+ * curved wall is no corner of two lines. The variance is the largest of
+ * the run's noise estimate, the lines' residual per degree of freedom and
+ * the floor: sides the lines do not fit (clutter, a second corner within
+ * reach) ask for more. */
+typedef struct {
+    float ratio_bound; /* the ratio route's bound */
+    float bound;       /* the lower of the two routes' bounds */
+    float noise_var;   /* the run's noise variance, at least floor^2 */
+} lc_corner_test_t;
+
+static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_corner_test_t *t)
+{
+    const float floor2 = c->p->floor * c->p->floor;
+    float var = c->noise2 > floor2 ? c->noise2 : floor2;
+    float evidence_bound;
+    t->noise_var = var;
+    t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * floor2;
+    t->bound = t->ratio_bound;
+    if (n > 5u) {
+        const float dof = (float)(n - 5u);
+        const float fit_var = rss_lines / dof;
+        const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+        var = fit_var > var ? fit_var : var;
+        float excess = dof * (bsf_expf(k2 / dof) - 1.0f);
+        if (excess < (float)n) {
+            excess = (float)n;
+        }
+        evidence_bound = rss_lines + excess * var;
+        t->bound = evidence_bound < t->bound ? evidence_bound : t->bound;
+    }
+}
+
+/* For the evidence route: the side's line is seen at most 80 deg from its
+ * normal (the sine of its angle to the ray through its centroid at least
+ * BSF_GRAZING_MIN_SIN). Nearer edge-on its returns are no surface the noise
+ * model describes: mixed pixels strung along the ray at a depth jump, or a
+ * tail past an edge. */
+static int side_seen(const lc_ctx_t *c, const lc_line_t *l)
+{
+    const float rx = l->mx + c->o.x;
+    const float ry = l->my + c->o.y;
+    const float cross = rx * l->dy - ry * l->dx;
+    return cross * cross >= BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN * (rx * rx + ry * ry);
+}
+
+/* For the evidence route: no two consecutive returns of positions a..b
+ * step along the ray by more than a surface seen at 80 deg incidence allows
+ * (tan 80 deg times their step across it) plus three standard deviations of
+ * the difference of two range readings (sqrt(2) sigma each). Such a step is
+ * a depth jump inside the run (an occluder's edge, a mixed pixel), and lines
+ * either side of it meet at no corner of one surface. */
+static int window_joined(const lc_ctx_t *c, size_t a, size_t b, float noise_var)
+{
+    const float tan_max =
+        sqrtf(1.0f - BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN) / BSF_GRAZING_MIN_SIN;
+    const float slack = 4.2426f * sqrtf(noise_var); /* 3 sqrt(2) sigma */
+    const bsf_point_t *pt = c->pts->pt;
+    size_t i;
+    for (i = a; i < b; ++i) {
+        const bsf_point_t p = pt[c->run[i + 1u]];
+        const bsf_point_t q = pt[c->run[i]];
+        const float dx = p.x - q.x;
+        const float dy = p.y - q.y;
+        /* both components times the range of p */
+        const float along = fabsf(dx * p.x + dy * p.y);
+        const float across = fabsf(dx * p.y - dy * p.x);
+        if (along > tan_max * across + slack * c->pts->range[c->run[i + 1u]]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* For the evidence route: a side shows no curvature unless a circle cuts
+ * its line's squared residual by more than LC_EVIDENCE_SIGMAS^2 noise
+ * variances. Three points or fewer show none (a circle fits any three). */
+static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var)
+{
+    const float cut = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
+    float rss_circle;
+    lc_enough_t enough;
+    /* no circle can cut more than the whole residual */
+    if (b - a + 1u <= 3u || !(l->rss > cut)) {
+        return 1;
+    }
+    enough.scale = 1.0f;
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = l->rss - cut; /* uncurved from there on */
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough,
+                            LC_CIRCLE_STEPS);
+    return rss_circle < 0.0f || rss_circle >= enough.target;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
  * corner, 0 otherwise. */
@@ -676,7 +852,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     size_t best;
     size_t i;
     const bsf_point_t *rp = c->rel;
-    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, lines_bound, best_d;
+    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
+    lc_corner_test_t test;
     lc_enough_t enough;
     bsf_point_t x;
     bsf_point_t ap;
@@ -750,10 +927,10 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     rss_lines = la.rss + lb.rss;
-    lines_bound = p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor;
+    corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
     /* The curve's residual is at most the line's: when the line already
      * fails the test, so does the curve, and no circle is fitted. */
-    if (!(lu.rss > lines_bound)) {
+    if (!(lu.rss > test.bound)) {
         return 0;
     }
     extent = sqrtf(dist2(rp[a0], rp[b1]));
@@ -762,18 +939,34 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = lu.rss; /* from there on, the line is the better curve */
-    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough);
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, 0u);
     if (rss_circle >= 0.0f && rss_circle < rss_curve) {
         rss_curve = rss_circle;
     }
-    if (!(rss_curve > lines_bound)) {
+    if (!(rss_curve > test.bound)) {
         return 0;
+    }
+    /* The evidence route judges against the geometric circle. */
+    if (!(rss_curve > test.ratio_bound) && rss_circle >= 0.0f) {
+        rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, LC_CIRCLE_STEPS);
+        if (rss_circle >= 0.0f && rss_circle < rss_curve) {
+            rss_curve = rss_circle;
+        }
+        if (!(rss_curve > test.bound)) {
+            return 0;
+        }
     }
     /* Each side must be straight: a circle may not explain it much better
      * than its line (a crease between two curved walls is no wall corner,
      * and its line intersection would lie off the crease). Last, as the
      * dearest test. */
     if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
+        return 0;
+    }
+    if (!(rss_curve > test.ratio_bound) &&
+        (!side_seen(c, &la) || !side_seen(c, &lb) || !window_joined(c, a0, b1, test.noise_var) ||
+         !side_uncurved(c, a0, apex - 1u, &la, test.noise_var) ||
+         !side_uncurved(c, apex + 1u, b1, &lb, test.noise_var))) {
         return 0;
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
@@ -944,6 +1137,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
+    c->noise2 = sigma * sigma;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
@@ -1106,6 +1300,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.y = 0.0f;
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
+    c.noise2 = 0.0f;
     blocks_detach(&c);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
