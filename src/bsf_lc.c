@@ -747,30 +747,46 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
  * reach) ask for more. */
 typedef struct {
     float ratio_bound; /* the ratio route's bound */
-    float bound;       /* the lower of the two routes' bounds */
+    float bound;       /* the ratio route's or a lower bound of the evidence route's */
+    float var;         /* the evidence route's noise variance */
     float noise_var;   /* the run's noise variance, at least floor^2 */
+    float rss_lines;
+    size_t n;
 } lc_corner_test_t;
 
 static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_corner_test_t *t)
 {
     const float floor2 = c->p->floor * c->p->floor;
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
     float var = c->noise2 > floor2 ? c->noise2 : floor2;
-    float evidence_bound;
     t->noise_var = var;
+    t->rss_lines = rss_lines;
+    t->n = n;
     t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * floor2;
     t->bound = t->ratio_bound;
     if (n > 5u) {
-        const float dof = (float)(n - 5u);
-        const float fit_var = rss_lines / dof;
-        const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+        const float fit_var = rss_lines / (float)(n - 5u);
+        /* e^x - 1 >= x: the evidence bound is at least this, and the
+         * exponential is only needed when a curve residual exceeds it */
+        float least;
         var = fit_var > var ? fit_var : var;
-        float excess = dof * (bsf_expf(k2 / dof) - 1.0f);
-        if (excess < (float)n) {
-            excess = (float)n;
-        }
-        evidence_bound = rss_lines + excess * var;
-        t->bound = evidence_bound < t->bound ? evidence_bound : t->bound;
+        least = rss_lines + (k2 > (float)n ? k2 : (float)n) * var;
+        t->bound = least < t->bound ? least : t->bound;
     }
+    t->var = var;
+}
+
+/* The evidence route's bound on the curve's squared residual (n > 5). */
+static float evidence_bound(const lc_corner_test_t *t)
+{
+    const float dof = (float)(t->n - 5u);
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+    float excess = dof * (bsf_expf(k2 / dof) - 1.0f);
+    /* and the curve must miss the points by more than their noise */
+    if (excess < (float)t->n) {
+        excess = (float)t->n;
+    }
+    return t->rss_lines + excess * t->var;
 }
 
 /* For the evidence route: the side's line is seen at most 80 deg from its
@@ -833,6 +849,40 @@ static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough,
                             LC_CIRCLE_STEPS);
     return rss_circle < 0.0f || rss_circle >= enough.target;
+}
+
+/* The evidence route for the split at apex whose curve residual rss_curve
+ * (the better of the line and the algebraic circle over a0..b1, whose sums
+ * lu centres) fell short of the ratio route: cheap tests first, the
+ * exponential and the geometric circle last. */
+static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a0, size_t apex,
+                          size_t b1, const lc_line_t *la, const lc_line_t *lb, const lc_line_t *lu,
+                          float rss_curve)
+{
+    float bound;
+    float rss_circle;
+    lc_enough_t enough;
+    if (t->n <= 5u || !side_seen(c, la) || !side_seen(c, lb) ||
+        !window_joined(c, a0, b1, t->noise_var)) {
+        return 0;
+    }
+    bound = evidence_bound(t);
+    if (!(rss_curve > bound)) {
+        return 0;
+    }
+    /* against the geometric circle: the algebraic one's residual exceeds
+     * the best circle's by a few noise variances on short or noisy arcs */
+    enough.scale = 1.0f;
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = bound; /* from there on, the corner stands */
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
+                            &enough, LC_CIRCLE_STEPS);
+    if (rss_circle >= 0.0f && !(rss_circle > bound)) {
+        return 0;
+    }
+    return side_uncurved(c, a0, apex - 1u, la, t->noise_var) &&
+           side_uncurved(c, apex + 1u, b1, lb, t->noise_var);
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -946,27 +996,15 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (!(rss_curve > test.bound)) {
         return 0;
     }
-    /* The evidence route judges against the geometric circle. */
-    if (!(rss_curve > test.ratio_bound) && rss_circle >= 0.0f) {
-        rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, LC_CIRCLE_STEPS);
-        if (rss_circle >= 0.0f && rss_circle < rss_curve) {
-            rss_curve = rss_circle;
-        }
-        if (!(rss_curve > test.bound)) {
-            return 0;
-        }
+    if (!(rss_curve > test.ratio_bound) &&
+        !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve)) {
+        return 0;
     }
     /* Each side must be straight: a circle may not explain it much better
      * than its line (a crease between two curved walls is no wall corner,
      * and its line intersection would lie off the crease). Last, as the
      * dearest test. */
     if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
-        return 0;
-    }
-    if (!(rss_curve > test.ratio_bound) &&
-        (!side_seen(c, &la) || !side_seen(c, &lb) || !window_joined(c, a0, b1, test.noise_var) ||
-         !side_uncurved(c, a0, apex - 1u, &la, test.noise_var) ||
-         !side_uncurved(c, apex + 1u, b1, &lb, test.noise_var))) {
         return 0;
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
