@@ -48,6 +48,7 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
     p.join_grazing = 0u;
+    p.corner_evidence = 0u;
     return p;
 }
 
@@ -65,7 +66,8 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
         !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
         !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
         !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
-        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u) {
+        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u ||
+        p->corner_evidence > 1u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -762,9 +764,9 @@ static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_co
     t->noise_var = var;
     t->rss_lines = rss_lines;
     t->n = n;
-    t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * floor2;
+    t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * c->p->floor * c->p->floor;
     t->bound = t->ratio_bound;
-    if (n > 5u) {
+    if (c->p->corner_evidence && n > 5u) {
         const float fit_var = rss_lines / (float)(n - 5u);
         /* e^x - 1 >= x: the evidence bound is at least this, and the
          * exponential is only needed when a curve residual exceeds it */
@@ -851,27 +853,32 @@ static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     return rss_circle < 0.0f || rss_circle >= enough.target;
 }
 
-/* The evidence route for the split at apex whose curve residual rss_curve
- * (the better of the line and the algebraic circle over a0..b1, whose sums
- * lu centres) fell short of the ratio route: cheap tests first, the
- * exponential and the geometric circle last. */
+/* Whether the evidence route can hold for the split at apex whose best
+ * line over a0..b1 leaves the squared residual lu->rss (a curve's is at
+ * most that): its cheap tests, before any circle is fitted. */
+static int evidence_possible(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a0, size_t b1,
+                             const lc_line_t *la, const lc_line_t *lb, const lc_line_t *lu)
+{
+    return t->n > 5u && lu->rss > evidence_bound(t) && side_seen(c, la) && side_seen(c, lb) &&
+           window_joined(c, a0, b1, t->noise_var);
+}
+
+/* The evidence route, once evidence_possible, for a curve residual
+ * rss_curve (the better of the line and the algebraic circle, centred on
+ * lu's centroid) that fell short of the ratio route: the curve must miss
+ * the points by the evidence bound also as the geometric circle (the
+ * algebraic one's residual exceeds the best circle's by a few noise
+ * variances on short or noisy arcs), and neither side may show curvature. */
 static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a0, size_t apex,
                           size_t b1, const lc_line_t *la, const lc_line_t *lb, const lc_line_t *lu,
                           float rss_curve)
 {
-    float bound;
+    const float bound = evidence_bound(t);
     float rss_circle;
     lc_enough_t enough;
-    if (t->n <= 5u || !side_seen(c, la) || !side_seen(c, lb) ||
-        !window_joined(c, a0, b1, t->noise_var)) {
-        return 0;
-    }
-    bound = evidence_bound(t);
     if (!(rss_curve > bound)) {
         return 0;
     }
-    /* against the geometric circle: the algebraic one's residual exceeds
-     * the best circle's by a few noise variances on short or noisy arcs */
     enough.scale = 1.0f;
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
@@ -904,6 +911,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     const bsf_point_t *rp = c->rel;
     float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
     lc_corner_test_t test;
+    int evidence_checked; /* evidence_possible has passed */
     lc_enough_t enough;
     bsf_point_t x;
     bsf_point_t ap;
@@ -983,6 +991,11 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (!(lu.rss > test.bound)) {
         return 0;
     }
+    /* Below the ratio route's bound only the evidence route can pass. */
+    evidence_checked = !(lu.rss > test.ratio_bound);
+    if (evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) {
+        return 0;
+    }
     extent = sqrtf(dist2(rp[a0], rp[b1]));
     rss_curve = lu.rss;
     enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
@@ -997,7 +1010,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         return 0;
     }
     if (!(rss_curve > test.ratio_bound) &&
-        !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve)) {
+        ((!evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) ||
+         !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve))) {
         return 0;
     }
     /* Each side must be straight: a circle may not explain it much better

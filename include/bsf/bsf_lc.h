@@ -25,6 +25,19 @@
  *     - each side is straight: a circle does not explain it curve_ratio times
  *       better per degree of freedom (n - 2 for a line, n - 3 for a circle;
  *       a side of three points passes, since any circle fits three points);
+ *     with corner_evidence, a split that fails the curve_ratio test is
+ *     still a corner when the curve's squared residual exceeds the two
+ *     lines' by as many noise variances as chance exceeds once in about
+ *     270 000 judgements (25 with many points, more with few: the F
+ *     distribution's tail with the noise variance estimated from the
+ *     lines), and by at least one noise variance per point, also against
+ *     the geometrically fitted circle; then neither side may show curvature
+ *     at that level, be seen at more than 80 deg incidence, nor any two
+ *     consecutive points step along the ray by more than such a surface
+ *     allows (a depth jump, a mixed pixel). The ratio test asks the same
+ *     factor whatever the number of points, so a shallow corner between
+ *     long sides (a 35 deg turn between 1.3 m sides scores 10-25 at 1 cm
+ *     noise) fails it by chance; this test grows with the noise instead;
  *     a rejected split merges its two pieces and the neighbours are judged
  *     again;
  *  3. report each corner at its apex beam, with the intersection of the two
@@ -62,6 +75,10 @@ typedef struct {
                                    (at most max_side) where four consecutive returns through it
                                    lie on one line, a wall seen at grazing incidence, or where
                                    such a wall starts at a corner; 0 (default): it does not */
+    uint8_t corner_evidence;  /**< 1: a split the curve_ratio test rejects is still a corner
+                                   when the best smooth curve misses the points by far more
+                                   than the noise explains (a likelihood-ratio test, see
+                                   above); 0 (default): curve_ratio alone */
 } bsf_lc_params_t;
 
 /** The defaults listed beside each field of bsf_lc_params_t. */
@@ -70,7 +87,7 @@ bsf_lc_params_t bsf_lc_params_default(void);
 /** @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM when a value is not
  *  finite or out of range (jump_a, split_min, max_side, curve_ratio, max_range > 0;
  *  jump_b, floor, apex_slack, min_side_len >= 0; split_sigmas >= 0; min_turn in (0, pi/2);
- *  min_side_points in 2..64; join_grazing 0 or 1). */
+ *  min_side_points in 2..64; join_grazing and corner_evidence 0 or 1). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
 /** Points of a run per summary block of bsf_lc_work_t. */
