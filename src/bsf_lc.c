@@ -733,7 +733,7 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
  * ratio route asks the curve for curve_ratio times the lines' residual plus
  * the floor: the same factor whatever the number of points, so a shallow
  * corner between long sides fails it by chance (a 35 deg turn between 1.3 m
- * sides at 1 cm noise scores 10-25) while the curve misses the points by
+ * sides at 1 cm noise scores 5-25) while the curve misses the points by
  * hundreds of noise variances. The evidence route is a likelihood-ratio
  * test against the noise: the curve's residual must exceed the lines' by
  * as many noise variances as chance exceeds once in e^(LC_EVIDENCE_SIGMAS^2

@@ -36,7 +36,7 @@
  *     consecutive points step along the ray by more than such a surface
  *     allows (a depth jump, a mixed pixel). The ratio test asks the same
  *     factor whatever the number of points, so a shallow corner between
- *     long sides (a 35 deg turn between 1.3 m sides scores 10-25 at 1 cm
+ *     long sides (a 35 deg turn between 1.3 m sides scores 5-25 at 1 cm
  *     noise) fails it by chance; this test grows with the noise instead;
  *     a rejected split merges its two pieces and the neighbours are judged
  *     again;
