@@ -751,6 +751,7 @@ typedef struct {
     float ratio_bound; /* the ratio route's bound */
     float bound;       /* the ratio route's or a lower bound of the evidence route's */
     float var;         /* the evidence route's noise variance */
+    float least;       /* a lower bound of evidence_bound (n > 5), else 0 */
     float noise_var;   /* the run's noise variance, at least floor^2 */
     float rss_lines;
     size_t n;
@@ -766,14 +767,16 @@ static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_co
     t->n = n;
     t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * c->p->floor * c->p->floor;
     t->bound = t->ratio_bound;
-    if (c->p->corner_evidence && n > 5u) {
+    t->least = 0.0f;
+    if (n > 5u) {
         const float fit_var = rss_lines / (float)(n - 5u);
+        var = fit_var > var ? fit_var : var;
         /* e^x - 1 >= x: the evidence bound is at least this, and the
          * exponential is only needed when a curve residual exceeds it */
-        float least;
-        var = fit_var > var ? fit_var : var;
-        least = rss_lines + (k2 > (float)n ? k2 : (float)n) * var;
-        t->bound = least < t->bound ? least : t->bound;
+        t->least = rss_lines + (k2 > (float)n ? k2 : (float)n) * var;
+        if (c->p->corner_evidence) {
+            t->bound = t->least < t->bound ? t->least : t->bound;
+        }
     }
     t->var = var;
 }
@@ -789,6 +792,13 @@ static float evidence_bound(const lc_corner_test_t *t)
         excess = (float)t->n;
     }
     return t->rss_lines + excess * t->var;
+}
+
+/* Whether a smooth curve that explains the points no worse than rss_curve
+ * still misses them by more than noise explains (evidence_bound). */
+static int curve_misses_points(const lc_corner_test_t *t, float rss_curve)
+{
+    return t->n > 5u && rss_curve > t->least && rss_curve > evidence_bound(t);
 }
 
 /* For the evidence route: the side's line is seen at most 80 deg from its
@@ -892,10 +902,36 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
            side_uncurved(c, apex + 1u, b1, lb, t->noise_var);
 }
 
+/* judge's verdicts on a split. */
+typedef enum {
+    /* no corner: the pieces either side of it merge, and the sides of its
+     * neighbours may reach across it */
+    LC_MERGE = 0,
+    /* a corner (*kp filled in) */
+    LC_CORNER = 1,
+    /* no corner, but the points turn there and no smooth curve explains
+     * them within the noise: a corner the tests cannot confirm (a shallow
+     * turn between long sides scores a curve_ratio of 5-25 at 1 cm noise),
+     * or a curved piece against a straight one. The pieces stay apart, so
+     * no neighbour's side reaches across it into the next wall: such a side
+     * has a larger residual, and its own corner was lost with it. */
+    LC_BOUNDARY = 2
+} lc_verdict_t;
+
+/* The verdict of a split that is no corner although its sides turn by
+ * min_turn and two lines explain them curve_ratio times better than one
+ * line: one smooth curve (residual rss_curve) explains them within the
+ * noise, or not. */
+static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
+{
+    return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
- * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
- * corner, 0 otherwise. */
-static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_keypoint_t *kp)
+ * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
+ * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
+static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m,
+                          bsf_keypoint_t *kp)
 {
     const bsf_lc_params_t *p = c->p;
     const float side2 = p->max_side * p->max_side;
@@ -918,7 +954,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
-        return 0;
+        return LC_MERGE;
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
@@ -949,21 +985,21 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
     if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
-        return 0;
+        return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
     if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
-        return 0;
+        return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
-        return 0;
+        return LC_MERGE;
     }
     if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
-        return 0;
+        return LC_MERGE;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
     if (!(fabsf(cross) >= c->sin_min_turn)) {
-        return 0;
+        return LC_MERGE;
     }
     t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
     xx = la.mx + t * la.dx;
@@ -977,24 +1013,24 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     if (!(xx * xx + xy * xy <=
           (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
-        return 0;
+        return LC_MERGE;
     }
     /* One smooth curve over both sides: the better of a line and a circle. */
     /* (the left side's sums are the first part of the whole's) */
     if (!fit_line_from(c, a0, b1, apex, la.sx, la.sy, &lu)) {
-        return 0;
+        return LC_MERGE;
     }
     rss_lines = la.rss + lb.rss;
     corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
     /* The curve's residual is at most the line's: when the line already
      * fails the test, so does the curve, and no circle is fitted. */
     if (!(lu.rss > test.bound)) {
-        return 0;
+        return LC_MERGE;
     }
     /* Below the ratio route's bound only the evidence route can pass. */
     evidence_checked = !(lu.rss > test.ratio_bound);
     if (evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) {
-        return 0;
+        return LC_MERGE;
     }
     extent = sqrtf(dist2(rp[a0], rp[b1]));
     rss_curve = lu.rss;
@@ -1007,19 +1043,19 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         rss_curve = rss_circle;
     }
     if (!(rss_curve > test.bound)) {
-        return 0;
+        return no_corner(&test, rss_curve);
     }
     if (!(rss_curve > test.ratio_bound) &&
         ((!evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) ||
          !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve))) {
-        return 0;
+        return no_corner(&test, rss_curve);
     }
     /* Each side must be straight: a circle may not explain it much better
      * than its line (a crease between two curved walls is no wall corner,
      * and its line intersection would lie off the crease). Last, as the
      * dearest test. */
     if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
-        return 0;
+        return no_corner(&test, rss_curve);
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
     best = apex;
@@ -1043,7 +1079,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
-    return 1;
+    return LC_CORNER;
 }
 
 /* Noise normal to the surface, from each point's distance to the chord of
@@ -1173,7 +1209,8 @@ static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, b
 }
 
 /* Corners of one run: split, then merge the splits that are no corner until
- * the survivors all pass. */
+ * the survivors all pass; a split judged LC_BOUNDARY stays, as no corner,
+ * and ends its neighbours' sides (is_brk marks it 2, a corner 1). */
 static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
                        size_t *n_found)
 {
@@ -1206,9 +1243,19 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
             /* A verdict depends only on the split and its two neighbours:
              * a corner whose neighbours have not moved since it was judged
              * stays one, with its keypoint still parked. */
+            lc_verdict_t verdict;
             if (w->judged_lo[j] == lo && w->judged_hi[j] == hi) {
                 ++j;
-            } else if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                continue;
+            }
+            verdict = judge(c, lo, w->brk[j], hi, m, &kp);
+            if (verdict == LC_BOUNDARY) {
+                /* nothing parked: its slot stays unused */
+                w->is_brk[w->brk[j]] = 2u;
+                w->judged_lo[j] = (uint16_t)lo;
+                w->judged_hi[j] = (uint16_t)hi;
+                ++j;
+            } else if (verdict == LC_MERGE) {
                 const size_t tail = nb - j - 1u;
                 const size_t slot = *n_found + j;
                 memmove(&w->brk[j], &w->brk[j + 1u], tail * sizeof w->brk[0]);
@@ -1221,6 +1268,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                 --nb;
                 changed = 1;
             } else {
+                w->is_brk[w->brk[j]] = 1u;
                 /* Parked where it lands if this pass turns out final; only
                  * a parked verdict is remembered (slots only move down). */
                 if (*n_found + j < out_cap) {
@@ -1238,12 +1286,15 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         const size_t base = *n_found;
         for (j = 0; j < nb; ++j) {
             const size_t parked = base + j; /* never below the next slot written */
+            if (w->is_brk[w->brk[j]] == 2u) {
+                continue; /* a boundary, judged with these neighbours */
+            }
             if (parked < out_cap) {
                 kp = out[parked];
             } else {
                 const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
                 const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-                if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                if (judge(c, lo, w->brk[j], hi, m, &kp) != LC_CORNER) {
                     continue; /* cannot happen: same judgement as in the pass */
                 }
             }
@@ -1254,7 +1305,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     for (j = 0; j < nb; ++j) {
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-        if (judge(c, lo, w->brk[j], hi, m, &kp)) {
+        if (judge(c, lo, w->brk[j], hi, m, &kp) == LC_CORNER) {
             keep(out, out_cap, n_found, first, &last, &kp, c->p);
         }
     }
