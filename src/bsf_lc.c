@@ -750,8 +750,7 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
 typedef struct {
     float ratio_bound; /* the ratio route's bound */
     float bound;       /* the ratio route's or a lower bound of the evidence route's */
-    float var;         /* the evidence route's noise variance */
-    float least;       /* a lower bound of evidence_bound (n > 5), else 0 */
+    float var;         /* the evidence route's noise variance (corner_evidence) */
     float noise_var;   /* the run's noise variance, at least floor^2 */
     float rss_lines;
     size_t n;
@@ -767,38 +766,57 @@ static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_co
     t->n = n;
     t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * c->p->floor * c->p->floor;
     t->bound = t->ratio_bound;
-    t->least = 0.0f;
-    if (n > 5u) {
+    if (c->p->corner_evidence && n > 5u) {
         const float fit_var = rss_lines / (float)(n - 5u);
-        var = fit_var > var ? fit_var : var;
         /* e^x - 1 >= x: the evidence bound is at least this, and the
          * exponential is only needed when a curve residual exceeds it */
-        t->least = rss_lines + (k2 > (float)n ? k2 : (float)n) * var;
-        if (c->p->corner_evidence) {
-            t->bound = t->least < t->bound ? t->least : t->bound;
-        }
+        float least;
+        var = fit_var > var ? fit_var : var;
+        least = rss_lines + (k2 > (float)n ? k2 : (float)n) * var;
+        t->bound = least < t->bound ? least : t->bound;
     }
     t->var = var;
+}
+
+/* How many noise variances a smooth curve's squared residual must exceed
+ * the two lines' by over n > 5 points: as many as chance exceeds once in
+ * about 270 000 judgements (the F distribution's tail, above), and at least
+ * one per point. */
+static float evidence_excess(size_t n)
+{
+    const float dof = (float)(n - 5u);
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+    const float excess = dof * (bsf_expf(k2 / dof) - 1.0f);
+    return excess > (float)n ? excess : (float)n;
 }
 
 /* The evidence route's bound on the curve's squared residual (n > 5). */
 static float evidence_bound(const lc_corner_test_t *t)
 {
-    const float dof = (float)(t->n - 5u);
-    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
-    float excess = dof * (bsf_expf(k2 / dof) - 1.0f);
-    /* and the curve must miss the points by more than their noise */
-    if (excess < (float)t->n) {
-        excess = (float)t->n;
-    }
-    return t->rss_lines + excess * t->var;
+    return t->rss_lines + evidence_excess(t->n) * t->var;
 }
 
 /* Whether a smooth curve that explains the points no worse than rss_curve
- * still misses them by more than noise explains (evidence_bound). */
+ * still misses them by more than the noise explains: the evidence route's
+ * bound, with the variance it uses (the largest of the run's noise, the
+ * floor and the lines' residual per degree of freedom), whatever
+ * corner_evidence says. */
 static int curve_misses_points(const lc_corner_test_t *t, float rss_curve)
 {
-    return t->n > 5u && rss_curve > t->least && rss_curve > evidence_bound(t);
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+    float var;
+    float dof;
+    if (t->n <= 5u) {
+        return 0;
+    }
+    dof = (float)(t->n - 5u);
+    var = t->rss_lines / dof > t->noise_var ? t->rss_lines / dof : t->noise_var;
+    /* evidence_excess(n) >= max(k2, n) (e^x - 1 >= x): most curves that
+     * explain the points are settled without the exponential */
+    if (!(rss_curve > t->rss_lines + (k2 > (float)t->n ? k2 : (float)t->n) * var)) {
+        return 0;
+    }
+    return rss_curve > t->rss_lines + evidence_excess(t->n) * var;
 }
 
 /* For the evidence route: the side's line is seen at most 80 deg from its
