@@ -39,7 +39,13 @@
  *     long sides (a 35 deg turn between 1.3 m sides scores 5-25 at 1 cm
  *     noise) fails it by chance; this test grows with the noise instead;
  *     a rejected split merges its two pieces and the neighbours are judged
- *     again;
+ *     again, unless its sides turn (by min_turn, and two lines beat one line
+ *     curve_ratio times) and no smooth curve explains its points within the
+ *     noise (the first bound of the evidence test above, whatever
+ *     corner_evidence says): such a split is no corner, but it stays and ends
+ *     its neighbours' sides, so a side never reaches across a shallow corner
+ *     the tests could not confirm into the next wall (where its line's
+ *     residual would grow and cost that neighbour its corner too);
  *  3. report each corner at its apex beam, with the intersection of the two
  *     lines as its position (PDM starts the vertex there and keeps it there).
  * Thresholds are absolute or relative to the estimated noise; none depends
