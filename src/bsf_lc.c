@@ -1260,7 +1260,8 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
             const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
             /* A verdict depends only on the split and its two neighbours:
              * a corner whose neighbours have not moved since it was judged
-             * stays one, with its keypoint still parked. */
+             * stays one, with its keypoint still parked, and a boundary
+             * stays a boundary. */
             lc_verdict_t verdict;
             if (w->judged_lo[j] == lo && w->judged_hi[j] == hi) {
                 ++j;

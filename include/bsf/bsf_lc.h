@@ -116,10 +116,12 @@ typedef struct {
     uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
     uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
     uint16_t stack_b[BSF_MAX_POINTS];
-    uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner verdict */
+    uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner or
+                                             boundary verdict */
     uint16_t judged_hi[BSF_MAX_POINTS];
     bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
-    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run */
+    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run; then each split's
+                                          last verdict (1 corner, 2 boundary) */
     /** summaries of the current run's points, block k holding positions
      *  k * BSF_LC_BLOCK on (long runs only) */
     bsf_lc_block_t block[(BSF_MAX_POINTS + BSF_LC_BLOCK - 1) / BSF_LC_BLOCK];
