@@ -20,6 +20,14 @@
 /* A circle is only a candidate shape when its radius is below this multiple
  * of the window's extent: a larger one is a line in float arithmetic. */
 #define LC_CIRCLE_MAX_RADIUS 10.0f
+/* Evidence a corner needs against the best smooth curve (corner_test_init):
+ * with many points, the curve's squared residual must exceed the two lines'
+ * by this squared times the noise variance, which chance (two chi-square
+ * degrees of freedom: one more parameter and the apex point) exceeds once
+ * in about 270 000 judgements. */
+#define LC_EVIDENCE_SIGMAS 5.0f
+/* Gauss-Newton steps of the geometric circle fit in the evidence route. */
+#define LC_CIRCLE_STEPS 3u
 
 bsf_lc_params_t bsf_lc_params_default(void)
 {
@@ -40,6 +48,7 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
     p.join_grazing = 0u;
+    p.corner_evidence = 0u;
     return p;
 }
 
@@ -57,7 +66,8 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
         !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
         !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
         !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
-        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u) {
+        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u ||
+        p->corner_evidence > 1u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -79,6 +89,7 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
+    float noise2; /* the current run's noise variance (run_noise squared) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -189,10 +200,65 @@ typedef struct {
     float target;
 } lc_enough_t;
 
+/* One Gauss-Newton step of the geometric circle fit (the sum of squared
+ * distances to the circle) over positions a..b, centre (*cx, *cy) relative
+ * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
+ * or leaves no sensible circle. */
+static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float *cx,
+                        float *cy, float *r)
+{
+    const bsf_point_t *rp = c->rel;
+    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
+    float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
+    float det, du, dv, dr;
+    size_t i;
+    for (i = a; i <= b; ++i) {
+        const float dx = rp[i].x - cx0 - *cx;
+        const float dy = rp[i].y - cy0 - *cy;
+        const float dist = sqrtf(dx * dx + dy * dy);
+        float u, v, g;
+        if (!(dist > 0.0f)) {
+            return;
+        }
+        /* the residual dist - r moves by -(u, v, 1) . (dcx, dcy, dr) */
+        u = dx / dist;
+        v = dy / dist;
+        g = dist - *r;
+        juu += u * u;
+        juv += u * v;
+        jvv += v * v;
+        ju += u;
+        jv += v;
+        n += 1.0f;
+        gu += u * g;
+        gv += v * g;
+        g1 += g;
+    }
+    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1) by Cramer. */
+    det = juu * (jvv * n - jv * jv) - juv * (juv * n - jv * ju) + ju * (juv * jv - jvv * ju);
+    if (!(fabsf(det) > 0.0f)) {
+        return;
+    }
+    du = (gu * (jvv * n - jv * jv) - juv * (gv * n - jv * g1) + ju * (gv * jv - jvv * g1)) / det;
+    dv = (juu * (gv * n - jv * g1) - gu * (juv * n - jv * ju) + ju * (juv * g1 - gv * ju)) / det;
+    dr = (juu * (jvv * g1 - gv * jv) - juv * (juv * g1 - gv * ju) + gu * (juv * jv - jvv * ju)) /
+         det;
+    if (!(*r + dr > 0.0f) || !(fabsf(du) + fabsf(dv) + fabsf(dr) < *r + 1.0f)) {
+        return; /* NaN ends here too */
+    }
+    *cx += du;
+    *cy += dv;
+    *r += dr;
+}
+
 /* Squared residual of the best circle through positions a..b (algebraic fit,
- * then geometric distances), or -1 when no sensible circle exists. */
+ * then geometric distances), or -1 when no sensible circle exists. With
+ * refine > 0, that many Gauss-Newton steps of the geometric fit first: the
+ * algebraic circle's residual exceeds the best circle's by a few noise
+ * variances on short or noisy arcs, which the evidence route would take as
+ * evidence of a corner. */
 static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent,
-                        const lc_enough_t *enough)
+                        const lc_enough_t *enough, unsigned refine)
 {
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
@@ -232,6 +298,9 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         return -1.0f;
     }
     r = sqrtf(r2);
+    for (; refine > 0u; --refine) {
+        circle_step(c, a, b, cx0, cy0, &cx, &cy, &r);
+    }
     for (i = a; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
         const float dy = rp[i].y - cy0 - cy;
@@ -275,7 +344,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
     enough.target = l->rss * (float)(n - 3u); /* straight from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough, 0u);
     if (rss_circle < 0.0f) {
         return 1;
     }
@@ -659,10 +728,228 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
     return 0;
 }
 
+/* LC's corner test on the best smooth curve's squared residual, for two
+ * lines with squared residual rss_lines over n points (apex included). The
+ * ratio route asks the curve for curve_ratio times the lines' residual plus
+ * the floor: the same factor whatever the number of points, so a shallow
+ * corner between long sides fails it by chance (a 35 deg turn between 1.3 m
+ * sides at 1 cm noise scores 5-25) while the curve misses the points by
+ * hundreds of noise variances. The evidence route is a likelihood-ratio
+ * test against the noise: the curve's residual must exceed the lines' by
+ * as many noise variances as chance exceeds once in e^(LC_EVIDENCE_SIGMAS^2
+ * / 2) (about 270 000) judgements, with the variance estimated from the
+ * lines' n - 5 degrees of freedom (n - 1 points, two lines of two
+ * parameters): the F distribution's tail for the one more parameter and the
+ * apex point, nu * (e^(k^2 / nu) - 1) variances for nu degrees of freedom
+ * (k^2 = 25 for many points, more for few). Sides that show curvature at
+ * that level then fail it (side_uncurved): a crease between a wall and a
+ * curved wall is no corner of two lines. The variance is the largest of
+ * the run's noise estimate, the lines' residual per degree of freedom and
+ * the floor: sides the lines do not fit (clutter, a second corner within
+ * reach) ask for more. */
+typedef struct {
+    float ratio_bound; /* the ratio route's bound */
+    float bound;       /* the ratio route's or a lower bound of the evidence route's */
+    float var;         /* the evidence route's noise variance (corner_evidence) */
+    float noise_var;   /* the run's noise variance, at least floor^2 */
+    float rss_lines;
+    size_t n;
+} lc_corner_test_t;
+
+static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_corner_test_t *t)
+{
+    const float floor2 = c->p->floor * c->p->floor;
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+    float var = c->noise2 > floor2 ? c->noise2 : floor2;
+    t->noise_var = var;
+    t->rss_lines = rss_lines;
+    t->n = n;
+    t->ratio_bound = c->p->curve_ratio * rss_lines + (float)n * c->p->floor * c->p->floor;
+    t->bound = t->ratio_bound;
+    if (c->p->corner_evidence && n > 5u) {
+        const float fit_var = rss_lines / (float)(n - 5u);
+        /* e^x - 1 >= x: the evidence bound is at least this, and the
+         * exponential is only needed when a curve residual exceeds it */
+        float least;
+        var = fit_var > var ? fit_var : var;
+        least = rss_lines + (k2 > (float)n ? k2 : (float)n) * var;
+        t->bound = least < t->bound ? least : t->bound;
+    }
+    t->var = var;
+}
+
+/* How many noise variances a smooth curve's squared residual must exceed
+ * the two lines' by over n > 5 points: as many as chance exceeds once in
+ * about 270 000 judgements (the F distribution's tail, above), and at least
+ * one per point. */
+static float evidence_excess(size_t n)
+{
+    const float dof = (float)(n - 5u);
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+    const float excess = dof * (bsf_expf(k2 / dof) - 1.0f);
+    return excess > (float)n ? excess : (float)n;
+}
+
+/* The evidence route's bound on the curve's squared residual (n > 5). */
+static float evidence_bound(const lc_corner_test_t *t)
+{
+    return t->rss_lines + evidence_excess(t->n) * t->var;
+}
+
+/* Whether a smooth curve that explains the points no worse than rss_curve
+ * still misses them by more than the noise explains: the evidence route's
+ * bound, with the variance it uses (the largest of the run's noise, the
+ * floor and the lines' residual per degree of freedom), whatever
+ * corner_evidence says. */
+static int curve_misses_points(const lc_corner_test_t *t, float rss_curve)
+{
+    const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
+    float var;
+    float dof;
+    if (t->n <= 5u) {
+        return 0;
+    }
+    dof = (float)(t->n - 5u);
+    var = t->rss_lines / dof > t->noise_var ? t->rss_lines / dof : t->noise_var;
+    /* evidence_excess(n) >= max(k2, n) (e^x - 1 >= x): most curves that
+     * explain the points are settled without the exponential */
+    if (!(rss_curve > t->rss_lines + (k2 > (float)t->n ? k2 : (float)t->n) * var)) {
+        return 0;
+    }
+    return rss_curve > t->rss_lines + evidence_excess(t->n) * var;
+}
+
+/* For the evidence route: the side's line is seen at most 80 deg from its
+ * normal (the sine of its angle to the ray through its centroid at least
+ * BSF_GRAZING_MIN_SIN). Nearer edge-on its returns are no surface the noise
+ * model describes: mixed pixels strung along the ray at a depth jump, or a
+ * tail past an edge. */
+static int side_seen(const lc_ctx_t *c, const lc_line_t *l)
+{
+    const float rx = l->mx + c->o.x;
+    const float ry = l->my + c->o.y;
+    const float cross = rx * l->dy - ry * l->dx;
+    return cross * cross >= BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN * (rx * rx + ry * ry);
+}
+
+/* For the evidence route: no two consecutive returns of positions a..b
+ * step along the ray by more than a surface seen at 80 deg incidence allows
+ * (tan 80 deg times their step across it) plus three standard deviations of
+ * the difference of two range readings (sqrt(2) sigma each). Such a step is
+ * a depth jump inside the run (an occluder's edge, a mixed pixel), and lines
+ * either side of it meet at no corner of one surface. */
+static int window_joined(const lc_ctx_t *c, size_t a, size_t b, float noise_var)
+{
+    const float tan_max =
+        sqrtf(1.0f - BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN) / BSF_GRAZING_MIN_SIN;
+    const float slack = 4.2426f * sqrtf(noise_var); /* 3 sqrt(2) sigma */
+    const bsf_point_t *pt = c->pts->pt;
+    size_t i;
+    for (i = a; i < b; ++i) {
+        const bsf_point_t p = pt[c->run[i + 1u]];
+        const bsf_point_t q = pt[c->run[i]];
+        const float dx = p.x - q.x;
+        const float dy = p.y - q.y;
+        /* both components times the range of p */
+        const float along = fabsf(dx * p.x + dy * p.y);
+        const float across = fabsf(dx * p.y - dy * p.x);
+        if (along > tan_max * across + slack * c->pts->range[c->run[i + 1u]]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* For the evidence route: a side shows no curvature unless a circle cuts
+ * its line's squared residual by more than LC_EVIDENCE_SIGMAS^2 noise
+ * variances. Three points or fewer show none (a circle fits any three). */
+static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var)
+{
+    const float cut = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
+    float rss_circle;
+    lc_enough_t enough;
+    /* no circle can cut more than the whole residual */
+    if (b - a + 1u <= 3u || !(l->rss > cut)) {
+        return 1;
+    }
+    enough.scale = 1.0f;
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = l->rss - cut; /* uncurved from there on */
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough,
+                            LC_CIRCLE_STEPS);
+    return rss_circle < 0.0f || rss_circle >= enough.target;
+}
+
+/* Whether the evidence route can hold for the split at apex whose best
+ * line over a0..b1 leaves the squared residual lu->rss (a curve's is at
+ * most that): its cheap tests, before any circle is fitted. */
+static int evidence_possible(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a0, size_t b1,
+                             const lc_line_t *la, const lc_line_t *lb, const lc_line_t *lu)
+{
+    return t->n > 5u && lu->rss > evidence_bound(t) && side_seen(c, la) && side_seen(c, lb) &&
+           window_joined(c, a0, b1, t->noise_var);
+}
+
+/* The evidence route, once evidence_possible, for a curve residual
+ * rss_curve (the better of the line and the algebraic circle, centred on
+ * lu's centroid) that fell short of the ratio route: the curve must miss
+ * the points by the evidence bound also as the geometric circle (the
+ * algebraic one's residual exceeds the best circle's by a few noise
+ * variances on short or noisy arcs), and neither side may show curvature. */
+static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a0, size_t apex,
+                          size_t b1, const lc_line_t *la, const lc_line_t *lb, const lc_line_t *lu,
+                          float rss_curve)
+{
+    const float bound = evidence_bound(t);
+    float rss_circle;
+    lc_enough_t enough;
+    if (!(rss_curve > bound)) {
+        return 0;
+    }
+    enough.scale = 1.0f;
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = bound; /* from there on, the corner stands */
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
+                            &enough, LC_CIRCLE_STEPS);
+    if (rss_circle >= 0.0f && !(rss_circle > bound)) {
+        return 0;
+    }
+    return side_uncurved(c, a0, apex - 1u, la, t->noise_var) &&
+           side_uncurved(c, apex + 1u, b1, lb, t->noise_var);
+}
+
+/* judge's verdicts on a split. */
+typedef enum {
+    /* no corner: the pieces either side of it merge, and the sides of its
+     * neighbours may reach across it */
+    LC_MERGE = 0,
+    /* a corner (*kp filled in) */
+    LC_CORNER = 1,
+    /* no corner, but the points turn there and no smooth curve explains
+     * them within the noise: a corner the tests cannot confirm (a shallow
+     * turn between long sides scores a curve_ratio of 5-25 at 1 cm noise),
+     * or a curved piece against a straight one. The pieces stay apart, so
+     * no neighbour's side reaches across it into the next wall: such a side
+     * has a larger residual, and its own corner was lost with it. */
+    LC_BOUNDARY = 2
+} lc_verdict_t;
+
+/* The verdict of a split that is no corner although its sides turn by
+ * min_turn and two lines explain them curve_ratio times better than one
+ * line: one smooth curve (residual rss_curve) explains them within the
+ * noise, or not. */
+static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
+{
+    return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
- * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
- * corner, 0 otherwise. */
-static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_keypoint_t *kp)
+ * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
+ * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
+static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m,
+                          bsf_keypoint_t *kp)
 {
     const bsf_lc_params_t *p = c->p;
     const float side2 = p->max_side * p->max_side;
@@ -676,14 +963,16 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     size_t best;
     size_t i;
     const bsf_point_t *rp = c->rel;
-    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, lines_bound, best_d;
+    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
+    lc_corner_test_t test;
+    int evidence_checked; /* evidence_possible has passed */
     lc_enough_t enough;
     bsf_point_t x;
     bsf_point_t ap;
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
-        return 0;
+        return LC_MERGE;
     }
     c->o = c->pts->pt[c->run[apex]];
     ap = rel_store(c, apex);
@@ -714,21 +1003,21 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     /* A side that runs to the end of the run may be one point shorter: a
      * far corner at the edge of what is seen has few points beyond it. */
     if (apex - a0 + (a0 == 0u ? 1u : 0u) < need || b1 - apex + (b1 + 1u == m ? 1u : 0u) < need) {
-        return 0;
+        return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
     if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
-        return 0;
+        return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
-        return 0;
+        return LC_MERGE;
     }
     if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
-        return 0;
+        return LC_MERGE;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
     if (!(fabsf(cross) >= c->sin_min_turn)) {
-        return 0;
+        return LC_MERGE;
     }
     t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
     xx = la.mx + t * la.dx;
@@ -742,19 +1031,24 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     }
     if (!(xx * xx + xy * xy <=
           (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
-        return 0;
+        return LC_MERGE;
     }
     /* One smooth curve over both sides: the better of a line and a circle. */
     /* (the left side's sums are the first part of the whole's) */
     if (!fit_line_from(c, a0, b1, apex, la.sx, la.sy, &lu)) {
-        return 0;
+        return LC_MERGE;
     }
     rss_lines = la.rss + lb.rss;
-    lines_bound = p->curve_ratio * rss_lines + (float)(b1 - a0 + 1u) * p->floor * p->floor;
+    corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
     /* The curve's residual is at most the line's: when the line already
      * fails the test, so does the curve, and no circle is fitted. */
-    if (!(lu.rss > lines_bound)) {
-        return 0;
+    if (!(lu.rss > test.bound)) {
+        return LC_MERGE;
+    }
+    /* Below the ratio route's bound only the evidence route can pass. */
+    evidence_checked = !(lu.rss > test.ratio_bound);
+    if (evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) {
+        return LC_MERGE;
     }
     extent = sqrtf(dist2(rp[a0], rp[b1]));
     rss_curve = lu.rss;
@@ -762,19 +1056,24 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = lu.rss; /* from there on, the line is the better curve */
-    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough);
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, 0u);
     if (rss_circle >= 0.0f && rss_circle < rss_curve) {
         rss_curve = rss_circle;
     }
-    if (!(rss_curve > lines_bound)) {
-        return 0;
+    if (!(rss_curve > test.bound)) {
+        return no_corner(&test, rss_curve);
+    }
+    if (!(rss_curve > test.ratio_bound) &&
+        ((!evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) ||
+         !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve))) {
+        return no_corner(&test, rss_curve);
     }
     /* Each side must be straight: a circle may not explain it much better
      * than its line (a crease between two curved walls is no wall corner,
      * and its line intersection would lie off the crease). Last, as the
      * dearest test. */
     if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
-        return 0;
+        return no_corner(&test, rss_curve);
     }
     /* The vertex beam: the point nearest the intersection, near the split. */
     best = apex;
@@ -798,7 +1097,7 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
-    return 1;
+    return LC_CORNER;
 }
 
 /* Noise normal to the surface, from each point's distance to the chord of
@@ -928,7 +1227,8 @@ static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, b
 }
 
 /* Corners of one run: split, then merge the splits that are no corner until
- * the survivors all pass. */
+ * the survivors all pass; a split judged LC_BOUNDARY stays, as no corner,
+ * and ends its neighbours' sides (is_brk marks it 2, a corner 1). */
 static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
                        size_t *n_found)
 {
@@ -944,6 +1244,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
+    c->noise2 = sigma * sigma;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
@@ -959,10 +1260,21 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
             const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
             /* A verdict depends only on the split and its two neighbours:
              * a corner whose neighbours have not moved since it was judged
-             * stays one, with its keypoint still parked. */
+             * stays one, with its keypoint still parked, and a boundary
+             * stays a boundary. */
+            lc_verdict_t verdict;
             if (w->judged_lo[j] == lo && w->judged_hi[j] == hi) {
                 ++j;
-            } else if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                continue;
+            }
+            verdict = judge(c, lo, w->brk[j], hi, m, &kp);
+            if (verdict == LC_BOUNDARY) {
+                /* nothing parked: its slot stays unused */
+                w->is_brk[w->brk[j]] = 2u;
+                w->judged_lo[j] = (uint16_t)lo;
+                w->judged_hi[j] = (uint16_t)hi;
+                ++j;
+            } else if (verdict == LC_MERGE) {
                 const size_t tail = nb - j - 1u;
                 const size_t slot = *n_found + j;
                 memmove(&w->brk[j], &w->brk[j + 1u], tail * sizeof w->brk[0]);
@@ -975,6 +1287,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                 --nb;
                 changed = 1;
             } else {
+                w->is_brk[w->brk[j]] = 1u;
                 /* Parked where it lands if this pass turns out final; only
                  * a parked verdict is remembered (slots only move down). */
                 if (*n_found + j < out_cap) {
@@ -992,12 +1305,15 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         const size_t base = *n_found;
         for (j = 0; j < nb; ++j) {
             const size_t parked = base + j; /* never below the next slot written */
+            if (w->is_brk[w->brk[j]] == 2u) {
+                continue; /* a boundary, judged with these neighbours */
+            }
             if (parked < out_cap) {
                 kp = out[parked];
             } else {
                 const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
                 const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-                if (!judge(c, lo, w->brk[j], hi, m, &kp)) {
+                if (judge(c, lo, w->brk[j], hi, m, &kp) != LC_CORNER) {
                     continue; /* cannot happen: same judgement as in the pass */
                 }
             }
@@ -1008,7 +1324,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     for (j = 0; j < nb; ++j) {
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-        if (judge(c, lo, w->brk[j], hi, m, &kp)) {
+        if (judge(c, lo, w->brk[j], hi, m, &kp) == LC_CORNER) {
             keep(out, out_cap, n_found, first, &last, &kp, c->p);
         }
     }
@@ -1106,6 +1422,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.y = 0.0f;
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
+    c.noise2 = 0.0f;
     blocks_detach(&c);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;

@@ -25,8 +25,27 @@
  *     - each side is straight: a circle does not explain it curve_ratio times
  *       better per degree of freedom (n - 2 for a line, n - 3 for a circle;
  *       a side of three points passes, since any circle fits three points);
+ *     with corner_evidence, a split that fails the curve_ratio test is
+ *     still a corner when the curve's squared residual exceeds the two
+ *     lines' by as many noise variances as chance exceeds once in about
+ *     270 000 judgements (25 with many points, more with few: the F
+ *     distribution's tail with the noise variance estimated from the
+ *     lines), and by at least one noise variance per point, also against
+ *     the geometrically fitted circle; then neither side may show curvature
+ *     at that level, be seen at more than 80 deg incidence, nor any two
+ *     consecutive points step along the ray by more than such a surface
+ *     allows (a depth jump, a mixed pixel). The ratio test asks the same
+ *     factor whatever the number of points, so a shallow corner between
+ *     long sides (a 35 deg turn between 1.3 m sides scores 5-25 at 1 cm
+ *     noise) fails it by chance; this test grows with the noise instead;
  *     a rejected split merges its two pieces and the neighbours are judged
- *     again;
+ *     again, unless its sides turn (by min_turn, and two lines beat one line
+ *     curve_ratio times) and no smooth curve explains its points within the
+ *     noise (the first bound of the evidence test above, whatever
+ *     corner_evidence says): such a split is no corner, but it stays and ends
+ *     its neighbours' sides, so a side never reaches across a shallow corner
+ *     the tests could not confirm into the next wall (where its line's
+ *     residual would grow and cost that neighbour its corner too);
  *  3. report each corner at its apex beam, with the intersection of the two
  *     lines as its position (PDM starts the vertex there and keeps it there).
  * Thresholds are absolute or relative to the estimated noise; none depends
@@ -62,6 +81,10 @@ typedef struct {
                                    (at most max_side) where four consecutive returns through it
                                    lie on one line, a wall seen at grazing incidence, or where
                                    such a wall starts at a corner; 0 (default): it does not */
+    uint8_t corner_evidence;  /**< 1: a split the curve_ratio test rejects is still a corner
+                                   when the best smooth curve misses the points by far more
+                                   than the noise explains (a likelihood-ratio test, see
+                                   above); 0 (default): curve_ratio alone */
 } bsf_lc_params_t;
 
 /** The defaults listed beside each field of bsf_lc_params_t. */
@@ -70,7 +93,7 @@ bsf_lc_params_t bsf_lc_params_default(void);
 /** @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM when a value is not
  *  finite or out of range (jump_a, split_min, max_side, curve_ratio, max_range > 0;
  *  jump_b, floor, apex_slack, min_side_len >= 0; split_sigmas >= 0; min_turn in (0, pi/2);
- *  min_side_points in 2..64; join_grazing 0 or 1). */
+ *  min_side_points in 2..64; join_grazing and corner_evidence 0 or 1). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
 /** Points of a run per summary block of bsf_lc_work_t. */
@@ -93,10 +116,12 @@ typedef struct {
     uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
     uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
     uint16_t stack_b[BSF_MAX_POINTS];
-    uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner verdict */
+    uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner or
+                                             boundary verdict */
     uint16_t judged_hi[BSF_MAX_POINTS];
     bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
-    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run */
+    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run; then each split's
+                                          last verdict (1 corner, 2 boundary) */
     /** summaries of the current run's points, block k holding positions
      *  k * BSF_LC_BLOCK on (long runs only) */
     bsf_lc_block_t block[(BSF_MAX_POINTS + BSF_LC_BLOCK - 1) / BSF_LC_BLOCK];

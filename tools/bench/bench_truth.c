@@ -7,7 +7,8 @@
  *   bench_truth                  full table (docs/GROUND_TRUTH.md)
  *   bench_truth --quick --check  small run that fails (exit 1) when a target is missed (ctest)
  *   options: --poses N, --paper (paper-faithful configuration), --grazing (SVED and
- *            LC join walls seen at grazing incidence), --datasets DIR
+ *            LC join walls seen at grazing incidence), --evidence (LC's corner
+ *            evidence test, bsf_lc_params_t.corner_evidence), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
@@ -67,7 +68,8 @@ static int16_t hits[BSF_MAX_POINTS];
 static bsf_truth_acc_t acc;
 
 static int paper_mode = 0;
-static int grazing_mode = 0; /* --grazing: join walls seen at grazing incidence */
+static int grazing_mode = 0;  /* --grazing: join walls seen at grazing incidence */
+static int evidence_mode = 0; /* --evidence: LC's corner evidence test */
 
 static bsf_params_t make_params(void)
 {
@@ -76,6 +78,9 @@ static bsf_params_t make_params(void)
     if (grazing_mode) {
         p.sved.join_grazing = 1u;
         p.lc.join_grazing = 1u;
+    }
+    if (evidence_mode) {
+        p.lc.corner_evidence = 1u;
     }
     return p;
 }
@@ -399,6 +404,8 @@ int main(int argc, char **argv)
             paper_mode = 1;
         } else if (strcmp(argv[a], "--grazing") == 0) {
             grazing_mode = 1;
+        } else if (strcmp(argv[a], "--evidence") == 0) {
+            evidence_mode = 1;
         } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
             n_poses = strtol(argv[++a], NULL, 10);
         } else if (strcmp(argv[a], "--datasets") == 0 && a + 1 < argc) {
@@ -411,7 +418,8 @@ int main(int argc, char **argv)
             only_noise = strtod(argv[++a], NULL) / 1000.0;
         } else {
             fprintf(stderr,
-                    "usage: %s [--quick] [--check] [--verbose] [--paper] [--grazing] [--poses N] "
+                    "usage: %s [--quick] [--check] [--verbose] [--paper] [--grazing] [--evidence] "
+                    "[--poses N] "
                     "[--scene NAME] "
                     "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
                     argv[0]);
@@ -425,9 +433,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_truth: --poses must be >= 1\n");
         return 2;
     }
-    printf("bench_truth: %s configuration%s, %ld poses per row\n",
+    printf("bench_truth: %s configuration%s%s, %ld poses per row\n",
            paper_mode ? "paper-faithful" : "default", grazing_mode ? " with grazing joins" : "",
-           n_poses);
+           evidence_mode ? " with LC's corner evidence test" : "", n_poses);
     print_header();
     for (w = 0; w < N_SCENES; ++w) {
         if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {

@@ -113,6 +113,7 @@ static const param_desc_t g_params[] = {
     PARAM("lc_min_side_len", lc.min_side_len, PT_FLOAT),
     PARAM("lc_max_range", lc.max_range, PT_FLOAT),
     PARAM("lc_join_grazing", lc.join_grazing, PT_U8),
+    PARAM("lc_corner_evidence", lc.corner_evidence, PT_U8),
     PARAM("lc_min_side_points", lc.min_side_points, PT_U16),
     PARAM("bid_neigh_a", bid.neigh_a, PT_FLOAT),
     PARAM("bid_neigh_b", bid.neigh_b, PT_FLOAT),
