@@ -79,6 +79,7 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
+    float tol; /* the run's split tolerance (detect_run) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -659,6 +660,56 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
     return 0;
 }
 
+/* A side ends where the wall it measures ends: walking in from its far
+ * end, points farther than the run's split tolerance from the side's line
+ * lie on the next surface (a side longer than a face reaches round the
+ * neighbouring corner once the split there has been merged, and a few such
+ * points spoil the line's residual and hide both corners). Returns the new
+ * far end, between near and far. */
+static size_t side_end_on_line(const lc_ctx_t *c, const lc_line_t *l, size_t near, size_t far)
+{
+    while (far != near) {
+        const float ex = c->rel[far].x - l->mx;
+        const float ey = c->rel[far].y - l->my;
+        if (!(fabsf(ex * l->dy - ey * l->dx) > c->tol)) {
+            break;
+        }
+        far = far > near ? far - 1u : far + 1u;
+    }
+    return far;
+}
+
+/* A side trimmed by side_end_on_line still long enough for judge's tests:
+ * need points from the apex (one fewer at the run's end) and len2 squared
+ * metres. */
+static int side_long_enough(const lc_ctx_t *c, size_t apex, size_t end, size_t need, size_t m,
+                            float len2)
+{
+    const size_t count = end < apex ? apex - end + (end == 0u ? 1u : 0u)
+                                    : end - apex + (end + 1u == m ? 1u : 0u);
+    return count >= need && dist2(c->rel[end], c->rel[apex]) >= len2;
+}
+
+/* The line of one side, a0..apex-1 (left) or apex+1..b1 (right), cut at the
+ * end of its wall (side_end_on_line) when what is left is still a side;
+ * *end is updated. Returns 0 when no line fits. */
+static int side_line(const lc_ctx_t *c, size_t apex, size_t *end, size_t need, size_t m,
+                     float len2, lc_line_t *l)
+{
+    const int left = *end < apex;
+    const size_t near = left ? apex - 1u : apex + 1u;
+    size_t cut;
+    if (!(left ? fit_line(c, *end, near, l) : fit_line(c, near, *end, l))) {
+        return 0;
+    }
+    cut = side_end_on_line(c, l, near, *end);
+    if (cut == *end || !side_long_enough(c, apex, cut, need, m, len2)) {
+        return 1;
+    }
+    *end = cut;
+    return left ? fit_line(c, cut, near, l) : fit_line(c, near, cut, l);
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns 1 and fills *kp (beam index, intersection, ...) for a
  * corner, 0 otherwise. */
@@ -723,7 +774,8 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
         return 0;
     }
-    if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
+    if (!side_line(c, apex, &a0, need, m, len2, &la) ||
+        !side_line(c, apex, &b1, need, m, len2, &lb)) {
         return 0;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
@@ -944,6 +996,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
+    c->tol = tol;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
@@ -1106,6 +1159,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.o.y = 0.0f;
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
+    c.tol = p->split_min;
     blocks_detach(&c);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
