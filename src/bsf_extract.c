@@ -545,10 +545,9 @@ static bsf_status_t fit_split(bsf_extractor_t *ex, const bsf_segment_t *s, size_
         } else if (a == 0u && b + 1u == n) {
             append_feature(res, s->first, s->last, s->n_points, s->kind, n_ctrl, e_curve);
         } else {
-            append_feature(res, beam_of_point(ex, s, a), beam_of_point(ex, s, b),
-                           (uint16_t)(b + 1u - a),
-                           (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl,
-                           e_curve);
+            append_feature(
+                res, beam_of_point(ex, s, a), beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
+                (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl, e_curve);
         }
     }
     if (st != BSF_OK) {

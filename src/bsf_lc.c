@@ -685,16 +685,16 @@ static size_t side_end_on_line(const lc_ctx_t *c, const lc_line_t *l, size_t nea
 static int side_long_enough(const lc_ctx_t *c, size_t apex, size_t end, size_t need, size_t m,
                             float len2)
 {
-    const size_t count = end < apex ? apex - end + (end == 0u ? 1u : 0u)
-                                    : end - apex + (end + 1u == m ? 1u : 0u);
+    const size_t count =
+        end < apex ? apex - end + (end == 0u ? 1u : 0u) : end - apex + (end + 1u == m ? 1u : 0u);
     return count >= need && dist2(c->rel[end], c->rel[apex]) >= len2;
 }
 
 /* The line of one side, a0..apex-1 (left) or apex+1..b1 (right), cut at the
  * end of its wall (side_end_on_line) when what is left is still a side;
  * *end is updated. Returns 0 when no line fits. */
-static int side_line(const lc_ctx_t *c, size_t apex, size_t *end, size_t need, size_t m,
-                     float len2, lc_line_t *l)
+static int side_line(const lc_ctx_t *c, size_t apex, size_t *end, size_t need, size_t m, float len2,
+                     lc_line_t *l)
 {
     const int left = *end < apex;
     const size_t near = left ? apex - 1u : apex + 1u;

@@ -72,9 +72,9 @@ typedef struct {
      *  the features. Metres, >= 0; 0 turns it off (bsf_params_paper).
      *  Default 0.25. */
     float split_dist;
-    bsf_clock_fn clock;               /**< optional, see bsf_clock_fn */
-    void *clock_user;                 /**< passed to clock */
-    uint32_t clock_hz;                /**< ticks per second of clock (> 0 when clock is set) */
+    bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
+    void *clock_user;   /**< passed to clock */
+    uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */
 } bsf_params_t;
 
 /** Defaults for a method: what a user gets (segmentation extensions on,
