@@ -432,7 +432,8 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
 /* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
  * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
  * point lies more than split_dist from the curve, just after that point,
- * moved inwards so each side keeps SPLIT_MIN_POINTS points. The RMS bounds
+ * moved inwards so each side keeps SPLIT_MIN_POINTS points, or in the middle
+ * when the fit used every control point it may have. The RMS bounds
  * the largest distance (max^2 <= n rms^2), so most fits need no search. */
 static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t n_ctrl,
                           float e_curve, const bsf_result_t *res)
@@ -446,6 +447,11 @@ static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t 
     }
     if (farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n, ex->scratch.seg.use.fit.pdm.t,
                        &res->ctrl[res->n_ctrl], n_ctrl, &at) <= bound * bound) {
+        return 0u;
+    }
+    if (n_ctrl >= (size_t)ex->params.pdm.max_ctrl) {
+        /* The fit ran out of control points, not of data that fits: cutting
+         * at the worst point would only chip the end off (measured) */
         return 0u;
     }
     at = at < SPLIT_MIN_POINTS - 1u ? SPLIT_MIN_POINTS - 1u : at;
