@@ -79,7 +79,8 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
-    float tol; /* the run's split tolerance (detect_run) */
+    float tol;            /* the run's split tolerance (detect_run) */
+    const uint8_t *split; /* the run's splits before any merge, by position */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -665,9 +666,12 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
  * lie on the next surface (a side longer than a face reaches round the
  * neighbouring corner once the split there has been merged, and a few such
  * points spoil the line's residual and hide both corners). Returns the new
- * far end, between near and far. */
+ * far end, between near and far; far itself when the side crosses no split
+ * of the run (c->split), merged since. */
 static size_t side_end_on_line(const lc_ctx_t *c, const lc_line_t *l, size_t near, size_t far)
 {
+    const size_t far0 = far;
+    size_t i;
     while (far != near) {
         const float ex = c->rel[far].x - l->mx;
         const float ey = c->rel[far].y - l->my;
@@ -676,7 +680,14 @@ static size_t side_end_on_line(const lc_ctx_t *c, const lc_line_t *l, size_t nea
         }
         far = far > near ? far - 1u : far + 1u;
     }
-    return far;
+    /* Only where the side crosses a split that was merged: elsewhere its
+     * far end is a corner the judge already bounds it by, or the run's end. */
+    for (i = near; far != far0 && i != far0; i = far0 > near ? i + 1u : i - 1u) {
+        if (c->split[i]) {
+            return far;
+        }
+    }
+    return far0;
 }
 
 /* A side trimmed by side_end_on_line still long enough for judge's tests:
@@ -997,6 +1008,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         tol = c->p->split_min;
     }
     c->tol = tol;
+    c->split = w->is_brk;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
@@ -1160,6 +1172,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
     c.tol = p->split_min;
+    c.split = work->is_brk;
     blocks_detach(&c);
     for (i = 0; i <= pts->count; ++i) {
         int close_run = i == pts->count;
