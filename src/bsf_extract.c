@@ -1,6 +1,5 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
-#include "bsf/bsf_bspline.h"
 
 #include <string.h>
 
@@ -404,22 +403,29 @@ static uint16_t beam_of_point(const bsf_extractor_t *ex, const bsf_segment_t *s,
     }
 }
 
-/* The point of pts[0..n) farthest from its footpoint on the curve (PDM's
- * parameters t), as its squared distance; *at receives its index. */
+/* The point of pts[0..n) farthest from its footpoint on the curve ctrl[0..m)
+ * (PDM's parameters t), as its squared distance; *at receives its index.
+ * The span's basis in closed form (docs/DESIGN.md, appendix): k0 = 1 on the
+ * first span, k2 = 1 on the last, 1/2 elsewhere. */
 static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
-                            const bsf_point_t *ctrl, size_t n_ctrl, size_t *at)
+                            const bsf_point_t *ctrl, size_t m, size_t *at)
 {
+    const size_t last = m - 3u;
     float worst = 0.0f;
     size_t i;
     *at = 0u;
     for (i = 0; i < n; ++i) {
-        bsf_point_t c;
-        float dx, dy, d2;
-        if (bsf_bspline_eval(ctrl, n_ctrl, t[i], &c, NULL, NULL) != BSF_OK) {
-            continue; /* cannot happen: n_ctrl and t come from a fit */
-        }
-        dx = c.x - pts[i].x;
-        dy = c.y - pts[i].y;
+        const float x = t[i] * (float)(m - 2u);
+        size_t s = x > 0.0f ? (size_t)x : 0u;
+        float u, b0, b2, dx, dy, d2;
+        s = s > last ? last : s;
+        u = x - (float)s;
+        b0 = (s == 0u ? 1.0f : 0.5f) * (1.0f - u) * (1.0f - u);
+        b2 = (s == last ? 1.0f : 0.5f) * u * u;
+        dx = ctrl[s + 1u].x + b0 * (ctrl[s].x - ctrl[s + 1u].x) +
+             b2 * (ctrl[s + 2u].x - ctrl[s + 1u].x) - pts[i].x;
+        dy = ctrl[s + 1u].y + b0 * (ctrl[s].y - ctrl[s + 1u].y) +
+             b2 * (ctrl[s + 2u].y - ctrl[s + 1u].y) - pts[i].y;
         d2 = dx * dx + dy * dy;
         if (d2 > worst) {
             worst = d2;
@@ -432,16 +438,17 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
 /* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
  * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
  * point lies more than split_dist from the curve, just after that point,
- * moved inwards so each side keeps SPLIT_MIN_POINTS points, or in the middle
- * when the fit used every control point it may have. The RMS bounds
- * the largest distance (max^2 <= n rms^2), so most fits need no search. */
+ * moved inwards so each side keeps SPLIT_MIN_POINTS points. A fit that used
+ * every control point it may have stands: its worst point is at an end the
+ * cap left off, and cutting there only chips the end off. The RMS bounds the
+ * largest distance (max^2 <= n rms^2), so most fits need no search. */
 static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t n_ctrl,
                           float e_curve, const bsf_result_t *res)
 {
     const float bound = ex->params.split_dist;
     const size_t n = b + 1u - a;
     size_t at;
-    if (!(bound > 0.0f) || n < 2u * SPLIT_MIN_POINTS ||
+    if (!(bound > 0.0f) || n < 2u * SPLIT_MIN_POINTS || n_ctrl >= (size_t)ex->params.pdm.max_ctrl ||
         e_curve * e_curve * (float)n <= bound * bound) {
         return 0u;
     }
@@ -449,47 +456,49 @@ static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t 
                        &res->ctrl[res->n_ctrl], n_ctrl, &at) <= bound * bound) {
         return 0u;
     }
-    if (n_ctrl >= (size_t)ex->params.pdm.max_ctrl) {
-        /* The fit ran out of control points, not of data that fits: cutting
-         * at the worst point would only chip the end off (measured) */
-        return 0u;
-    }
     at = at < SPLIT_MIN_POINTS - 1u ? SPLIT_MIN_POINTS - 1u : at;
     at = at > n - SPLIT_MIN_POINTS - 1u ? n - SPLIT_MIN_POINTS - 1u : at;
     return a + at + 1u;
 }
 
-/* PDM fit of points a..b of the gathered segment with the vertices inside
- * them (positions from 2 to count - 3, as gather_segment keeps them), into
- * res->ctrl[res->n_ctrl..] without appending a feature. *n_vertex_out
- * receives the vertices used. */
+/* PDM fit of points a..b of the gathered segment with its vertices inside
+ * them (from 2 to count - 3 points in, as gather_segment keeps them), into
+ * res->ctrl[res->n_ctrl..] without appending a feature. The vertex
+ * positions, ascending, are shifted to the piece in place and back, so no
+ * copy is made. *n_vertex_out receives the vertices used. */
 static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n_vertex,
                                bsf_result_t *res, size_t *n_ctrl, float *e_curve,
                                size_t *n_vertex_out)
 {
-    uint16_t pos[BSF_PDM_MAX_VERTICES];
-    bsf_point_t anchor[BSF_PDM_MAX_VERTICES];
-    const size_t n = b + 1u - a;
-    const size_t room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
+    uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
     const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
-    size_t nv = 0u;
+    size_t v0 = 0u;
+    size_t v1;
     size_t i;
-    for (i = 0; i < n_vertex; ++i) {
-        const size_t at = ex->scratch.seg.use.fit.vertex_pos[i];
-        if (at >= a + 2u && at + 3u <= b + 1u) {
-            if (nv == (size_t)BSF_PDM_MAX_VERTICES) {
-                return BSF_ERR_CAPACITY; /* more corners than one feature can hold */
-            }
-            pos[nv] = (uint16_t)(at - a);
-            anchor[nv++] = ex->scratch.seg.use.fit.vertex_anchor[i];
-        }
+    bsf_status_t st;
+    while (v0 < n_vertex && pos[v0] < a + 2u) {
+        ++v0;
     }
-    *n_vertex_out = nv;
-    return bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], n, pos,
-                                anchored ? anchor : NULL, nv, &ex->params.pdm,
-                                &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
-                                &res->ctrl_is_vertex[res->n_ctrl], room, n_ctrl, e_curve, NULL);
+    for (v1 = v0; v1 < n_vertex && (size_t)pos[v1] + 3u <= b + 1u;) {
+        ++v1;
+    }
+    *n_vertex_out = v1 - v0;
+    if (v1 - v0 > (size_t)BSF_PDM_MAX_VERTICES) {
+        return BSF_ERR_CAPACITY; /* more corners than one feature can hold */
+    }
+    for (i = v0; i < v1; ++i) {
+        pos[i] = (uint16_t)(pos[i] - a);
+    }
+    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], b + 1u - a, &pos[v0],
+                              anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
+                              &ex->params.pdm, &ex->scratch.seg.use.fit.pdm,
+                              &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl],
+                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, NULL);
+    for (i = v0; i < v1; ++i) {
+        pos[i] = (uint16_t)(pos[i] + a);
+    }
+    return st;
 }
 
 /* Append the feature whose control points were just fitted at res->n_ctrl. */
@@ -509,12 +518,13 @@ static void append_feature(bsf_result_t *res, uint16_t first_beam, uint16_t last
     res->stats.n_ctrl += (uint32_t)n_ctrl;
 }
 
-/* Fit a segment of n gathered points as features, splitting it by the cut
- * policy (split_point) into pieces that each fit. Any failure of a piece
- * undoes the pieces appended so far and returns its status; the caller then
- * fits the segment whole. */
-static bsf_status_t fit_split(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
-                              size_t n_vertex, bsf_result_t *res)
+/* Fit a segment of n gathered points as features: whole, or split by the
+ * cut policy (split_point) into pieces that each fit, left to right. A piece
+ * that fails undoes the pieces appended before it; the segment is then
+ * fitted whole, unsplit, or its status returned when the whole fit fails or
+ * the result has no room (BSF_ERR_BUFFER). */
+static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
+                               size_t n_vertex, bsf_result_t *res)
 {
     uint16_t lo[SPLIT_STACK];
     uint16_t hi[SPLIT_STACK];
@@ -522,27 +532,39 @@ static bsf_status_t fit_split(bsf_extractor_t *ex, const bsf_segment_t *s, size_
     const uint16_t ctrl0 = res->n_ctrl;
     const uint32_t in0 = res->stats.n_in_features;
     const uint32_t nctrl0 = res->stats.n_ctrl;
+    int may_split = 1;
     size_t depth = 1u;
-    bsf_status_t st = BSF_OK;
     lo[0] = 0u;
     hi[0] = (uint16_t)(n - 1u);
-    while (depth > 0u && st == BSF_OK) {
+    while (depth > 0u) {
         const size_t a = lo[depth - 1u];
         const size_t b = hi[depth - 1u];
         size_t n_ctrl = 0u;
         size_t nv = 0u;
         float e_curve = 0.0f;
-        size_t cut;
+        size_t cut = 0u;
+        bsf_status_t st = BSF_ERR_BUFFER;
         --depth;
-        if (res->n_features >= BSF_MAX_SEGMENTS || (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl < 3u) {
-            st = BSF_ERR_BUFFER;
-            break;
+        if (res->n_features < BSF_MAX_SEGMENTS && (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl >= 3u) {
+            st = fit_points(ex, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
         }
-        st = fit_points(ex, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
         if (st != BSF_OK) {
-            break;
+            res->n_features = features0;
+            res->n_ctrl = ctrl0;
+            res->stats.n_in_features = in0;
+            res->stats.n_ctrl = nctrl0;
+            if (st == BSF_ERR_BUFFER || (a == 0u && b + 1u == n)) {
+                return st;
+            }
+            may_split = 0; /* start again: the whole segment, unsplit */
+            depth = 1u;
+            lo[0] = 0u;
+            hi[0] = (uint16_t)(n - 1u);
+            continue;
         }
-        cut = depth + 2u <= SPLIT_STACK ? split_point(ex, a, b, n_ctrl, e_curve, res) : 0u;
+        if (may_split && depth + 2u <= SPLIT_STACK) {
+            cut = split_point(ex, a, b, n_ctrl, e_curve, res);
+        }
         if (cut != 0u) {
             lo[depth] = (uint16_t)cut; /* right piece, fitted after the left */
             hi[depth++] = (uint16_t)b;
@@ -556,13 +578,7 @@ static bsf_status_t fit_split(bsf_extractor_t *ex, const bsf_segment_t *s, size_
                 (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl, e_curve);
         }
     }
-    if (st != BSF_OK) {
-        res->n_features = features0;
-        res->n_ctrl = ctrl0;
-        res->stats.n_in_features = in0;
-        res->stats.n_ctrl = nctrl0;
-    }
-    return st;
+    return BSF_OK;
 }
 
 /* Fit one segment and append its feature (or the pieces the cut policy
@@ -572,37 +588,29 @@ static bsf_status_t fit_split(bsf_extractor_t *ex, const bsf_segment_t *s, size_
 static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf_result_t *res)
 {
     size_t n_vertex = 0u;
-    size_t n_ctrl = 0u;
-    size_t nv = 0u;
     size_t n;
     float e_curve = 0.0f;
     bsf_status_t st;
     const size_t room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
-    const int lsba = USES_RPOS(ex);
 
     /* No fit when no feature could fit: a feature has at least 3 control
      * points (4 from LSBA). */
-    if (res->n_features >= BSF_MAX_SEGMENTS || room < (lsba ? 4u : 3u)) {
+    if (res->n_features >= BSF_MAX_SEGMENTS || room < (USES_RPOS(ex) ? 4u : 3u)) {
         return BSF_ERR_BUFFER;
     }
     n = gather_segment(ex, s, &n_vertex);
-    if (lsba) {
-        st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
-        if (st == BSF_OK) {
-            n_ctrl = 4u;
-            memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
-        }
-    } else {
-        if (ex->params.split_dist > 0.0f && n >= 2u * SPLIT_MIN_POINTS &&
-            fit_split(ex, s, n, n_vertex, res) == BSF_OK) {
-            return BSF_OK;
-        }
-        st = fit_points(ex, 0u, n - 1u, n_vertex, res, &n_ctrl, &e_curve, &nv);
+    if (n == 0u) {
+        return BSF_ERR_DEGENERATE; /* as PDM and LSBA say for too few points */
     }
+    if (!USES_RPOS(ex)) {
+        return fit_pieces(ex, s, n, n_vertex, res);
+    }
+    st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
     if (st != BSF_OK) {
         return st;
     }
-    append_feature(res, s->first, s->last, s->n_points, s->kind, n_ctrl, e_curve);
+    memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
+    append_feature(res, s->first, s->last, s->n_points, s->kind, 4u, e_curve);
     return BSF_OK;
 }
 
