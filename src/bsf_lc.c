@@ -638,15 +638,30 @@ static inline size_t walk(const lc_ctx_t *c, int blocks, size_t pos, size_t stop
     return walk_side(c, pos, stop, step, side2);
 }
 
+/* Whether positions strictly between apex and end hold a split of the run
+ * (c->split: every split before any merge). */
+static int side_crosses_split(const lc_ctx_t *c, size_t apex, size_t end)
+{
+    size_t i = (end < apex ? end : apex) + 1u;
+    const size_t stop = end < apex ? apex : end;
+    while (i < stop && !c->split[i]) {
+        ++i;
+    }
+    return i < stop;
+}
+
 /* With blocks: 1 when the turn bound proves that the sides a0..apex and
  * apex..b1 make no corner, else 0 after storing the window's relative
- * points for the exact fits. Without blocks: 0. */
+ * points for the exact fits. Without blocks: 0. A side that crosses a split
+ * may be cut at the end of its wall (side_line), which the bound does not
+ * cover: then no bound, same answers. */
 static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t apex, size_t b1)
 {
 #if !BSF_CONFIG_COMPACT
     if (blocks) {
         /* every path from here to the turn test ends in "no corner" */
-        if (surely_no_turn(c, a0, apex, b1)) {
+        if (!side_crosses_split(c, apex, a0) && !side_crosses_split(c, apex, b1) &&
+            surely_no_turn(c, a0, apex, b1)) {
             return 1;
         }
         fill_rel(c, a0, b1);
@@ -666,12 +681,9 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
  * lie on the next surface (a side longer than a face reaches round the
  * neighbouring corner once the split there has been merged, and a few such
  * points spoil the line's residual and hide both corners). Returns the new
- * far end, between near and far; far itself when the side crosses no split
- * of the run (c->split), merged since. */
+ * far end, between near and far. */
 static size_t side_end_on_line(const lc_ctx_t *c, const lc_line_t *l, size_t near, size_t far)
 {
-    const size_t far0 = far;
-    size_t i;
     while (far != near) {
         const float ex = c->rel[far].x - l->mx;
         const float ey = c->rel[far].y - l->my;
@@ -680,17 +692,10 @@ static size_t side_end_on_line(const lc_ctx_t *c, const lc_line_t *l, size_t nea
         }
         far = far > near ? far - 1u : far + 1u;
     }
-    /* Only where the side crosses a split that was merged: elsewhere its
-     * far end is a corner the judge already bounds it by, or the run's end. */
-    for (i = near; far != far0 && i != far0; i = far0 > near ? i + 1u : i - 1u) {
-        if (c->split[i]) {
-            return far;
-        }
-    }
-    return far0;
+    return far;
 }
 
-/* A side trimmed by side_end_on_line still long enough for judge's tests:
+/* A side cut by side_end_on_line still long enough for judge's tests:
  * need points from the apex (one fewer at the run's end) and len2 squared
  * metres. */
 static int side_long_enough(const lc_ctx_t *c, size_t apex, size_t end, size_t need, size_t m,
@@ -714,7 +719,11 @@ static int side_line(const lc_ctx_t *c, size_t apex, size_t *end, size_t need, s
         return 0;
     }
     cut = side_end_on_line(c, l, near, *end);
-    if (cut == *end || !side_long_enough(c, apex, cut, need, m, len2)) {
+    /* Only where the side crosses a split (merged since, or the neighbour
+     * it reaches past): elsewhere its far end is the run's end or a corner
+     * the judge already bounds it by. */
+    if (cut == *end || !side_crosses_split(c, apex, *end) ||
+        !side_long_enough(c, apex, cut, need, m, len2)) {
         return 1;
     }
     *end = cut;
