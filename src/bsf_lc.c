@@ -652,16 +652,13 @@ static int side_crosses_split(const lc_ctx_t *c, size_t apex, size_t end)
 
 /* With blocks: 1 when the turn bound proves that the sides a0..apex and
  * apex..b1 make no corner, else 0 after storing the window's relative
- * points for the exact fits. Without blocks: 0. A side that crosses a split
- * may be cut at the end of its wall (side_line), which the bound does not
- * cover: then no bound, same answers. */
+ * points for the exact fits. Without blocks: 0. */
 static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t apex, size_t b1)
 {
 #if !BSF_CONFIG_COMPACT
     if (blocks) {
         /* every path from here to the turn test ends in "no corner" */
-        if (!side_crosses_split(c, apex, a0) && !side_crosses_split(c, apex, b1) &&
-            surely_no_turn(c, a0, apex, b1)) {
+        if (surely_no_turn(c, a0, apex, b1)) {
             return 1;
         }
         fill_rel(c, a0, b1);
@@ -706,28 +703,27 @@ static int side_long_enough(const lc_ctx_t *c, size_t apex, size_t end, size_t n
     return count >= need && dist2(c->rel[end], c->rel[apex]) >= len2;
 }
 
-/* The line of one side, a0..apex-1 (left) or apex+1..b1 (right), cut at the
- * end of its wall (side_end_on_line) when what is left is still a side;
- * *end is updated. Returns 0 when no line fits. */
-static int side_line(const lc_ctx_t *c, size_t apex, size_t *end, size_t need, size_t m, float len2,
-                     lc_line_t *l)
+/* Side a0..apex-1 (left, *end = a0) or apex+1..b1 (right, *end = b1) with
+ * its fitted line *l, cut at the end of its wall (side_end_on_line) and
+ * refitted when it crosses a split and what is left is still a side.
+ * Returns 1 when cut, else 0. */
+static int side_cut(const lc_ctx_t *c, size_t apex, size_t *end, size_t need, size_t m, float len2,
+                    lc_line_t *l)
 {
     const int left = *end < apex;
     const size_t near = left ? apex - 1u : apex + 1u;
-    size_t cut;
-    if (!(left ? fit_line(c, *end, near, l) : fit_line(c, near, *end, l))) {
-        return 0;
-    }
-    cut = side_end_on_line(c, l, near, *end);
+    const size_t cut = side_end_on_line(c, l, near, *end);
     /* Only where the side crosses a split (merged since, or the neighbour
      * it reaches past): elsewhere its far end is the run's end or a corner
      * the judge already bounds it by. */
     if (cut == *end || !side_crosses_split(c, apex, *end) ||
         !side_long_enough(c, apex, cut, need, m, len2)) {
-        return 1;
+        return 0;
     }
     *end = cut;
-    return left ? fit_line(c, cut, near, l) : fit_line(c, near, cut, l);
+    /* at least need >= 2 points: the fit succeeds */
+    (void)(left ? fit_line(c, cut, near, l) : fit_line(c, near, cut, l));
+    return 1;
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
@@ -794,13 +790,21 @@ static int judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t m, bsf_k
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
         return 0;
     }
-    if (!side_line(c, apex, &a0, need, m, len2, &la) ||
-        !side_line(c, apex, &b1, need, m, len2, &lb)) {
+    if (!fit_line(c, a0, apex - 1u, &la) || !fit_line(c, apex + 1u, b1, &lb)) {
         return 0;
     }
     cross = la.dx * lb.dy - la.dy * lb.dx;
     if (!(fabsf(cross) >= c->sin_min_turn)) {
         return 0;
+    }
+    /* After the turn test, so the block path's turn bound (on the uncut
+     * sides) stays exact; a cut side must still turn. */
+    if ((side_cut(c, apex, &a0, need, m, len2, &la) | side_cut(c, apex, &b1, need, m, len2, &lb)) !=
+        0) {
+        cross = la.dx * lb.dy - la.dy * lb.dx;
+        if (!(fabsf(cross) >= c->sin_min_turn)) {
+            return 0;
+        }
     }
     t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
     xx = la.mx + t * la.dx;
