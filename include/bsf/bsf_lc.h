@@ -14,7 +14,10 @@
  *     max_side metres from the apex): fit a total-least-squares line to each
  *     side (the apex left out) and keep the split as a corner only when
  *     - each side has min_side_points points and reaches min_side_len,
- *     - the lines turn by at least min_turn,
+ *     - the lines turn by at least min_turn (then a side that crosses
+ *       another split of the run ends where its points leave its line by
+ *       more than the split tolerance, and is refitted: it must not run
+ *       round the next corner, and must still turn),
  *     - their intersection lies near the apex (within twice the local beam
  *       spacing plus apex_slack), and
  *     - two lines explain the points much better than one smooth curve: the
