@@ -736,6 +736,15 @@ static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
             res->stats.n_unfitted++;
         }
     }
+    /* A split segment's later pieces may start past a segment that lies
+     * inside its run (an occluder, SVED's look-back), or past the seam of a
+     * full-circle scan: then the features go back into beam order. */
+    for (si = 1; si < res->n_features; ++si) {
+        if (beam_order_key(&res->features[si]) <= beam_order_key(&res->features[si - 1u])) {
+            put_features_in_beam_order(res);
+            break;
+        }
+    }
     res->stats.n_features = res->n_features;
 }
 
