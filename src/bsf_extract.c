@@ -4,6 +4,9 @@
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
+#ifndef BSF_SPLIT_DIST_DEFAULT
+#define BSF_SPLIT_DIST_DEFAULT 0.25f
+#endif
 
 static const char *const method_names[BSF_METHOD_COUNT] = {
     "falko-sved-pdm",
@@ -54,6 +57,7 @@ bsf_params_t bsf_params_default(bsf_method_t method)
         p.pdm.bias_window = 0u;
     }
     p.no_return = bsf_no_return_params_default();
+    p.split_dist = BSF_SPLIT_DIST_DEFAULT;
     p.clock = NULL;
     p.clock_user = NULL;
     p.clock_hz = 0u;
@@ -65,6 +69,7 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     bsf_params_t p = bsf_params_default(method);
     p.sved = bsf_sved_params_paper();
     p.no_return.min_run = 0u;
+    p.split_dist = 0.0f;
     /* The first release's refinement target, so the paper-faithful rows of
      * bsf table1 are the numbers that release printed. */
     p.pdm.target_rms = 0.015f;
@@ -79,7 +84,8 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
         return BSF_ERR_ARG;
     }
     if ((p->clock != NULL && p->clock_hz == 0u) || !(p->no_return.code >= 0.0f) ||
-        !(p->no_return.code <= 3.402823466e38f)) {
+        !(p->no_return.code <= 3.402823466e38f) || !(p->split_dist >= 0.0f) ||
+        !(p->split_dist <= BSF_FIT_MAX_COORD)) {
         return BSF_ERR_PARAM;
     }
     if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
@@ -372,59 +378,239 @@ static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     return n;
 }
 
-/* Fit one segment and append its feature to the result. Returns BSF_OK,
- * BSF_ERR_BUFFER when the feature table or the control-point pool has no room
- * left for it, or another error when the fit itself fails (then nothing is
- * appended). */
+/* Pieces of one segment waiting to be fitted by the cut policy: each split
+ * pushes two, the left one fitted first, so the stack holds at most one
+ * piece per level of splitting and this bounds the depth. */
+#define SPLIT_STACK 8u
+/* Fewest points of a piece: a quadratic's three control points, so a piece
+ * always fits and no point leaves the features. */
+#define SPLIT_MIN_POINTS 3u
+
+/* Beam of the k-th valid point of segment s (as gather_segment visits them). */
+static uint16_t beam_of_point(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t k)
+{
+    size_t b;
+    for (b = s->first;; b = (b + 1u < ex->points.count) ? b + 1u : 0u) {
+        if (ex->scratch.seg.label[b] == s->first) {
+            if (k == 0u) {
+                return (uint16_t)b;
+            }
+            --k;
+        }
+        if (b == s->last) {
+            return (uint16_t)b;
+        }
+    }
+}
+
+/* The point of pts[0..n) farthest from its footpoint on the curve ctrl[0..m)
+ * (PDM's parameters t), as its squared distance; *at receives its index.
+ * The span's basis in closed form (docs/DESIGN.md, appendix): k0 = 1 on the
+ * first span, k2 = 1 on the last, 1/2 elsewhere. */
+static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
+                            const bsf_point_t *ctrl, size_t m, size_t *at)
+{
+    const size_t last = m - 3u;
+    float worst = 0.0f;
+    size_t i;
+    *at = 0u;
+    for (i = 0; i < n; ++i) {
+        const float x = t[i] * (float)(m - 2u);
+        size_t s = x > 0.0f ? (size_t)x : 0u;
+        float u, b0, b2, dx, dy, d2;
+        s = s > last ? last : s;
+        u = x - (float)s;
+        b0 = (s == 0u ? 1.0f : 0.5f) * (1.0f - u) * (1.0f - u);
+        b2 = (s == last ? 1.0f : 0.5f) * u * u;
+        dx = ctrl[s + 1u].x + b0 * (ctrl[s].x - ctrl[s + 1u].x) +
+             b2 * (ctrl[s + 2u].x - ctrl[s + 1u].x) - pts[i].x;
+        dy = ctrl[s + 1u].y + b0 * (ctrl[s].y - ctrl[s + 1u].y) +
+             b2 * (ctrl[s + 2u].y - ctrl[s + 1u].y) - pts[i].y;
+        d2 = dx * dx + dy * dy;
+        if (d2 > worst) {
+            worst = d2;
+            *at = i;
+        }
+    }
+    return worst;
+}
+
+/* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
+ * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
+ * point lies more than split_dist from the curve, just after that point,
+ * moved inwards so each side keeps SPLIT_MIN_POINTS points. A fit that used
+ * every control point it may have stands: its worst point is at an end the
+ * cap left off, and cutting there only chips the end off. The RMS bounds the
+ * largest distance (max^2 <= n rms^2), so most fits need no search. */
+static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t n_ctrl,
+                          float e_curve, const bsf_result_t *res)
+{
+    const float bound = ex->params.split_dist;
+    const size_t n = b + 1u - a;
+    size_t at;
+    if (!(bound > 0.0f) || n < 2u * SPLIT_MIN_POINTS || n_ctrl >= (size_t)ex->params.pdm.max_ctrl ||
+        e_curve * e_curve * (float)n <= bound * bound) {
+        return 0u;
+    }
+    if (farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n, ex->scratch.seg.use.fit.pdm.t,
+                       &res->ctrl[res->n_ctrl], n_ctrl, &at) <= bound * bound) {
+        return 0u;
+    }
+    at = at < SPLIT_MIN_POINTS - 1u ? SPLIT_MIN_POINTS - 1u : at;
+    at = at > n - SPLIT_MIN_POINTS - 1u ? n - SPLIT_MIN_POINTS - 1u : at;
+    return a + at + 1u;
+}
+
+/* PDM fit of points a..b of the gathered segment with its vertices inside
+ * them (from 2 to count - 3 points in, as gather_segment keeps them), into
+ * res->ctrl[res->n_ctrl..] without appending a feature. The vertex
+ * positions, ascending, are shifted to the piece in place and back, so no
+ * copy is made. *n_vertex_out receives the vertices used. */
+static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n_vertex,
+                               bsf_result_t *res, size_t *n_ctrl, float *e_curve,
+                               size_t *n_vertex_out)
+{
+    uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
+    /* LC's keypoint is the walls' intersection: the vertex stays there. */
+    const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
+    size_t v0 = 0u;
+    size_t v1;
+    size_t i;
+    bsf_status_t st;
+    while (v0 < n_vertex && pos[v0] < a + 2u) {
+        ++v0;
+    }
+    for (v1 = v0; v1 < n_vertex && (size_t)pos[v1] + 3u <= b + 1u;) {
+        ++v1;
+    }
+    *n_vertex_out = v1 - v0;
+    if (v1 - v0 > (size_t)BSF_PDM_MAX_VERTICES) {
+        return BSF_ERR_CAPACITY; /* more corners than one feature can hold */
+    }
+    for (i = v0; i < v1; ++i) {
+        pos[i] = (uint16_t)(pos[i] - a);
+    }
+    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], b + 1u - a, &pos[v0],
+                              anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
+                              &ex->params.pdm, &ex->scratch.seg.use.fit.pdm,
+                              &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl],
+                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, NULL);
+    for (i = v0; i < v1; ++i) {
+        pos[i] = (uint16_t)(pos[i] + a);
+    }
+    return st;
+}
+
+/* Append the feature whose control points were just fitted at res->n_ctrl. */
+static void append_feature(bsf_result_t *res, uint16_t first_beam, uint16_t last_beam,
+                           uint16_t n_points, uint8_t kind, size_t n_ctrl, float e_curve)
+{
+    bsf_feature_t *f = &res->features[res->n_features++];
+    f->first_beam = first_beam;
+    f->last_beam = last_beam;
+    f->n_points = n_points;
+    f->ctrl_first = res->n_ctrl;
+    f->n_ctrl = (uint8_t)n_ctrl;
+    f->kind = kind;
+    f->e_curve = e_curve;
+    res->n_ctrl = (uint16_t)(res->n_ctrl + n_ctrl);
+    res->stats.n_in_features += n_points;
+    res->stats.n_ctrl += (uint32_t)n_ctrl;
+}
+
+/* Fit a segment of n gathered points as features: whole, or split by the
+ * cut policy (split_point) into pieces that each fit, left to right. A piece
+ * that fails undoes the pieces appended before it; the segment is then
+ * fitted whole, unsplit, or its status returned when the whole fit fails or
+ * the result has no room (BSF_ERR_BUFFER). */
+static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
+                               size_t n_vertex, bsf_result_t *res)
+{
+    uint16_t lo[SPLIT_STACK];
+    uint16_t hi[SPLIT_STACK];
+    const uint16_t features0 = res->n_features;
+    const uint16_t ctrl0 = res->n_ctrl;
+    const uint32_t in0 = res->stats.n_in_features;
+    const uint32_t nctrl0 = res->stats.n_ctrl;
+    int may_split = 1;
+    size_t depth = 1u;
+    lo[0] = 0u;
+    hi[0] = (uint16_t)(n - 1u);
+    while (depth > 0u) {
+        const size_t a = lo[depth - 1u];
+        const size_t b = hi[depth - 1u];
+        size_t n_ctrl = 0u;
+        size_t nv = 0u;
+        float e_curve = 0.0f;
+        size_t cut = 0u;
+        bsf_status_t st = BSF_ERR_BUFFER;
+        --depth;
+        if (res->n_features < BSF_MAX_SEGMENTS && (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl >= 3u) {
+            st = fit_points(ex, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
+        }
+        if (st != BSF_OK) {
+            res->n_features = features0;
+            res->n_ctrl = ctrl0;
+            res->stats.n_in_features = in0;
+            res->stats.n_ctrl = nctrl0;
+            if (st == BSF_ERR_BUFFER || (a == 0u && b + 1u == n)) {
+                return st;
+            }
+            may_split = 0; /* start again: the whole segment, unsplit */
+            depth = 1u;
+            lo[0] = 0u;
+            hi[0] = (uint16_t)(n - 1u);
+            continue;
+        }
+        if (may_split && depth + 2u <= SPLIT_STACK) {
+            cut = split_point(ex, a, b, n_ctrl, e_curve, res);
+        }
+        if (cut != 0u) {
+            lo[depth] = (uint16_t)cut; /* right piece, fitted after the left */
+            hi[depth++] = (uint16_t)b;
+            lo[depth] = (uint16_t)a;
+            hi[depth++] = (uint16_t)(cut - 1u);
+        } else if (a == 0u && b + 1u == n) {
+            append_feature(res, s->first, s->last, s->n_points, s->kind, n_ctrl, e_curve);
+        } else {
+            append_feature(
+                res, beam_of_point(ex, s, a), beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
+                (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl, e_curve);
+        }
+    }
+    return BSF_OK;
+}
+
+/* Fit one segment and append its feature (or the pieces the cut policy
+ * splits it into) to the result. Returns BSF_OK, BSF_ERR_BUFFER when the
+ * feature table or the control-point pool has no room left for it, or
+ * another error when the fit itself fails (then nothing is appended). */
 static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf_result_t *res)
 {
-    bsf_feature_t *f;
     size_t n_vertex = 0u;
-    size_t n_ctrl = 0u;
     size_t n;
     float e_curve = 0.0f;
     bsf_status_t st;
     const size_t room = (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl;
-    const int lsba = USES_RPOS(ex);
 
     /* No fit when no feature could fit: a feature has at least 3 control
      * points (4 from LSBA). */
-    if (res->n_features >= BSF_MAX_SEGMENTS || room < (lsba ? 4u : 3u)) {
+    if (res->n_features >= BSF_MAX_SEGMENTS || room < (USES_RPOS(ex) ? 4u : 3u)) {
         return BSF_ERR_BUFFER;
     }
     n = gather_segment(ex, s, &n_vertex);
-    if (lsba) {
-        st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
-        if (st == BSF_OK) {
-            n_ctrl = 4u;
-            memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
-        }
-    } else if (n_vertex > BSF_PDM_MAX_VERTICES) {
-        st = BSF_ERR_CAPACITY; /* more corners than one feature can hold */
-    } else {
-        /* LC's keypoint is the walls' intersection: the vertex stays there. */
-        const bsf_point_t *anchor = ex->params.method == BSF_METHOD_LC_SVED_PDM
-                                        ? ex->scratch.seg.use.fit.vertex_anchor
-                                        : NULL;
-        st = bsf_pdm_fit_anchored(
-            ex->scratch.seg.use.fit.seg_points, n, ex->scratch.seg.use.fit.vertex_pos, anchor,
-            n_vertex, &ex->params.pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
-            &res->ctrl_is_vertex[res->n_ctrl], room, &n_ctrl, &e_curve, NULL);
+    if (n == 0u) {
+        return BSF_ERR_DEGENERATE; /* as PDM and LSBA say for too few points */
     }
+    if (!USES_RPOS(ex)) {
+        return fit_pieces(ex, s, n, n_vertex, res);
+    }
+    st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
     if (st != BSF_OK) {
         return st;
     }
-    f = &res->features[res->n_features++];
-    f->first_beam = s->first;
-    f->last_beam = s->last;
-    f->n_points = s->n_points;
-    f->ctrl_first = res->n_ctrl;
-    f->n_ctrl = (uint8_t)n_ctrl;
-    f->kind = s->kind;
-    f->e_curve = e_curve;
-    res->n_ctrl = (uint16_t)(res->n_ctrl + n_ctrl);
-    res->stats.n_in_features += s->n_points;
-    res->stats.n_ctrl += (uint32_t)n_ctrl;
+    memset(&res->ctrl_is_vertex[res->n_ctrl], 0, 4u);
+    append_feature(res, s->first, s->last, s->n_points, s->kind, 4u, e_curve);
     return BSF_OK;
 }
 
@@ -548,6 +734,15 @@ static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
             /* Not fitted: its points count as wasted (docs/DESIGN.md, "PDM and
              * refinement"). */
             res->stats.n_unfitted++;
+        }
+    }
+    /* A split segment's later pieces may start past a segment that lies
+     * inside its run (an occluder, SVED's look-back), or past the seam of a
+     * full-circle scan: then the features go back into beam order. */
+    for (si = 1; si < res->n_features; ++si) {
+        if (beam_order_key(&res->features[si]) <= beam_order_key(&res->features[si - 1u])) {
+            put_features_in_beam_order(res);
+            break;
         }
     }
     res->stats.n_features = res->n_features;

@@ -65,9 +65,16 @@ typedef struct {
     bsf_rpos_params_t rpos;           /**< used by RPOS-LSBA */
     bsf_pdm_params_t pdm;             /**< used by the three PDM methods */
     bsf_no_return_params_t no_return; /**< no-return codes, every method (bsf_scan.h) */
-    bsf_clock_fn clock;               /**< optional, see bsf_clock_fn */
-    void *clock_user;                 /**< passed to clock */
-    uint32_t clock_hz;                /**< ticks per second of clock (> 0 when clock is set) */
+    /** Cut policy of the three PDM methods (docs/DESIGN.md, "Cut policy"): a
+     *  feature with a point farther than this from its curve is split just
+     *  after its farthest point, and each side (at least 3 points) is fitted
+     *  on its own, at most 7 splits deep; no point leaves
+     *  the features. Metres, >= 0; 0 turns it off (bsf_params_paper).
+     *  Default 0.25. */
+    float split_dist;
+    bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
+    void *clock_user;   /**< passed to clock */
+    uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */
 } bsf_params_t;
 
 /** Defaults for a method: what a user gets (segmentation extensions on,

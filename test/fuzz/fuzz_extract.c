@@ -191,7 +191,7 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
     uint32_t iv = raw ? v : (v & 0xFFu);
     memcpy(&fv, &v, sizeof fv);
 #define F(dst) (dst) = raw ? fv : near((dst), v)
-    switch ((field & 0x7Fu) % 49u) {
+    switch ((field & 0x7Fu) % 50u) {
     case 0: F(p->sved.a); break;
     case 1: F(p->sved.b); break;
     case 2: p->sved.min_segment_points = (uint16_t)iv; break;
@@ -256,6 +256,7 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
         p->lc.max_range = raw ? fv : 0.25f * (float)(v & 0xFFu);
         break;
     case 48: p->lc.min_side_points = (uint16_t)(raw ? v : iv % 70u); break;
+    case 49: F(p->split_dist); break;
     default:
         F(p->sved.a);
         F(p->sved.b);

@@ -344,6 +344,89 @@ static void test_clock_hook_times_each_stage(void)
     TEST_ASSERT_EQUAL_UINT32(0u, res.stats.time_ns);
 }
 
+/* Largest distance of feature f's points (scan beams, in order, valid and
+ * not claimed by another feature: here every valid beam of its range) to its
+ * curve, the curve sampled 64 times per span. */
+static double feature_max_dist(const bsf_scan_t *s, const bsf_feature_t *f)
+{
+    const bsf_point_t *ctrl = &res.ctrl[f->ctrl_first];
+    const size_t samples = 64u * (size_t)(f->n_ctrl - 2u);
+    double worst = 0.0;
+    size_t b;
+    for (b = f->first_beam; b <= f->last_beam; ++b) {
+        const double a = (double)s->angle_min + (double)b * (double)s->angle_increment;
+        const double px = (double)s->ranges[b] * cos(a);
+        const double py = (double)s->ranges[b] * sin(a);
+        double best = 1e30;
+        size_t k;
+        for (k = 0; k <= samples; ++k) {
+            bsf_point_t c;
+            TEST_ASSERT_EQUAL_INT(
+                BSF_OK,
+                bsf_bspline_eval(ctrl, f->n_ctrl, (float)k / (float)samples, &c, NULL, NULL));
+            best = fmin(best, hypot((double)c.x - px, (double)c.y - py));
+        }
+        worst = fmax(worst, best);
+    }
+    return worst;
+}
+
+/* Rough vegetation at 18 m (ranges scattering by +-0.3 m from beam to beam,
+ * as on an outdoor log): the cut policy splits a feature whose points stray
+ * more than split_dist from its curve, so every sent curve stays within it
+ * of its points, and no point leaves the features. */
+static void test_the_cut_policy_splits_rough_features_and_keeps_every_point(void)
+{
+    static const float scatter[12] = {0.0f,   -0.33f, 0.19f, -0.13f, 0.34f,  -0.05f,
+                                      -0.31f, 0.27f,  0.02f, 0.33f,  -0.29f, 0.11f};
+    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scan_t s;
+    uint32_t in_features_unsplit;
+    double worst_unsplit = 0.0;
+    double worst = 0.0;
+    uint16_t n_unsplit;
+    size_t i;
+    s.ranges = ranges;
+    s.count = 241u;
+    s.angle_min = -1.0471976f;
+    s.angle_increment = 2.0943951f / 240.0f;
+    s.range_min = 0.05f;
+    s.range_max = 40.0f;
+    for (i = 0; i < s.count; ++i) {
+        /* 40 beams of it (a fit that runs out of control points is not
+         * split), nothing elsewhere */
+        ranges[i] = (i >= 100u && i < 140u) ? 18.0f + scatter[(i * 7u) % 12u] : 0.0f;
+    }
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, bsf_params_paper(BSF_METHOD_LC_SVED_PDM).split_dist);
+    TEST_ASSERT_EQUAL_FLOAT(0.25f, p.split_dist);
+    p.split_dist = 0.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
+    in_features_unsplit = res.stats.n_in_features;
+    n_unsplit = res.n_features;
+    for (i = 0; i < res.n_features; ++i) {
+        worst_unsplit = fmax(worst_unsplit, feature_max_dist(&s, &res.features[i]));
+    }
+    p.split_dist = 0.25f;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
+    for (i = 0; i < res.n_features; ++i) {
+        const bsf_feature_t *f = &res.features[i];
+        worst = fmax(worst, feature_max_dist(&s, f));
+        TEST_ASSERT_TRUE(f->n_points >= 3u);
+        if (i > 0u) {
+            TEST_ASSERT_TRUE(f->first_beam > res.features[i - 1u].last_beam);
+        }
+    }
+    printf("rough surface: %u features, worst point %.3f m unsplit; %u features, %.3f m split\n",
+           (unsigned)n_unsplit, worst_unsplit, (unsigned)res.n_features, worst);
+    TEST_ASSERT_TRUE(worst_unsplit > 0.25);
+    TEST_ASSERT_TRUE(res.n_features > n_unsplit);
+    TEST_ASSERT_TRUE(worst <= 0.25);
+    TEST_ASSERT_EQUAL_UINT32(in_features_unsplit, res.stats.n_in_features);
+    TEST_ASSERT_EQUAL_UINT32(res.stats.n_features, res.n_features);
+}
+
 static void test_bad_parameters_and_arguments_are_refused(void)
 {
     bsf_params_t p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
@@ -367,6 +450,13 @@ static void test_bad_parameters_and_arguments_are_refused(void)
     p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
     p.clock = fake_clock;
     p.clock_hz = 0u;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_extractor_init(&ex, &p));
+    p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
+    p.split_dist = -0.1f;
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_extractor_init(&ex, &p));
+    p.split_dist = nanf("");
+    TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_extractor_init(&ex, &p));
+    p.split_dist = INFINITY;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_extractor_init(&ex, &p));
     p = bsf_params_default(BSF_METHOD_FALKO_SVED_PDM);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
@@ -423,6 +513,7 @@ int main(void)
     RUN_TEST(test_retrievability_and_compactness_equal_hand_counts);
     RUN_TEST(test_vertex_count_twice_in_compactness);
     RUN_TEST(test_clock_hook_times_each_stage);
+    RUN_TEST(test_the_cut_policy_splits_rough_features_and_keeps_every_point);
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
     RUN_TEST(test_method_names_round_trip);

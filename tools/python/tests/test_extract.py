@@ -79,6 +79,8 @@ def test_methods_and_parameters():
     assert bsf.default_params("falko-sved-pdm")["pdm_bias_window"] == 0
     assert bsf.default_params()["sved_lookback"] == 4 and bsf.default_params()["no_return_min_run"] == 5
     assert bsf.Extractor(sved_min_segment_points=7).params["sved_min_segment_points"] == 7
+    assert bsf.default_params()["split_dist"] == pytest.approx(0.25)
+    assert bsf.Extractor(split_dist=0.0).params["split_dist"] == 0.0
 
 
 def test_timing_off_gives_zero_time():
