@@ -228,6 +228,16 @@ def field(line, name):
 net = sum(field(l, "created") - field(l, "merged") - field(l, "removed") for l in map_lines)
 check(net == len(feats), f"listen: created - merged - removed over all frames = the map's features ({net}, {len(feats)})")
 check(map_lines and field(map_lines[-1], "features") == len(feats), "listen's last line counts the map's features")
+check(map_lines and all(re.search(r"\bflagged=0 absent=0\b", l) for l in map_lines),
+      "listen: a lossless map stream never flags a feature")
+with open(os.path.join(WORK, "lossy.map"), "rb") as f:
+    r = run(["listen", "-"], input=f.read())
+lossy_lines = [l for l in r.stdout.decode().splitlines() if l.startswith("map seq=")]
+check(r.returncode == 0 and lossy_lines and field(lossy_lines[-1], "missing") == 1
+      and field(lossy_lines[-1], "flagged") + field(lossy_lines[-1], "absent") > 0,
+      "listen: after a lost map frame the receiver's flagged and absent features show on the line")
+check(re.search(r"features \(\d+ flagged: unconfirmed or stale\), \d+ ids never received", r.stdout.decode()) is not None,
+      "listen's summary counts flagged features and ids never received")
 
 # 5. loss: a damaged frame in the middle costs only what it carried.
 mid = len(data) // 2

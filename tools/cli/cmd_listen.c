@@ -33,7 +33,9 @@ static const char listen_help[] =
     "Map line (a map stream, bsf extract --map): the map frame's seq, how many map\n"
     "features it created, extended, moved, merged and removed in the receiver's\n"
     "map, snapshots, the pose it carried, records the receiver could not apply,\n"
-    "bytes, then the receiver's totals (features) and map frames missing.\n";
+    "bytes, then the receiver's totals: features, flagged (features it cannot\n"
+    "vouch for since a lost frame, or whose record could not apply), absent (ids\n"
+    "sent but never received) and map frames missing.\n";
 
 typedef struct {
     long baud;
@@ -214,11 +216,28 @@ static void note_seq(listen_state_t *ls, uint32_t seq)
     ls->last_seq = seq;
 }
 
+/* Features the receiver cannot vouch for (unconfirmed after a loss, or
+ * stale) and ids it knows were sent but never got (missing). */
+static void map_flags(const bsf_map_rx_t *rx, unsigned long *flagged, unsigned long *absent)
+{
+    const uint32_t limit = bsf_map_rx_id_limit(rx);
+    uint32_t id;
+    *flagged = 0u;
+    *absent = 0u;
+    for (id = 0; id < limit; ++id) {
+        const int st = bsf_map_rx_feature_state(rx, id);
+        *flagged += st == BSF_MAP_RX_UNCONFIRMED || st == BSF_MAP_RX_STALE;
+        *absent += st == BSF_MAP_RX_MISSING;
+    }
+}
+
 /* A map frame into the receiver's map, and its line. -1 out of memory. */
 static int map_frame(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
                      const bsf_decoder_stats_t *s)
 {
     map_change_t c;
+    unsigned long flagged;
+    unsigned long absent;
     const unsigned long poses_before = ls->have_map ? ls->map.n_path : 0u;
     if (!ls->have_map) {
         if (map_view_init(&ls->map, 1) != 0) {
@@ -251,8 +270,11 @@ static int map_frame(listen_state_t *ls, const bsf_frame_t *fr, size_t bytes,
     } else {
         fputs("none", stdout);
     }
-    printf(" skipped=%lu bytes=%zu | features=%lu ok=%lu dropped=%lu missing=%lu\n", c.skipped,
-           bytes, ls->map_features, (unsigned long)s->frames_ok, dropped(s), ls->map_seq_gaps);
+    map_flags(ls->map.rx, &flagged, &absent);
+    printf(" skipped=%lu bytes=%zu | features=%lu flagged=%lu absent=%lu ok=%lu dropped=%lu "
+           "missing=%lu\n",
+           c.skipped, bytes, ls->map_features, flagged, absent, (unsigned long)s->frames_ok,
+           dropped(s), ls->map_seq_gaps);
     return 0;
 }
 
@@ -463,9 +485,12 @@ int cmd_listen(int argc, char **argv)
     }
     print_summary(&dec.stats, ls.seq_gaps);
     if (ls.have_map) {
-        printf("map: %lu frames, %llu bytes, %lu features, %lu map frames missing by sequence, "
-               "%lu records skipped\n",
-               ls.map.frames, ls.map.bytes, ls.map_features, ls.map_seq_gaps,
+        unsigned long flagged;
+        unsigned long absent;
+        map_flags(ls.map.rx, &flagged, &absent);
+        printf("map: %lu frames, %llu bytes, %lu features (%lu flagged: unconfirmed or stale), "
+               "%lu ids never received, %lu map frames missing by sequence, %lu records skipped\n",
+               ls.map.frames, ls.map.bytes, ls.map_features, flagged, absent, ls.map_seq_gaps,
                (unsigned long)ls.map.rx->stats.records_skipped);
     }
     if (fflush(stdout) != 0) {
