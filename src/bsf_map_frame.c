@@ -205,8 +205,11 @@ static int get_record(rd_t *r, int64_t *prev_id, rec_t *rec)
     rec->op = tag & 7u;
     rec->upd = (tag >> BSF_MAP_TAG_UPD_SHIFT) & 15u;
     rec->high = (tag & BSF_MAP_TAG_HIGH) ? 1u : 0u;
-    if (rec->op >= BSF_MAP_REC_OPS) {
+    if (rec->op > BSF_MAP_REC_ID_LIMIT) {
         return 0;
+    }
+    if (rec->op == BSF_MAP_REC_ID_LIMIT) {
+        return rec->upd == 0u && !rec->high && get_u(r, 0xFFFFFFFFu, &rec->id);
     }
     if (rec->op == BSF_MAP_REC_POSE) {
         int64_t x;
@@ -715,6 +718,24 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
     return 1;
 }
 
+/* The id-limit record at the start of a snapshot round, within *budget:
+ * with it a receiver that lost frames (or joined late) learns which ids
+ * exist without waiting for the next new feature. 1 when it fit. */
+static int put_id_limit(const bsf_map_t *m, wr_t *w, size_t *budget)
+{
+    const size_t len = 1u + ulen(m->next_id);
+    if (len > *budget || len > (size_t)(w->end - w->p)) {
+        return 0;
+    }
+    tally_close(w);
+    w->rec_start = w->p;
+    w->rec_op = BSF_MAP_REC_SNAPSHOT; /* counted with the snapshots it completes */
+    put_byte(w, (uint8_t)BSF_MAP_REC_ID_LIMIT);
+    put_u(w, m->next_id);
+    *budget -= len;
+    return 1;
+}
+
 /* Snapshot records: the sent values of fully sent features, in id order
  * from snapshot_next, within the byte budget; a feature larger than what is
  * left goes in parts over several frames (restarted when its head changes
@@ -722,6 +743,7 @@ static int put_feature(bsf_map_t *m, wr_t *w, int64_t *prev_id, bsf_map_feature_
 static void put_snapshots(bsf_map_t *m, wr_t *w, int64_t *prev_id)
 {
     size_t budget = m->params.snapshot_budget;
+    int limit_sent = 0;
     uint16_t tries;
     for (tries = 0; tries <= m->n_features; ++tries) {
         uint16_t slot = BSF_MAP_NONE;
@@ -767,6 +789,11 @@ static void put_snapshots(bsf_map_t *m, wr_t *w, int64_t *prev_id)
             }
             m->snapshot_next = m->features[slot].id;
             m->snapshot_pos = 0u;
+            if (slot == lowest && !limit_sent) {
+                /* a round starts: which ids exist, then the features */
+                limit_sent = 1;
+                (void)put_id_limit(m, w, &budget);
+            }
         }
         f = &m->features[slot];
         if (!bsf_map_chain_clean(m, f)) {
@@ -1112,6 +1139,18 @@ static int rx_record(bsf_map_rx_t *rx, const rec_t *rec, const uint8_t *end)
                          BSF_WIRE_RAD_PER_THETA;
         rx->has_pose = 1u;
         ++rx->stats.poses;
+        return 1;
+    }
+    if (rec->op == BSF_MAP_REC_ID_LIMIT) {
+        /* every id the robot has given is below it: those this receiver
+         * never got are missing, none above it exists */
+        if (rec->id > BSF_MAP_RX_MAX_FEATURES) {
+            rx->over_cap = 1u;
+        }
+        if (rec->id > rx->id_limit) {
+            rx->id_limit = rec->id < BSF_MAP_RX_MAX_FEATURES ? rec->id : BSF_MAP_RX_MAX_FEATURES;
+        }
+        rx->ids_known = 1u;
         return 1;
     }
     if (rec->op == BSF_MAP_REC_NEW) {

@@ -36,7 +36,10 @@
 #define BSF_MAP_REC_MERGE 3u
 #define BSF_MAP_REC_SNAPSHOT 4u
 #define BSF_MAP_REC_POSE 5u
-#define BSF_MAP_REC_OPS 6u
+#define BSF_MAP_REC_OPS 6u /* operations with their own byte count in the stats */
+/* The robot's next feature id: every id it has given is below it. Sent with
+ * the snapshots (its bytes counted with them), once per round. */
+#define BSF_MAP_REC_ID_LIMIT 6u
 
 /* Tag: bits 0-2 operation, bits 3-6 the feature's update count mod 16,
  * bit 7 the end of an append (1: head) or the reversal of a merge's first

@@ -351,8 +351,9 @@ typedef enum {
  * feature was last confirmed (a frame advances a feature's 4-bit update
  * count by at most 4, docs/FORMAT.md section 11.3). Ids are given in send
  * order, so an id below bsf_map_rx_id_limit() never received is missing; so
- * is any id at or above it after a loss, until a new-feature record shows
- * which ids exist. Returns BSF_ERR_ARG for NULL rx.
+ * is any id at or above it after a loss, until a new-feature record or an
+ * id-limit record (sent with each snapshot round) shows which ids exist.
+ * Returns BSF_ERR_ARG for NULL rx.
  */
 BSF_NODISCARD int bsf_map_rx_feature_state(const bsf_map_rx_t *rx, uint32_t id);
 

@@ -463,7 +463,8 @@ class Map:
     @property
     def more_missing(self) -> bool:
         """True when, after a loss, features with ids above the largest seen may
-        have been sent and never received (until a new feature arrives)."""
+        have been sent and never received (until a new feature, or the id-limit
+        record that starts each snapshot round, arrives)."""
         return bool(self._rx.more_missing())
 
     def note_loss(self) -> None:
