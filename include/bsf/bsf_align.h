@@ -74,11 +74,15 @@ typedef enum {
     BSF_ALIGN_DECLINE_TOO_LARGE = 4,   /**< the correction exceeds max_xy or max_theta */
     BSF_ALIGN_DECLINE_DIVERGED = 5,    /**< correspondences lost while iterating, or a
                                             non-finite step */
-    BSF_ALIGN_DECLINE_UNDETERMINED = 6 /**< no direction is determined by the geometry */
+    BSF_ALIGN_DECLINE_UNDETERMINED = 6, /**< no direction is determined by the geometry */
+    BSF_ALIGN_DECLINE_NO_BETTER = 7     /**< the scan fits the map no better at the aligned
+                                             pose than at the prior (Huber cost of every
+                                             point against its nearest map curve, distances
+                                             capped at max_dist / 4) */
 } bsf_align_decline_t;
 
 /** Number of bsf_align_decline_t values (for tables of counts). */
-#define BSF_ALIGN_DECLINE_COUNT 7
+#define BSF_ALIGN_DECLINE_COUNT 8
 
 /** Bits of bsf_align_result_t.flags. */
 /** A direction was left free: the pose keeps the prior along min_eigvec
