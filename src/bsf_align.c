@@ -750,7 +750,8 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
     for (it = 0; it < (int)p->max_iter; ++it) {
         float step[3];
         float g2[3];
-        gate = p->max_dist * (it < 3 ? (it == 0 ? 1.0f : (it == 1 ? 0.6f : 0.36f)) : ALIGN_GATE_LAST);
+        gate =
+            p->max_dist * (it < 3 ? (it == 0 ? 1.0f : (it == 1 ? 0.6f : 0.36f)) : ALIGN_GATE_LAST);
         associate(w, p, tx, ty, prior->theta + dth, gate, it < 3, &ne);
         if (it == 0) {
             cost_prior = ne.cost; /* the first pass is at the prior */

@@ -67,13 +67,13 @@ void bsf_align_params_default(bsf_align_params_t *p);
 
 /** Why alignment declined (bsf_align_result_t.declined); the pose is then the prior. */
 typedef enum {
-    BSF_ALIGN_ACCEPTED = 0,            /**< not declined: the pose is the aligned one */
-    BSF_ALIGN_DECLINE_FEW_POINTS = 1,  /**< the scan has fewer than min_matches points */
-    BSF_ALIGN_DECLINE_EMPTY_MAP = 2,   /**< no map curve near the prior */
-    BSF_ALIGN_DECLINE_FEW_MATCHES = 3, /**< fewer than min_matches correspondences */
-    BSF_ALIGN_DECLINE_TOO_LARGE = 4,   /**< the correction exceeds max_xy or max_theta */
-    BSF_ALIGN_DECLINE_DIVERGED = 5,    /**< correspondences lost while iterating, or a
-                                            non-finite step */
+    BSF_ALIGN_ACCEPTED = 0,             /**< not declined: the pose is the aligned one */
+    BSF_ALIGN_DECLINE_FEW_POINTS = 1,   /**< the scan has fewer than min_matches points */
+    BSF_ALIGN_DECLINE_EMPTY_MAP = 2,    /**< no map curve near the prior */
+    BSF_ALIGN_DECLINE_FEW_MATCHES = 3,  /**< fewer than min_matches correspondences */
+    BSF_ALIGN_DECLINE_TOO_LARGE = 4,    /**< the correction exceeds max_xy or max_theta */
+    BSF_ALIGN_DECLINE_DIVERGED = 5,     /**< correspondences lost while iterating, or a
+                                             non-finite step */
     BSF_ALIGN_DECLINE_UNDETERMINED = 6, /**< no direction is determined by the geometry */
     BSF_ALIGN_DECLINE_NO_BETTER = 7     /**< the scan fits the map no better at the aligned
                                              pose than at the prior (Huber cost of every
