@@ -20,7 +20,8 @@
  * the geometry leaves undetermined (the axis of a long featureless corridor) is not
  * solved: the pose keeps the prior along it and BSF_ALIGN_FLAG_FREE is set.
  * When alignment cannot be trusted (too few points or correspondences, a
- * correction larger than the bounds, divergence) the call succeeds but
+ * correction larger than the bounds, divergence, or a pose at which the
+ * scan's points fit the map worse than at the prior) the call succeeds but
  * declines: the pose is the prior and `declined` says why.
  *
  * Fixed memory: bsf_align_work_t is caller-owned and sized by the caps in
