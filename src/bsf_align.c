@@ -25,6 +25,9 @@
 /* Feature curves are sampled about this often (metres), at most so many per span. */
 #define ALIGN_SAMPLE_SPACING 0.05f
 #define ALIGN_SAMPLES_PER_SPAN 16u
+/* Share of max_dist the correspondence gate shrinks to; residuals are capped
+ * at it when the aligned pose is compared with the prior. */
+#define ALIGN_GATE_LAST 0.25f
 
 void bsf_align_params_default(bsf_align_params_t *p)
 {
@@ -51,6 +54,7 @@ const char *bsf_align_decline_str(int declined)
     case BSF_ALIGN_DECLINE_TOO_LARGE: return "correction too large";
     case BSF_ALIGN_DECLINE_DIVERGED: return "diverged";
     case BSF_ALIGN_DECLINE_UNDETERMINED: return "undetermined";
+    case BSF_ALIGN_DECLINE_NO_BETTER: return "no better than the prior";
     default: return "unknown";
     }
 }
@@ -529,6 +533,8 @@ typedef struct {
     float h[9];   /* J^T W J, (x, y, theta) */
     float g[3];   /* J^T W r */
     float sum_r2; /* sum of squared residuals of the point matches */
+    float cost;   /* search passes: Huber cost of every point against its nearest
+                     chord, distances capped at ALIGN_GATE_LAST * max_dist */
     uint16_t n_match;
     uint16_t n_vmatch;
 } align_normal_t;
@@ -537,6 +543,13 @@ static float huber_weight(float r, float k)
 {
     const float a = fabsf(r);
     return a <= k ? 1.0f : k / a;
+}
+
+/* Huber loss of residual r (half the square within k, linear beyond). */
+static float huber_cost(float r, float k)
+{
+    const float a = fabsf(r);
+    return a <= k ? 0.5f * a * a : k * (a - 0.5f * k);
 }
 
 static void add_row(align_normal_t *ne, float jx, float jy, float jt, float r, float w)
@@ -553,14 +566,18 @@ static void add_row(align_normal_t *ne, float jx, float jy, float jt, float r, f
 }
 
 /* One association pass. search = 1: each point's nearest chord through the
- * grid (remembered in w->match); search = 0: the chord of the last search
- * again, its line as the tangent (the pose moved by millimetres since). */
+ * grid (remembered in w->match), and ne->cost; search = 0: the chord of the
+ * last search again, its line as the tangent (the pose moved by millimetres
+ * since). The cost does not depend on `gate` (at least the cap): a chord
+ * within the cap is within max_dist / 2, always found through the grid. */
 static void associate(bsf_align_work_t *w, const bsf_align_params_t *p, float tx, float ty,
                       float th, float gate, int search, align_normal_t *ne)
 {
     float s;
     float c;
     const float gate2 = gate * gate;
+    const float cap = ALIGN_GATE_LAST * p->max_dist;
+    const float cap_cost = huber_cost(cap, p->huber);
     uint16_t i;
     memset(ne, 0, sizeof *ne);
     bsf_sincosf(th, &s, &c);
@@ -610,6 +627,9 @@ static void associate(bsf_align_work_t *w, const bsf_align_params_t *p, float tx
                 }
             }
             w->match[i] = best_k >= 0 ? (uint16_t)best_k : 0xFFFFu;
+            if (best_k < 0 || best > cap * cap) {
+                ne->cost += cap_cost;
+            }
         }
         if (best_k >= 0) {
             const bsf_align_seg_t *sg = &w->segs[best_k];
@@ -618,6 +638,9 @@ static void associate(bsf_align_work_t *w, const bsf_align_params_t *p, float tx
             const float r = nx * (qx - sg->ax) + ny * (qy - sg->ay);
             add_row(ne, nx, ny, ny * rx - nx * ry, r, huber_weight(r, p->huber));
             ne->sum_r2 += r * r;
+            if (search && best <= cap * cap) {
+                ne->cost += huber_cost(r, p->huber);
+            }
             ++ne->n_match;
         }
     }
@@ -698,6 +721,9 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
     float d[3];
     float s0;
     float c0;
+    float cost_prior = 0.0f;
+    float cost_aligned;
+    int projected;
     int n_free;
     int it;
     int i;
@@ -724,8 +750,12 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
     for (it = 0; it < (int)p->max_iter; ++it) {
         float step[3];
         float g2[3];
-        gate = p->max_dist * (it < 3 ? (it == 0 ? 1.0f : (it == 1 ? 0.6f : 0.36f)) : 0.25f);
+        gate =
+            p->max_dist * (it < 3 ? (it == 0 ? 1.0f : (it == 1 ? 0.6f : 0.36f)) : ALIGN_GATE_LAST);
         associate(w, p, tx, ty, prior->theta + dth, gate, it < 3, &ne);
+        if (it == 0) {
+            cost_prior = ne.cost; /* the first pass is at the prior */
+        }
         out->n_iter = (uint8_t)(it + 1);
         if (ne.n_match < p->min_matches) {
             out->declined = it == 0 ? BSF_ALIGN_DECLINE_FEW_MATCHES : BSF_ALIGN_DECLINE_DIVERGED;
@@ -786,6 +816,7 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
         d[1] -= proj * v[1 * 3 + i];
         d[2] -= proj * v[2 * 3 + i];
     }
+    projected = tx != d[0] || ty != d[1] || dth != d[2] * il;
     tx = d[0];
     ty = d[1];
     dth = d[2] * il;
@@ -808,6 +839,20 @@ static void align_core(bsf_align_work_t *w, const bsf_align_params_t *p, const b
     }
     if (tx * tx + ty * ty > p->max_xy * p->max_xy || fabsf(dth) > p->max_theta) {
         out->declined = BSF_ALIGN_DECLINE_TOO_LARGE;
+        return;
+    }
+    /* Gauss-Newton minimises a cost whose correspondences and gate change as
+     * it goes; it can end where the whole scan fits the map worse than at
+     * the prior (a stretch of points drawn onto a neighbouring wall). The
+     * same cost, every point against its nearest chord, decides, at the
+     * pose returned (after the projection off the free directions). */
+    cost_aligned = ne.cost;
+    if (projected) {
+        associate(w, p, tx, ty, prior->theta + dth, gate, 1, &ne);
+        cost_aligned = ne.cost;
+    }
+    if (!bsf_finite_bits(cost_aligned) || cost_aligned > cost_prior) {
+        out->declined = BSF_ALIGN_DECLINE_NO_BETTER;
         return;
     }
     out->pose.x = prior->x + tx;

@@ -20,7 +20,8 @@
  * the geometry leaves undetermined (the axis of a long featureless corridor) is not
  * solved: the pose keeps the prior along it and BSF_ALIGN_FLAG_FREE is set.
  * When alignment cannot be trusted (too few points or correspondences, a
- * correction larger than the bounds, divergence) the call succeeds but
+ * correction larger than the bounds, divergence, or a pose at which the
+ * scan's points fit the map worse than at the prior) the call succeeds but
  * declines: the pose is the prior and `declined` says why.
  *
  * Fixed memory: bsf_align_work_t is caller-owned and sized by the caps in
@@ -67,18 +68,22 @@ void bsf_align_params_default(bsf_align_params_t *p);
 
 /** Why alignment declined (bsf_align_result_t.declined); the pose is then the prior. */
 typedef enum {
-    BSF_ALIGN_ACCEPTED = 0,            /**< not declined: the pose is the aligned one */
-    BSF_ALIGN_DECLINE_FEW_POINTS = 1,  /**< the scan has fewer than min_matches points */
-    BSF_ALIGN_DECLINE_EMPTY_MAP = 2,   /**< no map curve near the prior */
-    BSF_ALIGN_DECLINE_FEW_MATCHES = 3, /**< fewer than min_matches correspondences */
-    BSF_ALIGN_DECLINE_TOO_LARGE = 4,   /**< the correction exceeds max_xy or max_theta */
-    BSF_ALIGN_DECLINE_DIVERGED = 5,    /**< correspondences lost while iterating, or a
-                                            non-finite step */
-    BSF_ALIGN_DECLINE_UNDETERMINED = 6 /**< no direction is determined by the geometry */
+    BSF_ALIGN_ACCEPTED = 0,             /**< not declined: the pose is the aligned one */
+    BSF_ALIGN_DECLINE_FEW_POINTS = 1,   /**< the scan has fewer than min_matches points */
+    BSF_ALIGN_DECLINE_EMPTY_MAP = 2,    /**< no map curve near the prior */
+    BSF_ALIGN_DECLINE_FEW_MATCHES = 3,  /**< fewer than min_matches correspondences */
+    BSF_ALIGN_DECLINE_TOO_LARGE = 4,    /**< the correction exceeds max_xy or max_theta */
+    BSF_ALIGN_DECLINE_DIVERGED = 5,     /**< correspondences lost while iterating, or a
+                                             non-finite step */
+    BSF_ALIGN_DECLINE_UNDETERMINED = 6, /**< no direction is determined by the geometry */
+    BSF_ALIGN_DECLINE_NO_BETTER = 7     /**< the scan fits the map no better at the aligned
+                                             pose than at the prior (Huber cost of every
+                                             point against its nearest map curve, distances
+                                             capped at max_dist / 4) */
 } bsf_align_decline_t;
 
 /** Number of bsf_align_decline_t values (for tables of counts). */
-#define BSF_ALIGN_DECLINE_COUNT 7
+#define BSF_ALIGN_DECLINE_COUNT 8
 
 /** Bits of bsf_align_result_t.flags. */
 /** A direction was left free: the pose keeps the prior along min_eigvec

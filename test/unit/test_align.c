@@ -278,11 +278,69 @@ static void test_align_declines_bad_input(void)
     TEST_ASSERT_EQUAL_STRING("unknown", bsf_align_decline_str(99));
 }
 
+/* Scan vertices that disagree with the map (moved 0.25 m) pull the pose off
+ * where the scan's points fit; with them weighted heavily, Gauss-Newton ends
+ * where every point fits worse than at the (true) prior, and the call keeps
+ * the prior. The same scan with its own vertices stays within 2 cm of it. */
+static void test_align_declines_a_fit_worse_than_the_prior(void)
+{
+    static bsf_result_t moved;
+    bsf_align_params_t p;
+    int n_declined = 0;
+    long k;
+    office_map();
+    bsf_align_params_default(&p);
+    p.vertex_weight = 100.0f;
+    for (k = 5; k < N_SCANS; k += 17) {
+        double x;
+        double y;
+        double th;
+        bsf_pose_t prior;
+        bsf_align_result_t r;
+        size_t j;
+        int n_vertices = 0;
+        bsf_scene_demo_pose(k, N_SCANS, &x, &y, &th);
+        scan_at(x, y, th, 0.0, 7000u + (uint64_t)k);
+        prior.x = (float)x;
+        prior.y = (float)y;
+        prior.theta = (float)th;
+        memcpy(&moved, &res, sizeof moved);
+        for (j = 0; j < moved.n_ctrl; ++j) {
+            if (moved.ctrl_is_vertex[j]) {
+                moved.ctrl[j].x += 0.25f;
+                ++n_vertices;
+            }
+        }
+        if (n_vertices == 0) {
+            continue;
+        }
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_align_points(&work, &p, &map, &ex.points, &moved, &prior, &r));
+        assert_finite_result(&r);
+        assert_declined(&r, BSF_ALIGN_DECLINE_NO_BETTER, &prior);
+        TEST_ASSERT_TRUE(r.n_matches >= 12u);
+        ++n_declined;
+
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_align_points(&work, &p, &map, &ex.points, &res, &prior, &r));
+        assert_finite_result(&r);
+        TEST_ASSERT_TRUE(r.declined == BSF_ALIGN_ACCEPTED ||
+                         r.declined == BSF_ALIGN_DECLINE_NO_BETTER);
+        TEST_ASSERT_FLOAT_WITHIN(0.02f, (float)x, r.pose.x);
+        TEST_ASSERT_FLOAT_WITHIN(0.02f, (float)y, r.pose.y);
+        TEST_ASSERT_FLOAT_WITHIN(0.006f, (float)th, r.pose.theta);
+    }
+    TEST_ASSERT_TRUE(n_declined >= 3);
+    TEST_ASSERT_EQUAL_STRING("no better than the prior",
+                             bsf_align_decline_str(BSF_ALIGN_DECLINE_NO_BETTER));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_align_recovers_known_offset);
     RUN_TEST(test_align_corridor_keeps_prior_along_axis);
     RUN_TEST(test_align_declines_bad_input);
+    RUN_TEST(test_align_declines_a_fit_worse_than_the_prior);
     return UNITY_END();
 }
