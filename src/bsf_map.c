@@ -1683,19 +1683,17 @@ static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx
     return m;
 }
 
-/* A chain whose two ends meet (within match_dist, the widest gate at which
- * two observations are one surface point) where the legs that end it would
- * cross, within ctrl_spacing of both ends (as far as a rounded fit may put a
- * corner's point, vertex_gate): the chain runs round a convex object and
- * closes at a corner that no scan sees as one, since each scan's feature
- * ends there (a silhouette). Both ends go to the legs' crossing, and the
- * tail there becomes the corner's vertex (one vertex: the head meets it).
- * Parallel legs never cross near: a loop closed along a straight wall is
- * left as it is. */
+/* A chain whose two ends meet where the legs that end it cross, the ends
+ * and the crossing all within match_dist of each other (the widest gate at
+ * which two observations are one surface point): the chain runs round a
+ * convex object and closes at a corner that no scan sees as one, since
+ * each scan's feature ends there (a silhouette). Both ends go to the
+ * crossing, and the tail there becomes the corner's vertex (one vertex: the
+ * head meets it). Parallel legs never cross near: a loop closed along a
+ * straight wall is left as it is. */
 static void close_loops(bsf_map_t *m)
 {
     const float md2 = m->params.match_dist * m->params.match_dist;
-    const float sp2 = m->params.ctrl_spacing * m->params.ctrl_spacing;
     const float near2 = m->params.match_dist_near * m->params.match_dist_near;
     uint16_t fs;
     for (fs = 0; fs < m->n_features; ++fs) {
@@ -1738,8 +1736,8 @@ static void close_loops(bsf_map_t *m)
         sa = ((t->x - h->x) * by - (t->y - h->y) * bx) / cross;
         xx = h->x + sa * ax;
         xy = h->y + sa * ay;
-        if ((xx - h->x) * (xx - h->x) + (xy - h->y) * (xy - h->y) > sp2 ||
-            (xx - t->x) * (xx - t->x) + (xy - t->y) * (xy - t->y) > sp2) {
+        if ((xx - h->x) * (xx - h->x) + (xy - h->y) * (xy - h->y) > md2 ||
+            (xx - t->x) * (xx - t->x) + (xy - t->y) * (xy - t->y) > md2) {
             continue;
         }
         /* a smooth join (one plain point at the crossing) passes a quarter
