@@ -932,6 +932,69 @@ static unsigned joining_end(const bsf_map_t *m, const label_t *l, const sample_t
     return 0u;
 }
 
+/* Gate of a point at range r from the sensor (fuse_feature's). */
+static float range_gate(const bsf_map_params_t *p, float r)
+{
+    const float g = p->match_dist_near + p->match_dist_per_m * r;
+    return g < p->match_dist ? g : p->match_dist;
+}
+
+/* 1 when feature fu was never sent and each of its points lies within the
+ * gate (at its range from the sensor sx, sy) of a chord of feature fa in
+ * the search window: fu is a second copy of a stretch of fa, made when an
+ * earlier scan's samples were labelled against a curve that rounded a
+ * corner fa has since been given. */
+static int copy_of(const bsf_map_t *m, uint16_t fu, uint16_t fa, float sx, float sy)
+{
+    const bsf_map_feature_t *u = &m->features[fu];
+    uint16_t i;
+    if ((u->flags & (BSF_MAP_FF_SENT | BSF_MAP_FF_OP)) != 0u) {
+        return 0;
+    }
+    for (i = u->head; i != BSF_MAP_NONE; i = m->ctrl[i].next) {
+        const bsf_map_ctrl_t *c = &m->ctrl[i];
+        const float rx = c->x - sx;
+        const float ry = c->y - sy;
+        const float gate = range_gate(&m->params, sqrtf(rx * rx + ry * ry));
+        int near = 0;
+        uint16_t g;
+        for (g = 0; g < m->n_segs && !near; ++g) {
+            const bsf_map_seg_t *sg = &m->segs[g];
+            bsf_map_ctrl_t a;
+            bsf_map_ctrl_t b;
+            if (sg->feature != fa) {
+                continue;
+            }
+            a.x = sg->ax;
+            a.y = sg->ay;
+            b.x = sg->bx;
+            b.y = sg->by;
+            near = seg_dist2(c, &a, &b) <= gate * gate;
+        }
+        if (!near) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* 1 when a scan travelling along (tx, ty) leaves feature fs through its
+ * end (1 head, 2 tail): the end's outward direction (from its inner
+ * neighbour to it, the clamped curve's end tangent) runs with the travel.
+ * A scan that meets an end while travelling into the feature is running
+ * back over it (a second copy of the same face): joining or extending
+ * there would fold the chain back on itself. */
+static int leaves_through(const bsf_map_t *m, uint16_t fs, unsigned end, float tx, float ty)
+{
+    const bsf_map_feature_t *f = &m->features[fs];
+    const uint16_t e = end == 1u ? f->head : f->tail;
+    const uint16_t in = end == 1u ? m->ctrl[e].next : m->ctrl[e].prev;
+    if (in == BSF_MAP_NONE) {
+        return 1;
+    }
+    return (m->ctrl[e].x - m->ctrl[in].x) * tx + (m->ctrl[e].y - m->ctrl[in].y) * ty > 0.0f;
+}
+
 /* Extend slot fs at end (1 head, 2 tail) with samples from..to, walking
  * outward from the matched part. */
 static void extend(bsf_map_t *m, uint16_t fs, unsigned end, const sample_t *s, long from, long to)
@@ -1396,6 +1459,26 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
                 const unsigned ea = joining_end(m, &lab[k], &s[k]);
                 const unsigned eb = joining_end(m, &lab[g], &s[g]);
                 if (ea != 0u && eb != 0u &&
+                    (!leaves_through(m, lab[k].feature, ea, s[k].dx, s[k].dy) ||
+                     !leaves_through(m, lab[g].feature, eb, -s[g].dx, -s[g].dy))) {
+                    /* the scan does not leave one through its end and enter
+                     * the other through its end: it runs back over one of
+                     * them. A copy never sent goes (this scan refined the
+                     * other); otherwise they merge as before */
+                    uint16_t drop = BSF_MAP_NONE;
+                    if (copy_of(m, lab[g].feature, lab[k].feature, sx, sy)) {
+                        drop = lab[g].feature;
+                    } else if (copy_of(m, lab[k].feature, lab[g].feature, sx, sy)) {
+                        drop = lab[k].feature;
+                    }
+                    if (drop != BSF_MAP_NONE) {
+                        chain_free(m, m->features[drop].head);
+                        feature_remove_slot(m, drop);
+                        ++m->stats.n_merged;
+                        return; /* slots moved */
+                    }
+                }
+                if (ea != 0u && eb != 0u &&
                     merge(m, lab[k].feature, ea, lab[g].feature, eb, s, (long)k + 1, (long)g - 1)) {
                     /* slots moved: this observation's work ends here */
                     return;
@@ -1453,13 +1536,6 @@ static void drop_transients(bsf_map_t *m)
         feature_remove_slot(m, fs);
         ++m->stats.n_transient;
     }
-}
-
-/* Gate of a point at range r from the sensor (fuse_feature's). */
-static float range_gate(const bsf_map_params_t *p, float r)
-{
-    const float g = p->match_dist_near + p->match_dist_per_m * r;
-    return g < p->match_dist ? g : p->match_dist;
 }
 
 /* Bearing from (sx, sy) of each of the n points q, unwrapped along them,
@@ -1607,6 +1683,84 @@ static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx
     return m;
 }
 
+/* A chain whose two ends meet where the legs that end it cross, the ends
+ * and the crossing all within match_dist of each other (the widest gate at
+ * which two observations are one surface point): the chain runs round a
+ * convex object and closes at a corner that no scan sees as one, since
+ * each scan's feature ends there (a silhouette). Both ends go to the
+ * crossing, and the tail there becomes the corner's vertex (one vertex: the
+ * head meets it). Parallel legs never cross near: a loop closed along a
+ * straight wall is left as it is. */
+static void close_loops(bsf_map_t *m)
+{
+    const float md2 = m->params.match_dist * m->params.match_dist;
+    const float near2 = m->params.match_dist_near * m->params.match_dist_near;
+    uint16_t fs;
+    for (fs = 0; fs < m->n_features; ++fs) {
+        const bsf_map_feature_t *f = &m->features[fs];
+        bsf_map_ctrl_t *h;
+        bsf_map_ctrl_t *t;
+        const bsf_map_ctrl_t *h1;
+        const bsf_map_ctrl_t *t1;
+        float ax;
+        float ay;
+        float bx;
+        float by;
+        float cross;
+        float sa;
+        float xx;
+        float xy;
+        float mx;
+        float my;
+        if (f->last_seen != m->stats.n_fused || (f->flags & BSF_MAP_FF_OP) != 0u ||
+            f->n_ctrl < 4u) {
+            continue;
+        }
+        h = &m->ctrl[f->head];
+        t = &m->ctrl[f->tail];
+        h1 = &m->ctrl[h->next];
+        t1 = &m->ctrl[t->prev];
+        if ((h->flags & BSF_MAP_CF_VERTEX) != 0u ||
+            (h->x - t->x) * (h->x - t->x) + (h->y - t->y) * (h->y - t->y) > md2) {
+            continue;
+        }
+        ax = h->x - h1->x;
+        ay = h->y - h1->y;
+        bx = t->x - t1->x;
+        by = t->y - t1->y;
+        cross = ax * by - ay * bx;
+        if (cross * cross <= 1e-12f * (ax * ax + ay * ay) * (bx * bx + by * by)) {
+            continue;
+        }
+        /* h + sa * a = t + sb * b */
+        sa = ((t->x - h->x) * by - (t->y - h->y) * bx) / cross;
+        xx = h->x + sa * ax;
+        xy = h->y + sa * ay;
+        if ((xx - h->x) * (xx - h->x) + (xy - h->y) * (xy - h->y) > md2 ||
+            (xx - t->x) * (xx - t->x) + (xy - t->y) * (xy - t->y) > md2) {
+            continue;
+        }
+        /* a smooth join (one plain point at the crossing) passes a quarter
+         * of the crossing's distance from its neighbours' midpoint away from
+         * it: within the tightest gate, the ends are explained without a
+         * corner (a round pillar closing on itself) */
+        mx = 0.5f * (h1->x + t1->x) - xx;
+        my = 0.5f * (h1->y + t1->y) - xy;
+        if (0.0625f * (mx * mx + my * my) <= near2) {
+            continue;
+        }
+        if (!(t->flags & BSF_MAP_CF_VERTEX)) {
+            t->flags |= BSF_MAP_CF_VERTEX;
+            t->corner_obs = 1u;
+            ++m->stats.n_vertex_made;
+        }
+        h->x = xx;
+        h->y = xy;
+        t->x = xx;
+        t->y = xy;
+    }
+}
+
 static bsf_status_t check_scan(const bsf_result_t *scan, const bsf_pose_t *pose, float step)
 {
     /* world coordinates stay within what the wire's quantised values hold */
@@ -1708,6 +1862,7 @@ int bsf_map_fuse(bsf_map_t *map, const bsf_result_t *scan, const bsf_pose_t *pos
             fuse_feature(map, w, vtx, n, pose->x, pose->y, &nr);
         }
     }
+    close_loops(map);
     return (int)scan->n_features;
 }
 

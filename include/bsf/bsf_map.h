@@ -98,10 +98,12 @@ typedef struct {
     uint32_t n_obs;            /**< scan features fused */
     uint32_t n_new;            /**< map features created */
     uint32_t n_extended;       /**< extensions of a map feature at one end */
-    uint32_t n_merged;         /**< two map features joined into one */
+    uint32_t n_merged;         /**< two map features joined into one, or a never-sent copy
+                                    of a map feature dropped */
     uint32_t n_refined;        /**< control point refinements (one per point per scan) */
     uint32_t n_vertex_merged;  /**< scan vertices merged into an existing map vertex */
-    uint32_t n_vertex_made;    /**< map control points turned into a vertex by a scan vertex */
+    uint32_t n_vertex_made;    /**< map control points turned into a vertex by a scan vertex,
+                                    or where a chain closes on itself at a corner */
     uint32_t n_forgotten;      /**< features dropped from RAM (the receiver keeps them) */
     uint32_t n_forgotten_ctrl; /**< their control points */
     uint32_t n_dropped_obs;    /**< scan features left out: caps full, nothing to forget */
