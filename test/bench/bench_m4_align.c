@@ -84,18 +84,12 @@ int main(void)
     }
     for (k = 0; k < n; ++k) {
         const bench_map_scan_t *sc = &bench_map_scans[k];
-        bsf_scan_t s;
+        const bsf_scan_t s = bench_map_scan(k);
         bsf_align_result_t ar;
         uint32_t t0;
         uint32_t t1;
         uint32_t *base;
         int st;
-        s.ranges = &bench_map_ranges[sc->first];
-        s.count = sc->count;
-        s.angle_min = -1.57079633f;
-        s.angle_increment = sc->angle_increment;
-        s.range_min = 0.0f;
-        s.range_max = 80.0f;
         if (bsf_extract(&g_ex, &s, &g_res) < 0) {
             printf("scan %u: extraction failed\n", (unsigned)k);
             return 1;

@@ -11,6 +11,7 @@
 
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
+#include "demo_scan.h"
 #include "unity.h"
 
 #if BSF_ALIGN_MAX_SEGS > 64
@@ -22,7 +23,6 @@ static bsf_result_t res;
 static bsf_map_t map;
 static bsf_align_work_t work;
 static bsf_scene_t scene;
-static float ranges[BSF_MAX_POINTS];
 
 void setUp(void)
 {
@@ -34,28 +34,6 @@ void tearDown(void)
 
 #define N_SCANS 60
 
-static void scan_at(long k, uint64_t seed, bsf_pose_t *pose)
-{
-    bsf_scene_rng_t rng;
-    bsf_scan_t s;
-    bsf_lidar_t l;
-    double x;
-    double y;
-    double th;
-    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
-    bsf_scene_demo_pose(k, N_SCANS, &x, &y, &th);
-    l = bsf_lidar_default(x, y, th, 361u, 1.5 * 3.14159265358979);
-    l.noise_sigma = 0.01;
-    bsf_scene_rng_seed(&rng, seed);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
-    s = bsf_scene_lidar_scan(&l, ranges);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
-    pose->x = (float)x;
-    pose->y = (float)y;
-    pose->theta = (float)th;
-}
-
 static void test_align_caps_cut_is_reported(void)
 {
     long k;
@@ -64,14 +42,14 @@ static void test_align_caps_cut_is_reported(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_init(&map, NULL));
     for (k = 0; k < N_SCANS; ++k) {
         bsf_pose_t pose;
-        scan_at(k, 300u + (uint64_t)k, &pose);
+        demo_scan_extract(&scene, k, N_SCANS, 300u + (uint64_t)k, &ex, &res, &pose);
         TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
     }
     for (k = 0; k < N_SCANS; k += 6) {
         bsf_pose_t truth;
         bsf_pose_t prior;
         bsf_align_result_t r;
-        scan_at(k, 800u + (uint64_t)k, &truth);
+        demo_scan_extract(&scene, k, N_SCANS, 800u + (uint64_t)k, &ex, &res, &truth);
         prior = truth;
         prior.x += 0.05f;
         prior.theta -= 0.01f;

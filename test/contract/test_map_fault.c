@@ -18,6 +18,7 @@
 
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
+#include "demo_scan.h"
 #include "unity.h"
 
 #define N_LOOP 90
@@ -35,7 +36,6 @@ static bsf_map_rx_t rx;
 static bsf_decoder_t dec;
 static bsf_frame_t frame;
 static bsf_scene_t scene;
-static float ranges[BSF_MAX_POINTS];
 static uint8_t stream[STREAM_CAP];
 static size_t frame_start[MAX_FRAMES + 1];
 static uint32_t frame_seq[MAX_FRAMES];
@@ -90,27 +90,6 @@ void setUp(void)
 
 void tearDown(void)
 {
-}
-
-/* Scan k of the demo office's loop, extracted; its true pose in *pose. */
-static void scan_k(long k, bsf_pose_t *pose)
-{
-    bsf_scene_rng_t srng;
-    bsf_scan_t s;
-    bsf_lidar_t l;
-    double x, y, th;
-    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
-    bsf_scene_demo_pose(k % N_LOOP, N_LOOP, &x, &y, &th);
-    l = bsf_lidar_default(x, y, th, 361u, 1.5 * 3.14159265358979);
-    l.noise_sigma = 0.01;
-    bsf_scene_rng_seed(&srng, 77u + (uint64_t)k);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &srng, ranges, NULL, BSF_MAX_POINTS));
-    s = bsf_scene_lidar_scan(&l, ranges);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
-    pose->x = (float)x;
-    pose->y = (float)y;
-    pose->theta = (float)th;
 }
 
 /* The sequence number of a map payload (a uvar after the type byte). */
@@ -218,7 +197,7 @@ static void make_stream(uint16_t budget)
         bsf_pose_t pose = {1.0f, 1.0f, 0.0f};
         size_t len = 0u;
         if (k < N_DRIVE) {
-            scan_k(k, &pose);
+            demo_scan_extract(&scene, k % N_LOOP, N_LOOP, 77u + (uint64_t)k, &ex, &res, &pose);
         } else {
             res.n_features = 0u; /* the robot stands still: snapshots go round */
             res.n_ctrl = 0u;

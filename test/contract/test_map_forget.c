@@ -9,6 +9,7 @@
 
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
+#include "demo_scan.h"
 #include "unity.h"
 
 #if BSF_MAP_MAX_CTRL > 512
@@ -22,7 +23,6 @@ static bsf_map_rx_t rx;
 static bsf_decoder_t dec;
 static bsf_frame_t frame;
 static bsf_scene_t scene;
-static float ranges[BSF_MAX_POINTS];
 static uint8_t buf[BSF_MAP_FRAME_MAX_SIZE];
 static int32_t q_a[2 * 1024];
 static int32_t q_b[2 * 1024];
@@ -42,28 +42,6 @@ void setUp(void)
 
 void tearDown(void)
 {
-}
-
-static void scan_k(long k, bsf_pose_t *pose)
-{
-    bsf_scene_rng_t rng;
-    bsf_scan_t s;
-    bsf_lidar_t l;
-    double x;
-    double y;
-    double th;
-    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
-    bsf_scene_demo_pose(k % N_SCANS, N_SCANS, &x, &y, &th);
-    l = bsf_lidar_default(x, y, th, 361u, 1.5 * 3.14159265358979);
-    l.noise_sigma = 0.01;
-    bsf_scene_rng_seed(&rng, 100u + (uint64_t)k);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
-    s = bsf_scene_lidar_scan(&l, ranges);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-    TEST_ASSERT_TRUE(bsf_extract(&ex, &s, &res) >= 0);
-    pose->x = (float)x;
-    pose->y = (float)y;
-    pose->theta = (float)th;
 }
 
 static void deliver(const uint8_t *data, size_t len)
@@ -111,7 +89,7 @@ static void test_map_forgets_sent_features_and_receiver_keeps_them(void)
         bsf_pose_t pose;
         size_t len = 0;
         size_t i;
-        scan_k(k, &pose);
+        demo_scan_extract(&scene, k % N_SCANS, N_SCANS, 100u + (uint64_t)k, &ex, &res, &pose);
         TEST_ASSERT_TRUE(bsf_map_fuse(&map, &res, &pose) >= 0);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
         deliver(buf, len);

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "fuzz_check.h"
+#include "fuzz_input.h"
 #include "fuzz_map_gen.h"
 
 static bsf_map_t map;
@@ -28,37 +29,6 @@ static bsf_result_t scan;
 static bsf_points_t points;
 static bsf_align_result_t out;
 static bsf_align_result_t untouched;
-
-typedef struct {
-    const uint8_t *p;
-    size_t n;
-} input_t;
-
-static uint8_t take1(input_t *in)
-{
-    uint8_t v = 0u;
-    if (in->n > 0u) {
-        v = in->p[0];
-        ++in->p;
-        --in->n;
-    }
-    return v;
-}
-
-static uint16_t take2(input_t *in)
-{
-    const uint16_t lo = take1(in);
-    return (uint16_t)(lo | ((uint16_t)take1(in) << 8));
-}
-
-static float take_raw(input_t *in)
-{
-    uint32_t bits = take2(in);
-    float f;
-    bits |= (uint32_t)take2(in) << 16;
-    memcpy(&f, &bits, sizeof f);
-    return f;
-}
 
 static float take_coord(input_t *in)
 {

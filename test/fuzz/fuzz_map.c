@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "fuzz_check.h"
+#include "fuzz_input.h"
 #include "fuzz_map_gen.h"
 
 static bsf_map_t map;
@@ -43,37 +44,6 @@ static int32_t q_robot[2u * BSF_MAP_MAX_CTRL];
 static int32_t q_rx[2u * BSF_MAP_MAX_CTRL];
 static uint8_t v_robot[BSF_MAP_MAX_CTRL];
 static uint8_t v_rx[BSF_MAP_MAX_CTRL];
-
-typedef struct {
-    const uint8_t *p;
-    size_t n;
-} input_t;
-
-static uint8_t take1(input_t *in)
-{
-    uint8_t v = 0u;
-    if (in->n > 0u) {
-        v = in->p[0];
-        ++in->p;
-        --in->n;
-    }
-    return v;
-}
-
-static uint16_t take2(input_t *in)
-{
-    const uint16_t lo = take1(in);
-    return (uint16_t)(lo | ((uint16_t)take1(in) << 8));
-}
-
-static float take_raw(input_t *in)
-{
-    uint32_t bits = take2(in);
-    float f;
-    bits |= (uint32_t)take2(in) << 16;
-    memcpy(&f, &bits, sizeof f);
-    return f;
-}
 
 /* centimetres as int16: up to 327 m */
 static float take_cm(input_t *in)

@@ -53,6 +53,7 @@
 #include <time.h>
 #include <zlib.h>
 
+#include "bench_util.h"
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
 #include "carmen.h"
@@ -502,13 +503,6 @@ static double rx_length(void)
     len = c.length;
     mg_curves_free(&c);
     return len;
-}
-
-static double now_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e6 + (double)ts.tv_nsec * 1e-3;
 }
 
 static int fuse_run(const run_t *r, mode_t_ mode, run_result_t *out)

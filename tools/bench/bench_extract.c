@@ -38,6 +38,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "bsf/bsf.h"
 #include "bsf_port_clock.h"
 #include "bench_scenes.h"
@@ -64,20 +65,6 @@ typedef struct {
 static bsf_extractor_t g_ex;
 static bsf_extractor_t g_ex_noclock;
 static bsf_result_t g_res;
-
-static double now_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e6 + (double)ts.tv_nsec * 1e-3;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a;
-    const double y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 static void *xmalloc(size_t n)
 {
@@ -170,16 +157,7 @@ typedef struct {
 static summary_t summarise(double *samples, size_t n_scans, int passes, double *per_scan)
 {
     summary_t s;
-    size_t i;
-    double sum = 0.0;
-    for (i = 0; i < n_scans; ++i) {
-        double *v = &samples[i * (size_t)passes];
-        qsort(v, (size_t)passes, sizeof *v, cmp_double);
-        per_scan[i] = v[passes / 2];
-        sum += per_scan[i];
-    }
-    qsort(per_scan, n_scans, sizeof *per_scan, cmp_double);
-    s.mean = sum / (double)n_scans;
+    s.mean = per_scan_medians(samples, n_scans, passes, per_scan) / (double)n_scans;
     s.median = per_scan[n_scans / 2];
     s.p99 = per_scan[(n_scans * 99u) / 100u];
     s.max = per_scan[n_scans - 1u];

@@ -20,23 +20,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "bsf/bsf.h"
 #include "bsf/bsf_falko.h"
 #include "carmen.h"
-
-static double now_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e6 + (double)ts.tv_nsec * 1e-3;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a;
-    const double y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 typedef struct {
     float *ranges;
@@ -51,18 +38,11 @@ static void print_stats(const char *what, double *samples, size_t n_scans, int p
                         double *per_scan)
 {
     size_t i;
-    double mean = 0.0, all = 0.0;
+    double mean, all = 0.0;
     for (i = 0; i < n_scans * (size_t)passes; ++i) {
         all += samples[i];
     }
-    for (i = 0; i < n_scans; ++i) {
-        double *s = &samples[i * (size_t)passes];
-        qsort(s, (size_t)passes, sizeof *s, cmp_double);
-        per_scan[i] = s[passes / 2];
-        mean += per_scan[i];
-    }
-    qsort(per_scan, n_scans, sizeof *per_scan, cmp_double);
-    mean /= (double)n_scans;
+    mean = per_scan_medians(samples, n_scans, passes, per_scan) / (double)n_scans;
     printf("%s us/scan (per-scan median over passes): mean %.2f  median %.2f  p99 %.2f  max %.2f;"
            " mean of all calls %.2f\n",
            what, mean, per_scan[n_scans / 2], per_scan[(n_scans * 99) / 100], per_scan[n_scans - 1],

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "bsf/bsf.h"
 
 #define MAX_PTS 64
@@ -57,13 +58,6 @@ static void add_point(bench_case_t *c, double x, double y, double sigma)
     c->pts[c->n].x = (float)(x + sigma * gauss());
     c->pts[c->n].y = (float)(y + sigma * gauss());
     c->n++;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a;
-    const double y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 static void run_case(const bench_case_t *c, size_t reps)

@@ -51,6 +51,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
 #include "bsf_truth.h"
@@ -286,13 +287,6 @@ static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t 
     return fuse_scan(col, px, py, pth);
 }
 
-static double now_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e6 + 1e-3 * (double)ts.tv_nsec;
-}
-
 /* A map frame through the decoder into the receiver, as a link delivers it. */
 static int to_receiver(const uint8_t *buf, size_t len)
 {
@@ -362,12 +356,6 @@ static int fuse_scan(column_t *col, double px, double py, double pth)
     ++g_fused;
     return map_flush(
         col, g_pose_every > 0 && (g_fused - 1u) % (unsigned long)g_pose_every == 0u ? &pose : NULL);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : (x > y ? 1 : 0);
 }
 
 /* The bytes of the final map sent once: the snapshot records of one round

@@ -73,6 +73,31 @@ static int ends_with_gz(const char *path)
     return n >= 3u && strcmp(path + n - 3u, ".gz") == 0;
 }
 
+#ifndef BSF_HAVE_ZLIB
+FILE *carmen_gzip_pipe(const char *path, const char *opts)
+{
+    size_t i, n = 0;
+    FILE *f;
+    char *cmd = malloc(4u * strlen(path) + strlen(opts) + 32u);
+    if (cmd == NULL) {
+        return NULL;
+    }
+    n += (size_t)sprintf(cmd, "gzip %s -- '", opts);
+    for (i = 0; path[i] != '\0'; ++i) {
+        if (path[i] == '\'') {
+            memcpy(cmd + n, "'\\''", 4u);
+            n += 4u;
+        } else {
+            cmd[n++] = path[i];
+        }
+    }
+    memcpy(cmd + n, "' 2>/dev/null", 14u);
+    f = popen(cmd, "r");
+    free(cmd);
+    return f;
+}
+#endif
+
 carmen_reader_t *carmen_open(const char *path, FILE *err)
 {
     carmen_reader_t *r;
@@ -121,28 +146,10 @@ carmen_reader_t *carmen_open(const char *path, FILE *err)
         return NULL;
     }
     if (fgetc(r->file) == 0x1f && fgetc(r->file) == 0x8b) {
-        /* gzip magic: decompress through gzip, the path single-quoted;
-         * gzip's own complaints are replaced by the reader's report. */
-        size_t i, n = 0;
-        char *cmd = malloc(4u * strlen(path) + 48u);
-        if (cmd == NULL) {
-            carmen_close(r);
-            return NULL;
-        }
+        /* gzip magic: decompress through gzip; its own complaints are
+         * replaced by the reader's report. */
         fclose(r->file);
-        r->file = NULL;
-        n += (size_t)sprintf(cmd, "gzip -dc -- '");
-        for (i = 0; path[i] != '\0'; ++i) {
-            if (path[i] == '\'') {
-                memcpy(cmd + n, "'\\''", 4u);
-                n += 4u;
-            } else {
-                cmd[n++] = path[i];
-            }
-        }
-        memcpy(cmd + n, "' 2>/dev/null", 14u);
-        r->file = popen(cmd, "r");
-        free(cmd);
+        r->file = carmen_gzip_pipe(path, "-dc");
         r->piped = 1;
         if (r->file == NULL) {
             carmen_close(r);

@@ -102,6 +102,16 @@ typedef struct carmen_reader carmen_reader_t;
  */
 carmen_reader_t *carmen_open(const char *path, FILE *err);
 
+#ifndef BSF_HAVE_ZLIB
+/**
+ * Without zlib: the output of `gzip OPTS -- PATH` read through popen (the
+ * path quoted for the shell, gzip's complaints dropped): "-dc" decompresses,
+ * "-dcf" passes plain text through as well. NULL when it cannot start or
+ * memory runs out; pclose it.
+ */
+FILE *carmen_gzip_pipe(const char *path, const char *opts);
+#endif
+
 /**
  * Read the next laser message into *scan.
  * @return 1 when a scan was read, 0 at the (checked) end of the data, -1 on

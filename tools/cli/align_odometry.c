@@ -91,28 +91,11 @@ static int src_open(line_src_t *src, const char *path)
     return src->gz != NULL ? 0 : -1;
 #else
     FILE *probe = fopen(path, "rb");
-    size_t i, n = 0;
-    char *cmd;
     if (probe == NULL) {
         return -1; /* a clear "cannot open" rather than gzip's complaint */
     }
     fclose(probe);
-    cmd = malloc(4u * strlen(path) + 48u);
-    if (cmd == NULL) {
-        return -1;
-    }
-    n += (size_t)sprintf(cmd, "gzip -dcf -- '");
-    for (i = 0; path[i] != '\0'; ++i) {
-        if (path[i] == '\'') {
-            memcpy(cmd + n, "'\\''", 4u);
-            n += 4u;
-        } else {
-            cmd[n++] = path[i];
-        }
-    }
-    memcpy(cmd + n, "' 2>/dev/null", 14u);
-    src->pipe = popen(cmd, "r");
-    free(cmd);
+    src->pipe = carmen_gzip_pipe(path, "-dcf");
     return src->pipe != NULL ? 0 : -1;
 #endif
 }

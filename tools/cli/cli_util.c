@@ -127,6 +127,25 @@ const char *opt_value(int argc, char **argv, int *i, const char *name, int *err)
     return argv[*i];
 }
 
+int draw_option(int argc, char **argv, int *i, draw_opts_t *o, int *err)
+{
+    const char *v;
+    if ((v = opt_value(argc, argv, i, "-o", err)) != NULL) {
+        o->out_path = v;
+    } else if ((v = opt_value(argc, argv, i, "--points", err)) != NULL) {
+        o->points = v;
+    } else if ((v = opt_value(argc, argv, i, "--prior", err)) != NULL) {
+        o->prior = v;
+    } else if ((v = opt_value(argc, argv, i, "--width", err)) != NULL) {
+        if (parse_float(v, 100.0, 20000.0, &o->width) != 0) {
+            *err = usage_error("--width needs pixels in [100, 20000], got '%s'", v);
+        }
+    } else {
+        return *err != 0;
+    }
+    return 1;
+}
+
 int is_help(const char *a)
 {
     return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0;

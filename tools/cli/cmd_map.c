@@ -286,31 +286,20 @@ int cmd_map(int argc, char **argv)
     static map_ctx_t ctx;
     static bsf_point_t ctrl[MAP_MAX_POINTS];
     static uint8_t vtx[MAP_MAX_POINTS];
-    const char *in_path = NULL, *out_path = NULL, *points = NULL, *prior = NULL;
-    double width = 1600.0;
+    const char *in_path = NULL;
+    draw_opts_t draw = {NULL, NULL, NULL, 1600.0};
     int json = 0, i, err = 0, rc = 0;
     stream_summary_t sum;
     map_totals_t t;
     FILE *in, *info;
     for (i = 1; i < argc; ++i) {
-        const char *v;
         if (is_help(argv[i])) {
             fputs(map_help, stdout);
             return 0;
         } else if (strcmp(argv[i], "--json") == 0) {
             json = 1;
-        } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
-            out_path = v;
-        } else if ((v = opt_value(argc, argv, &i, "--points", &err)) != NULL) {
-            points = v;
-        } else if ((v = opt_value(argc, argv, &i, "--prior", &err)) != NULL) {
-            prior = v;
-        } else if ((v = opt_value(argc, argv, &i, "--width", &err)) != NULL) {
-            if (parse_float(v, 100.0, 20000.0, &width) != 0) {
-                return usage_error("--width needs pixels in [100, 20000], got '%s'", v);
-            }
-        } else if (err) {
-            return err;
+        } else if (draw_option(argc, argv, &i, &draw, &err)) {
+            /* stored, or err set */
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
             return usage_error("unknown option '%s'", argv[i]);
         } else if (in_path == NULL) {
@@ -325,13 +314,13 @@ int cmd_map(int argc, char **argv)
     if (in_path == NULL) {
         return usage_error("map needs an input stream (or '-')");
     }
-    if (points != NULL && out_path == NULL) {
+    if (draw.points != NULL && draw.out_path == NULL) {
         return usage_error("--points goes with -o MAP.svg");
     }
-    if (prior != NULL && out_path == NULL) {
+    if (draw.prior != NULL && draw.out_path == NULL) {
         return usage_error("--prior goes with -o MAP.svg");
     }
-    if (json && out_path != NULL && strcmp(out_path, "-") == 0) {
+    if (json && draw.out_path != NULL && strcmp(draw.out_path, "-") == 0) {
         return usage_error("--json and -o - would both write to stdout");
     }
     memset(&ctx, 0, sizeof ctx);
@@ -366,13 +355,13 @@ int cmd_map(int argc, char **argv)
     if (json) {
         print_json(&ctx.view, ctrl, vtx);
     }
-    if (out_path != NULL &&
-        write_svg(out_path, in_path, &ctx.view, width, points, prior, ctrl, vtx, &t) != 0) {
+    if (draw.out_path != NULL && write_svg(draw.out_path, in_path, &ctx.view, draw.width,
+                                           draw.points, draw.prior, ctrl, vtx, &t) != 0) {
         rc = -1;
     }
-    info = (json || (out_path != NULL && strcmp(out_path, "-") == 0)) ? stderr : stdout;
-    if (out_path != NULL && rc == 0) {
-        fprintf(stderr, "%s: wrote %s\n", g_cmd, out_path);
+    info = (json || (draw.out_path != NULL && strcmp(draw.out_path, "-") == 0)) ? stderr : stdout;
+    if (draw.out_path != NULL && rc == 0) {
+        fprintf(stderr, "%s: wrote %s\n", g_cmd, draw.out_path);
     }
     fprintf(info,
             "%s: %lu features, %lu control points, %lu vertices, %.1f m of curve, %lu stale, "

@@ -732,9 +732,9 @@ int write_map_svg(const char *out_path, FILE *in, const char *in_name, long lo, 
 
 int cmd_render(int argc, char **argv)
 {
-    const char *in_path = NULL, *out_path = NULL, *points = NULL, *prior = NULL;
+    const char *in_path = NULL;
+    draw_opts_t draw = {NULL, NULL, NULL, 1600.0};
     long lo = 0, hi = -1;
-    double width = 1600.0;
     FILE *in;
     int i, err = 0, rc;
     for (i = 1; i < argc; ++i) {
@@ -742,19 +742,11 @@ int cmd_render(int argc, char **argv)
         if (is_help(argv[i])) {
             fputs(render_help, stdout);
             return 0;
-        } else if ((v = opt_value(argc, argv, &i, "-o", &err)) != NULL) {
-            out_path = v;
+        } else if (draw_option(argc, argv, &i, &draw, &err)) {
+            /* stored, or err set */
         } else if ((v = opt_value(argc, argv, &i, "--scans", &err)) != NULL) {
             if (parse_scan_range(v, &lo, &hi) != 0) {
                 return usage_error("--scans needs K..L (or K..), got '%s'", v);
-            }
-        } else if ((v = opt_value(argc, argv, &i, "--points", &err)) != NULL) {
-            points = v;
-        } else if ((v = opt_value(argc, argv, &i, "--prior", &err)) != NULL) {
-            prior = v;
-        } else if ((v = opt_value(argc, argv, &i, "--width", &err)) != NULL) {
-            if (parse_float(v, 100.0, 20000.0, &width) != 0) {
-                return usage_error("--width needs pixels in [100, 20000], got '%s'", v);
             }
         } else if (err) {
             return err;
@@ -769,17 +761,18 @@ int cmd_render(int argc, char **argv)
             return err;
         }
     }
-    if (in_path == NULL || out_path == NULL) {
+    if (in_path == NULL || draw.out_path == NULL) {
         return usage_error("render needs an input stream and -o MAP.svg");
     }
     in = open_seekable(in_path);
     if (in == NULL) {
         return EXIT_FAIL;
     }
-    rc = write_map_svg(out_path, in, in_path, lo, hi, points, NULL, prior, in_path, width);
+    rc = write_map_svg(draw.out_path, in, in_path, lo, hi, draw.points, NULL, draw.prior, in_path,
+                       draw.width);
     close_in(in);
     if (rc == 0) {
-        fprintf(stderr, "%s: wrote %s\n", g_cmd, out_path);
+        fprintf(stderr, "%s: wrote %s\n", g_cmd, draw.out_path);
     }
     return rc == 0 ? 0 : EXIT_FAIL;
 }

@@ -63,6 +63,17 @@ int parse_long(const char *s, long lo, long hi, long *out);
 int parse_float(const char *s, double lo, double hi, double *out);
 /** Option value: "--opt=v" or "--opt v". Returns the value or NULL (and sets *err). */
 const char *opt_value(int argc, char **argv, int *i, const char *name, int *err);
+/** The drawing options of map and render. */
+typedef struct {
+    const char *out_path; /**< -o MAP.svg */
+    const char *points;   /**< --points LOG: raw points under the map */
+    const char *prior;    /**< --prior CSV: the odometry path, dashed */
+    double width;         /**< --width PX (the caller's default when absent) */
+} draw_opts_t;
+/** 1 when argv[*i] is a drawing option (-o, --points, --prior, --width): its
+ *  value stored, *i past it, and *err set when the value is missing or out of
+ *  range; 0 when it is none of them. */
+int draw_option(int argc, char **argv, int *i, draw_opts_t *o, int *err);
 /** Is a an -h or --help? */
 int is_help(const char *a);
 /** A file to read, or stdin for "-"; NULL with a message on failure. */

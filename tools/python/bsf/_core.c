@@ -73,6 +73,19 @@ static PyObject *raise_status(bsf_status_t st, const char *what)
     return NULL;
 }
 
+/* Append item to list and drop the caller's reference to it: 0, or -1 with an
+ * exception set (item NULL: the call that made it failed). */
+static int list_append_new(PyObject *list, PyObject *item)
+{
+    int rc;
+    if (item == NULL) {
+        return -1;
+    }
+    rc = PyList_Append(list, item);
+    Py_DECREF(item);
+    return rc;
+}
+
 /* ---- parameters ------------------------------------------------------------ */
 
 typedef enum { PT_INT, PT_FLOAT, PT_U16, PT_U8 } param_type_t;
@@ -873,12 +886,10 @@ static PyObject *decoder_run(DecoderObject *self, const uint8_t *data, size_t le
             PyObject *t =
                 Py_BuildValue("(Nn)", frame_to_tuple(self->frame), (Py_ssize_t)self->since_frame);
             self->since_frame = 0;
-            if (t == NULL || PyList_Append(out, t) != 0) {
-                Py_XDECREF(t);
+            if (list_append_new(out, t) != 0) {
                 Py_DECREF(out);
                 return NULL;
             }
-            Py_DECREF(t);
         } else if (used == 0) {
             break;
         }
@@ -1012,6 +1023,13 @@ static int map_rx_ready(const MapReceiverObject *self)
     return 1;
 }
 
+/* A new empty list for a method that lists the receiver's features; NULL with
+ * an exception when the receiver is not initialised or memory is short. */
+static PyObject *map_rx_new_list(const MapReceiverObject *self)
+{
+    return map_rx_ready(self) ? PyList_New(0) : NULL;
+}
+
 /* apply(payload) -> records skipped; BsfError when the payload is refused. */
 static PyObject *MapReceiver_apply(MapReceiverObject *self, PyObject *arg)
 {
@@ -1034,13 +1052,9 @@ static PyObject *MapReceiver_apply(MapReceiverObject *self, PyObject *arg)
 /* features() -> [(id, ctrl bytes (float32 x, y pairs), vertex bytes, stale)] */
 static PyObject *MapReceiver_features(MapReceiverObject *self, PyObject *unused)
 {
-    PyObject *out;
+    PyObject *out = map_rx_new_list(self);
     uint32_t id, limit;
     (void)unused;
-    if (!map_rx_ready(self)) {
-        return NULL;
-    }
-    out = PyList_New(0);
     if (out == NULL) {
         return NULL;
     }
@@ -1062,12 +1076,10 @@ static PyObject *MapReceiver_features(MapReceiverObject *self, PyObject *unused)
         t = Py_BuildValue("(ky#y#O)", (unsigned long)id, (const char *)self->ctrl,
                           (Py_ssize_t)((size_t)n * sizeof(bsf_point_t)), (const char *)self->vtx,
                           (Py_ssize_t)n, stale ? Py_True : Py_False);
-        if (t == NULL || PyList_Append(out, t) != 0) {
-            Py_XDECREF(t);
+        if (list_append_new(out, t) != 0) {
             Py_DECREF(out);
             return NULL;
         }
-        Py_DECREF(t);
     }
     return out;
 }
@@ -1086,13 +1098,9 @@ static PyObject *MapReceiver_note_loss(MapReceiverObject *self, PyObject *unused
 /* missing() -> [id]: ids below the id limit that were sent but never received. */
 static PyObject *MapReceiver_missing(MapReceiverObject *self, PyObject *unused)
 {
-    PyObject *out;
+    PyObject *out = map_rx_new_list(self);
     uint32_t id, limit;
     (void)unused;
-    if (!map_rx_ready(self)) {
-        return NULL;
-    }
-    out = PyList_New(0);
     if (out == NULL) {
         return NULL;
     }
@@ -1100,12 +1108,10 @@ static PyObject *MapReceiver_missing(MapReceiverObject *self, PyObject *unused)
     for (id = 0; id < limit; ++id) {
         if (bsf_map_rx_feature_state(self->rx, id) == BSF_MAP_RX_MISSING) {
             PyObject *v = PyLong_FromUnsignedLong((unsigned long)id);
-            if (v == NULL || PyList_Append(out, v) != 0) {
-                Py_XDECREF(v);
+            if (list_append_new(out, v) != 0) {
                 Py_DECREF(out);
                 return NULL;
             }
-            Py_DECREF(v);
         }
     }
     return out;
