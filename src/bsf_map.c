@@ -1419,6 +1419,27 @@ static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *
     }
 }
 
+/* Points of scan curve w (n >= 3 slots) at every knot and mid-span: two
+ * per span and the curve's end, 2 n - 3 in all. */
+static size_t knot_count(size_t n)
+{
+    return 2u * n - 3u;
+}
+
+/* Point i of those knot_count(n): knot i / 2 when i is even, else the middle
+ * of span i / 2. */
+static bsf_point_t knot_point(const bsf_point_t *w, size_t n, size_t i)
+{
+    const size_t k = i / 2u < n - 2u ? i / 2u : n - 3u; /* the span */
+    const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
+    float b[3];
+    bsf_point_t q;
+    span_basis(ends, 0.5f * (float)(i - 2u * k), b);
+    q.x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
+    q.y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
+    return q;
+}
+
 /* Points of a new map feature from scan curve w (n slots, vtx): the
  * curve at every knot and mid-span of the scan's B-spline, a vertex (two
  * slots) being the knot between its slots. A scan's control points lie off
@@ -1442,17 +1463,14 @@ static size_t new_points(const bsf_point_t *w, const uint8_t *vtx, size_t n, new
             ++k;
         }
     }
-    for (k = 0; k + 2u < n; ++k) {
-        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
-        unsigned h;
-        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
-            float b[3];
-            span_basis(ends, 0.5f * (float)h, b);
-            p[np].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
-            p[np].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
-            p[np].vertex = (uint8_t)(h == 0u && k > 0u && pair[k]);
-            ++np;
-        }
+    for (k = 0; k < knot_count(n); ++k) {
+        const bsf_point_t q = knot_point(w, n, k);
+        p[np].x = q.x;
+        p[np].y = q.y;
+        /* knot k / 2, not the curve's ends */
+        p[np].vertex =
+            (uint8_t)((k & 1u) == 0u && k > 0u && k + 1u < knot_count(n) && pair[k / 2u]);
+        ++np;
     }
     if (np >= 3u) {
         return np;
@@ -1734,17 +1752,8 @@ static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx
     size_t k;
     size_t m;
     float dir;
-    /* the curve at every knot and mid-span */
-    for (k = 0; k + 2u < n; ++k) {
-        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
-        unsigned h;
-        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
-            float b[3];
-            span_basis(ends, 0.5f * (float)h, b);
-            cv[nc].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
-            cv[nc].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
-            ++nc;
-        }
+    for (nc = 0; nc < knot_count(n); ++nc) {
+        cv[nc] = knot_point(w, n, nc);
     }
     dir = bearings(cv, nc, sx, sy, th, r);
     folds(p, th, r, nc, dir, &head, &tail);
