@@ -42,7 +42,10 @@
  *    poses on a loop, tools/scene): curve to true surface every 1 cm along
  *    the curves (quantiles per length of curve); "surface seen" is the true surface hit by a valid
  * return (2 cm bins along each shape); a corner counts as seen in a scan when bsf_truth_corner_seen
- * says so, and as one map vertex when exactly one map vertex lies within 3 cm of it.
+ * says so, and as one map vertex when exactly one map vertex lies within 3 cm of it;
+ *  - folds: places where a curve turns back on itself (mg_bspline_folds, map_geom.h): more than
+ *    150 degrees between the chords 2 cm of arc before and after a point of the B-spline, the
+ *    curve cut at its vertices; a vertex turning more than 150 degrees is counted apart.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
