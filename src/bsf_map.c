@@ -779,16 +779,51 @@ static void refine(bsf_map_t *m, uint16_t fs, const sample_t *s, const label_t *
     }
 }
 
+/* A chain that turns by more than about 150 degrees between two legs runs
+ * back over itself (a fold); a true corner that sharp is rarer than a fit
+ * or a join gone wrong. */
+#define FOLD_COS 0.866f
+
+/* 1 when a leg (bx, by) after a leg (ax, ay) turns back by more than
+ * acos(-FOLD_COS); a zero leg never does. */
+static int turns_back(float ax, float ay, float bx, float by)
+{
+    const float d = ax * bx + ay * by;
+    return d < 0.0f && d * d >= FOLD_COS * FOLD_COS * (ax * ax + ay * ay) * (bx * bx + by * by);
+}
+
+/* A chain end: its point and outward direction (from its inner neighbour
+ * to it, the clamped curve's end tangent). */
+typedef struct {
+    float x, y;
+    float ox, oy;
+} anchor_t;
+
+static anchor_t end_anchor(const bsf_map_t *m, const bsf_map_feature_t *f, unsigned end)
+{
+    const uint16_t e = end == 1u ? f->head : f->tail;
+    const uint16_t in = end == 1u ? m->ctrl[e].next : m->ctrl[e].prev;
+    anchor_t a;
+    a.x = m->ctrl[e].x;
+    a.y = m->ctrl[e].y;
+    a.ox = in == BSF_MAP_NONE ? 0.0f : a.x - m->ctrl[in].x;
+    a.oy = in == BSF_MAP_NONE ? 0.0f : a.y - m->ctrl[in].y;
+    return a;
+}
+
 /* Points along samples from..to (step +1 or -1), every sp metres and at
- * every vertex, starting after the anchor (ax, ay); the last one ends the
- * run. Returns the count (at most cap). */
-static size_t resample(float sp, const sample_t *s, long from, long to, int has_anchor, float ax,
-                       float ay, newpt_t *out, size_t cap)
+ * every vertex, starting after the chain end *an (none when NULL); the
+ * last one ends the run. A sample that does not lie ahead of the point
+ * before it along its own tangent (in the walk's sense) is passed over:
+ * the chain would step back there and fold on itself. Returns the count
+ * (at most cap). */
+static size_t resample(float sp, const sample_t *s, long from, long to, const anchor_t *an,
+                       newpt_t *out, size_t cap)
 {
     const long dir = to >= from ? 1 : -1;
-    float px = ax;
-    float py = ay;
-    int have_prev = has_anchor;
+    float px = an != NULL ? an->x : 0.0f;
+    float py = an != NULL ? an->y : 0.0f;
+    int have_prev = an != NULL;
     size_t n = 0;
     long k;
     for (k = from;; k += dir) {
@@ -797,6 +832,12 @@ static size_t resample(float sp, const sample_t *s, long from, long to, int has_
         const float dx = q->x - px;
         const float dy = q->y - py;
         const float d2 = dx * dx + dy * dy;
+        if (have_prev && !q->vertex && (dx * q->dx + dy * q->dy) * (float)dir <= 0.0f) {
+            if (last) {
+                break;
+            }
+            continue;
+        }
         if (!have_prev || q->vertex || d2 >= sp * sp) {
             if (q->vertex && n > 0u && !out[n - 1u].vertex && d2 < 0.09f * sp * sp) {
                 --n; /* a point just before a vertex gives way to it */
@@ -995,18 +1036,67 @@ static int leaves_through(const bsf_map_t *m, uint16_t fs, unsigned end, float t
     return (m->ctrl[e].x - m->ctrl[in].x) * tx + (m->ctrl[e].y - m->ctrl[in].y) * ty > 0.0f;
 }
 
+/* 1 when joining feature slot fa's end ea to slot fb's end eb, for a scan
+ * whose samples qa and qb matched them, would turn the chain back over
+ * itself (at a's end, from a's last leg into the join, or from the join
+ * into b's first leg: legs, not the curve, which follows its control
+ * polygon) at an end that lies farther than a control spacing from the
+ * scan's sample: the scan did not reach that end (it matched a long end
+ * span far from it), and the chain would run from the end back to it. A
+ * fold between ends the scan reached is two overlapping copies, which
+ * refinement pulls together. */
+static int join_folds(const bsf_map_t *m, uint16_t fa, unsigned ea, const sample_t *qa, uint16_t fb,
+                      unsigned eb, const sample_t *qb)
+{
+    const anchor_t a = end_anchor(m, &m->features[fa], ea);
+    const anchor_t b = end_anchor(m, &m->features[fb], eb);
+    const float sp2 = m->params.ctrl_spacing * m->params.ctrl_spacing;
+    const float jx = b.x - a.x;
+    const float jy = b.y - a.y;
+    if ((a.x - qa->x) * (a.x - qa->x) + (a.y - qa->y) * (a.y - qa->y) <= sp2 &&
+        (b.x - qb->x) * (b.x - qb->x) + (b.y - qb->y) * (b.y - qb->y) <= sp2) {
+        return 0;
+    }
+    if (jx * jx + jy * jy < 1e-6f) {
+        return turns_back(a.ox, a.oy, -b.ox, -b.oy);
+    }
+    return turns_back(a.ox, a.oy, jx, jy) || turns_back(jx, jy, -b.ox, -b.oy);
+}
+
+static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to);
+
 /* Extend slot fs at end (1 head, 2 tail) with samples from..to, walking
- * outward from the matched part. */
-static void extend(bsf_map_t *m, uint16_t fs, unsigned end, const sample_t *s, long from, long to)
+ * outward from the matched part (its last sample `matched`, next to from).
+ * Only a scan that leaves the feature through that end continues it; one
+ * that runs back along it, or that left it well before the end for a
+ * surface behind the end, would fold the chain back on itself there. */
+static void extend(bsf_map_t *m, uint16_t fs, unsigned end, const sample_t *s, long from, long to,
+                   long matched)
 {
     bsf_map_feature_t *f = &m->features[fs];
-    const bsf_map_ctrl_t *e = &m->ctrl[end == 1u ? f->head : f->tail];
+    const anchor_t an = end_anchor(m, f, end);
     newpt_t p[MAX_SAMPLES];
     size_t n;
+    const sample_t *q = &s[from];
+    const sample_t *in = &s[matched]; /* the last matched sample, next to from */
+    const float sp = m->params.ctrl_spacing;
+    const float tx = from > matched ? q->dx : -q->dx;
+    const float ty = from > matched ? q->dy : -q->dy;
+    if (!leaves_through(m, fs, end, tx, ty)) {
+        return; /* the scan runs back along the feature: nothing beyond its end */
+    }
+    if ((in->x - an.x) * (in->x - an.x) + (in->y - an.y) * (in->y - an.y) > sp * sp &&
+        turns_back(an.ox, an.oy, q->x - an.x, q->y - an.y)) {
+        /* the scan left the feature a spacing or more before its end (it
+         * matched a long end span) and runs on behind the end: another
+         * surface, not a continuation of this chain */
+        new_from_run(m, s, from, to);
+        return;
+    }
     if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing * 0.5f) {
         return;
     }
-    n = resample(m->params.ctrl_spacing, s, from, to, 1, e->x, e->y, p, MAX_SAMPLES);
+    n = resample(m->params.ctrl_spacing, s, from, to, &an, p, MAX_SAMPLES);
     if (n > 0u && chain_extend(m, f, p, n, end == 1u)) {
         feature_bbox(m, f);
         ++m->stats.n_extended;
@@ -1020,7 +1110,7 @@ static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
     if (run_length(s, from, to) < MIN_RUN_SPACINGS * m->params.ctrl_spacing) {
         return;
     }
-    n = resample(m->params.ctrl_spacing, s, from, to, 0, 0.0f, 0.0f, p, MAX_SAMPLES);
+    n = resample(m->params.ctrl_spacing, s, from, to, NULL, p, MAX_SAMPLES);
     (void)feature_new(m, p, n);
 }
 
@@ -1043,10 +1133,10 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
         return 0;
     }
     if (lo <= hi) {
-        const bsf_map_ctrl_t *e = &m->ctrl[es == 1u ? a->head : a->tail];
+        const anchor_t an = end_anchor(m, a, es);
         const bsf_map_ctrl_t *o = &m->ctrl[eu == 1u ? u->head : u->tail];
         const float sp = m->params.ctrl_spacing;
-        n = resample(m->params.ctrl_spacing, s, down ? hi : lo, down ? lo : hi, 1, e->x, e->y, p,
+        n = resample(m->params.ctrl_spacing, s, down ? hi : lo, down ? lo : hi, &an, p,
                      MAX_SAMPLES);
         while (n > 0u && !p[n - 1u].vertex &&
                (p[n - 1u].x - o->x) * (p[n - 1u].x - o->x) +
@@ -1061,6 +1151,35 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
     /* u oriented so that its joining end meets a's */
     if ((es == 2u) == (eu == 2u)) {
         chain_reverse(m, u);
+    }
+    /* u's points at its joining end that lie behind the join along the
+     * scan's travel into u overlap a (two ends of one wall seen past each
+     * other): linked as they are, the chain would run back and forth there */
+    {
+        const sample_t *t = &s[down ? lo - 1 : hi + 1];
+        const float tx = down ? -t->dx : t->dx;
+        const float ty = down ? -t->dy : t->dy;
+        const bsf_map_ctrl_t *e = &m->ctrl[es == 1u ? a->head : a->tail];
+        const float lx = n > 0u ? p[n - 1u].x : e->x;
+        const float ly = n > 0u ? p[n - 1u].y : e->y;
+        for (;;) {
+            const uint16_t j = es == 2u ? u->head : u->tail;
+            bsf_map_ctrl_t *c = &m->ctrl[j];
+            if ((c->x - lx) * tx + (c->y - ly) * ty > 0.0f || (c->flags & BSF_MAP_CF_VERTEX) ||
+                u->n_ctrl <= 2u) {
+                break;
+            }
+            if (es == 2u) {
+                u->head = c->next;
+                m->ctrl[u->head].prev = BSF_MAP_NONE;
+            } else {
+                u->tail = c->prev;
+                m->ctrl[u->tail].next = BSF_MAP_NONE;
+            }
+            c->next = BSF_MAP_NONE;
+            chain_free(m, j);
+            --u->n_ctrl;
+        }
     }
     (void)chain_extend(m, a, p, n, es == 1u); /* outward from a's end */
     if (es == 2u) {
@@ -1113,10 +1232,10 @@ static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned e
         op->flags |= BSF_MAP_OP_REV_B;
     }
     if (from <= to) {
-        const bsf_map_ctrl_t *at = &m->ctrl[a->tail];
+        const anchor_t an = end_anchor(m, a, 2u);
         const bsf_map_ctrl_t *bh = &m->ctrl[b->head];
         const float sp = m->params.ctrl_spacing;
-        n = resample(m->params.ctrl_spacing, s, from, to, 1, at->x, at->y, p, MAX_SAMPLES);
+        n = resample(m->params.ctrl_spacing, s, from, to, &an, p, MAX_SAMPLES);
         /* no bridge point crowding b's head */
         while (n > 0u && !p[n - 1u].vertex &&
                (p[n - 1u].x - bh->x) * (p[n - 1u].x - bh->x) +
@@ -1300,6 +1419,27 @@ static void make_vertex_between(bsf_map_t *m, const sample_t *s, const label_t *
     }
 }
 
+/* Points of scan curve w (n >= 3 slots) at every knot and mid-span: two
+ * per span and the curve's end, 2 n - 3 in all. */
+static size_t knot_count(size_t n)
+{
+    return 2u * n - 3u;
+}
+
+/* Point i of those knot_count(n): knot i / 2 when i is even, else the middle
+ * of span i / 2. */
+static bsf_point_t knot_point(const bsf_point_t *w, size_t n, size_t i)
+{
+    const size_t k = i / 2u < n - 2u ? i / 2u : n - 3u; /* the span */
+    const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
+    float b[3];
+    bsf_point_t q;
+    span_basis(ends, 0.5f * (float)(i - 2u * k), b);
+    q.x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
+    q.y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
+    return q;
+}
+
 /* Points of a new map feature from scan curve w (n slots, vtx): the
  * curve at every knot and mid-span of the scan's B-spline, a vertex (two
  * slots) being the knot between its slots. A scan's control points lie off
@@ -1323,17 +1463,14 @@ static size_t new_points(const bsf_point_t *w, const uint8_t *vtx, size_t n, new
             ++k;
         }
     }
-    for (k = 0; k + 2u < n; ++k) {
-        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
-        unsigned h;
-        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
-            float b[3];
-            span_basis(ends, 0.5f * (float)h, b);
-            p[np].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
-            p[np].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
-            p[np].vertex = (uint8_t)(h == 0u && k > 0u && pair[k]);
-            ++np;
-        }
+    for (k = 0; k < knot_count(n); ++k) {
+        const bsf_point_t q = knot_point(w, n, k);
+        p[np].x = q.x;
+        p[np].y = q.y;
+        /* knot k / 2, not the curve's ends */
+        p[np].vertex =
+            (uint8_t)((k & 1u) == 0u && k > 0u && k + 1u < knot_count(n) && pair[k / 2u]);
+        ++np;
     }
     if (np >= 3u) {
         return np;
@@ -1458,13 +1595,14 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
             if (lab[g].feature != lab[k].feature) {
                 const unsigned ea = joining_end(m, &lab[k], &s[k]);
                 const unsigned eb = joining_end(m, &lab[g], &s[g]);
-                if (ea != 0u && eb != 0u &&
-                    (!leaves_through(m, lab[k].feature, ea, s[k].dx, s[k].dy) ||
-                     !leaves_through(m, lab[g].feature, eb, -s[g].dx, -s[g].dy))) {
+                const int through = ea != 0u && eb != 0u &&
+                                    leaves_through(m, lab[k].feature, ea, s[k].dx, s[k].dy) &&
+                                    leaves_through(m, lab[g].feature, eb, -s[g].dx, -s[g].dy);
+                if (ea != 0u && eb != 0u && !through) {
                     /* the scan does not leave one through its end and enter
                      * the other through its end: it runs back over one of
                      * them. A copy never sent goes (this scan refined the
-                     * other); otherwise they merge as before */
+                     * other); otherwise they merge unless the join folds */
                     uint16_t drop = BSF_MAP_NONE;
                     if (copy_of(m, lab[g].feature, lab[k].feature, sx, sy)) {
                         drop = lab[g].feature;
@@ -1479,6 +1617,8 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
                     }
                 }
                 if (ea != 0u && eb != 0u &&
+                    (through ||
+                     !join_folds(m, lab[k].feature, ea, &s[k], lab[g].feature, eb, &s[g])) &&
                     merge(m, lab[k].feature, ea, lab[g].feature, eb, s, (long)k + 1, (long)g - 1)) {
                     /* slots moved: this observation's work ends here */
                     return;
@@ -1494,7 +1634,7 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     if (first > 0) {
         const unsigned e = joining_end(m, &lab[first], &s[first]);
         if (e != 0u) {
-            extend(m, lab[first].feature, e, s, first - 1, 0);
+            extend(m, lab[first].feature, e, s, first - 1, 0, first);
         } else {
             new_from_run(m, s, 0, first - 1);
         }
@@ -1502,7 +1642,7 @@ static void fuse_feature(bsf_map_t *m, const bsf_point_t *w, const uint8_t *vtx,
     if (last + 1 < (long)ns) {
         const unsigned e = joining_end(m, &lab[last], &s[last]);
         if (e != 0u) {
-            extend(m, lab[last].feature, e, s, last + 1, (long)ns - 1);
+            extend(m, lab[last].feature, e, s, last + 1, (long)ns - 1, last);
         } else {
             new_from_run(m, s, last + 1, (long)ns - 1);
         }
@@ -1612,17 +1752,8 @@ static size_t trim_folds(const bsf_map_params_t *p, bsf_point_t *w, uint8_t *vtx
     size_t k;
     size_t m;
     float dir;
-    /* the curve at every knot and mid-span */
-    for (k = 0; k + 2u < n; ++k) {
-        const uint8_t ends = (uint8_t)((k == 0u ? 1u : 0u) | (k + 3u == n ? 2u : 0u));
-        unsigned h;
-        for (h = 0; h < (k + 3u == n ? 3u : 2u); ++h) {
-            float b[3];
-            span_basis(ends, 0.5f * (float)h, b);
-            cv[nc].x = b[0] * w[k].x + b[1] * w[k + 1u].x + b[2] * w[k + 2u].x;
-            cv[nc].y = b[0] * w[k].y + b[1] * w[k + 1u].y + b[2] * w[k + 2u].y;
-            ++nc;
-        }
+    for (nc = 0; nc < knot_count(n); ++nc) {
+        cv[nc] = knot_point(w, n, nc);
     }
     dir = bearings(cv, nc, sx, sy, th, r);
     folds(p, th, r, nc, dir, &head, &tail);

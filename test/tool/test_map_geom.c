@@ -64,6 +64,35 @@ static void test_bspline_with_a_vertex_is_two_straight_spans(void)
     mg_curves_free(&c);
 }
 
+static void test_folds_count_turning_back_not_bends_or_corners(void)
+{
+    /* a straight wall, a 10 cm round pillar (control points on a regular
+     * octagon, run past a full turn), a curve that runs out and back along
+     * itself (a cusp), and a 10 degree wedge whose corner is a vertex */
+    const double wall[10] = {0.0, 0.0, 0.5, 0.01, 1.0, 0.0, 1.5, -0.01, 2.0, 0.0};
+    const double cusp[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
+    const double wedge[8] = {0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.176};
+    const uint8_t wedge_vtx[4] = {0u, 1u, 1u, 0u};
+    double pillar[2u * 11u];
+    mg_folds_t f;
+    size_t k;
+    for (k = 0; k < 11u; ++k) {
+        pillar[2u * k] = 0.1 * cos(0.785398 * (double)k);
+        pillar[2u * k + 1u] = 0.1 * sin(0.785398 * (double)k);
+    }
+    memset(&f, 0, sizeof f);
+    TEST_ASSERT_EQUAL_INT(0, mg_bspline_folds(wall, 5u, NULL, &f));
+    TEST_ASSERT_EQUAL_INT(0, mg_bspline_folds(pillar, 11u, NULL, &f));
+    TEST_ASSERT_EQUAL_UINT(0u, f.folds + f.sharp_vertices);
+    TEST_ASSERT_EQUAL_INT(0, mg_bspline_folds(cusp, 3u, NULL, &f));
+    TEST_ASSERT_EQUAL_UINT(1u, f.folds);
+    memset(&f, 0, sizeof f);
+    TEST_ASSERT_EQUAL_INT(0, mg_bspline_folds(wedge, 4u, wedge_vtx, &f));
+    TEST_ASSERT_EQUAL_UINT(0u, f.folds); /* the corner is the vertex's, counted apart */
+    TEST_ASSERT_EQUAL_UINT(1u, f.sharp_vertices);
+    TEST_ASSERT_EQUAL_INT(-1, mg_bspline_folds(wall, 2u, NULL, &f));
+}
+
 static void test_index_distance_equals_brute_force(void)
 {
     mg_curves_t c;
@@ -162,6 +191,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_bspline_with_a_vertex_is_two_straight_spans);
+    RUN_TEST(test_folds_count_turning_back_not_bends_or_corners);
     RUN_TEST(test_index_distance_equals_brute_force);
     RUN_TEST(test_histogram_quantiles_and_share);
     RUN_TEST(test_grid_baseline_on_a_square_room);

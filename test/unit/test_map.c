@@ -887,6 +887,130 @@ static void test_map_copy_run_back_over_is_dropped(void)
     assert_rx_equals_sent();
 }
 
+/* Folds of map feature i's curve (the robot's values): places where the
+ * clamped quadratic B-spline, sampled 32 times per span and cut at its
+ * vertices, turns by more than 150 degrees between the chord from 2 cm of
+ * arc before a sample and the chord to 2 cm after it. */
+static int curve_folds(size_t i)
+{
+    static bsf_point_t c[256];
+    static uint8_t is_v[256];
+    static float px[32u * 256u + 1u];
+    static float py[32u * 256u + 1u];
+    static float arc[32u * 256u + 1u];
+    static uint8_t cut[256];
+    const int n = bsf_map_feature_ctrl(&map, i, 0, c, is_v, 256u, NULL);
+    int spans;
+    int s;
+    int k;
+    int ns = 0;
+    int lo = 0;
+    int folds = 0;
+    TEST_ASSERT_TRUE(n >= 3 && n <= 256);
+    spans = n - 2;
+    memset(cut, 0, sizeof cut);
+    for (k = 0; k + 1 < n; ++k) {
+        if (is_v[k] && is_v[k + 1]) {
+            cut[k] = 1u; /* the vertex is the curve at knot k */
+            ++k;
+        }
+    }
+    for (s = 0; s < spans; ++s) {
+        for (k = s == 0 ? 0 : 1; k <= 32; ++k) {
+            const float u = (float)k / 32.0f;
+            const float v = 1.0f - u;
+            float w0 = 0.5f * v * v;
+            float w1 = 0.5f + u - u * u;
+            float w2 = 0.5f * u * u;
+            if (spans == 1) {
+                w0 = v * v;
+                w1 = 2.0f * u * v;
+                w2 = u * u;
+            } else if (s == 0) {
+                w0 = v * v;
+                w1 = 2.0f * u - 1.5f * u * u;
+            } else if (s == spans - 1) {
+                w1 = 2.0f * v - 1.5f * v * v;
+                w2 = u * u;
+            }
+            px[ns] = w0 * c[s].x + w1 * c[s + 1].x + w2 * c[s + 2].x;
+            py[ns] = w0 * c[s].y + w1 * c[s + 1].y + w2 * c[s + 2].y;
+            arc[ns] =
+                ns == 0 ? 0.0f : arc[ns - 1] + hypotf(px[ns] - px[ns - 1], py[ns] - py[ns - 1]);
+            ++ns;
+        }
+    }
+    for (s = 1; s <= spans; ++s) {
+        const int hi = 32 * s;
+        int in_fold = 0;
+        if (s < spans && !cut[s]) {
+            continue;
+        }
+        for (k = lo; k <= hi; ++k) {
+            int a = k;
+            int b = k;
+            int back = 0;
+            while (a > lo && arc[k] - arc[a] < 0.02f) {
+                --a;
+            }
+            while (b < hi && arc[b] - arc[k] < 0.02f) {
+                ++b;
+            }
+            if (arc[k] - arc[a] >= 0.02f && arc[b] - arc[k] >= 0.02f) {
+                const float ux = px[k] - px[a];
+                const float uy = py[k] - py[a];
+                const float vx = px[b] - px[k];
+                const float vy = py[b] - py[k];
+                back = ux * vx + uy * vy < -0.866f * hypotf(ux, uy) * hypotf(vx, vy);
+            }
+            folds += back && !in_fold ? 1 : 0;
+            in_fold = back;
+        }
+        lo = hi;
+    }
+    return folds;
+}
+
+/* A straight wall at x = 0 from y = 0 to y = -1, sent (a straight run goes
+ * out as its ends: one span). A later scan runs down the wall and turns
+ * off it at y = -0.6 onto a wall running east: its samples past the turn
+ * match nothing, and the end of the map's feature nearest to the last
+ * matched one is the wall's tail, 40 cm farther down. The scan does not
+ * leave the wall through that end, so the east wall is not appended there
+ * (appended, the chain ran down to the tail and back up to the turn: a
+ * fold); it becomes a feature of its own, and no curve in the map folds. */
+static void test_map_run_off_before_an_end_does_not_extend_it(void)
+{
+    static const float wall[] = {0.0f, 0.0f, 0.0f, -0.25f, 0.0f, -0.5f, 0.0f, -0.75f, 0.0f, -1.0f};
+    static const float turn[] = {0.0f, 0.0f,  0.0f, -0.3f, 0.0f, -0.6f,
+                                 0.3f, -0.6f, 0.6f, -0.6f, 0.9f, -0.6f};
+    const bsf_pose_t pose = {1.0f, 0.5f, 0.0f};
+    size_t i;
+    int k;
+    start(NULL);
+    for (k = 0; k < 4; ++k) {
+        world_feature(wall, NULL, 5u, &pose);
+        fuse_and_send(&pose);
+    }
+    TEST_ASSERT_EQUAL_size_t(1u, bsf_map_feature_count(&map));
+    TEST_ASSERT_EQUAL_INT(0, curve_folds(0u));
+    world_feature(turn, NULL, 6u, &pose);
+    fuse_and_send(&pose);
+    for (i = 0; i < bsf_map_feature_count(&map); ++i) {
+        static bsf_point_t c[256];
+        const int n = bsf_map_feature_ctrl(&map, i, 0, c, NULL, 256u, NULL);
+        int j;
+        TEST_ASSERT_TRUE(n >= 3 && n <= 256);
+        TEST_ASSERT_EQUAL_INT(0, curve_folds(i));
+        if (hypotf(c[0].x, c[0].y) <= 0.03f || hypotf(c[n - 1].x, c[n - 1].y) <= 0.03f) {
+            for (j = 0; j < n; ++j) { /* the wall's feature holds the wall alone */
+                TEST_ASSERT_TRUE(c[j].x < 0.05f);
+            }
+        }
+    }
+    assert_rx_equals_sent();
+}
+
 /* A round pillar (0.5 m radius) seen from three sides, each view 118
  * degrees of it, the last a little less: the chain runs round it and its
  * ends meet (about 7 cm apart) where their legs cross, but a smooth join
@@ -1010,6 +1134,7 @@ int main(void)
     RUN_TEST(test_map_chain_closes_at_a_silhouette_corner);
     RUN_TEST(test_map_round_pillar_gets_no_corner);
     RUN_TEST(test_map_copy_run_back_over_is_dropped);
+    RUN_TEST(test_map_run_off_before_an_end_does_not_extend_it);
     RUN_TEST(test_map_small_frames_carry_everything);
     RUN_TEST(test_map_frame_interval_batches_changes);
     return UNITY_END();

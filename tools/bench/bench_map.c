@@ -42,7 +42,10 @@
  *    poses on a loop, tools/scene): curve to true surface every 1 cm along
  *    the curves (quantiles per length of curve); "surface seen" is the true surface hit by a valid
  * return (2 cm bins along each shape); a corner counts as seen in a scan when bsf_truth_corner_seen
- * says so, and as one map vertex when exactly one map vertex lies within 3 cm of it.
+ * says so, and as one map vertex when exactly one map vertex lies within 3 cm of it;
+ *  - folds: places where a curve turns back on itself (mg_bspline_folds, map_geom.h): more than
+ *    150 degrees between the chords 2 cm of arc before and after a point of the B-spline, the
+ *    curve cut at its vertices; a vertex turning more than 150 degrees is counted apart.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -79,9 +82,10 @@ typedef struct {
     unsigned long scans, failed;
     /* per-scan stream */
     size_t stream_bytes, stream_gz_bytes;
-    mg_hist_t own_dist;  /* raw point to its own scan's features */
-    mg_hist_t prev_dist; /* raw point to the previous scan's features: how well poses agree */
-    mg_hist_t own_truth; /* per-scan feature samples to the true surface */
+    mg_hist_t own_dist;   /* raw point to its own scan's features */
+    mg_hist_t prev_dist;  /* raw point to the previous scan's features: how well poses agree */
+    mg_hist_t own_truth;  /* per-scan feature samples to the true surface */
+    mg_folds_t own_folds; /* folds of every scan's features (world frame), summed */
     /* grid */
     mg_grid_result_t grid;
     int grid_ok;
@@ -93,9 +97,10 @@ typedef struct {
     unsigned long rx_mismatch, rx_compared, fuse_failed;
     unsigned long rx_points, robot_points; /* distinct control points */
     double map_length;
-    mg_hist_t map_dist;  /* raw point to the final map */
-    mg_hist_t map_truth; /* map curve samples to the true surface */
-    double *fuse_us;     /* host time per fuse call */
+    mg_hist_t map_dist;   /* raw point to the final map */
+    mg_hist_t map_truth;  /* map curve samples to the true surface */
+    mg_folds_t map_folds; /* folds of the receiver's final map */
+    double *fuse_us;      /* host time per fuse call */
     size_t n_fuse_us;
     /* synthetic truth */
     double seen_m;
@@ -198,8 +203,9 @@ static void to_world(double px, double py, double pth, double sx, double sy, dou
     *wy = py + s * sx + c * sy;
 }
 
-/* g_res's features in the world frame (pose px, py, pth) into c. */
-static int result_curves(mg_curves_t *c, double px, double py, double pth)
+/* g_res's features in the world frame (pose px, py, pth) into c; their
+ * folds added to *folds. */
+static int result_curves(mg_curves_t *c, double px, double py, double pth, mg_folds_t *folds)
 {
     static double xy[2u * BSF_MAX_CTRL_PER_FEATURE];
     size_t i, k;
@@ -213,7 +219,8 @@ static int result_curves(mg_curves_t *c, double px, double py, double pth)
             const bsf_point_t *p = &g_res.ctrl[f->ctrl_first + k];
             to_world(px, py, pth, (double)p->x, (double)p->y, &xy[2u * k], &xy[2u * k + 1u]);
         }
-        if (mg_curves_add_bspline(c, xy, f->n_ctrl, &g_res.ctrl_is_vertex[f->ctrl_first]) != 0) {
+        if (mg_curves_add_bspline(c, xy, f->n_ctrl, &g_res.ctrl_is_vertex[f->ctrl_first]) != 0 ||
+            mg_bspline_folds(xy, f->n_ctrl, &g_res.ctrl_is_vertex[f->ctrl_first], folds) != 0) {
             return -1;
         }
     }
@@ -280,7 +287,7 @@ static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t 
     if (scratch->n_seg > 0u) {
         own_scan_distances(pts, first, scratch, &col->prev_dist);
     }
-    if (result_curves(scratch, px, py, pth) != 0) {
+    if (result_curves(scratch, px, py, pth, &col->own_folds) != 0) {
         return -1;
     }
     own_scan_distances(pts, first, scratch, &col->own_dist);
@@ -453,7 +460,8 @@ static int final_map(column_t *col, mg_curves_t *map)
             xy[2 * k] = (double)ctrl[k].x;
             xy[2 * k + 1] = (double)ctrl[k].y;
         }
-        if (mg_curves_add_bspline(map, xy, (size_t)n, vtx) != 0) {
+        if (mg_curves_add_bspline(map, xy, (size_t)n, vtx) != 0 ||
+            mg_bspline_folds(xy, (size_t)n, vtx, &col->map_folds) != 0) {
             return -1;
         }
     }
@@ -914,6 +922,9 @@ static void print_table(void)
                                     : 0.0,
                      col->corners_one, col->corners_5, col->corners_many)
             : printf(" – |"));
+    ROW("**map: folds (curve turning back > 150 deg within 2 cm of arc either side), vertices "
+        "turning > 150 deg**",
+        printf(" %lu, %lu |", col->map_folds.folds, col->map_folds.sharp_vertices));
     ROW("map: features, control points, vertices, curve m",
         printf(" %lu, %lu, %lu, %.1f |", col->map_features, col->rx_points, col->map_vertices,
                col->map_length));
@@ -939,6 +950,8 @@ static void print_table(void)
                100.0 * mg_hist_share_below(&col->own_dist, 0.02),
                100.0 * mg_hist_share_below(&col->own_dist, 0.10),
                100.0 * mg_hist_share_below(&col->own_dist, 0.50)));
+    ROW("per-scan features: folds, vertices turning > 150 deg (all scans, summed)",
+        printf(" %lu, %lu |", col->own_folds.folds, col->own_folds.sharp_vertices));
     ROW("per-scan features to true surface p99 / max mm",
         col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->own_truth, 0.99),
                                 1000.0 * col->own_truth.max)

@@ -141,6 +141,81 @@ int mg_curves_add_bspline(mg_curves_t *c, const double *xy, size_t n_ctrl, const
     return 0;
 }
 
+/* Index of the first sample after i (step +1) or before it (-1), within
+ * [lo, hi], at least MG_FOLD_CHORD of arc away; -1 when there is none. */
+static long fold_reach(const double *arc, long i, long lo, long hi, long step)
+{
+    long j = i + step;
+    while (j >= lo && j <= hi && fabs(arc[j] - arc[i]) < MG_FOLD_CHORD) {
+        j += step;
+    }
+    return j >= lo && j <= hi ? j : -1;
+}
+
+/* 1 when the chords a -> i and i -> b turn by more than MG_FOLD_TURN_DEG. */
+static int folds_back(const double *p, long a, long i, long b)
+{
+    const double ux = p[2 * i] - p[2 * a], uy = p[2 * i + 1] - p[2 * a + 1];
+    const double vx = p[2 * b] - p[2 * i], vy = p[2 * b + 1] - p[2 * i + 1];
+    const double c = cos(MG_FOLD_TURN_DEG * 3.14159265358979323846 / 180.0);
+    return ux * vx + uy * vy < c * hypot(ux, uy) * hypot(vx, vy);
+}
+
+int mg_bspline_folds(const double *xy, size_t n_ctrl, const uint8_t *vertex, mg_folds_t *f)
+{
+    static double pts[2u * (MG_FOLD_SAMPLES_PER_SPAN * 4096u + 1u)];
+    static double arc[MG_FOLD_SAMPLES_PER_SPAN * 4096u + 1u];
+    static uint8_t cut[4096u];
+    size_t spans, s, k, n = 0;
+    long lo = 0;
+    if (n_ctrl < 3u || n_ctrl > 4096u) {
+        return -1;
+    }
+    spans = n_ctrl - 2u;
+    memset(cut, 0, spans + 1u);
+    /* a vertex (slots k, k + 1) is the curve at the knot between spans k - 1 and k */
+    for (k = 0; vertex != NULL && k + 1u < n_ctrl; ++k) {
+        if (vertex[k] && vertex[k + 1u]) {
+            cut[k] = k > 0u && k < spans;
+            ++k;
+        }
+    }
+    for (s = 0; s < spans; ++s) {
+        for (k = (s == 0u ? 0u : 1u); k <= MG_FOLD_SAMPLES_PER_SPAN; ++k) {
+            bspline_point(xy, spans, s, (double)k / MG_FOLD_SAMPLES_PER_SPAN, &pts[2u * n],
+                          &pts[2u * n + 1u]);
+            arc[n] = n == 0u ? 0.0
+                             : arc[n - 1u] + hypot(pts[2u * n] - pts[2u * n - 2u],
+                                                   pts[2u * n + 1u] - pts[2u * n - 1u]);
+            ++n;
+        }
+    }
+    /* smooth pieces between vertices (and the curve's ends) */
+    for (s = 1; s <= spans; ++s) {
+        const long hi = (long)(s * MG_FOLD_SAMPLES_PER_SPAN);
+        long i;
+        int in_fold = 0;
+        if (s < spans && !cut[s]) {
+            continue;
+        }
+        for (i = lo; i <= hi; ++i) {
+            const long a = fold_reach(arc, i, lo, hi, -1);
+            const long b = fold_reach(arc, i, lo, hi, 1);
+            const int back = a >= 0 && b >= 0 && folds_back(pts, a, i, b);
+            f->folds += back && !in_fold ? 1u : 0u;
+            in_fold = back;
+        }
+        if (s < spans) {
+            /* the vertex's own turn, between its two legs */
+            const long a = fold_reach(arc, hi, lo, hi, -1);
+            const long b = fold_reach(arc, hi, hi, (long)n - 1, 1);
+            f->sharp_vertices += a >= 0 && b >= 0 && folds_back(pts, a, hi, b) ? 1u : 0u;
+        }
+        lo = hi;
+    }
+    return 0;
+}
+
 #define MG_CELL 0.1
 
 int mg_index_build(mg_index_t *ix, const mg_curves_t *c)

@@ -42,6 +42,29 @@ int mg_curves_add_vertex(mg_curves_t *c, double x, double y);
  */
 int mg_curves_add_bspline(mg_curves_t *c, const double *xy, size_t n_ctrl, const uint8_t *vertex);
 
+/**
+ * Folds of a curve: places where it turns back on itself. The curve is
+ * sampled MG_FOLD_SAMPLES_PER_SPAN times per span; at each sample the chord
+ * from the curve MG_FOLD_CHORD metres of arc before it and the chord to the
+ * curve MG_FOLD_CHORD after it are compared, and a run of samples where they
+ * turn by more than MG_FOLD_TURN_DEG is one fold. Chords, not derivatives: at
+ * a cusp the derivative vanishes. A circle turns that much between chords of
+ * 2 cm only when its radius is under 8 mm, which no scan resolves, so a
+ * real round surface never counts. The curve is cut at its vertices (the
+ * map's corners, where the spans on either side are straight): a vertex's
+ * own turn is the corner's angle, counted apart in sharp_vertices when it
+ * exceeds MG_FOLD_TURN_DEG, since a true corner that acute is possible.
+ */
+#define MG_FOLD_SAMPLES_PER_SPAN 64
+#define MG_FOLD_CHORD 0.02
+#define MG_FOLD_TURN_DEG 150.0
+typedef struct {
+    unsigned long folds;          /* turns back within the smooth pieces */
+    unsigned long sharp_vertices; /* vertices turning more than MG_FOLD_TURN_DEG */
+} mg_folds_t;
+/** Add the folds of the curve mg_curves_add_bspline takes to *f. 0, or -1 for a bad curve. */
+int mg_bspline_folds(const double *xy, size_t n_ctrl, const uint8_t *vertex, mg_folds_t *f);
+
 /** Largest distance a query resolves, metres; farther reads as this. */
 #define MG_DIST_MAX 0.5
 /** Uniform grid over the segments of a curve set, for nearest distances. */
