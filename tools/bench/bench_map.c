@@ -97,10 +97,13 @@ typedef struct {
     unsigned long rx_mismatch, rx_compared, fuse_failed;
     unsigned long rx_points, robot_points; /* distinct control points */
     double map_length;
-    mg_hist_t map_dist;   /* raw point to the final map */
-    mg_hist_t map_truth;  /* map curve samples to the true surface */
-    mg_folds_t map_folds; /* folds of the receiver's final map */
-    double *fuse_us;      /* host time per fuse call */
+    mg_hist_t map_dist; /* raw point to the final map */
+    unsigned long
+        miss_own_near;          /* beyond 5 cm of the map, within 5 cm of its own scan's features */
+    unsigned long miss_own_far; /* beyond 5 cm of both */
+    mg_hist_t map_truth;        /* map curve samples to the true surface */
+    mg_folds_t map_folds;       /* folds of the receiver's final map */
+    double *fuse_us;            /* host time per fuse call */
     size_t n_fuse_us;
     /* synthetic truth */
     double seen_m;
@@ -227,10 +230,30 @@ static int result_curves(mg_curves_t *c, double px, double py, double pth, mg_fo
     return 0;
 }
 
+/* Each raw point's distance to its own scan's features, kept to split the
+ * map's misses by cause (index as in the run's mg_points_t). */
+static float *g_own_dist;
+static size_t g_own_cap;
+
+static int own_dist_keep(size_t i, double d)
+{
+    if (i >= g_own_cap) {
+        const size_t cap = g_own_cap > 0u ? 2u * g_own_cap : 65536u;
+        float *bigger = realloc(g_own_dist, (cap > i ? cap : i + 1u) * sizeof *bigger);
+        if (bigger == NULL) {
+            return -1;
+        }
+        g_own_dist = bigger;
+        g_own_cap = cap > i ? cap : i + 1u;
+    }
+    g_own_dist[i] = (float)d;
+    return 0;
+}
+
 /* Distance from each point [first, n) of pts to the curves of one scan, brute force
- * (a scan has a few hundred segments). */
-static void own_scan_distances(const mg_points_t *pts, size_t first, const mg_curves_t *c,
-                               mg_hist_t *h)
+ * (a scan has a few hundred segments); kept per point when keep is set. */
+static int own_scan_distances(const mg_points_t *pts, size_t first, const mg_curves_t *c,
+                              mg_hist_t *h, int keep)
 {
     size_t i, k;
     for (i = first; i < pts->n; ++i) {
@@ -250,7 +273,11 @@ static void own_scan_distances(const mg_points_t *pts, size_t first, const mg_cu
         }
         best = sqrt(best);
         mg_hist_add(h, best < MG_DIST_MAX ? best : MG_DIST_MAX);
+        if (keep && own_dist_keep(i, best) != 0) {
+            return -1;
+        }
     }
+    return 0;
 }
 
 static int fuse_scan(column_t *col, double px, double py, double pth);
@@ -285,12 +312,14 @@ static int take_scan(column_t *col, const bsf_scan_t *sc, uint32_t seq, int64_t 
     }
     /* scratch still holds the previous extracted scan's curves (none for the first) */
     if (scratch->n_seg > 0u) {
-        own_scan_distances(pts, first, scratch, &col->prev_dist);
+        (void)own_scan_distances(pts, first, scratch, &col->prev_dist, 0);
     }
     if (result_curves(scratch, px, py, pth, &col->own_folds) != 0) {
         return -1;
     }
-    own_scan_distances(pts, first, scratch, &col->own_dist);
+    if (own_scan_distances(pts, first, scratch, &col->own_dist, 1) != 0) {
+        return -1;
+    }
     return fuse_scan(col, px, py, pth);
 }
 
@@ -498,9 +527,20 @@ static int map_coverage(column_t *col, const mg_points_t *pts, const mg_curves_t
     if (mg_index_build(&ix, map) != 0) {
         return -1;
     }
+    col->miss_own_near = col->miss_own_far = 0u;
     for (i = 0; i < pts->n; ++i) {
-        mg_hist_add(&col->map_dist,
-                    mg_index_dist(&ix, (double)pts->xy[2u * i], (double)pts->xy[2u * i + 1u]));
+        const double d = mg_index_dist(&ix, (double)pts->xy[2u * i], (double)pts->xy[2u * i + 1u]);
+        mg_hist_add(&col->map_dist, d);
+        /* a miss its own scan's features hold is a place the map lies elsewhere
+         * (poses that disagree, surfaces averaged); one they do not is
+         * clutter no scan's extraction made a feature of */
+        if (d > 0.05 && i < g_own_cap) {
+            if (g_own_dist[i] <= 0.05f) {
+                ++col->miss_own_near;
+            } else {
+                ++col->miss_own_far;
+            }
+        }
     }
     mg_index_free(&ix);
     return 0;
@@ -908,6 +948,13 @@ static void print_table(void)
                100.0 * mg_hist_share_below(&col->map_dist, 0.02),
                100.0 * mg_hist_share_below(&col->map_dist, 0.10),
                100.0 * mg_hist_share_below(&col->map_dist, 0.50)));
+    ROW("map: points beyond 5 cm that their own scan's features hold within 5 cm / that they do "
+        "not",
+        printf(" %.1f / %.1f %% |",
+               100.0 * (double)col->miss_own_near /
+                   (double)(col->map_dist.n > 0u ? col->map_dist.n : 1u),
+               100.0 * (double)col->miss_own_far /
+                   (double)(col->map_dist.n > 0u ? col->map_dist.n : 1u)));
     ROW("**map: curve to true surface p99 / max mm**",
         col->synthetic ? printf(" %.1f / %.1f |", 1000.0 * mg_hist_quantile(&col->map_truth, 0.99),
                                 1000.0 * col->map_truth.max)
@@ -1063,6 +1110,7 @@ int main(int argc, char **argv)
     }
     print_table();
     free(g_stream);
+    free(g_own_dist);
     for (i = 0; i < (int)g_n_cols; ++i) {
         free(g_cols[i].fuse_us);
     }
