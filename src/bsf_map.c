@@ -1027,6 +1027,9 @@ static int copy_of(const bsf_map_t *m, uint16_t fu, uint16_t fa, float sx, float
  * there would fold the chain back on itself. */
 static int leaves_through(const bsf_map_t *m, uint16_t fs, unsigned end, float tx, float ty)
 {
+    /* the end read directly, not through end_anchor(): this runs for every
+     * labelled pair, and going through the anchor cost 0.2 % more fuse
+     * instructions on the M4F */
     const bsf_map_feature_t *f = &m->features[fs];
     const uint16_t e = end == 1u ? f->head : f->tail;
     const uint16_t in = end == 1u ? m->ctrl[e].next : m->ctrl[e].prev;
@@ -1114,9 +1117,6 @@ static void new_from_run(bsf_map_t *m, const sample_t *s, long from, long to)
     (void)feature_new(m, p, n);
 }
 
-/* Join slot fa (its end ea) to slot fb (its end eb) through samples
- * from..to (may be empty: from > to). Both must be fully sent, so that the
- * merge record can go before any other change to them. */
 /* Join feature slot fu, never sent, to slot fs at fs's end es (fu's end eu
  * meeting it) through samples lo..hi (none when lo > hi), walked from fs
  * toward fu: upward, or downward when `down`. fu's points become unsent points at that end of fs,
@@ -1127,13 +1127,13 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
 {
     bsf_map_feature_t *a = &m->features[fs];
     bsf_map_feature_t *u = &m->features[fu];
+    const anchor_t an = end_anchor(m, a, es);
     newpt_t p[MAX_SAMPLES];
     size_t n = 0;
     if ((size_t)a->n_ctrl + u->n_ctrl + MAX_SAMPLES > BSF_MAP_REC_MAX_POINTS) {
         return 0;
     }
     if (lo <= hi) {
-        const anchor_t an = end_anchor(m, a, es);
         const bsf_map_ctrl_t *o = &m->ctrl[eu == 1u ? u->head : u->tail];
         const float sp = m->params.ctrl_spacing;
         n = resample(m->params.ctrl_spacing, s, down ? hi : lo, down ? lo : hi, &an, p,
@@ -1159,9 +1159,8 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
         const sample_t *t = &s[down ? lo - 1 : hi + 1];
         const float tx = down ? -t->dx : t->dx;
         const float ty = down ? -t->dy : t->dy;
-        const bsf_map_ctrl_t *e = &m->ctrl[es == 1u ? a->head : a->tail];
-        const float lx = n > 0u ? p[n - 1u].x : e->x;
-        const float ly = n > 0u ? p[n - 1u].y : e->y;
+        const float lx = n > 0u ? p[n - 1u].x : an.x;
+        const float ly = n > 0u ? p[n - 1u].y : an.y;
         for (;;) {
             const uint16_t j = es == 2u ? u->head : u->tail;
             bsf_map_ctrl_t *c = &m->ctrl[j];
@@ -1199,6 +1198,9 @@ static int absorb(bsf_map_t *m, uint16_t fs, unsigned es, uint16_t fu, unsigned 
     return 1;
 }
 
+/* Join slot fa (its end ea) to slot fb (its end eb) through samples
+ * from..to (may be empty: from > to). Both must be fully sent, so that the
+ * merge record can go before any other change to them. */
 static int merge(bsf_map_t *m, uint16_t fa, unsigned ea, uint16_t fb, unsigned eb,
                  const sample_t *s, long from, long to)
 {

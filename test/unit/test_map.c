@@ -84,6 +84,29 @@ static void assert_rx_equals_sent(void)
     }
 }
 
+/* Vertices of the receiver's map within 3 cm of (x, y). */
+static uint32_t rx_vertices_near(double x, double y)
+{
+    static bsf_point_t pts[4096];
+    static uint8_t vtx[4096];
+    uint32_t near = 0;
+    uint32_t id;
+    for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
+        const int n = bsf_map_rx_feature_ctrl(&rx, id, pts, vtx, 4096u, NULL);
+        int j;
+        TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
+        for (j = 0; j + 1 < n; ++j) {
+            if (vtx[j] && vtx[j + 1]) {
+                const double dx = (double)pts[j].x - x;
+                const double dy = (double)pts[j].y - y;
+                near += dx * dx + dy * dy <= 0.03 * 0.03 ? 1u : 0u;
+                ++j;
+            }
+        }
+    }
+    return near;
+}
+
 /* Start a map (NULL: the defaults, but a frame every call) and a receiver. */
 static void start(const bsf_map_params_t *p)
 {
@@ -278,23 +301,7 @@ static void test_map_corners_become_one_vertex_each(void)
         (void)deliver(buf, len);
     }
     for (c = 0; c < n_corners; ++c) {
-        uint32_t near = 0;
-        uint32_t id;
-        for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
-            static bsf_point_t pts[4096];
-            static uint8_t vtx[4096];
-            const int n = bsf_map_rx_feature_ctrl(&rx, id, pts, vtx, 4096u, NULL);
-            int j;
-            TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
-            for (j = 0; j + 1 < n; ++j) {
-                if (vtx[j] && vtx[j + 1]) {
-                    const double dx = (double)pts[j].x - corner_x[c];
-                    const double dy = (double)pts[j].y - corner_y[c];
-                    near += dx * dx + dy * dy <= 0.03 * 0.03 ? 1u : 0u;
-                    ++j;
-                }
-            }
-        }
+        const uint32_t near = rx_vertices_near(corner_x[c], corner_y[c]);
         TEST_ASSERT_TRUE_MESSAGE(near <= 1u, "a corner became two map vertices");
         if (corner_seen[c] >= 5u) {
             ++n_judged;
@@ -834,8 +841,6 @@ static void test_map_copy_run_back_over_is_dropped(void)
     static int16_t hits[BSF_MAX_POINTS];
     bsf_scene_rng_t rng;
     long k;
-    uint32_t id;
-    int near = 0;
     start(NULL);
     bsf_scene_truth_curved(&scene);
     bsf_scene_rng_seed(&rng, 4323u);
@@ -870,20 +875,7 @@ static void test_map_copy_run_back_over_is_dropped(void)
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_map_encode(&map, NULL, buf, sizeof buf, &len));
         (void)deliver(buf, len);
     }
-    for (id = 0; id < bsf_map_rx_id_limit(&rx); ++id) {
-        static bsf_point_t pts[4096];
-        static uint8_t vtx[4096];
-        const int n = bsf_map_rx_feature_ctrl(&rx, id, pts, vtx, 4096u, NULL);
-        int j;
-        TEST_ASSERT_TRUE(n >= 0 && n <= 4096);
-        for (j = 0; j + 1 < n; ++j) {
-            if (vtx[j] && vtx[j + 1]) {
-                near += hypotf(pts[j].x + 2.4f, pts[j].y + 0.6f) <= 0.03f ? 1 : 0;
-                ++j;
-            }
-        }
-    }
-    TEST_ASSERT_EQUAL_INT(1, near);
+    TEST_ASSERT_EQUAL_INT(1, rx_vertices_near(-2.4, -0.6));
     assert_rx_equals_sent();
 }
 
