@@ -47,8 +47,8 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * side within max_side of the apex, so the beam spacing, not the range,
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
-    p.join_grazing = 0u;
-    p.corner_evidence = 0u;
+    p.join_grazing = 1u;
+    p.corner_evidence = 1u;
     return p;
 }
 

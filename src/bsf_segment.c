@@ -34,7 +34,7 @@ bsf_sved_params_t bsf_sved_params_default(void)
     p.max_gap_beams = 16u;
     p.radius_max = 1.0f;
     p.reject_mixed = 1u;
-    p.join_grazing = 0u;
+    p.join_grazing = 1u;
     return p;
 }
 

@@ -80,11 +80,11 @@ typedef struct {
     uint8_t join_grazing;     /**< 1: a run goes on across a step wider than the jump radius
                                    (at most max_side) where four consecutive returns through it
                                    lie on one line, a wall seen at grazing incidence, or where
-                                   such a wall starts at a corner; 0 (default): it does not */
+                                   such a wall starts at a corner (default); 0: it does not */
     uint8_t corner_evidence;  /**< 1: a split the curve_ratio test rejects is still a corner
                                    when the best smooth curve misses the points by far more
                                    than the noise explains (a likelihood-ratio test, see
-                                   above); 0 (default): curve_ratio alone */
+                                   above; default); 0: curve_ratio alone */
 } bsf_lc_params_t;
 
 /** The defaults listed beside each field of bsf_lc_params_t. */

@@ -56,8 +56,9 @@ typedef struct {
  *    joins no segment, so it cannot bend or bridge either surface.
  *  - join_grazing: a wall seen at grazing incidence returns one point every
  *    half metre or more at 7 m, farther apart than the radius, yet on a line
- *    to millimetres; such steps join the current segment (off by default:
- *    it finds more corners but lets curves stray farther, docs/GROUND_TRUTH.md).
+ *    to millimetres; such steps join the current segment (on by default, off
+ *    in the paper's rule: the corners of such walls are found,
+ *    docs/GROUND_TRUTH.md).
  */
 typedef struct {
     float a;                     /**< distance threshold at range 0, metres, finite, > 0 */
@@ -74,7 +75,7 @@ typedef struct {
                                than the radius (at most radius_max, used when radius_max > 0)
                                where four consecutive returns through the step lie on one line,
                                a wall seen at grazing incidence, or where such a wall starts at
-                               a corner; 0 (default and the paper): it does not */
+                               a corner (default); 0 (the paper): it does not */
 } bsf_sved_params_t;
 
 /** Largest lookback of bsf_sved_params_t. */
@@ -90,7 +91,7 @@ typedef struct {
 /**
  * SVED defaults (what the extractor uses unless told otherwise): the paper's
  * a = 0.2 m, b = 0.07 /m, min_segment_points = 5, plus lookback 4,
- * max_gap_beams 16, radius_max 1.0 m, reject_mixed 1 and join_grazing 0 (docs/TABLE1.md has
+ * max_gap_beams 16, radius_max 1.0 m, reject_mixed 1 and join_grazing 1 (docs/TABLE1.md has
  * the measurements behind each value).
  */
 bsf_sved_params_t bsf_sved_params_default(void);

@@ -790,7 +790,7 @@ static void test_bad_parameters_are_refused(void)
     sp = sd;
     sp.min_segment_points = 0u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
-    TEST_ASSERT_EQUAL_UINT8(0u, sd.join_grazing);
+    TEST_ASSERT_EQUAL_UINT8(1u, sd.join_grazing);
     TEST_ASSERT_EQUAL_UINT8(0u, bsf_sved_params_paper().join_grazing);
     sp = sd;
     sp.join_grazing = 2u;
