@@ -90,6 +90,7 @@ typedef struct {
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
     float noise2; /* the current run's noise variance (run_noise squared) */
+    size_t start; /* beam where the pass starts (ring_start, else 0) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -1195,12 +1196,21 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
     return nb;
 }
 
+/* Position of beam b on the pass, which starts at beam start (0, or past the
+ * seam's cut on a full-circle scan of count beams). */
+static size_t pass_pos(size_t b, size_t start, size_t count)
+{
+    return b >= start ? b - start : b + count - start;
+}
+
 /* Two keypoints of one run on one corner: beams closer than the points a
  * side needs, or intersections within apex_slack of each other. */
-static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf_lc_params_t *p)
+static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const lc_ctx_t *c)
 {
-    return (size_t)a->index + p->min_side_points >= (size_t)b->index ||
-           dist2(a->point, b->point) <= p->apex_slack * p->apex_slack;
+    const size_t count = c->pts->count;
+    return pass_pos(a->index, c->start, count) + c->p->min_side_points >=
+               pass_pos(b->index, c->start, count) ||
+           dist2(a->point, b->point) <= c->p->apex_slack * c->p->apex_slack;
 }
 
 /* Append kp, or merge it into the previous keypoint of the same run (from
@@ -1208,9 +1218,9 @@ static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf
  * mirrors the previous keypoint even when out is full, so the count does not
  * depend on out_cap. */
 static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, bsf_keypoint_t *last,
-                 const bsf_keypoint_t *kp, const bsf_lc_params_t *p)
+                 const bsf_keypoint_t *kp, const lc_ctx_t *c)
 {
-    if (*n > first && too_close(last, kp, p)) {
+    if (*n > first && too_close(last, kp, c)) {
         if (kp->score > last->score) {
             *last = *kp;
             if (*n - 1u < out_cap) {
@@ -1317,7 +1327,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                     continue; /* cannot happen: same judgement as in the pass */
                 }
             }
-            keep(out, out_cap, n_found, first, &last, &kp, c->p);
+            keep(out, out_cap, n_found, first, &last, &kp, c);
         }
         return;
     }
@@ -1325,7 +1335,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
         if (judge(c, lo, w->brk[j], hi, m, &kp) == LC_CORNER) {
-            keep(out, out_cap, n_found, first, &last, &kp, c->p);
+            keep(out, out_cap, n_found, first, &last, &kp, c);
         }
     }
 }
@@ -1393,6 +1403,56 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
     return i;
 }
 
+/* Point b continues the run that ends at point a: within the jump radius,
+ * or (join_grazing) the next beam on one wall seen at grazing incidence
+ * (never through the seam of a full-circle scan). */
+static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+{
+    return within_jump(pts, p, a, b) ||
+           (p->join_grazing && a + 1u == b && bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP));
+}
+
+/* Where the pass over a full-circle scan starts: the first valid beam (from
+ * 0) that does not continue the run of the valid beam before it on the ring,
+ * so that no run is cut at the seam; 0 when every step joins (one closed
+ * surface all round: the seam then cuts it, as on a scan that is no ring). */
+static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
+{
+    size_t prev = pts->count;
+    size_t i;
+    for (i = pts->count; i > 0u; --i) {
+        if (pts->valid[i - 1u]) {
+            prev = i - 1u;
+            break;
+        }
+    }
+    if (prev == pts->count) {
+        return 0u;
+    }
+    for (i = 0; i < pts->count; ++i) {
+        if (!pts->valid[i]) {
+            continue;
+        }
+        if (i != prev && !lc_joins(pts, p, prev, i) && past_occluder(pts, p, prev, i) == i) {
+            return i;
+        }
+        prev = i;
+    }
+    return 0u;
+}
+
+/* Reverse out[lo, hi). */
+static void reverse_keypoints(bsf_keypoint_t *out, size_t lo, size_t hi)
+{
+    while (hi > lo + 1u) {
+        const bsf_keypoint_t t = out[lo];
+        out[lo] = out[hi - 1u];
+        out[hi - 1u] = t;
+        ++lo;
+        --hi;
+    }
+}
+
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
 {
@@ -1401,6 +1461,8 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     size_t n_found = 0;
     size_t m = 0;
     size_t i;
+    size_t step;
+    size_t start;
     if (n_out != NULL) {
         *n_out = 0u;
     }
@@ -1424,19 +1486,20 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.sin_min_turn = bsf_sinf(p->min_turn);
     c.noise2 = 0.0f;
     blocks_detach(&c);
-    for (i = 0; i <= pts->count; ++i) {
-        int close_run = i == pts->count;
+    start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
+    c.start = start;
+    for (step = 0; step <= pts->count; ++step) {
+        int close_run = step == pts->count;
+        i = close_run ? 0u : (start + step < pts->count ? start + step : start + step - pts->count);
         if (!close_run && !pts->valid[i]) {
             continue;
         }
         if (!close_run && m > 0u) {
-            close_run = !within_jump(pts, p, work->run[m - 1u], i) &&
-                        !(p->join_grazing && work->run[m - 1u] + 1u == i &&
-                          bsf_grazing_join(pts, i - 1u, BSF_GRAZING_LC_CAP));
+            close_run = !lc_joins(pts, p, work->run[m - 1u], i);
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
-                if (j > i) {
-                    i = j - 1u; /* the run resumes at j */
+                if (j > i && step + (j - i) < pts->count) {
+                    step += j - i - 1u; /* the run resumes at j */
                     continue;
                 }
             }
@@ -1447,9 +1510,21 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             }
             m = 0;
         }
-        if (i < pts->count) {
+        if (step < pts->count) {
             work->run[m++] = (uint16_t)i;
         }
+    }
+    if (start > 0u) {
+        /* Found from the pass's start on: the corners before beam start
+         * (those past the seam) go first, so out stays in beam order. */
+        const size_t n_kept = n_found < out_cap ? n_found : out_cap;
+        size_t n_after = 0u;
+        while (n_after < n_kept && out[n_after].index >= start) {
+            ++n_after;
+        }
+        reverse_keypoints(out, 0u, n_after);
+        reverse_keypoints(out, n_after, n_kept);
+        reverse_keypoints(out, 0u, n_kept);
     }
     *n_out = n_found;
     return n_found > out_cap ? BSF_ERR_CAPACITY : BSF_OK;

@@ -48,6 +48,11 @@
  *     residual would grow and cost that neighbour its corner too);
  *  3. report each corner at its apex beam, with the intersection of the two
  *     lines as its position (PDM starts the vertex there and keeps it there).
+ * On a full-circle scan (bsf_points_full_circle) the pass starts at the first
+ * beam where a run breaks anyway, so a run goes on through the seam between
+ * the last and the first beam and a corner straight behind the sensor is
+ * judged as one ahead is (a closed surface all round, with no break, is cut
+ * at the seam).
  * Thresholds are absolute or relative to the estimated noise; none depends
  * on the other corners of the scan. Cost is linear in beams per split level.
  */
@@ -135,7 +140,8 @@ typedef struct {
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers (out may be NULL when out_cap
  *         is 0); BSF_ERR_PARAM for bad parameters; BSF_ERR_CAPACITY when
  *         pts->count > BSF_MAX_POINTS or more than out_cap corners were found
- *         (out holds the first out_cap, *n_out the total).
+ *         (out holds the first out_cap, counted from where the pass starts on a
+ *         full-circle scan, in beam order; *n_out the total).
  */
 BSF_NODISCARD bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p,
                                          bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,

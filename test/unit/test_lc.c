@@ -59,6 +59,30 @@ static size_t detect(double x, double y, double heading, size_t n, double fov, d
     return n_out;
 }
 
+/* As detect(), on a full-circle sensor of n beams (2 pi / n apart) whose
+ * seam, between its last and first beam, points straight behind it. */
+static size_t detect_ring(double x, double y, double heading, size_t n, double sigma)
+{
+    bsf_lidar_t lid = bsf_lidar_default(x, y, heading, n, 2.0 * PI);
+    bsf_scene_rng_t rng;
+    bsf_scan_t scan;
+    bsf_lc_params_t p = bsf_lc_params_default();
+    size_t n_out = 0;
+    lid.angle_increment = 2.0 * PI / (double)n;
+    lid.angle_min = -PI + 0.5 * lid.angle_increment;
+    lid.noise_sigma = sigma;
+    lid.range_max = range_max;
+    lid.no_return = (float)(range_max + 1.0);
+    bsf_scene_rng_seed(&rng, 7u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, &rng, ranges, NULL, BSF_MAX_POINTS));
+    scan = bsf_scene_lidar_scan(&lid, ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    TEST_ASSERT_TRUE(bsf_points_full_circle(&points));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
+    return n_out;
+}
+
 /* Distance from keypoint k to the world point (wx, wy) seen from the pose. */
 static double dist_to(size_t k, double x, double y, double heading, double wx, double wy)
 {
@@ -85,6 +109,36 @@ static void test_corners_of_many_angles_are_found_where_the_walls_meet(void)
         /* The two-line intersection, not the nearest beam: millimetres. */
         TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 4.0, 0.0) < 0.005);
     }
+}
+
+/* A corner straight behind a full-circle sensor lies across the seam, its
+ * two walls at the two ends of the beam array: the pass starts where a run
+ * breaks anyway, so the walls make one run and the corner is found as one
+ * ahead is (without it each wall was a run of its own and the corner was
+ * lost). Keypoints still come out in beam order. */
+static void test_a_corner_behind_a_full_circle_sensor_is_found_across_the_seam(void)
+{
+    size_t n;
+    size_t k;
+    int behind = -1;
+    int ahead = -1;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, -4.0, 0.0, -0.35 * PI, 3.0, 0.35 * PI, 3.0));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 4.0, 0.0, 0.65 * PI, 3.0, 1.35 * PI, 3.0));
+    n = detect_ring(0.0, 0.0, 0.0, 360u, 0.01);
+    TEST_ASSERT_EQUAL_size_t(2u, n);
+    for (k = 0; k < n; ++k) {
+        if (dist_to(k, 0.0, 0.0, 0.0, -4.0, 0.0) < 0.03) {
+            behind = (int)k;
+        }
+        if (dist_to(k, 0.0, 0.0, 0.0, 4.0, 0.0) < 0.03) {
+            ahead = (int)k;
+        }
+    }
+    TEST_ASSERT_TRUE_MESSAGE(behind >= 0, "the corner across the seam");
+    TEST_ASSERT_TRUE_MESSAGE(ahead >= 0, "the corner ahead");
+    TEST_ASSERT_TRUE(kps[0].index < kps[1].index);
 }
 
 static void test_a_lone_far_corner_is_found_at_one_degree_beams(void)
@@ -425,6 +479,7 @@ int main(void)
     RUN_TEST(test_shallow_corners_between_long_sides_are_found_with_the_evidence_test);
     RUN_TEST(test_the_evidence_test_adds_no_corner_on_walls_pillars_curves_or_depth_steps);
     RUN_TEST(test_corners_between_long_shallow_sides_are_not_lost_to_a_missed_neighbour);
+    RUN_TEST(test_a_corner_behind_a_full_circle_sensor_is_found_across_the_seam);
     RUN_TEST(test_refused_calls);
     RUN_TEST(test_more_corners_than_room_reports_capacity_and_the_total);
     return UNITY_END();
