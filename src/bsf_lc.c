@@ -17,9 +17,9 @@
 /* Single distances above this do not count towards the noise estimate
  * (corners and jumps inside a run), metres. */
 #define LC_NOISE_CLIP 0.05f
-/* Shortest distance from a point to either end of the chord that gives the
- * local direction in the noise estimate, metres: well above range noise,
- * well below the length of a wall. */
+/* Shortest span across the ray of the beams from a point to either end of
+ * its chord in the noise estimate, metres: well above range noise, well
+ * below the length of a wall. */
 #define LC_NOISE_BASE 0.05f
 /* A circle is only a candidate shape when its radius is below this multiple
  * of the window's extent: a larger one is a line in float arithmetic. */
@@ -1105,74 +1105,74 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
 }
 
 /* Noise of a run, from each point's distance to the chord of its two
- * neighbours, measured across the local direction of the run: the chord
- * between the nearest points at least LC_NOISE_BASE before and after it
- * (the neighbours' own chord where the beams are sparser than that). Where
- * the beams are denser than the noise (fine beams, near walls), the
- * neighbours' chord points anywhere and a point's distance to it says
- * little: at 0.11 deg beams and 1 cm noise it gave half the noise. Returns
- * the noise normal to the surface, averaged over the run; *along_ray gets
- * the noise along the rays, from the points where the beams are denser
- * than LC_NOISE_BASE and seen within 80 deg of the normal (0 when there
- * are none): their distances over the cosines of their incidence, so a
- * wall seen obliquely, whose noise runs mostly along it, does not lower
- * it. Both window ends only move forward: linear cost. */
+ * neighbours. Where the beams are denser than the noise (fine beams, near
+ * walls), the neighbours' chord points anywhere and a point's distance to
+ * it says little (at 0.11 deg beams and 1 cm range noise it gave about
+ * half that): there the direction comes from the chord of the points k
+ * positions either side, k beams spanning at least LC_NOISE_BASE at the
+ * point's range, the point is measured across it from its neighbours'
+ * midpoint, and only every k-th point is measured (the estimate needs no
+ * more, and dense runs cost less than before). Returns the noise normal to
+ * the surface, averaged over the run; *along_ray gets the noise along the
+ * rays from the points measured with k > 1 and seen within 80 deg of the
+ * normal (0 when there are none): their distances over the cosines of
+ * their incidence, so a wall seen obliquely, whose noise runs mostly along
+ * it, does not lower it. */
 static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m, float *along_ray)
 {
-    const float base2 = LC_NOISE_BASE * LC_NOISE_BASE;
+    const float step_angle = fabsf(pts->angle_increment);
     float sum = 0.0f;
-    float dense_sum = 0.0f; /* distances of the points with a wider chord */
+    float dense_sum = 0.0f; /* distances of the points measured with k > 1 */
     float dense_cos = 0.0f; /* and the cosines of their incidence */
     size_t n = 0;
     size_t i;
-    size_t lo = 0;
-    size_t hi = 1;
+    size_t k = 1;
     *along_ray = 0.0f;
     if (m < 3u) {
         return 0.0f;
     }
-    for (i = 1; i + 1u < m; ++i) {
-        const bsf_point_t a = pts->pt[run[i - 1u]];
+    for (i = 1; i + 1u < m; i += k) {
+        const float r = pts->range[run[i]];
+        const float spacing = r * step_angle; /* beam spacing across the ray */
         const bsf_point_t q = pts->pt[run[i]];
-        const bsf_point_t b = pts->pt[run[i + 1u]];
-        int wider;
+        bsf_point_t a;
+        bsf_point_t b;
         float ex;
         float ey;
         float len;
-        float d;
-        while (lo + 1u < i && dist2(pts->pt[run[lo + 1u]], q) >= base2) {
-            ++lo;
+        k = 1u;
+        if (spacing < LC_NOISE_BASE) {
+            const float want = LC_NOISE_BASE / spacing; /* > 1; inf when spacing is 0 */
+            k = want < (float)m ? (size_t)want + 1u : m;
         }
-        if (hi <= i) {
-            hi = i + 1u;
-        }
-        while (hi + 1u < m && dist2(pts->pt[run[hi]], q) < base2) {
-            ++hi;
-        }
-        wider = lo + 1u != i || hi != i + 1u;
-        if (!wider) {
+        a = pts->pt[run[i - 1u]];
+        b = pts->pt[run[i + 1u]];
+        if (k == 1u) {
             ex = b.x - a.x;
             ey = b.y - a.y;
-            d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x));
         } else {
-            /* across the wider chord, from the neighbours' midpoint */
-            const bsf_point_t pl = pts->pt[run[lo]];
-            const bsf_point_t ph = pts->pt[run[hi]];
+            /* the direction from the wider chord, the point against its
+             * neighbours' midpoint */
+            const bsf_point_t pl = pts->pt[run[i > k ? i - k : 0u]];
+            const bsf_point_t ph = pts->pt[run[i + k < m ? i + k : m - 1u]];
             ex = ph.x - pl.x;
             ey = ph.y - pl.y;
-            d = fabsf(ex * (q.y - 0.5f * (a.y + b.y)) - ey * (q.x - 0.5f * (a.x + b.x)));
+            a.x = 0.5f * (a.x + b.x);
+            a.y = 0.5f * (a.y + b.y);
         }
         len = sqrtf(ex * ex + ey * ey);
         if (len > 0.0f) {
-            d /= len;
+            const float d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
             if (d <= LC_NOISE_CLIP) {
                 sum += d;
                 ++n;
-                /* cosine of the incidence: sine of the chord's angle to the ray */
-                const float cos_inc = fabsf(ex * q.y - ey * q.x) / (len * pts->range[run[i]]);
-                if (wider && cos_inc >= BSF_GRAZING_MIN_SIN) {
-                    dense_sum += d;
-                    dense_cos += cos_inc;
+                if (k > 1u) {
+                    /* cosine of the incidence: sine of the chord's angle to the ray */
+                    const float cos_inc = fabsf(ex * q.y - ey * q.x) / (len * r);
+                    if (cos_inc >= BSF_GRAZING_MIN_SIN) {
+                        dense_sum += d;
+                        dense_cos += cos_inc;
+                    }
                 }
             }
         }

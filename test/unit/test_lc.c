@@ -369,7 +369,7 @@ static void test_corners_between_long_shallow_sides_are_not_lost_to_a_missed_nei
  * recess faces the sensor: noise split its walls every few points and the
  * sides of the true corners reached past the next corner. 4 of these 24
  * corners were found (in each configuration), now 23: the tolerance
- * follows the noise along the rays (9-10 mm measured). */
+ * follows the noise along the rays (8.5-12 mm measured). */
 static void test_the_corners_of_a_recess_are_found_with_beams_denser_than_the_noise(void)
 {
     static const double xy[12] = {-8.0, -1.0, -0.5, -1.0, -0.5, -1.5,
