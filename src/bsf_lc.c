@@ -1145,20 +1145,17 @@ static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m, f
             const float want = LC_NOISE_BASE / spacing; /* > 1; inf when spacing is 0 */
             k = want < (float)m ? (size_t)want + 1u : m;
         }
-        a = pts->pt[run[i - 1u]];
-        b = pts->pt[run[i + 1u]];
-        if (k == 1u) {
-            ex = b.x - a.x;
-            ey = b.y - a.y;
-        } else {
-            /* the direction from the wider chord, the point against its
-             * neighbours' midpoint */
-            const bsf_point_t pl = pts->pt[run[i > k ? i - k : 0u]];
-            const bsf_point_t ph = pts->pt[run[i + k < m ? i + k : m - 1u]];
-            ex = ph.x - pl.x;
-            ey = ph.y - pl.y;
-            a.x = 0.5f * (a.x + b.x);
-            a.y = 0.5f * (a.y + b.y);
+        /* the chord's ends (the neighbours when k is 1) */
+        a = pts->pt[run[i > k ? i - k : 0u]];
+        b = pts->pt[run[i + k < m ? i + k : m - 1u]];
+        ex = b.x - a.x;
+        ey = b.y - a.y;
+        if (k > 1u) {
+            /* the point against its neighbours' midpoint, across the chord */
+            const bsf_point_t na = pts->pt[run[i - 1u]];
+            const bsf_point_t nb = pts->pt[run[i + 1u]];
+            a.x = 0.5f * (na.x + nb.x);
+            a.y = 0.5f * (na.y + nb.y);
         }
         len = sqrtf(ex * ex + ey * ey);
         if (len > 0.0f) {
