@@ -9,7 +9,15 @@
  *  1. split the run where a point lies farther than a tolerance from the chord
  *     of its piece (Douglas-Peucker without recursion); the tolerance is
  *     split_sigmas times the run's noise, estimated from how far each point
- *     lies from the chord of its two neighbours, and at least split_min;
+ *     lies from the chord of its two neighbours, and at least split_min.
+ *     Where the beams are denser than 5 cm at the point's range, the
+ *     chord's direction comes from the points 5 cm of beams either side
+ *     (the neighbours' chord would point anywhere at centimetre noise), and
+ *     the tolerance is split_sigmas times the noise along the rays there
+ *     when that is larger: a wall facing the sensor has many points with
+ *     the whole range noise across it, which the run's average across its
+ *     surfaces (lowered by walls seen obliquely) would split every few
+ *     points;
  *  2. judge every split point with the two pieces beside it (each cut to
  *     max_side metres from the apex): fit a total-least-squares line to each
  *     side (the apex left out) and keep the split as a corner only when
