@@ -276,6 +276,128 @@ static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, f
     return 1;
 }
 
+/* Beam i + k (any sign) into *j, wrapping on a ring; 0 when that beam is
+ * outside the scan or invalid. */
+static int neighbour_beam(const bsf_points_t *pts, size_t i, long k, int ring, size_t *j)
+{
+    const long n = (long)pts->count;
+    long m = (long)i + k;
+    if (m < 0 || m >= n) {
+        if (!ring || k <= -n || k >= n) {
+            return 0;
+        }
+        m = m < 0 ? m + n : m - n;
+    }
+    if (!pts->valid[(size_t)m]) {
+        return 0;
+    }
+    *j = (size_t)m;
+    return 1;
+}
+
+/* Returns on the surface a mixed pixel's range is nearest to, fitted for the
+ * "off its surface" route of the mixed-pixel rule. */
+#define SEG_MIXED_WINDOW 8
+
+/* Squared noise floor of that route (3 mm: ranges quantised to a centimetre
+ * scatter by about this much), so noise-free ranges do not make every
+ * rounding error a mixed pixel. */
+#define SEG_MIXED_FLOOR2 (0.003f * 0.003f)
+
+/* How far from that surface's line, in its estimated noise sigmas, a return
+ * lies off it. Extrapolating the line one beam past its window scatters the
+ * return's distance by about 1.3 sigma, so 5 drops a real end return by
+ * chance about once in 10 000 (more when the window's own scatter
+ * underestimates the noise, once in a few hundred). */
+#define SEG_MIXED_SIGMAS2 25.0f
+
+/* Beam i (range strictly between those of its neighbours at a depth jump)
+ * lies off the surface whose neighbour range it is nearer to: the total
+ * least-squares line through the SEG_MIXED_WINDOW returns on that side misses
+ * it by more than SEG_MIXED_SIGMAS noise sigmas (estimated from that line's
+ * own residual), towards the other surface. near_dir is -1 or +1, the side
+ * of that neighbour. A return at a surface's real end lies on its line; a
+ * mixed pixel, read between the two surfaces along its ray, does not. */
+static int off_its_surface(const bsf_points_t *pts, size_t i, int near_dir, int ring,
+                           int other_is_farther)
+{
+    bsf_point_t w[SEG_MIXED_WINDOW];
+    float cx = 0.0f;
+    float cy = 0.0f;
+    float sxx = 0.0f;
+    float sxy = 0.0f;
+    float syy = 0.0f;
+    float half_tr;
+    float half_diff;
+    float root;
+    float lam;
+    float nx;
+    float ny;
+    float var;
+    float d;
+    float d_sensor;
+    int k;
+    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
+        size_t j;
+        if (!neighbour_beam(pts, i, (long)near_dir * (long)(k + 1), ring, &j)) {
+            return 0;
+        }
+        w[k] = pts->pt[j];
+        cx += w[k].x;
+        cy += w[k].y;
+    }
+    cx *= 1.0f / (float)SEG_MIXED_WINDOW;
+    cy *= 1.0f / (float)SEG_MIXED_WINDOW;
+    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
+        const float dx = w[k].x - cx;
+        const float dy = w[k].y - cy;
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    /* Smallest eigenvalue of the scatter matrix (the squared residual of the
+     * best line) and its eigenvector (the line's normal). */
+    half_tr = 0.5f * (sxx + syy);
+    half_diff = 0.5f * (sxx - syy);
+    root = sqrtf(half_diff * half_diff + sxy * sxy);
+    lam = half_tr - root;
+    if (lam < 0.0f) {
+        lam = 0.0f;
+    }
+    if (half_diff >= 0.0f) {
+        /* x spreads more: the normal is mostly along y */
+        nx = sxy;
+        ny = lam - sxx;
+    } else {
+        nx = lam - syy;
+        ny = sxy;
+    }
+    {
+        const float len2 = nx * nx + ny * ny;
+        if (!(len2 > 0.0f)) {
+            /* an axis-aligned line: the normal is the axis of less spread */
+            nx = half_diff >= 0.0f ? 0.0f : 1.0f;
+            ny = half_diff >= 0.0f ? 1.0f : 0.0f;
+        } else {
+            const float inv = 1.0f / sqrtf(len2);
+            nx *= inv;
+            ny *= inv;
+        }
+    }
+    var = lam / (float)(SEG_MIXED_WINDOW - 2);
+    if (!(var >= SEG_MIXED_FLOOR2)) {
+        var = SEG_MIXED_FLOOR2;
+    }
+    d = nx * (pts->pt[i].x - cx) + ny * (pts->pt[i].y - cy);
+    if (!(d * d > SEG_MIXED_SIGMAS2 * var)) {
+        return 0;
+    }
+    /* Towards the other surface: on the sensor's side of the line when the
+     * other surface is nearer, beyond it when farther. */
+    d_sensor = -(nx * cx + ny * cy);
+    return other_is_farther ? (d > 0.0f) != (d_sensor > 0.0f) : (d > 0.0f) == (d_sensor > 0.0f);
+}
+
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
@@ -284,6 +406,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     float lo;
     float hi;
     float jump;
+    int have_outer;
     int k;
     if (i >= 2u && i + 2u < pts->count) {
         /* Inside the scan (most beams): the cheap tests first. */
@@ -297,13 +420,14 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         r[3] = rg[3];
         lo = r[1] < r[3] ? r[1] : r[3];
         hi = r[1] < r[3] ? r[3] : r[1];
-        if (!(r[2] > lo && r[2] < hi) || !((v[0] != 0u) & (v[4] != 0u))) {
+        if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
+        have_outer = (v[0] != 0u) & (v[4] != 0u);
         r[0] = rg[0];
         r[4] = rg[4];
     } else {
-        for (k = -2; k <= 2; ++k) {
+        for (k = -1; k <= 1; ++k) {
             if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
                 return 0;
             }
@@ -313,13 +437,21 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
+        have_outer = neighbour_range(pts, i, -2, ring, &r[0]) &&
+                     neighbour_range(pts, i, 2, ring, &r[4]);
     }
     jump = hi - lo;
     if (beam_within(rad, jump * jump)) {
         return 0;
     }
-    return fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
-           r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump;
+    if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
+        r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
+        return 1;
+    }
+    /* Near one surface in range: it is a mixed pixel only when it lies on
+     * neither surface (a return at a corner lies on one of them). */
+    return off_its_surface(pts, i, -1, ring, r[3] > r[2]) &&
+           off_its_surface(pts, i, 1, ring, r[1] > r[2]);
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */
