@@ -295,107 +295,197 @@ static int neighbour_beam(const bsf_points_t *pts, size_t i, long k, int ring, s
     return 1;
 }
 
-/* Returns on the surface a mixed pixel's range is nearest to, fitted for the
- * "off its surface" route of the mixed-pixel rule. */
-#define SEG_MIXED_WINDOW 8
+/* The "on neither surface" route of the mixed-pixel rule looks at up to
+ * SEG_MIXED_WINDOW returns on each side of a beam, consecutive ones within
+ * the segmentation radius of each other (one surface). It fits a line to
+ * all of them but the nearest, so that the nearest can show whether the
+ * surface reaches the beam unbroken; a side of fewer than SEG_MIXED_MIN_SIDE
+ * such returns is too short to judge. */
+#define SEG_MIXED_WINDOW 10
+#define SEG_MIXED_MIN_SIDE 8
 
 /* Squared noise floor of that route (3 mm: ranges quantised to a centimetre
  * scatter by about this much), so noise-free ranges do not make every
  * rounding error a mixed pixel. */
 #define SEG_MIXED_FLOOR2 (0.003f * 0.003f)
 
-/* How far from that surface's line, in its estimated noise sigmas, a return
- * lies off it. Extrapolating the line one beam past its window scatters the
- * return's distance by about 1.3 sigma, so 5 drops a real end return by
- * chance about once in 10 000 (more when the window's own scatter
- * underestimates the noise, once in a few hundred). */
-#define SEG_MIXED_SIGMAS2 25.0f
+/* How far off a side's line a return lies, in standard deviations of its
+ * distance from that line extrapolated past the returns it was fitted to.
+ * 4 leaves a real end return on its line but for a chance of about one in
+ * 15 000 (more when a side's own scatter underestimates the noise). */
+#define SEG_MIXED_SIGMAS2 16.0f
 
-/* Beam i (range strictly between those of its neighbours at a depth jump)
- * lies off the surface whose neighbour range it is nearer to: the total
- * least-squares line through the SEG_MIXED_WINDOW returns on that side misses
- * it by more than SEG_MIXED_SIGMAS noise sigmas (estimated from that line's
- * own residual), towards the other surface. near_dir is -1 or +1, the side
- * of that neighbour. A return at a surface's real end lies on its line; a
- * mixed pixel, read between the two surfaces along its ray, does not. */
-static int off_its_surface(const bsf_points_t *pts, size_t i, int near_dir, int ring,
-                           int other_is_farther)
+/* Largest ratio of the two sides' noise variance estimates. Two straight
+ * walls with 5 to 8 returns each exceed 10 by chance about once in a
+ * hundred (the F distribution); a corner inside a window, centimetres off
+ * its line, exceeds it many times over. */
+#define SEG_MIXED_VAR_RATIO 10.0f
+
+/* A side's line through the returns beside beam i, the nearest left out. */
+typedef struct {
+    float cx, cy;   /* centroid */
+    float nx, ny;   /* unit normal */
+    float var;      /* noise variance estimated from its residual */
+    float reach_i;  /* variance of beam i's distance from it, in noise variances */
+    float d_near;   /* signed distance of the nearest return from it */
+    float reach_nr; /* the same variance for the nearest return */
+    int n;          /* returns, the nearest included */
+} side_line_t;
+
+/* Signed distance of p from line l. */
+static float side_distance(const side_line_t *l, bsf_point_t p)
+{
+    return l->nx * (p.x - l->cx) + l->ny * (p.y - l->cy);
+}
+
+/* The total least-squares line through the returns on side dir (-1: the
+ * beams before i, +1: after) of beam i, all but the nearest; l->n < 3 when
+ * there are too few for one. */
+static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring,
+                      const beam_radius_t *rad0, side_line_t *l)
 {
     bsf_point_t w[SEG_MIXED_WINDOW];
-    float cx = 0.0f;
-    float cy = 0.0f;
+    beam_radius_t rad = *rad0;
     float sxx = 0.0f;
     float sxy = 0.0f;
     float syy = 0.0f;
-    float half_tr;
     float half_diff;
-    float root;
     float lam;
-    float nx;
-    float ny;
-    float var;
-    float d;
-    float d_sensor;
+    float m;
+    float spread;
     int k;
+    l->n = 0;
+    l->cx = 0.0f;
+    l->cy = 0.0f;
+    l->nx = 0.0f;
+    l->ny = 1.0f;
+    l->var = 0.0f;
+    l->reach_i = 1.0f;
+    l->reach_nr = 1.0f;
+    l->d_near = 0.0f;
     for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
         size_t j;
-        if (!neighbour_beam(pts, i, (long)near_dir * (long)(k + 1), ring, &j)) {
-            return 0;
+        if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+            break;
         }
-        w[k] = pts->pt[j];
-        cx += w[k].x;
-        cy += w[k].y;
+        if (l->n > 0) {
+            const float dx = pts->pt[j].x - w[l->n - 1].x;
+            const float dy = pts->pt[j].y - w[l->n - 1].y;
+            beam_radius_start(&rad, pts->range[j]);
+            if (!beam_within(&rad, dx * dx + dy * dy)) {
+                break; /* a depth jump: the surface ends */
+            }
+        }
+        w[l->n] = pts->pt[j];
+        if (l->n > 0) {
+            l->cx += w[l->n].x;
+            l->cy += w[l->n].y;
+        }
+        l->n++;
     }
-    cx *= 1.0f / (float)SEG_MIXED_WINDOW;
-    cy *= 1.0f / (float)SEG_MIXED_WINDOW;
-    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
-        const float dx = w[k].x - cx;
-        const float dy = w[k].y - cy;
+    if (l->n < 4) {
+        l->n = l->n < 3 ? l->n : 2;
+        return;
+    }
+    m = (float)(l->n - 1);
+    l->cx /= m;
+    l->cy /= m;
+    for (k = 1; k < l->n; ++k) {
+        const float dx = w[k].x - l->cx;
+        const float dy = w[k].y - l->cy;
         sxx += dx * dx;
         sxy += dx * dy;
         syy += dy * dy;
     }
     /* Smallest eigenvalue of the scatter matrix (the squared residual of the
      * best line) and its eigenvector (the line's normal). */
-    half_tr = 0.5f * (sxx + syy);
     half_diff = 0.5f * (sxx - syy);
-    root = sqrtf(half_diff * half_diff + sxy * sxy);
-    lam = half_tr - root;
+    lam = 0.5f * (sxx + syy) - sqrtf(half_diff * half_diff + sxy * sxy);
     if (lam < 0.0f) {
         lam = 0.0f;
     }
     if (half_diff >= 0.0f) {
-        /* x spreads more: the normal is mostly along y */
-        nx = sxy;
-        ny = lam - sxx;
+        l->nx = sxy; /* x spreads more: the normal is mostly along y */
+        l->ny = lam - sxx;
     } else {
-        nx = lam - syy;
-        ny = sxy;
+        l->nx = lam - syy;
+        l->ny = sxy;
     }
     {
-        const float len2 = nx * nx + ny * ny;
+        const float len2 = l->nx * l->nx + l->ny * l->ny;
         if (!(len2 > 0.0f)) {
             /* an axis-aligned line: the normal is the axis of less spread */
-            nx = half_diff >= 0.0f ? 0.0f : 1.0f;
-            ny = half_diff >= 0.0f ? 1.0f : 0.0f;
+            l->nx = half_diff >= 0.0f ? 0.0f : 1.0f;
+            l->ny = half_diff >= 0.0f ? 1.0f : 0.0f;
         } else {
             const float inv = 1.0f / sqrtf(len2);
-            nx *= inv;
-            ny *= inv;
+            l->nx *= inv;
+            l->ny *= inv;
         }
     }
-    var = lam / (float)(SEG_MIXED_WINDOW - 2);
-    if (!(var >= SEG_MIXED_FLOOR2)) {
-        var = SEG_MIXED_FLOOR2;
+    l->var = lam / (m - 2.0f);
+    /* Fitted returns at beam steps 2..n from beam i: a return's own noise,
+     * the line's at its centroid and its slope's over the distance in steps
+     * from the centroid (step (n + 2) / 2), spread = sum of squared steps. */
+    spread = m * (m * m - 1.0f) / 12.0f;
+    {
+        const float t_i = 0.5f * (m + 3.0f);
+        const float t_nr = t_i - 1.0f;
+        l->reach_i = 1.0f + 1.0f / m + t_i * t_i / spread;
+        l->reach_nr = 1.0f + 1.0f / m + t_nr * t_nr / spread;
     }
-    d = nx * (pts->pt[i].x - cx) + ny * (pts->pt[i].y - cy);
-    if (!(d * d > SEG_MIXED_SIGMAS2 * var)) {
+    l->d_near = side_distance(l, w[0]);
+}
+
+/* Beam i lies off side line l by more than the noise explains (variance
+ * var), towards the sensor when toward_sensor, else away from it. */
+static int off_side_line(const bsf_points_t *pts, size_t i, const side_line_t *l, float var,
+                         int toward_sensor)
+{
+    const float d = side_distance(l, pts->pt[i]);
+    float d_sensor;
+    if (!(d * d > SEG_MIXED_SIGMAS2 * l->reach_i * var)) {
         return 0;
     }
-    /* Towards the other surface: on the sensor's side of the line when the
-     * other surface is nearer, beyond it when farther. */
-    d_sensor = -(nx * cx + ny * cy);
-    return other_is_farther ? (d > 0.0f) != (d_sensor > 0.0f) : (d > 0.0f) == (d_sensor > 0.0f);
+    d_sensor = -(l->nx * l->cx + l->ny * l->cy); /* the sensor's side of the line */
+    return toward_sensor ? (d > 0.0f) == (d_sensor > 0.0f) : (d > 0.0f) != (d_sensor > 0.0f);
+}
+
+/* The side's surface reaches the beam next to i unbroken: enough returns,
+ * the nearest on the line of the others. */
+static int side_judged(const side_line_t *l, float var)
+{
+    return l->n >= SEG_MIXED_MIN_SIDE &&
+           l->d_near * l->d_near <= SEG_MIXED_SIGMAS2 * l->reach_nr * var;
+}
+
+/* Beam i, strictly between its neighbours in range at a depth jump, lies on
+ * neither surface: off the line of the returns before it towards the surface
+ * after it, and off the line of those after it towards the one before. */
+static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, const beam_radius_t *rad,
+                              int before_is_farther)
+{
+    side_line_t before;
+    side_line_t after;
+    float var_b;
+    float var_a;
+    side_line(pts, i, -1, ring, rad, &before);
+    side_line(pts, i, 1, ring, rad, &after);
+    var_b = before.var > SEG_MIXED_FLOOR2 ? before.var : SEG_MIXED_FLOOR2;
+    var_a = after.var > SEG_MIXED_FLOOR2 ? after.var : SEG_MIXED_FLOOR2;
+    /* A side too short, or turning at the beam next to i (a corner there, a
+     * wall seen at grazing incidence, a small object): the return stays. */
+    if (!side_judged(&before, var_b) || !side_judged(&after, var_a)) {
+        return 0;
+    }
+    /* Both sides are seen by the same sensor at about the same range: a side
+     * scattering SEG_MIXED_VAR_RATIO times more than the other is no line
+     * (a corner or a small object inside its window). */
+    if (var_b > SEG_MIXED_VAR_RATIO * var_a || var_a > SEG_MIXED_VAR_RATIO * var_b) {
+        return 0;
+    }
+    return off_side_line(pts, i, &before, var_b, before_is_farther) &&
+           off_side_line(pts, i, &after, var_a, !before_is_farther);
 }
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
@@ -450,8 +540,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     }
     /* Near one surface in range: it is a mixed pixel only when it lies on
      * neither surface (a return at a corner lies on one of them). */
-    return off_its_surface(pts, i, -1, ring, r[3] > r[2]) &&
-           off_its_surface(pts, i, 1, ring, r[1] > r[2]);
+    return on_neither_surface(pts, i, ring, rad, r[1] > r[2]);
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */
