@@ -527,8 +527,8 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
-        have_outer = neighbour_range(pts, i, -2, ring, &r[0]) &&
-                     neighbour_range(pts, i, 2, ring, &r[4]);
+        have_outer =
+            neighbour_range(pts, i, -2, ring, &r[0]) && neighbour_range(pts, i, 2, ring, &r[4]);
     }
     jump = hi - lo;
     if (beam_within(rad, jump * jump)) {
