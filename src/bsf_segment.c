@@ -339,13 +339,12 @@ static float side_distance(const side_line_t *l, bsf_point_t p)
 }
 
 /* The total least-squares line through the returns on side dir (-1: the
- * beams before i, +1: after) of beam i, all but the nearest; l->n < 3 when
- * there are too few for one. */
-static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring,
-                      const beam_radius_t *rad0, side_line_t *l)
+ * beams before i, +1: after) of beam i, all but the nearest; only l->n is
+ * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
+static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
+                      side_line_t *l)
 {
     bsf_point_t w[SEG_MIXED_WINDOW];
-    beam_radius_t rad = *rad0;
     float sxx = 0.0f;
     float sxy = 0.0f;
     float syy = 0.0f;
@@ -363,16 +362,23 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring,
     l->reach_i = 1.0f;
     l->reach_nr = 1.0f;
     l->d_near = 0.0f;
+    const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
     for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
         size_t j;
-        if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+        if (inside) {
+            /* most beams: no wrap, only validity */
+            j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
+            if (!pts->valid[j]) {
+                break;
+            }
+        } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
             break;
         }
+        /* beam i's radius for every step (worked out once per beam) */
         if (l->n > 0) {
             const float dx = pts->pt[j].x - w[l->n - 1].x;
             const float dy = pts->pt[j].y - w[l->n - 1].y;
-            beam_radius_start(&rad, pts->range[j]);
-            if (!beam_within(&rad, dx * dx + dy * dy)) {
+            if (!beam_within(rad, dx * dx + dy * dy)) {
                 break; /* a depth jump: the surface ends */
             }
         }
@@ -383,9 +389,8 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring,
         }
         l->n++;
     }
-    if (l->n < 4) {
-        l->n = l->n < 3 ? l->n : 2;
-        return;
+    if (l->n < SEG_MIXED_MIN_SIDE) {
+        return; /* too short to judge (side_judged): no line needed */
     }
     m = (float)(l->n - 1);
     l->cx /= m;
@@ -462,20 +467,24 @@ static int side_judged(const side_line_t *l, float var)
 /* Beam i, strictly between its neighbours in range at a depth jump, lies on
  * neither surface: off the line of the returns before it towards the surface
  * after it, and off the line of those after it towards the one before. */
-static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, const beam_radius_t *rad,
+static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
                               int before_is_farther)
 {
     side_line_t before;
     side_line_t after;
     float var_b;
     float var_a;
-    side_line(pts, i, -1, ring, rad, &before);
-    side_line(pts, i, 1, ring, rad, &after);
-    var_b = before.var > SEG_MIXED_FLOOR2 ? before.var : SEG_MIXED_FLOOR2;
-    var_a = after.var > SEG_MIXED_FLOOR2 ? after.var : SEG_MIXED_FLOOR2;
     /* A side too short, or turning at the beam next to i (a corner there, a
-     * wall seen at grazing incidence, a small object): the return stays. */
-    if (!side_judged(&before, var_b) || !side_judged(&after, var_a)) {
+     * wall seen at grazing incidence, a small object), or a return on a
+     * side's line: the return stays (each side judged as soon as fitted). */
+    side_line(pts, i, -1, ring, rad, &before);
+    var_b = before.var > SEG_MIXED_FLOOR2 ? before.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&before, var_b) || !off_side_line(pts, i, &before, var_b, before_is_farther)) {
+        return 0;
+    }
+    side_line(pts, i, 1, ring, rad, &after);
+    var_a = after.var > SEG_MIXED_FLOOR2 ? after.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&after, var_a)) {
         return 0;
     }
     /* Both sides are seen by the same sensor at about the same range: a side
@@ -484,8 +493,7 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, const
     if (var_b > SEG_MIXED_VAR_RATIO * var_a || var_a > SEG_MIXED_VAR_RATIO * var_b) {
         return 0;
     }
-    return off_side_line(pts, i, &before, var_b, before_is_farther) &&
-           off_side_line(pts, i, &after, var_a, !before_is_farther);
+    return off_side_line(pts, i, &after, var_a, !before_is_farther);
 }
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
@@ -540,6 +548,13 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     }
     /* Near one surface in range: it is a mixed pixel only when it lies on
      * neither surface (a return at a corner lies on one of them). */
+    /* Each side's run must go on past the neighbour (a step within the
+     * radius): a wall seen at grazing incidence, whose steps are wider, is
+     * no run to judge, and is most of what reaches this point. */
+    if (!have_outer || !beam_within(rad, (r[1] - r[0]) * (r[1] - r[0])) ||
+        !beam_within(rad, (r[4] - r[3]) * (r[4] - r[3]))) {
+        return 0;
+    }
     return on_neither_surface(pts, i, ring, rad, r[1] > r[2]);
 }
 
