@@ -315,11 +315,12 @@ static int neighbour_beam(const bsf_points_t *pts, size_t i, long k, int ring, s
  * 15 000 (more when a side's own scatter underestimates the noise). */
 #define SEG_MIXED_SIGMAS2 16.0f
 
-/* Largest ratio of the two sides' noise variance estimates. Two straight
- * walls with 5 to 8 returns each exceed 10 by chance about once in a
- * hundred (the F distribution); a corner inside a window, centimetres off
- * its line, exceeds it many times over. */
-#define SEG_MIXED_VAR_RATIO 10.0f
+/* A return is no mixed pixel when the nearest return of the run it lies
+ * off is off that run's line too, on the same side, by more than 1 /
+ * SEG_MIXED_TURN of its own offset: the run may turn there (a short surface
+ * of two or three returns between two walls, its first return too near the
+ * turn to show it). A mixed pixel's neighbour scatters about the line. */
+#define SEG_MIXED_TURN 4.0f
 
 /* A side's line through the returns beside beam i, the nearest left out. */
 typedef struct {
@@ -465,35 +466,54 @@ static int side_judged(const side_line_t *l, float var)
 }
 
 /* Beam i, strictly between its neighbours in range at a depth jump, lies on
- * neither surface: off the line of the returns before it towards the surface
- * after it, and off the line of those after it towards the one before. */
+ * neither surface. The surface nearer to it in range (the one it would join)
+ * must be a long straight run reaching beam i's neighbour unbroken, and beam
+ * i must lie off its line towards the other surface, not as the second step
+ * of a run turning away at that neighbour (the neighbour off the line too,
+ * on the same side, by a quarter of beam i's offset: a short surface between
+ * two walls). The other surface may be anything (a pillar, a small object):
+ * beam i lies beyond the radius of its nearest return and does not go on
+ * along a line through its next two (a wall seen at grazing incidence).
+ * near_before: the surface before beam i is the nearer in range;
+ * before_is_farther: it is farther from the sensor. */
 static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
-                              int before_is_farther)
+                              int near_before, int before_is_farther)
 {
-    side_line_t before;
-    side_line_t after;
-    float var_b;
-    float var_a;
-    /* A side too short, or turning at the beam next to i (a corner there, a
-     * wall seen at grazing incidence, a small object), or a return on a
-     * side's line: the return stays (each side judged as soon as fitted). */
-    side_line(pts, i, -1, ring, rad, &before);
-    var_b = before.var > SEG_MIXED_FLOOR2 ? before.var : SEG_MIXED_FLOOR2;
-    if (!side_judged(&before, var_b) || !off_side_line(pts, i, &before, var_b, before_is_farther)) {
+    side_line_t near;
+    float var;
+    float d;
+    size_t o[3] = {0u, 0u, 0u};
+    int k;
+    const int near_dir = near_before ? -1 : 1;
+    /* the near run lies farther from the sensor than beam i exactly when
+     * it is the before run and that is the farther one, or neither */
+    const int near_is_farther = near_before == before_is_farther;
+    side_line(pts, i, near_dir, ring, rad, &near);
+    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
         return 0;
     }
-    side_line(pts, i, 1, ring, rad, &after);
-    var_a = after.var > SEG_MIXED_FLOOR2 ? after.var : SEG_MIXED_FLOOR2;
-    if (!side_judged(&after, var_a)) {
+    d = side_distance(&near, pts->pt[i]);
+    if ((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d)) {
         return 0;
     }
-    /* Both sides are seen by the same sensor at about the same range: a side
-     * scattering SEG_MIXED_VAR_RATIO times more than the other is no line
-     * (a corner or a small object inside its window). */
-    if (var_b > SEG_MIXED_VAR_RATIO * var_a || var_a > SEG_MIXED_VAR_RATIO * var_b) {
+    for (k = 0; k < 3; ++k) {
+        if (!neighbour_beam(pts, i, (long)(-near_dir) * (long)(k + 1), ring, &o[k])) {
+            break;
+        }
+    }
+    if (k == 0) {
         return 0;
     }
-    return off_side_line(pts, i, &after, var_a, !before_is_farther);
+    {
+        const float dx = pts->pt[o[0]].x - pts->pt[i].x;
+        const float dy = pts->pt[o[0]].y - pts->pt[i].y;
+        if (beam_within(rad, dx * dx + dy * dy)) {
+            return 0;
+        }
+    }
+    return !(k == 3 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
+             bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]]));
 }
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
@@ -546,16 +566,16 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
         return 1;
     }
-    /* Near one surface in range: it is a mixed pixel only when it lies on
-     * neither surface (a return at a corner lies on one of them). */
-    /* Each side's run must go on past the neighbour (a step within the
-     * radius): a wall seen at grazing incidence, whose steps are wider, is
-     * no run to judge, and is most of what reaches this point. */
+    /* Near one surface in range: a mixed pixel only when it lies on neither.
+     * Both runs must go on past beam i's neighbours (steps within the
+     * radius): a wall seen at grazing incidence, whose steps are wider, is no
+     * run to judge, and is most of what reaches this point. */
     if (!have_outer || !beam_within(rad, (r[1] - r[0]) * (r[1] - r[0])) ||
         !beam_within(rad, (r[4] - r[3]) * (r[4] - r[3]))) {
         return 0;
     }
-    return on_neither_surface(pts, i, ring, rad, r[1] > r[2]);
+    return on_neither_surface(pts, i, ring, rad, r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi,
+                              r[1] > r[2]);
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */

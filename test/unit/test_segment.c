@@ -781,9 +781,10 @@ static void two_walls_at_a_depth_jump(double offset, double sigma, bsf_scene_rng
  * them in range but on neither's line, joins no segment (it would end the
  * far wall's feature in a hook towards the sensor); the far wall's real
  * first return stays. Without noise always; over 400 scans at 1 cm noise
- * the real return always stays and the mixed pixel goes but for a few
- * (9 with this seed) scans whose two walls happen to scatter very differently (the rule then
- * cannot tell a wall from a bent run and keeps the return). */
+ * the real return always stays and the mixed pixel goes but for a few (one
+ * with this seed): the rule keeps a return when the wall's nearest return
+ * also lies off its line, on the same side, by a quarter of its offset
+ * (the run may turn there), which noise now and then mimics. */
 static void test_sved_rejects_a_mixed_pixel_near_one_surface_and_keeps_a_real_end(void)
 {
     bsf_sved_params_t p = bsf_sved_params_default();
@@ -822,7 +823,7 @@ static void test_sved_rejects_a_mixed_pixel_near_one_surface_and_keeps_a_real_en
         TEST_ASSERT_EQUAL_UINT16(20u, label[20]);
         TEST_ASSERT_EQUAL_size_t(0u, n_wasted);
     }
-    TEST_ASSERT_TRUE(rejected >= 380);
+    TEST_ASSERT_TRUE(rejected >= 390);
     /* The paper's rule (no mixed-pixel rejection) keeps the mixed pixel. */
     p.reject_mixed = 0u;
     two_walls_at_a_depth_jump(0.2, 0.0, &rng);
