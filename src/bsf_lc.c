@@ -902,9 +902,23 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
                           float rss_curve)
 {
     const float bound = evidence_bound(t);
+    const size_t na = apex - a0;
+    const size_t nb = b1 - apex;
     float rss_circle;
     lc_enough_t enough;
     if (!(rss_curve > bound)) {
+        return 0;
+    }
+    /* Three independent tests: the sides first, the shorter one first, and
+     * the whole window's circle (the dearest) last, so a curved side (the
+     * usual failure on real logs) spares it. */
+    if (na <= nb) {
+        if (!side_uncurved(c, a0, apex - 1u, la, t->noise_var) ||
+            !side_uncurved(c, apex + 1u, b1, lb, t->noise_var)) {
+            return 0;
+        }
+    } else if (!side_uncurved(c, apex + 1u, b1, lb, t->noise_var) ||
+               !side_uncurved(c, a0, apex - 1u, la, t->noise_var)) {
         return 0;
     }
     enough.scale = 1.0f;
@@ -913,11 +927,7 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.target = bound; /* from there on, the corner stands */
     rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
                             &enough, LC_CIRCLE_STEPS);
-    if (rss_circle >= 0.0f && !(rss_circle > bound)) {
-        return 0;
-    }
-    return side_uncurved(c, a0, apex - 1u, la, t->noise_var) &&
-           side_uncurved(c, apex + 1u, b1, lb, t->noise_var);
+    return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
 /* judge's verdicts on a split. */
