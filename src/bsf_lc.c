@@ -907,9 +907,22 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
                           float rss_curve)
 {
     const float bound = evidence_bound(t);
+    /* the shorter side first: [s0, e0] on line l0, then [s1, e1] on l1 */
+    const int b_first = b1 - apex < apex - a0;
+    const size_t s0 = b_first ? apex + 1u : a0;
+    const size_t e0 = b_first ? b1 : apex - 1u;
+    const size_t s1 = b_first ? a0 : apex + 1u;
+    const size_t e1 = b_first ? apex - 1u : b1;
     float rss_circle;
     lc_enough_t enough;
     if (!(rss_curve > bound)) {
+        return 0;
+    }
+    /* Three independent tests: the sides first and the whole window's
+     * circle (the dearest) last, so a curved side (the usual failure on
+     * real logs) spares it. */
+    if (!side_uncurved(c, s0, e0, b_first ? lb : la, t->noise_var) ||
+        !side_uncurved(c, s1, e1, b_first ? la : lb, t->noise_var)) {
         return 0;
     }
     enough.scale = 1.0f;
@@ -918,11 +931,7 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.target = bound; /* from there on, the corner stands */
     rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
                             &enough, LC_CIRCLE_STEPS);
-    if (rss_circle >= 0.0f && !(rss_circle > bound)) {
-        return 0;
-    }
-    return side_uncurved(c, a0, apex - 1u, la, t->noise_var) &&
-           side_uncurved(c, apex + 1u, b1, lb, t->noise_var);
+    return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
 /* judge's verdicts on a split. */
