@@ -77,8 +77,8 @@ static int evidence_mode = -1;
 
 static bsf_params_t make_params(void)
 {
-    bsf_params_t p =
-        bsf_params_default(paper_mode ? BSF_METHOD_FALKO_SVED_PDM : BSF_METHOD_DEFAULT);
+    bsf_params_t p = paper_mode ? bsf_params_paper(BSF_METHOD_FALKO_SVED_PDM)
+                                : bsf_params_default(BSF_METHOD_DEFAULT);
     if (grazing_mode >= 0) {
         p.sved.join_grazing = (uint8_t)grazing_mode;
         p.lc.join_grazing = (uint8_t)grazing_mode;
