@@ -205,6 +205,14 @@ typedef struct {
     float target;
 } lc_enough_t;
 
+/* Never enough before the end: the whole residual (0 >= 1 never holds). */
+static const lc_enough_t lc_whole = {0.0f, 1.0f, 0.0f, 1.0f};
+
+/* A circle relative to the judgement's origin (the apex). */
+typedef struct {
+    float cx, cy, r;
+} lc_circle_t;
+
 /* One Gauss-Newton step of the geometric circle fit (the sum of squared
  * distances to the circle) over positions a..b, centre (*cx, *cy) relative
  * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
@@ -263,7 +271,7 @@ static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
  * variances on short or noisy arcs, which the evidence route would take as
  * evidence of a corner. */
 static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent,
-                        const lc_enough_t *enough, unsigned refine)
+                        const lc_enough_t *enough, unsigned refine, lc_circle_t *fit)
 {
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
@@ -305,6 +313,11 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     r = sqrtf(r2);
     for (; refine > 0u; --refine) {
         circle_step(c, a, b, cx0, cy0, &cx, &cy, &r);
+    }
+    if (fit != NULL) {
+        fit->cx = cx0 + cx;
+        fit->cy = cy0 + cy;
+        fit->r = r;
     }
     for (i = a; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
@@ -349,7 +362,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
     enough.target = l->rss * (float)(n - 3u); /* straight from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough, 0u);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough, 0u, NULL);
     if (rss_circle < 0.0f) {
         return 1;
     }
@@ -882,7 +895,7 @@ static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     enough.floor_rss = 0.0f;
     enough.target = l->rss - cut; /* uncurved from there on */
     rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough,
-                            LC_CIRCLE_STEPS);
+                            LC_CIRCLE_STEPS, NULL);
     return rss_circle < 0.0f || rss_circle >= enough.target;
 }
 
@@ -930,7 +943,7 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.floor_rss = 0.0f;
     enough.target = bound; /* from there on, the corner stands */
     rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
-                            &enough, LC_CIRCLE_STEPS);
+                            &enough, LC_CIRCLE_STEPS, NULL);
     return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
@@ -959,6 +972,261 @@ static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
     return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
 }
 
+/* Fill *kp for a corner at the split apex (window a0..b1) whose vertex is x
+ * (relative to the apex), between the sides of lines la and lb. */
+static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, bsf_point_t x,
+                            const lc_line_t *la, const lc_line_t *lb, float score,
+                            bsf_keypoint_t *kp)
+{
+    const bsf_point_t *rp = c->rel;
+    size_t best = apex;
+    float best_d = dist2(rp[apex], x);
+    size_t i;
+    /* The vertex beam: the point nearest the intersection, near the split. */
+    for (i = apex - 2u; i <= apex + 2u; ++i) {
+        if (i > a0 && i < b1) {
+            const float d = dist2(rp[i], x);
+            if (d < best_d) {
+                best_d = d;
+                best = i;
+            }
+        }
+    }
+    kp->index = c->run[best];
+    kp->point.x = x.x + c->o.x;
+    kp->point.y = x.y + c->o.y;
+    kp->orientation = bsf_atan2f(la->my + lb->my - 2.0f * x.y, la->mx + lb->mx - 2.0f * x.x);
+    {
+        const float ra = sqrtf(dist2(rp[a0], rp[apex]));
+        const float rb = sqrtf(dist2(rp[b1], rp[apex]));
+        kp->radius = ra > rb ? ra : rb;
+    }
+    kp->score = score;
+}
+
+/* The two-line verdict on the split at apex, window a0..b1, sides' lines la
+ * and lb (which turn by at least min_turn: cross is their cross product)
+ * whose intersection must lie within reach of the apex. */
+static lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1,
+                                const lc_line_t *la, const lc_line_t *lb, float cross, float reach,
+                                bsf_keypoint_t *kp)
+{
+    const bsf_point_t *rp = c->rel;
+    float t, extent, rss_curve, rss_circle, rss_lines;
+    lc_line_t lu;
+    lc_corner_test_t test;
+    int evidence_checked; /* evidence_possible has passed */
+    lc_enough_t enough;
+    bsf_point_t x;
+    t = ((lb->mx - la->mx) * lb->dy - (lb->my - la->my) * lb->dx) / cross;
+    x.x = la->mx + t * la->dx;
+    x.y = la->my + t * la->dy;
+    if (!(x.x * x.x + x.y * x.y <= reach * reach)) {
+        return LC_MERGE;
+    }
+    /* One smooth curve over both sides: the better of a line and a circle. */
+    /* (the left side's sums are the first part of the whole's) */
+    if (!fit_line_from(c, a0, b1, apex, la->sx, la->sy, &lu)) {
+        return LC_MERGE;
+    }
+    rss_lines = la->rss + lb->rss;
+    corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
+    /* The curve's residual is at most the line's: when the line already
+     * fails the test, so does the curve, and no circle is fitted. */
+    if (!(lu.rss > test.bound)) {
+        return LC_MERGE;
+    }
+    /* Below the ratio route's bound only the evidence route can pass. */
+    evidence_checked = !(lu.rss > test.ratio_bound);
+    if (evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) {
+        return LC_MERGE;
+    }
+    extent = sqrtf(dist2(rp[a0], rp[b1]));
+    rss_curve = lu.rss;
+    enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = lu.rss; /* from there on, the line is the better curve */
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, 0u, NULL);
+    if (rss_circle >= 0.0f && rss_circle < rss_curve) {
+        rss_curve = rss_circle;
+    }
+    if (!(rss_curve > test.bound)) {
+        return no_corner(&test, rss_curve);
+    }
+    if (!(rss_curve > test.ratio_bound) &&
+        ((!evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) ||
+         !evidence_holds(c, &test, a0, apex, b1, la, lb, &lu, rss_curve))) {
+        return no_corner(&test, rss_curve);
+    }
+    /* Each side must be straight: a circle may not explain it much better
+     * than its line (a crease between two curved walls is no wall corner,
+     * and its line intersection would lie off the crease). Last, as the
+     * dearest test. */
+    if (!side_straight(c, a0, apex - 1u, la) || !side_straight(c, apex + 1u, b1, lb)) {
+        return no_corner(&test, rss_curve);
+    }
+    corner_keypoint(c, a0, apex, b1, x, la, lb, rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f,
+                    kp);
+    return LC_CORNER;
+}
+
+/* One side of a crease: its line, or its circle when that cuts the line's
+ * squared residual by more than LC_EVIDENCE_SIGMAS^2 noise variances (the
+ * side shows curvature, side_uncurved's test). */
+typedef struct {
+    lc_circle_t k;
+    const lc_line_t *l;
+    float rss;
+    int round; /* 1: the circle k */
+} lc_piece_t;
+
+/* Fewest points on a side taken as a circle: a circle through a few points
+ * of a small pillar goes anywhere beyond them. */
+#define LC_CREASE_ROUND_POINTS 10u
+/* Fewest points on any side of a crease: a line through two or three
+ * points fits them whatever they are. */
+#define LC_CREASE_LINE_POINTS 3u
+
+/* Fit side a..b (line l) as a piece; returns 0 when the piece does not
+ * explain the side within the noise (noise_var per degree of freedom, plus
+ * LC_EVIDENCE_SIGMAS standard deviations of that chi-square sum): a side
+ * that reaches round a corner or onto another surface is no side of a
+ * crease, whatever shape fits it best. */
+static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var,
+                     lc_piece_t *s)
+{
+    const size_t n = b - a + 1u;
+    const float floor_rss = (float)n * c->p->floor * c->p->floor;
+    float rss_circle, dof;
+    s->l = l;
+    s->rss = l->rss;
+    s->round = 0;
+    if (n < LC_CREASE_LINE_POINTS) {
+        return 0;
+    }
+    dof = (float)(n - 2u);
+    if (n >= LC_CREASE_ROUND_POINTS) {
+        rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])),
+                                &lc_whole, LC_CIRCLE_STEPS, &s->k);
+        if (rss_circle >= 0.0f && s->k.r * s->k.r >= dist2(c->rel[a], c->rel[b]) &&
+            l->rss > rss_circle + LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var) {
+            s->rss = rss_circle;
+            s->round = 1;
+            dof = (float)(n - 3u);
+        }
+    }
+    return s->rss <= noise_var * (dof + LC_EVIDENCE_SIGMAS * sqrtf(2.0f * dof)) + floor_rss;
+}
+
+/* Signed distance of point q from piece s, and its unit gradient there. */
+static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
+{
+    float dx, dy, len;
+    if (!s->round) {
+        *gx = -s->l->dy;
+        *gy = s->l->dx;
+        return *gx * (q.x - s->l->mx) + *gy * (q.y - s->l->my);
+    }
+    dx = q.x - s->k.cx;
+    dy = q.y - s->k.cy;
+    len = sqrtf(dx * dx + dy * dy);
+    if (!(len > 0.0f)) {
+        *gx = 0.0f;
+        *gy = 0.0f;
+        return 0.0f;
+    }
+    *gx = dx / len;
+    *gy = dy / len;
+    return len - s->k.r;
+}
+
+/* Newton steps towards the crossing of a crease's pieces nearest the apex. */
+#define LC_CREASE_STEPS 6u
+
+/* A crease: where a curved wall meets a wall or another curved wall, the
+ * two-line test fails (a side's line does not fit it) although the points
+ * have a vertex. The split is a corner when, with each side the better of
+ * its line and its circle (at least one a circle) and each explained within
+ * the noise, the best smooth curve over both sides (the geometrically
+ * fitted circle) has curve_ratio times the sides' squared residual plus the
+ * floor, and the sides' fits cross within reach of the apex (as close as
+ * the two lines must) at an angle of min_turn or more. A round pillar or a
+ * smooth wall of varying curvature fails the last: the circles of its two
+ * sides touch, they do not cross. Otherwise the two-line verdict v stands. */
+static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1,
+                                 const lc_line_t *la, const lc_line_t *lb, float reach,
+                                 lc_verdict_t v, bsf_keypoint_t *kp)
+{
+    const size_t n = b1 - a0 + 1u;
+    const float noise_var =
+        c->noise2 > c->p->floor * c->p->floor ? c->noise2 : c->p->floor * c->p->floor;
+    const float curved = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
+    lc_piece_t pc[2];
+    float f[2], gx[2], gy[2];
+    float rss_curve, rss_pieces = 0.0f;
+    bsf_point_t x = {0.0f, 0.0f};
+    unsigned step;
+    int k;
+    int round = 0;
+    /* A side is taken as a circle only when its line leaves more than this
+     * (fit_piece): two straight sides stop here, judged already. */
+    if (!(la->rss > curved || lb->rss > curved) || !side_seen(c, la) || !side_seen(c, lb) ||
+        !window_joined(c, a0, b1, noise_var)) {
+        return v;
+    }
+    for (k = 0; k < 2; ++k) {
+        if (!fit_piece(c, k ? apex + 1u : a0, k ? b1 : apex - 1u, k ? lb : la, noise_var, &pc[k])) {
+            return v; /* a side fits no piece */
+        }
+        rss_pieces += pc[k].rss;
+        round |= pc[k].round;
+    }
+    if (!round) {
+        return v; /* two lines: judged already */
+    }
+    /* One smooth curve over both sides: the geometrically fitted circle (a
+     * line is its limit; none exists when the points lie on a line, which
+     * is no crease of a curved side) */
+    rss_curve = circle_rss(c, a0, b1, 0.5f * (la->mx + lb->mx), 0.5f * (la->my + lb->my),
+                           sqrtf(dist2(c->rel[a0], c->rel[b1])), &lc_whole, LC_CIRCLE_STEPS, NULL);
+    /* (the pieces are credited with no better than the noise: their fit to
+     * it is chance) */
+    if (!(rss_curve >
+          c->p->curve_ratio *
+                  (rss_pieces > (float)n * noise_var ? rss_pieces : (float)n * noise_var) +
+              (float)n * c->p->floor * c->p->floor)) {
+        return v;
+    }
+    /* Newton steps from the apex on the pieces' distances; the last round
+     * only checks: converged, and crossing at min_turn */
+    for (step = 0;; ++step) {
+        float det;
+        for (k = 0; k < 2; ++k) {
+            f[k] = piece_at(&pc[k], x, &gx[k], &gy[k]);
+        }
+        det = gx[0] * gy[1] - gy[0] * gx[1];
+        if (!(fabsf(det) >= c->sin_min_turn)) {
+            return v;
+        }
+        if (step == LC_CREASE_STEPS) {
+            if (!(f[0] * f[0] + f[1] * f[1] <= noise_var)) {
+                return v;
+            }
+            break;
+        }
+        /* solve [g0; g1] dx = -(f0, f1) */
+        x.x -= (f[0] * gy[1] - f[1] * gy[0]) / det;
+        x.y -= (gx[0] * f[1] - gx[1] * f[0]) / det;
+        if (!(x.x * x.x + x.y * x.y <= reach * reach)) {
+            return v;
+        }
+    }
+    corner_keypoint(c, a0, apex, b1, x, la, lb, rss_pieces > 0.0f ? rss_curve / rss_pieces : 1e30f,
+                    kp);
+    return LC_CORNER;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
  * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
@@ -971,17 +1239,11 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     const size_t need = p->min_side_points;
     lc_line_t la;
     lc_line_t lb;
-    lc_line_t lu;
     size_t a0 = apex;
     size_t b1 = apex;
-    size_t best;
-    size_t i;
     const bsf_point_t *rp = c->rel;
-    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
-    lc_corner_test_t test;
-    int evidence_checked; /* evidence_possible has passed */
-    lc_enough_t enough;
-    bsf_point_t x;
+    float cross, spacing, reach;
+    lc_verdict_t v;
     bsf_point_t ap;
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
@@ -1033,85 +1295,16 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     if (!(fabsf(cross) >= c->sin_min_turn)) {
         return LC_MERGE;
     }
-    t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
-    xx = la.mx + t * la.dx;
-    xy = la.my + t * la.dy;
-    x.x = xx;
-    x.y = xy;
-    spacing = sqrtf(dist2(rp[apex - 1u], ap));
+    /* the sides' fits must meet within twice the local beam spacing plus
+     * apex_slack of the apex */
+    spacing = dist2(rp[apex - 1u], ap);
     {
-        const float s2 = sqrtf(dist2(rp[apex + 1u], ap));
-        spacing = s2 > spacing ? s2 : spacing;
+        const float s2 = dist2(rp[apex + 1u], ap);
+        spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
-    if (!(xx * xx + xy * xy <=
-          (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
-        return LC_MERGE;
-    }
-    /* One smooth curve over both sides: the better of a line and a circle. */
-    /* (the left side's sums are the first part of the whole's) */
-    if (!fit_line_from(c, a0, b1, apex, la.sx, la.sy, &lu)) {
-        return LC_MERGE;
-    }
-    rss_lines = la.rss + lb.rss;
-    corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
-    /* The curve's residual is at most the line's: when the line already
-     * fails the test, so does the curve, and no circle is fitted. */
-    if (!(lu.rss > test.bound)) {
-        return LC_MERGE;
-    }
-    /* Below the ratio route's bound only the evidence route can pass. */
-    evidence_checked = !(lu.rss > test.ratio_bound);
-    if (evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) {
-        return LC_MERGE;
-    }
-    extent = sqrtf(dist2(rp[a0], rp[b1]));
-    rss_curve = lu.rss;
-    enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
-    enough.ratio = 1.0f;
-    enough.floor_rss = 0.0f;
-    enough.target = lu.rss; /* from there on, the line is the better curve */
-    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, 0u);
-    if (rss_circle >= 0.0f && rss_circle < rss_curve) {
-        rss_curve = rss_circle;
-    }
-    if (!(rss_curve > test.bound)) {
-        return no_corner(&test, rss_curve);
-    }
-    if (!(rss_curve > test.ratio_bound) &&
-        ((!evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) ||
-         !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve))) {
-        return no_corner(&test, rss_curve);
-    }
-    /* Each side must be straight: a circle may not explain it much better
-     * than its line (a crease between two curved walls is no wall corner,
-     * and its line intersection would lie off the crease). Last, as the
-     * dearest test. */
-    if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
-        return no_corner(&test, rss_curve);
-    }
-    /* The vertex beam: the point nearest the intersection, near the split. */
-    best = apex;
-    best_d = dist2(ap, x);
-    for (i = apex - 2u; i <= apex + 2u; ++i) {
-        if (i > a0 && i < b1) {
-            const float d = dist2(rp[i], x);
-            if (d < best_d) {
-                best_d = d;
-                best = i;
-            }
-        }
-    }
-    kp->index = c->run[best];
-    kp->point.x = xx + c->o.x;
-    kp->point.y = xy + c->o.y;
-    kp->orientation = bsf_atan2f(la.my + lb.my - 2.0f * xy, la.mx + lb.mx - 2.0f * xx);
-    {
-        const float ra = sqrtf(dist2(rp[a0], ap));
-        const float rb = sqrtf(dist2(rp[b1], ap));
-        kp->radius = ra > rb ? ra : rb;
-    }
-    kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
-    return LC_CORNER;
+    reach = 2.0f * spacing + p->apex_slack;
+    v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, kp);
+    return v == LC_CORNER ? v : judge_crease(c, a0, apex, b1, &la, &lb, 2.0f * spacing, v, kp);
 }
 
 /* Noise of a run, from each point's distance to the chord of its two
