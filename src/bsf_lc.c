@@ -93,7 +93,7 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
-    float noise2; /* the current run's noise variance (run_noise squared) */
+    float noise2; /* the current run's noise variance (run_noise squared), at least floor^2 */
     size_t start; /* beam where the pass starts (ring_start, else 0) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
@@ -760,7 +760,7 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
  * parameters): the F distribution's tail for the one more parameter and the
  * apex point, nu * (e^(k^2 / nu) - 1) variances for nu degrees of freedom
  * (k^2 = 25 for many points, more for few). Sides that show curvature at
- * that level then fail it (side_uncurved): a crease between a wall and a
+ * that level then fail it (side_curve): a crease between a wall and a
  * curved wall is no corner of two lines. The variance is the largest of
  * the run's noise estimate, the lines' residual per degree of freedom and
  * the floor: sides the lines do not fit (clutter, a second corner within
@@ -776,9 +776,8 @@ typedef struct {
 
 static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_corner_test_t *t)
 {
-    const float floor2 = c->p->floor * c->p->floor;
     const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
-    float var = c->noise2 > floor2 ? c->noise2 : floor2;
+    float var = c->noise2;
     t->noise_var = var;
     t->rss_lines = rss_lines;
     t->n = n;
@@ -878,25 +877,29 @@ static int window_joined(const lc_ctx_t *c, size_t a, size_t b, float noise_var)
     return 1;
 }
 
-/* For the evidence route: a side shows no curvature unless a circle cuts
- * its line's squared residual by more than LC_EVIDENCE_SIGMAS^2 noise
- * variances. Three points or fewer show none (a circle fits any three). */
-static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var)
+/* A side shows curvature when a circle cuts its line's squared residual by
+ * more than LC_EVIDENCE_SIGMAS^2 noise variances: returns that circle's
+ * squared residual (*fit the circle), else -1; also -1 when it is cap or
+ * more. Three points or fewer show none (a circle fits any three). With
+ * refine, that many Gauss-Newton steps of the geometric fit. */
+static float side_curve(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var,
+                        float cap, unsigned refine, lc_circle_t *fit)
 {
     const float cut = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
     float rss_circle;
     lc_enough_t enough;
     /* no circle can cut more than the whole residual */
     if (b - a + 1u <= 3u || !(l->rss > cut)) {
-        return 1;
+        return -1.0f;
     }
     enough.scale = 1.0f;
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
-    enough.target = l->rss - cut; /* uncurved from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough,
-                            LC_CIRCLE_STEPS, NULL);
-    return rss_circle < 0.0f || rss_circle >= enough.target;
+    enough.target = l->rss - cut < cap ? l->rss - cut : cap; /* uncurved from there on */
+    rss_circle =
+        circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough, refine, fit);
+    /* below the target the sum ran to the end: the whole residual */
+    return rss_circle < 0.0f || rss_circle >= enough.target ? -1.0f : rss_circle;
 }
 
 /* Whether the evidence route can hold for the split at apex whose best
@@ -928,14 +931,17 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     const size_t e1 = b_first ? apex - 1u : b1;
     float rss_circle;
     lc_enough_t enough;
+    lc_circle_t k;
     if (!(rss_curve > bound)) {
         return 0;
     }
     /* Three independent tests: the sides first and the whole window's
      * circle (the dearest) last, so a curved side (the usual failure on
      * real logs) spares it. */
-    if (!side_uncurved(c, s0, e0, b_first ? lb : la, t->noise_var) ||
-        !side_uncurved(c, s1, e1, b_first ? la : lb, t->noise_var)) {
+    if (side_curve(c, s0, e0, b_first ? lb : la, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, &k) >=
+            0.0f ||
+        side_curve(c, s1, e1, b_first ? la : lb, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, &k) >=
+            0.0f) {
         return 0;
     }
     enough.scale = 1.0f;
@@ -1073,7 +1079,7 @@ static lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_
 
 /* One side of a crease: its line, or its circle when that cuts the line's
  * squared residual by more than LC_EVIDENCE_SIGMAS^2 noise variances (the
- * side shows curvature, side_uncurved's test). */
+ * side shows curvature, side_curve's test). */
 typedef struct {
     lc_circle_t k;
     const lc_line_t *l;
@@ -1087,36 +1093,62 @@ typedef struct {
 /* Fewest points on any side of a crease: a line through two or three
  * points fits them whatever they are. */
 #define LC_CREASE_LINE_POINTS 3u
+/* Gauss-Newton steps of a crease side's circle fit. */
+#define LC_CREASE_CIRCLE_STEPS 3u
 
 /* Fit side a..b (line l) as a piece; returns 0 when the piece does not
  * explain the side within the noise (noise_var per degree of freedom, plus
  * LC_EVIDENCE_SIGMAS standard deviations of that chi-square sum): a side
  * that reaches round a corner or onto another surface is no side of a
  * crease, whatever shape fits it best. */
+/* The most squared residual a piece of dof degrees of freedom leaves within
+ * the noise: dof + LC_EVIDENCE_SIGMAS standard deviations of that
+ * chi-square sum, bounded as dof + k sqrt(2 dof) <= 2 dof + k^2 / 4. */
+static float piece_bound(float dof, float noise_var)
+{
+    return noise_var * (2.0f * dof + 0.25f * LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS);
+}
+
 static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var,
                      lc_piece_t *s)
 {
     const size_t n = b - a + 1u;
-    const float floor_rss = (float)n * c->p->floor * c->p->floor;
-    float rss_circle, dof;
+    float rss_circle;
+    float dof = (float)(n - 2u);
     s->l = l;
     s->rss = l->rss;
     s->round = 0;
     if (n < LC_CREASE_LINE_POINTS) {
         return 0;
     }
-    dof = (float)(n - 2u);
     if (n >= LC_CREASE_ROUND_POINTS) {
-        rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])),
-                                &lc_whole, LC_CIRCLE_STEPS, &s->k);
-        if (rss_circle >= 0.0f && s->k.r * s->k.r >= dist2(c->rel[a], c->rel[b]) &&
-            l->rss > rss_circle + LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var) {
+        /* When the line does not fit within the noise, only a circle that
+         * does can make the side a piece: the fit stops once it cannot,
+         * and first (speed) the algebraic circle, whose residual the
+         * geometric steps lower by a few noise variances, not by
+         * LC_EVIDENCE_SIGMAS^2 (clutter fails here). */
+        const float cap =
+            l->rss > piece_bound(dof, noise_var) ? piece_bound(dof - 1.0f, noise_var) : FLT_MAX;
+        if (cap < FLT_MAX) {
+            lc_enough_t enough;
+            enough.scale = 1.0f;
+            enough.ratio = 1.0f;
+            enough.floor_rss = 0.0f;
+            enough.target = cap + LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
+            rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])),
+                                    &enough, 0u, NULL);
+            if (!(rss_circle >= 0.0f && rss_circle < enough.target)) {
+                return 0;
+            }
+        }
+        rss_circle = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
+        if (rss_circle >= 0.0f && s->k.r * s->k.r >= dist2(c->rel[a], c->rel[b])) {
             s->rss = rss_circle;
             s->round = 1;
-            dof = (float)(n - 3u);
+            dof -= 1.0f;
         }
     }
-    return s->rss <= noise_var * (dof + LC_EVIDENCE_SIGMAS * sqrtf(2.0f * dof)) + floor_rss;
+    return s->rss <= piece_bound(dof, noise_var);
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
@@ -1159,10 +1191,11 @@ static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size
                                  lc_verdict_t v, bsf_keypoint_t *kp)
 {
     const size_t n = b1 - a0 + 1u;
-    const float noise_var =
-        c->noise2 > c->p->floor * c->p->floor ? c->noise2 : c->p->floor * c->p->floor;
+    const float noise_var = c->noise2;
     const float curved = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
+    const float least = c->p->curve_ratio * (float)n * noise_var;
     lc_piece_t pc[2];
+    lc_line_t lu;
     float f[2], gx[2], gy[2];
     float rss_curve, rss_pieces = 0.0f;
     bsf_point_t x = {0.0f, 0.0f};
@@ -1171,8 +1204,21 @@ static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size
     int round = 0;
     /* A side is taken as a circle only when its line leaves more than this
      * (fit_piece): two straight sides stop here, judged already. */
-    if (!(la->rss > curved || lb->rss > curved) || !side_seen(c, la) || !side_seen(c, lb) ||
-        !window_joined(c, a0, b1, noise_var)) {
+    if (!(la->rss > curved || lb->rss > curved)) {
+        return v;
+    }
+    /* Cheap tests first (speed only, the pieces' tests would fail too): a
+     * side fits no piece when its line leaves more than the noise allows
+     * and it is too short to be taken as a circle; */
+    for (k = 0; k < 2; ++k) {
+        const lc_line_t *l = k ? lb : la;
+        if (l->rss > piece_bound((float)(l->n - 2u), noise_var) && l->n < LC_CREASE_ROUND_POINTS) {
+            return v;
+        }
+    }
+    /* and the curve test below cannot pass when one line over both sides
+     * leaves less than this (the circle leaves at most as much) */
+    if (!fit_line_from(c, a0, b1, apex, la->sx, la->sy, &lu) || !(lu.rss > least)) {
         return v;
     }
     for (k = 0; k < 2; ++k) {
@@ -1188,18 +1234,19 @@ static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size
     /* One smooth curve over both sides: the geometrically fitted circle (a
      * line is its limit; none exists when the points lie on a line, which
      * is no crease of a curved side) */
-    rss_curve = circle_rss(c, a0, b1, 0.5f * (la->mx + lb->mx), 0.5f * (la->my + lb->my),
-                           sqrtf(dist2(c->rel[a0], c->rel[b1])), &lc_whole, LC_CIRCLE_STEPS, NULL);
+    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2(c->rel[a0], c->rel[b1])), &lc_whole,
+                           LC_CIRCLE_STEPS, NULL);
     /* (the pieces are credited with no better than the noise: their fit to
      * it is chance) */
     if (!(rss_curve >
           c->p->curve_ratio *
                   (rss_pieces > (float)n * noise_var ? rss_pieces : (float)n * noise_var) +
-              (float)n * c->p->floor * c->p->floor)) {
-        return v;
+              (float)n * c->p->floor * c->p->floor) ||
+        !window_joined(c, a0, b1, noise_var)) {
+        return v; /* (or a depth jump inside the window: no crease of one surface) */
     }
     /* Newton steps from the apex on the pieces' distances; the last round
-     * only checks: converged, and crossing at min_turn */
+     * only checks that they still cross at min_turn there */
     for (step = 0;; ++step) {
         float det;
         for (k = 0; k < 2; ++k) {
@@ -1210,9 +1257,6 @@ static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size
             return v;
         }
         if (step == LC_CREASE_STEPS) {
-            if (!(f[0] * f[0] + f[1] * f[1] <= noise_var)) {
-                return v;
-            }
             break;
         }
         /* solve [g0; g1] dx = -(f0, f1) */
@@ -1304,7 +1348,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     }
     reach = 2.0f * spacing + p->apex_slack;
     v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, kp);
-    return v == LC_CORNER ? v : judge_crease(c, a0, apex, b1, &la, &lb, 2.0f * spacing, v, kp);
+    return v == LC_CORNER ? v : judge_crease(c, a0, apex, b1, &la, &lb, reach, v, kp);
 }
 
 /* Noise of a run, from each point's distance to the chord of its two
@@ -1510,7 +1554,8 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
-    c->noise2 = sigma * sigma;
+    c->noise2 =
+        sigma * sigma > c->p->floor * c->p->floor ? sigma * sigma : c->p->floor * c->p->floor;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
