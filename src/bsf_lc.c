@@ -1013,9 +1013,12 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
 /* The two-line verdict on the split at apex, window a0..b1, sides' lines la
  * and lb (which turn by at least min_turn: cross is their cross product)
  * whose intersection must lie within reach of the apex. */
-static lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1,
-                                const lc_line_t *la, const lc_line_t *lb, float cross, float reach,
-                                bsf_keypoint_t *kp)
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline lc_verdict_t
+judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_t *la,
+            const lc_line_t *lb, float cross, float reach, bsf_point_t *xo, float *score)
 {
     const bsf_point_t *rp = c->rel;
     float t, extent, rss_curve, rss_circle, rss_lines;
@@ -1072,14 +1075,12 @@ static lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_
     if (!side_straight(c, a0, apex - 1u, la) || !side_straight(c, apex + 1u, b1, lb)) {
         return no_corner(&test, rss_curve);
     }
-    corner_keypoint(c, a0, apex, b1, x, la, lb, rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f,
-                    kp);
+    *xo = x;
+    *score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
     return LC_CORNER;
 }
 
-/* One side of a crease: its line, or its circle when that cuts the line's
- * squared residual by more than LC_EVIDENCE_SIGMAS^2 noise variances (the
- * side shows curvature, side_curve's test). */
+/* One side of a crease: its line or its circle (fit_piece). */
 typedef struct {
     lc_circle_t k;
     const lc_line_t *l;
@@ -1096,11 +1097,6 @@ typedef struct {
 /* Gauss-Newton steps of a crease side's circle fit. */
 #define LC_CREASE_CIRCLE_STEPS 3u
 
-/* Fit side a..b (line l) as a piece; returns 0 when the piece does not
- * explain the side within the noise (noise_var per degree of freedom, plus
- * LC_EVIDENCE_SIGMAS standard deviations of that chi-square sum): a side
- * that reaches round a corner or onto another surface is no side of a
- * crease, whatever shape fits it best. */
 /* The most squared residual a piece of dof degrees of freedom leaves within
  * the noise: dof + LC_EVIDENCE_SIGMAS standard deviations of that
  * chi-square sum, bounded as dof + k sqrt(2 dof) <= 2 dof + k^2 / 4. */
@@ -1109,46 +1105,39 @@ static float piece_bound(float dof, float noise_var)
     return noise_var * (2.0f * dof + 0.25f * LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS);
 }
 
+/* Fit side a..b (line l) as a piece: its line when that explains it within
+ * the noise (piece_bound), else its circle when that does, shows curvature
+ * (side_curve), has at least LC_CREASE_ROUND_POINTS points and spans at
+ * most 60 deg (its radius at least its chord: a circle through a bent
+ * polyline is tighter). Returns 0 when neither does: a side that reaches
+ * round a corner or onto another surface is no side of a crease. */
 static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var,
                      lc_piece_t *s)
 {
     const size_t n = b - a + 1u;
-    float rss_circle;
-    float dof = (float)(n - 2u);
+    /* the line's bound; a circle has one degree of freedom less */
+    const float cap = piece_bound((float)(n - 2u), noise_var) - 2.0f * noise_var;
     s->l = l;
     s->rss = l->rss;
     s->round = 0;
     if (n < LC_CREASE_LINE_POINTS) {
         return 0;
     }
-    if (n >= LC_CREASE_ROUND_POINTS) {
-        /* When the line does not fit within the noise, only a circle that
-         * does can make the side a piece: the fit stops once it cannot,
-         * and first (speed) the algebraic circle, whose residual the
-         * geometric steps lower by a few noise variances, not by
-         * LC_EVIDENCE_SIGMAS^2 (clutter fails here). */
-        const float cap =
-            l->rss > piece_bound(dof, noise_var) ? piece_bound(dof - 1.0f, noise_var) : FLT_MAX;
-        if (cap < FLT_MAX) {
-            lc_enough_t enough;
-            enough.scale = 1.0f;
-            enough.ratio = 1.0f;
-            enough.floor_rss = 0.0f;
-            enough.target = cap + LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
-            rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])),
-                                    &enough, 0u, NULL);
-            if (!(rss_circle >= 0.0f && rss_circle < enough.target)) {
-                return 0;
-            }
-        }
-        rss_circle = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
-        if (rss_circle >= 0.0f && s->k.r * s->k.r >= dist2(c->rel[a], c->rel[b])) {
-            s->rss = rss_circle;
-            s->round = 1;
-            dof -= 1.0f;
-        }
+    if (l->rss <= cap + 2.0f * noise_var) {
+        return 1; /* the line explains it */
     }
-    return s->rss <= piece_bound(dof, noise_var);
+    /* Only a circle that fits within the noise can make the side a piece:
+     * the fits stop once it cannot, and first (speed) the algebraic
+     * circle, whose residual the geometric steps lower by a few noise
+     * variances, not by LC_EVIDENCE_SIGMAS^2 (clutter stops here). */
+    if (n < LC_CREASE_ROUND_POINTS ||
+        side_curve(c, a, b, l, noise_var, cap + LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var,
+                   0u, &s->k) < 0.0f) {
+        return 0;
+    }
+    s->rss = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
+    s->round = 1;
+    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2(c->rel[a], c->rel[b]);
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
@@ -1186,9 +1175,12 @@ static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
  * the two lines must) at an angle of min_turn or more. A round pillar or a
  * smooth wall of varying curvature fails the last: the circles of its two
  * sides touch, they do not cross. Otherwise the two-line verdict v stands. */
-static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1,
-                                 const lc_line_t *la, const lc_line_t *lb, float reach,
-                                 lc_verdict_t v, bsf_keypoint_t *kp)
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline lc_verdict_t
+judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_t *la,
+             const lc_line_t *lb, float reach, lc_verdict_t v, bsf_point_t *xo, float *score)
 {
     const size_t n = b1 - a0 + 1u;
     const float noise_var = c->noise2;
@@ -1207,17 +1199,9 @@ static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size
     if (!(la->rss > curved || lb->rss > curved)) {
         return v;
     }
-    /* Cheap tests first (speed only, the pieces' tests would fail too): a
-     * side fits no piece when its line leaves more than the noise allows
-     * and it is too short to be taken as a circle; */
-    for (k = 0; k < 2; ++k) {
-        const lc_line_t *l = k ? lb : la;
-        if (l->rss > piece_bound((float)(l->n - 2u), noise_var) && l->n < LC_CREASE_ROUND_POINTS) {
-            return v;
-        }
-    }
-    /* and the curve test below cannot pass when one line over both sides
-     * leaves less than this (the circle leaves at most as much) */
+    /* Cheap first (speed): the curve test below cannot pass when one line
+     * over both sides leaves less than this (the circle leaves at most as
+     * much). */
     if (!fit_line_from(c, a0, b1, apex, la->sx, la->sy, &lu) || !(lu.rss > least)) {
         return v;
     }
@@ -1266,8 +1250,8 @@ static lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size
             return v;
         }
     }
-    corner_keypoint(c, a0, apex, b1, x, la, lb, rss_pieces > 0.0f ? rss_curve / rss_pieces : 1e30f,
-                    kp);
+    *xo = x;
+    *score = rss_pieces > 0.0f ? rss_curve / rss_pieces : 1e30f;
     return LC_CORNER;
 }
 
@@ -1287,8 +1271,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     size_t b1 = apex;
     const bsf_point_t *rp = c->rel;
     float cross, spacing, reach;
+    float score = 0.0f;
     lc_verdict_t v;
     bsf_point_t ap;
+    bsf_point_t x = {0.0f, 0.0f};
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
@@ -1347,8 +1333,14 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
     reach = 2.0f * spacing + p->apex_slack;
-    v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, kp);
-    return v == LC_CORNER ? v : judge_crease(c, a0, apex, b1, &la, &lb, reach, v, kp);
+    v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, &x, &score);
+    if (v != LC_CORNER) {
+        v = judge_crease(c, a0, apex, b1, &la, &lb, reach, v, &x, &score);
+    }
+    if (v == LC_CORNER) {
+        corner_keypoint(c, a0, apex, b1, x, &la, &lb, score, kp);
+    }
+    return v;
 }
 
 /* Noise of a run, from each point's distance to the chord of its two
