@@ -1217,15 +1217,14 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
     }
     /* One smooth curve over both sides: the geometrically fitted circle (a
      * line is its limit; none exists when the points lie on a line, which
-     * is no crease of a curved side) */
+     * is no crease of a curved side). The pieces are credited with no
+     * better than the noise: their fit to it is chance. */
     rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2(c->rel[a0], c->rel[b1])), &lc_whole,
                            LC_CIRCLE_STEPS, NULL);
-    /* (the pieces are credited with no better than the noise: their fit to
-     * it is chance) */
-    if (!(rss_curve >
-          c->p->curve_ratio *
-                  (rss_pieces > (float)n * noise_var ? rss_pieces : (float)n * noise_var) +
-              (float)n * c->p->floor * c->p->floor) ||
+    if (rss_pieces < (float)n * noise_var) {
+        rss_pieces = (float)n * noise_var;
+    }
+    if (!(rss_curve > c->p->curve_ratio * rss_pieces + (float)n * c->p->floor * c->p->floor) ||
         !window_joined(c, a0, b1, noise_var)) {
         return v; /* (or a depth jump inside the window: no crease of one surface) */
     }
@@ -1251,7 +1250,7 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
         }
     }
     *xo = x;
-    *score = rss_pieces > 0.0f ? rss_curve / rss_pieces : 1e30f;
+    *score = rss_curve / rss_pieces;
     return LC_CORNER;
 }
 
