@@ -121,6 +121,17 @@ static float dist2(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
+/* dist2 as one copy for the judgement's dozen single uses in the compact
+ * build (code size); the loops over a run keep dist2 inlined. */
+#if BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline))
+#endif
+static float
+dist2_once(bsf_point_t a, bsf_point_t b)
+{
+    return dist2(a, b);
+}
+
 /* Unit eigenvector (*dx, *dy) of the scatter [sxx sxy; sxy syy] for its
  * larger eigenvalue lmax: of the two equivalent forms, the one with the
  * larger norm is the better conditioned. 0 when both vanish (all points
@@ -357,7 +368,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     if (l->rss * (float)(n - 3u) <= line_dof * floor_rss) {
         return 1;
     }
-    extent = sqrtf(dist2(c->rel[a], c->rel[b]));
+    extent = sqrtf(dist2_once(c->rel[a], c->rel[b]));
     enough.scale = line_dof;
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
@@ -896,8 +907,8 @@ static float side_curve(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = l->rss - cut < cap ? l->rss - cut : cap; /* uncurved from there on */
-    rss_circle =
-        circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough, refine, fit);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2_once(c->rel[a], c->rel[b])), &enough,
+                            refine, fit);
     /* below the target the sum ran to the end: the whole residual */
     return rss_circle < 0.0f || rss_circle >= enough.target ? -1.0f : rss_circle;
 }
@@ -948,7 +959,7 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = bound; /* from there on, the corner stands */
-    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
                             &enough, LC_CIRCLE_STEPS, NULL);
     return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
@@ -986,12 +997,12 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
 {
     const bsf_point_t *rp = c->rel;
     size_t best = apex;
-    float best_d = dist2(rp[apex], x);
+    float best_d = dist2_once(rp[apex], x);
     size_t i;
     /* The vertex beam: the point nearest the intersection, near the split. */
     for (i = apex - 2u; i <= apex + 2u; ++i) {
         if (i > a0 && i < b1) {
-            const float d = dist2(rp[i], x);
+            const float d = dist2_once(rp[i], x);
             if (d < best_d) {
                 best_d = d;
                 best = i;
@@ -1003,8 +1014,8 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
     kp->point.y = x.y + c->o.y;
     kp->orientation = bsf_atan2f(la->my + lb->my - 2.0f * x.y, la->mx + lb->mx - 2.0f * x.x);
     {
-        const float ra = sqrtf(dist2(rp[a0], rp[apex]));
-        const float rb = sqrtf(dist2(rp[b1], rp[apex]));
+        const float ra = sqrtf(dist2_once(rp[a0], rp[apex]));
+        const float rb = sqrtf(dist2_once(rp[b1], rp[apex]));
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = score;
@@ -1050,7 +1061,7 @@ judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_
     if (evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) {
         return LC_MERGE;
     }
-    extent = sqrtf(dist2(rp[a0], rp[b1]));
+    extent = sqrtf(dist2_once(rp[a0], rp[b1]));
     rss_curve = lu.rss;
     enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
     enough.ratio = 1.0f;
@@ -1137,7 +1148,7 @@ static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, 
     }
     s->rss = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
     s->round = 1;
-    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2(c->rel[a], c->rel[b]);
+    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2_once(c->rel[a], c->rel[b]);
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
@@ -1221,8 +1232,8 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
      * line is its limit; none exists when the points lie on a line, which
      * is no crease of a curved side). The pieces are credited with no
      * better than the noise: their fit to it is chance. */
-    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2(c->rel[a0], c->rel[b1])), &lc_whole,
-                           LC_CIRCLE_STEPS, NULL);
+    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
+                           &lc_whole, LC_CIRCLE_STEPS, NULL);
     if (rss_pieces < (float)n * noise_var) {
         rss_pieces = (float)n * noise_var;
     }
@@ -1290,10 +1301,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
+    if (apex - a0 < need || dist2_once(rp[a0], ap) < len2) {
         a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
-    if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
+    if (b1 - apex < need || dist2_once(rp[b1], ap) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A wall seen at grazing incidence has a return every half metre or
@@ -1313,7 +1324,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
+    if (dist2_once(rp[a0], ap) < len2 || dist2_once(rp[b1], ap) < len2) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
@@ -1328,9 +1339,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     }
     /* the sides' fits must meet within twice the local beam spacing plus
      * apex_slack of the apex */
-    spacing = dist2(rp[apex - 1u], ap);
+    spacing = dist2_once(rp[apex - 1u], ap);
     {
-        const float s2 = dist2(rp[apex + 1u], ap);
+        const float s2 = dist2_once(rp[apex + 1u], ap);
         spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
     reach = 2.0f * spacing + p->apex_slack;
