@@ -942,16 +942,15 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     const size_t e1 = b_first ? apex - 1u : b1;
     float rss_circle;
     lc_enough_t enough;
-    lc_circle_t k;
     if (!(rss_curve > bound)) {
         return 0;
     }
     /* Three independent tests: the sides first and the whole window's
      * circle (the dearest) last, so a curved side (the usual failure on
      * real logs) spares it. */
-    if (side_curve(c, s0, e0, b_first ? lb : la, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, &k) >=
+    if (side_curve(c, s0, e0, b_first ? lb : la, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, NULL) >=
             0.0f ||
-        side_curve(c, s1, e1, b_first ? la : lb, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, &k) >=
+        side_curve(c, s1, e1, b_first ? la : lb, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, NULL) >=
             0.0f) {
         return 0;
     }
@@ -1023,7 +1022,9 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
 
 /* The two-line verdict on the split at apex, window a0..b1, sides' lines la
  * and lb (which turn by at least min_turn: cross is their cross product)
- * whose intersection must lie within reach of the apex. */
+ * whose intersection must lie within reach of the apex: LC_CORNER with the
+ * intersection in *xo and the evidence in *score, else the verdict. Inlined
+ * into judge, its one caller (code size). */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((always_inline))
 #endif
@@ -1177,15 +1178,17 @@ static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
 #define LC_CREASE_STEPS 6u
 
 /* A crease: where a curved wall meets a wall or another curved wall, the
- * two-line test fails (a side's line does not fit it) although the points
- * have a vertex. The split is a corner when, with each side the better of
- * its line and its circle (at least one a circle) and each explained within
- * the noise, the best smooth curve over both sides (the geometrically
- * fitted circle) has curve_ratio times the sides' squared residual plus the
- * floor, and the sides' fits cross within reach of the apex (as close as
- * the two lines must) at an angle of min_turn or more. A round pillar or a
- * smooth wall of varying curvature fails the last: the circles of its two
- * sides touch, they do not cross. Otherwise the two-line verdict v stands. */
+ * two-line test fails or puts the vertex off it (a side's line does not fit
+ * that side) although the points have a vertex. The split is a corner when
+ * each side is a piece (fit_piece), at least one a circle, the best smooth
+ * curve over both sides (the geometrically fitted circle) leaves
+ * curve_ratio times the pieces' squared residual (at least n noise
+ * variances) plus the floor, no depth jump lies in the window, and the
+ * pieces cross within reach of the apex (as close as the two lines must) at
+ * an angle of min_turn or more. A round pillar or a smooth wall of varying
+ * curvature fails the last: the circles of its two sides touch, they do not
+ * cross. LC_CORNER with the crossing in *xo and the evidence in *score,
+ * else v. Inlined into judge, its one caller (code size). */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((always_inline))
 #endif
