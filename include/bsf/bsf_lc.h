@@ -54,8 +54,23 @@
  *     its neighbours' sides, so a side never reaches across a shallow corner
  *     the tests could not confirm into the next wall (where its line's
  *     residual would grow and cost that neighbour its corner too);
+ *     once the lines turn by min_turn, and before their other tests, a split
+ *     where a side's line does not explain its points within the noise
+ *     (2 (n - 2) + 6.25 noise variances) is judged as a crease, where a
+ *     curved wall meets a wall or another curved wall: each side is its
+ *     line, or its circle when that cuts the line's residual by 25 noise
+ *     variances, has at least 10 points, spans at most 60 deg and fits
+ *     within the noise itself; the split is a corner when the best circle
+ *     over both sides leaves curve_ratio times the two pieces' squared
+ *     residual (counted at no less than the noise) plus the floor, no depth
+ *     jump lies in the window, and the pieces cross near the apex (as near
+ *     as the lines must) at min_turn or more. The circles of one pillar, or
+ *     of a wall of varying curvature, touch rather than cross, so these get
+ *     no corner. Where a side is round, the two lines' intersection would
+ *     lie off the crease even when they pass;
  *  3. report each corner at its apex beam, with the intersection of the two
- *     lines as its position (PDM starts the vertex there and keeps it there).
+ *     lines (of the crease's pieces) as its position (PDM starts the vertex
+ *     there and keeps it there).
  * On a full-circle scan (bsf_points_full_circle) the pass starts at the first
  * beam where a run breaks anyway, so a run goes on through the seam between
  * the last and the first beam and a corner straight behind the sensor is
@@ -144,7 +159,8 @@ typedef struct {
  * Detect corners. Keypoints come out ascending by beam index, with point =
  * the two-line intersection (sensor frame), orientation = the direction of
  * the corner's bisector (radians), radius = the longer side used (metres) and
- * score = the curve-to-lines residual ratio (higher = sharper evidence).
+ * score = the curve-to-lines residual ratio (curve to pieces for a crease;
+ * higher = sharper evidence).
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers (out may be NULL when out_cap
  *         is 0); BSF_ERR_PARAM for bad parameters; BSF_ERR_CAPACITY when
  *         pts->count > BSF_MAX_POINTS or more than out_cap corners were found

@@ -299,6 +299,48 @@ static void test_straight_walls_pillars_and_curved_walls_give_no_corner(void)
     TEST_ASSERT_EQUAL_size_t(0u, detect(1.0, 0.5, 0.0, 541u, 1.5 * PI, 0.01));
 }
 
+/* Where a straight wall cuts a round room (a 5 m circle, the wall 2 m from
+ * its centre: the arc meets it at 66 deg), the crease gets a corner at
+ * every beam spacing; the room without the wall, and a smooth wall of
+ * varying curvature (an ellipse, 6 by 3.5 m, as 60 edges turning 6 deg
+ * each), get none. */
+static void test_a_crease_between_an_arc_and_a_wall_is_a_corner_a_smooth_curve_is_not(void)
+{
+    static const size_t beams[3] = {361u, 541u, 1081u};
+    const double cx = sqrt(25.0 - 4.0);
+    double ellipse[120];
+    size_t b;
+    size_t k;
+    for (k = 0; k < 60u; ++k) {
+        ellipse[2u * k] = 6.0 * cos(2.0 * PI * (double)k / 60.0);
+        ellipse[2u * k + 1u] = 3.5 * sin(2.0 * PI * (double)k / 60.0);
+    }
+    for (b = 0; b < 3u; ++b) {
+        size_t n;
+        int side;
+        bsf_scene_init(&scene);
+        TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 0.0, 0.0, 5.0) >= 0);
+        TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, -6.0, -2.0, 6.0, -2.0) >= 0);
+        n = detect(0.0, 0.5, -0.5 * PI, beams[b], 1.5 * PI, 0.01);
+        TEST_ASSERT_EQUAL_size_t(2u, n);
+        for (side = -1; side <= 1; side += 2) {
+            double best = 1e9;
+            for (k = 0; k < n; ++k) {
+                const double d = dist_to(k, 0.0, 0.5, -0.5 * PI, (double)side * cx, -2.0);
+                best = d < best ? d : best;
+            }
+            TEST_ASSERT_TRUE_MESSAGE(best < 0.03, "no corner within 3 cm of the crease");
+        }
+        bsf_scene_init(&scene);
+        TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 0.0, 0.0, 5.0) >= 0);
+        TEST_ASSERT_EQUAL_size_t(0u, detect(0.0, 0.5, -0.5 * PI, beams[b], 1.5 * PI, 0.01));
+        bsf_scene_init(&scene);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, ellipse, 60u, 1));
+        TEST_ASSERT_EQUAL_size_t(0u, detect(1.0, 0.5, 0.0, beams[b], 1.5 * PI, 0.01));
+        TEST_ASSERT_EQUAL_size_t(0u, detect(-2.0, -1.0, 0.7, beams[b], 1.5 * PI, 0.01));
+    }
+}
+
 /* A zig-zag shelf front (145 deg corners, 0.89 m sides) 3.2-3.5 m away at
  * 0.75 deg beams and 1 cm noise: the best circle over two sides misses
  * their points by about 2 cm rms, some 200 noise variances, but only about
@@ -528,6 +570,7 @@ int main(void)
     RUN_TEST(test_noisy_room_gives_its_four_corners_and_nothing_else);
     RUN_TEST(test_every_corner_of_a_zig_zag_shelf_is_found);
     RUN_TEST(test_straight_walls_pillars_and_curved_walls_give_no_corner);
+    RUN_TEST(test_a_crease_between_an_arc_and_a_wall_is_a_corner_a_smooth_curve_is_not);
     RUN_TEST(test_shallow_corners_between_long_sides_are_found_with_the_evidence_test);
     RUN_TEST(test_the_evidence_test_adds_no_corner_on_walls_pillars_curves_or_depth_steps);
     RUN_TEST(test_corners_between_long_shallow_sides_are_not_lost_to_a_missed_neighbour);
