@@ -520,7 +520,9 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
 {
-    float r[5];
+    /* zeroed: r[0] and r[4] are read only when have_outer says they were
+     * set, which some compilers cannot see */
+    float r[5] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     float lo;
     float hi;
     float jump;
