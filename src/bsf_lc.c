@@ -17,6 +17,10 @@
 /* Single distances above this do not count towards the noise estimate
  * (corners and jumps inside a run), metres. */
 #define LC_NOISE_CLIP 0.05f
+/* Shortest span across the ray of the beams from a point to either end of
+ * its chord in the noise estimate, metres: well above range noise, well
+ * below the length of a wall. */
+#define LC_NOISE_BASE 0.05f
 /* A circle is only a candidate shape when its radius is below this multiple
  * of the window's extent: a larger one is a line in float arithmetic. */
 #define LC_CIRCLE_MAX_RADIUS 10.0f
@@ -47,8 +51,8 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * side within max_side of the apex, so the beam spacing, not the range,
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
-    p.join_grazing = 0u;
-    p.corner_evidence = 0u;
+    p.join_grazing = 1u;
+    p.corner_evidence = 1u;
     return p;
 }
 
@@ -89,7 +93,8 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
-    float noise2; /* the current run's noise variance (run_noise squared) */
+    float noise2; /* the current run's noise variance (run_noise squared), at least floor^2 */
+    size_t start; /* beam where the pass starts (ring_start, else 0) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -114,6 +119,17 @@ static float dist2(bsf_point_t a, bsf_point_t b)
     const float dx = a.x - b.x;
     const float dy = a.y - b.y;
     return dx * dx + dy * dy;
+}
+
+/* dist2 as one copy for the judgement's dozen single uses in the compact
+ * build (code size); the loops over a run keep dist2 inlined. */
+#if BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline))
+#endif
+static float
+dist2_once(bsf_point_t a, bsf_point_t b)
+{
+    return dist2(a, b);
 }
 
 /* Unit eigenvector (*dx, *dy) of the scatter [sxx sxy; sxy syy] for its
@@ -200,6 +216,14 @@ typedef struct {
     float target;
 } lc_enough_t;
 
+/* Never enough before the end: the whole residual (0 >= 1 never holds). */
+static const lc_enough_t lc_whole = {0.0f, 1.0f, 0.0f, 1.0f};
+
+/* A circle relative to the judgement's origin (the apex). */
+typedef struct {
+    float cx, cy, r;
+} lc_circle_t;
+
 /* One Gauss-Newton step of the geometric circle fit (the sum of squared
  * distances to the circle) over positions a..b, centre (*cx, *cy) relative
  * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
@@ -258,7 +282,7 @@ static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
  * variances on short or noisy arcs, which the evidence route would take as
  * evidence of a corner. */
 static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float extent,
-                        const lc_enough_t *enough, unsigned refine)
+                        const lc_enough_t *enough, unsigned refine, lc_circle_t *fit)
 {
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
@@ -301,6 +325,11 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     for (; refine > 0u; --refine) {
         circle_step(c, a, b, cx0, cy0, &cx, &cy, &r);
     }
+    if (fit != NULL) {
+        fit->cx = cx0 + cx;
+        fit->cy = cy0 + cy;
+        fit->r = r;
+    }
     for (i = a; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
         const float dy = rp[i].y - cy0 - cy;
@@ -339,12 +368,12 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     if (l->rss * (float)(n - 3u) <= line_dof * floor_rss) {
         return 1;
     }
-    extent = sqrtf(dist2(c->rel[a], c->rel[b]));
+    extent = sqrtf(dist2_once(c->rel[a], c->rel[b]));
     enough.scale = line_dof;
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
     enough.target = l->rss * (float)(n - 3u); /* straight from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough, 0u);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, extent, &enough, 0u, NULL);
     if (rss_circle < 0.0f) {
         return 1;
     }
@@ -742,7 +771,7 @@ static inline int blocks_rule_out(lc_ctx_t *c, int blocks, size_t a0, size_t ape
  * parameters): the F distribution's tail for the one more parameter and the
  * apex point, nu * (e^(k^2 / nu) - 1) variances for nu degrees of freedom
  * (k^2 = 25 for many points, more for few). Sides that show curvature at
- * that level then fail it (side_uncurved): a crease between a wall and a
+ * that level then fail it (side_curve): a crease between a wall and a
  * curved wall is no corner of two lines. The variance is the largest of
  * the run's noise estimate, the lines' residual per degree of freedom and
  * the floor: sides the lines do not fit (clutter, a second corner within
@@ -758,9 +787,8 @@ typedef struct {
 
 static void corner_test_init(const lc_ctx_t *c, float rss_lines, size_t n, lc_corner_test_t *t)
 {
-    const float floor2 = c->p->floor * c->p->floor;
     const float k2 = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS;
-    float var = c->noise2 > floor2 ? c->noise2 : floor2;
+    float var = c->noise2;
     t->noise_var = var;
     t->rss_lines = rss_lines;
     t->n = n;
@@ -860,25 +888,29 @@ static int window_joined(const lc_ctx_t *c, size_t a, size_t b, float noise_var)
     return 1;
 }
 
-/* For the evidence route: a side shows no curvature unless a circle cuts
- * its line's squared residual by more than LC_EVIDENCE_SIGMAS^2 noise
- * variances. Three points or fewer show none (a circle fits any three). */
-static int side_uncurved(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var)
+/* A side shows curvature when a circle cuts its line's squared residual by
+ * more than LC_EVIDENCE_SIGMAS^2 noise variances: returns that circle's
+ * squared residual (*fit the circle), else -1; also -1 when it is cap or
+ * more. Three points or fewer show none (a circle fits any three). With
+ * refine, that many Gauss-Newton steps of the geometric fit. */
+static float side_curve(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var,
+                        float cap, unsigned refine, lc_circle_t *fit)
 {
     const float cut = LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var;
     float rss_circle;
     lc_enough_t enough;
     /* no circle can cut more than the whole residual */
     if (b - a + 1u <= 3u || !(l->rss > cut)) {
-        return 1;
+        return -1.0f;
     }
     enough.scale = 1.0f;
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
-    enough.target = l->rss - cut; /* uncurved from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2(c->rel[a], c->rel[b])), &enough,
-                            LC_CIRCLE_STEPS);
-    return rss_circle < 0.0f || rss_circle >= enough.target;
+    enough.target = l->rss - cut < cap ? l->rss - cut : cap; /* uncurved from there on */
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2_once(c->rel[a], c->rel[b])), &enough,
+                            refine, fit);
+    /* below the target the sum ran to the end: the whole residual */
+    return rss_circle < 0.0f || rss_circle >= enough.target ? -1.0f : rss_circle;
 }
 
 /* Whether the evidence route can hold for the split at apex whose best
@@ -902,22 +934,33 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
                           float rss_curve)
 {
     const float bound = evidence_bound(t);
+    /* the shorter side first: [s0, e0] on line l0, then [s1, e1] on l1 */
+    const int b_first = b1 - apex < apex - a0;
+    const size_t s0 = b_first ? apex + 1u : a0;
+    const size_t e0 = b_first ? b1 : apex - 1u;
+    const size_t s1 = b_first ? a0 : apex + 1u;
+    const size_t e1 = b_first ? apex - 1u : b1;
     float rss_circle;
     lc_enough_t enough;
     if (!(rss_curve > bound)) {
+        return 0;
+    }
+    /* Three independent tests: the sides first and the whole window's
+     * circle (the dearest) last, so a curved side (the usual failure on
+     * real logs) spares it. */
+    if (side_curve(c, s0, e0, b_first ? lb : la, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, NULL) >=
+            0.0f ||
+        side_curve(c, s1, e1, b_first ? la : lb, t->noise_var, FLT_MAX, LC_CIRCLE_STEPS, NULL) >=
+            0.0f) {
         return 0;
     }
     enough.scale = 1.0f;
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = bound; /* from there on, the corner stands */
-    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2(c->rel[a0], c->rel[b1])),
-                            &enough, LC_CIRCLE_STEPS);
-    if (rss_circle >= 0.0f && !(rss_circle > bound)) {
-        return 0;
-    }
-    return side_uncurved(c, a0, apex - 1u, la, t->noise_var) &&
-           side_uncurved(c, apex + 1u, b1, lb, t->noise_var);
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
+                            &enough, LC_CIRCLE_STEPS, NULL);
+    return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
 /* judge's verdicts on a split. */
@@ -945,6 +988,288 @@ static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
     return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
 }
 
+/* Fill *kp for a corner at the split apex (window a0..b1) whose vertex is x
+ * (relative to the apex), between the sides of lines la and lb. */
+static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, bsf_point_t x,
+                            const lc_line_t *la, const lc_line_t *lb, float score,
+                            bsf_keypoint_t *kp)
+{
+    const bsf_point_t *rp = c->rel;
+    size_t best = apex;
+    float best_d = dist2_once(rp[apex], x);
+    size_t i;
+    /* The vertex beam: the point nearest the intersection, near the split. */
+    for (i = apex - 2u; i <= apex + 2u; ++i) {
+        if (i > a0 && i < b1) {
+            const float d = dist2_once(rp[i], x);
+            if (d < best_d) {
+                best_d = d;
+                best = i;
+            }
+        }
+    }
+    kp->index = c->run[best];
+    kp->point.x = x.x + c->o.x;
+    kp->point.y = x.y + c->o.y;
+    kp->orientation = bsf_atan2f(la->my + lb->my - 2.0f * x.y, la->mx + lb->mx - 2.0f * x.x);
+    {
+        const float ra = sqrtf(dist2_once(rp[a0], rp[apex]));
+        const float rb = sqrtf(dist2_once(rp[b1], rp[apex]));
+        kp->radius = ra > rb ? ra : rb;
+    }
+    kp->score = score;
+}
+
+/* The two-line verdict on the split at apex, window a0..b1, sides' lines la
+ * and lb (which turn by at least min_turn: cross is their cross product)
+ * whose intersection must lie within reach of the apex: LC_CORNER with the
+ * intersection in *xo and the evidence in *score, else the verdict. Inlined
+ * into judge, its one caller (code size). */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline lc_verdict_t
+judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_t *la,
+            const lc_line_t *lb, float cross, float reach, bsf_point_t *xo, float *score)
+{
+    const bsf_point_t *rp = c->rel;
+    float t, extent, rss_curve, rss_circle, rss_lines;
+    lc_line_t lu;
+    lc_corner_test_t test;
+    int evidence_checked; /* evidence_possible has passed */
+    lc_enough_t enough;
+    bsf_point_t x;
+    t = ((lb->mx - la->mx) * lb->dy - (lb->my - la->my) * lb->dx) / cross;
+    x.x = la->mx + t * la->dx;
+    x.y = la->my + t * la->dy;
+    if (!(x.x * x.x + x.y * x.y <= reach * reach)) {
+        return LC_MERGE;
+    }
+    /* One smooth curve over both sides: the better of a line and a circle. */
+    /* (the left side's sums are the first part of the whole's) */
+    if (!fit_line_from(c, a0, b1, apex, la->sx, la->sy, &lu)) {
+        return LC_MERGE;
+    }
+    rss_lines = la->rss + lb->rss;
+    corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
+    /* The curve's residual is at most the line's: when the line already
+     * fails the test, so does the curve, and no circle is fitted. */
+    if (!(lu.rss > test.bound)) {
+        return LC_MERGE;
+    }
+    /* Below the ratio route's bound only the evidence route can pass. */
+    evidence_checked = !(lu.rss > test.ratio_bound);
+    if (evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) {
+        return LC_MERGE;
+    }
+    extent = sqrtf(dist2_once(rp[a0], rp[b1]));
+    rss_curve = lu.rss;
+    enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
+    enough.ratio = 1.0f;
+    enough.floor_rss = 0.0f;
+    enough.target = lu.rss; /* from there on, the line is the better curve */
+    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, 0u, NULL);
+    if (rss_circle >= 0.0f && rss_circle < rss_curve) {
+        rss_curve = rss_circle;
+    }
+    if (!(rss_curve > test.bound)) {
+        return no_corner(&test, rss_curve);
+    }
+    if (!(rss_curve > test.ratio_bound) &&
+        ((!evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) ||
+         !evidence_holds(c, &test, a0, apex, b1, la, lb, &lu, rss_curve))) {
+        return no_corner(&test, rss_curve);
+    }
+    /* Each side must be straight: a circle may not explain it much better
+     * than its line (a crease between two curved walls is no wall corner,
+     * and its line intersection would lie off the crease). Last, as the
+     * dearest test. */
+    if (!side_straight(c, a0, apex - 1u, la) || !side_straight(c, apex + 1u, b1, lb)) {
+        return no_corner(&test, rss_curve);
+    }
+    *xo = x;
+    *score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
+    return LC_CORNER;
+}
+
+/* One side of a crease: its line or its circle (fit_piece). */
+typedef struct {
+    lc_circle_t k;
+    const lc_line_t *l;
+    float rss;
+    int round; /* 1: the circle k */
+} lc_piece_t;
+
+/* Fewest points on a side taken as a circle: a circle through a few points
+ * of a small pillar goes anywhere beyond them. */
+#define LC_CREASE_ROUND_POINTS 10u
+/* Fewest points on any side of a crease: a line through two or three
+ * points fits them whatever they are. */
+#define LC_CREASE_LINE_POINTS 3u
+/* Gauss-Newton steps of a crease side's circle fit. */
+#define LC_CREASE_CIRCLE_STEPS 3u
+
+/* The most squared residual a piece of dof degrees of freedom leaves within
+ * the noise: dof + LC_EVIDENCE_SIGMAS standard deviations of that
+ * chi-square sum, bounded as dof + k sqrt(2 dof) <= 2 dof + k^2 / 4. */
+static float piece_bound(float dof, float noise_var)
+{
+    return noise_var * (2.0f * dof + 0.25f * LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS);
+}
+
+/* Fit side a..b (line l) as a piece: its line when that explains it within
+ * the noise (piece_bound), else its circle when that does, shows curvature
+ * (side_curve), has at least LC_CREASE_ROUND_POINTS points and spans at
+ * most 60 deg (its radius at least its chord: a circle through a bent
+ * polyline is tighter). Returns 0 when neither does: a side that reaches
+ * round a corner or onto another surface is no side of a crease. */
+static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, float noise_var,
+                     lc_piece_t *s)
+{
+    const size_t n = b - a + 1u;
+    /* the line's bound; a circle has one degree of freedom less */
+    const float cap = piece_bound((float)(n - 2u), noise_var) - 2.0f * noise_var;
+    s->l = l;
+    s->rss = l->rss;
+    s->round = 0;
+    if (n < LC_CREASE_LINE_POINTS) {
+        return 0;
+    }
+    if (l->rss <= cap + 2.0f * noise_var) {
+        return 1; /* the line explains it */
+    }
+    /* Only a circle that fits within the noise can make the side a piece:
+     * the fits stop once it cannot, and first (speed) the algebraic
+     * circle, whose residual the geometric steps lower by a few noise
+     * variances, not by LC_EVIDENCE_SIGMAS^2 (clutter stops here). */
+    if (n < LC_CREASE_ROUND_POINTS ||
+        side_curve(c, a, b, l, noise_var, cap + LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS * noise_var,
+                   0u, &s->k) < 0.0f) {
+        return 0;
+    }
+    s->rss = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
+    s->round = 1;
+    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2_once(c->rel[a], c->rel[b]);
+}
+
+/* Signed distance of point q from piece s, and its unit gradient there. */
+static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
+{
+    float dx, dy, len;
+    if (!s->round) {
+        *gx = -s->l->dy;
+        *gy = s->l->dx;
+        return *gx * (q.x - s->l->mx) + *gy * (q.y - s->l->my);
+    }
+    dx = q.x - s->k.cx;
+    dy = q.y - s->k.cy;
+    len = sqrtf(dx * dx + dy * dy);
+    if (!(len > 0.0f)) {
+        *gx = 0.0f;
+        *gy = 0.0f;
+        return 0.0f;
+    }
+    *gx = dx / len;
+    *gy = dy / len;
+    return len - s->k.r;
+}
+
+/* Newton steps towards the crossing of a crease's pieces nearest the apex. */
+#define LC_CREASE_STEPS 6u
+
+/* A crease: where a curved wall meets a wall or another curved wall, the
+ * two-line test fails or puts the vertex off it (a side's line does not fit
+ * that side) although the points have a vertex. The split is a corner when
+ * each side is a piece (fit_piece), at least one a circle, the best smooth
+ * curve over both sides (the geometrically fitted circle) leaves
+ * curve_ratio times the pieces' squared residual (at least n noise
+ * variances) plus the floor, no depth jump lies in the window, and the
+ * pieces cross within reach of the apex (as close as the two lines must) at
+ * an angle of min_turn or more. A round pillar or a smooth wall of varying
+ * curvature fails the last: the circles of its two sides touch, they do not
+ * cross. LC_CORNER with the crossing in *xo and the evidence in *score,
+ * else v. Inlined into judge, its one caller (code size). */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline lc_verdict_t
+judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_t *la,
+             const lc_line_t *lb, float reach, lc_verdict_t v, bsf_point_t *xo, float *score)
+{
+    const size_t n = b1 - a0 + 1u;
+    const float noise_var = c->noise2;
+    lc_piece_t pc[2];
+    float f[2], gx[2], gy[2];
+    float rss_curve, rss_pieces = 0.0f;
+    bsf_point_t x = {0.0f, 0.0f};
+    unsigned step;
+    int k;
+    int round = 0;
+    /* A side is a circle only when its line does not explain it, and then
+     * only with LC_CREASE_ROUND_POINTS points (fit_piece): two lines, or a
+     * short side its line does not explain, stop here. */
+    for (k = 0; k < 2; ++k) {
+        const lc_line_t *l = k ? lb : la;
+        if (l->rss > piece_bound((float)(l->n - 2u), noise_var)) {
+            if (l->n < LC_CREASE_ROUND_POINTS) {
+                return v;
+            }
+            round = 1;
+        }
+    }
+    if (!round) {
+        return v;
+    }
+    round = 0;
+    for (k = 0; k < 2; ++k) {
+        if (!fit_piece(c, k ? apex + 1u : a0, k ? b1 : apex - 1u, k ? lb : la, noise_var, &pc[k])) {
+            return v; /* a side fits no piece */
+        }
+        rss_pieces += pc[k].rss;
+        round |= pc[k].round;
+    }
+    if (!round) {
+        return v; /* two lines: judged already */
+    }
+    /* One smooth curve over both sides: the geometrically fitted circle (a
+     * line is its limit; none exists when the points lie on a line, which
+     * is no crease of a curved side). The pieces are credited with no
+     * better than the noise: their fit to it is chance. */
+    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
+                           &lc_whole, LC_CIRCLE_STEPS, NULL);
+    if (rss_pieces < (float)n * noise_var) {
+        rss_pieces = (float)n * noise_var;
+    }
+    if (!(rss_curve > c->p->curve_ratio * rss_pieces + (float)n * c->p->floor * c->p->floor) ||
+        !window_joined(c, a0, b1, noise_var)) {
+        return v; /* (or a depth jump inside the window: no crease of one surface) */
+    }
+    /* Newton steps from the apex on the pieces' distances; the last round
+     * only checks that they still cross at min_turn there */
+    for (step = 0;; ++step) {
+        float det;
+        for (k = 0; k < 2; ++k) {
+            f[k] = piece_at(&pc[k], x, &gx[k], &gy[k]);
+        }
+        det = gx[0] * gy[1] - gy[0] * gx[1];
+        if (!(fabsf(det) >= c->sin_min_turn)) {
+            return v;
+        }
+        if (step == LC_CREASE_STEPS) {
+            break;
+        }
+        /* solve [g0; g1] dx = -(f0, f1) */
+        x.x -= (f[0] * gy[1] - f[1] * gy[0]) / det;
+        x.y -= (gx[0] * f[1] - gx[1] * f[0]) / det;
+        if (!(x.x * x.x + x.y * x.y <= reach * reach)) {
+            return v;
+        }
+    }
+    *xo = x;
+    *score = rss_curve / rss_pieces;
+    return LC_CORNER;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
  * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
@@ -957,18 +1282,14 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     const size_t need = p->min_side_points;
     lc_line_t la;
     lc_line_t lb;
-    lc_line_t lu;
     size_t a0 = apex;
     size_t b1 = apex;
-    size_t best;
-    size_t i;
     const bsf_point_t *rp = c->rel;
-    float cross, t, xx, xy, spacing, extent, rss_curve, rss_circle, rss_lines, best_d;
-    lc_corner_test_t test;
-    int evidence_checked; /* evidence_possible has passed */
-    lc_enough_t enough;
-    bsf_point_t x;
+    float cross, spacing, reach;
+    float score = 0.0f;
+    lc_verdict_t v;
     bsf_point_t ap;
+    bsf_point_t x = {0.0f, 0.0f};
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
     if (!(c->pts->range[c->run[apex]] <= p->max_range)) {
@@ -983,10 +1304,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2(rp[a0], ap) < len2) {
+    if (apex - a0 < need || dist2_once(rp[a0], ap) < len2) {
         a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
-    if (b1 - apex < need || dist2(rp[b1], ap) < len2) {
+    if (b1 - apex < need || dist2_once(rp[b1], ap) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A wall seen at grazing incidence has a return every half metre or
@@ -1006,7 +1327,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2(rp[a0], ap) < len2 || dist2(rp[b1], ap) < len2) {
+    if (dist2_once(rp[a0], ap) < len2 || dist2_once(rp[b1], ap) < len2) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
@@ -1019,115 +1340,99 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     if (!(fabsf(cross) >= c->sin_min_turn)) {
         return LC_MERGE;
     }
-    t = ((lb.mx - la.mx) * lb.dy - (lb.my - la.my) * lb.dx) / cross;
-    xx = la.mx + t * la.dx;
-    xy = la.my + t * la.dy;
-    x.x = xx;
-    x.y = xy;
-    spacing = sqrtf(dist2(rp[apex - 1u], ap));
+    /* the sides' fits must meet within twice the local beam spacing plus
+     * apex_slack of the apex */
+    spacing = dist2_once(rp[apex - 1u], ap);
     {
-        const float s2 = sqrtf(dist2(rp[apex + 1u], ap));
-        spacing = s2 > spacing ? s2 : spacing;
+        const float s2 = dist2_once(rp[apex + 1u], ap);
+        spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
-    if (!(xx * xx + xy * xy <=
-          (2.0f * spacing + p->apex_slack) * (2.0f * spacing + p->apex_slack))) {
-        return LC_MERGE;
+    reach = 2.0f * spacing + p->apex_slack;
+    /* A crease first: where a side is round, the lines' intersection lies
+     * off the vertex even when two lines pass (a 5 m arc against a wall at
+     * 1 cm noise: 4 cm along the wall). */
+    v = judge_crease(c, a0, apex, b1, &la, &lb, reach, LC_MERGE, &x, &score);
+    if (v != LC_CORNER) {
+        v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, &x, &score);
     }
-    /* One smooth curve over both sides: the better of a line and a circle. */
-    /* (the left side's sums are the first part of the whole's) */
-    if (!fit_line_from(c, a0, b1, apex, la.sx, la.sy, &lu)) {
-        return LC_MERGE;
+    if (v == LC_CORNER) {
+        corner_keypoint(c, a0, apex, b1, x, &la, &lb, score, kp);
     }
-    rss_lines = la.rss + lb.rss;
-    corner_test_init(c, rss_lines, b1 - a0 + 1u, &test);
-    /* The curve's residual is at most the line's: when the line already
-     * fails the test, so does the curve, and no circle is fitted. */
-    if (!(lu.rss > test.bound)) {
-        return LC_MERGE;
-    }
-    /* Below the ratio route's bound only the evidence route can pass. */
-    evidence_checked = !(lu.rss > test.ratio_bound);
-    if (evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) {
-        return LC_MERGE;
-    }
-    extent = sqrtf(dist2(rp[a0], rp[b1]));
-    rss_curve = lu.rss;
-    enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
-    enough.ratio = 1.0f;
-    enough.floor_rss = 0.0f;
-    enough.target = lu.rss; /* from there on, the line is the better curve */
-    rss_circle = circle_rss(c, a0, b1, lu.mx, lu.my, extent, &enough, 0u);
-    if (rss_circle >= 0.0f && rss_circle < rss_curve) {
-        rss_curve = rss_circle;
-    }
-    if (!(rss_curve > test.bound)) {
-        return no_corner(&test, rss_curve);
-    }
-    if (!(rss_curve > test.ratio_bound) &&
-        ((!evidence_checked && !evidence_possible(c, &test, a0, b1, &la, &lb, &lu)) ||
-         !evidence_holds(c, &test, a0, apex, b1, &la, &lb, &lu, rss_curve))) {
-        return no_corner(&test, rss_curve);
-    }
-    /* Each side must be straight: a circle may not explain it much better
-     * than its line (a crease between two curved walls is no wall corner,
-     * and its line intersection would lie off the crease). Last, as the
-     * dearest test. */
-    if (!side_straight(c, a0, apex - 1u, &la) || !side_straight(c, apex + 1u, b1, &lb)) {
-        return no_corner(&test, rss_curve);
-    }
-    /* The vertex beam: the point nearest the intersection, near the split. */
-    best = apex;
-    best_d = dist2(ap, x);
-    for (i = apex - 2u; i <= apex + 2u; ++i) {
-        if (i > a0 && i < b1) {
-            const float d = dist2(rp[i], x);
-            if (d < best_d) {
-                best_d = d;
-                best = i;
-            }
-        }
-    }
-    kp->index = c->run[best];
-    kp->point.x = xx + c->o.x;
-    kp->point.y = xy + c->o.y;
-    kp->orientation = bsf_atan2f(la.my + lb.my - 2.0f * xy, la.mx + lb.mx - 2.0f * xx);
-    {
-        const float ra = sqrtf(dist2(rp[a0], ap));
-        const float rb = sqrtf(dist2(rp[b1], ap));
-        kp->radius = ra > rb ? ra : rb;
-    }
-    kp->score = rss_lines > 0.0f ? rss_curve / rss_lines : 1e30f;
-    return LC_CORNER;
+    return v;
 }
 
-/* Noise normal to the surface, from each point's distance to the chord of
- * its two neighbours. */
-static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m)
+/* Noise of a run, from each point's distance to the chord of its two
+ * neighbours. Where the beams are denser than the noise (fine beams, near
+ * walls), the neighbours' chord points anywhere and a point's distance to
+ * it says little (at 0.11 deg beams and 1 cm range noise it gave about
+ * half that): there the direction comes from the chord of the points k
+ * positions either side, k beams spanning at least LC_NOISE_BASE at the
+ * point's range, the point is measured across it from its neighbours'
+ * midpoint, and only every k-th point is measured (the estimate needs no
+ * more, and dense runs cost less than before). Returns the noise normal to
+ * the surface, averaged over the run; *along_ray gets the noise along the
+ * rays from the points measured with k > 1 and seen within 80 deg of the
+ * normal (0 when there are none): their distances over the cosines of
+ * their incidence, so a wall seen obliquely, whose noise runs mostly along
+ * it, does not lower it. */
+static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m, float *along_ray)
 {
+    const float step_angle = fabsf(pts->angle_increment);
     float sum = 0.0f;
+    float dense_sum = 0.0f; /* distances of the points measured with k > 1 */
+    float dense_cos = 0.0f; /* and the cosines of their incidence */
     size_t n = 0;
     size_t i;
-    bsf_point_t a;
-    bsf_point_t q;
+    size_t k = 1;
+    *along_ray = 0.0f;
     if (m < 3u) {
         return 0.0f;
     }
-    a = pts->pt[run[0]];
-    q = pts->pt[run[1]];
-    for (i = 1; i + 1u < m; ++i) {
-        const bsf_point_t b = pts->pt[run[i + 1u]];
-        const float ex = b.x - a.x;
-        const float ey = b.y - a.y;
-        const float len = sqrtf(ex * ex + ey * ey);
+    for (i = 1; i + 1u < m; i += k) {
+        const float r = pts->range[run[i]];
+        const float spacing = r * step_angle; /* beam spacing across the ray */
+        const bsf_point_t q = pts->pt[run[i]];
+        bsf_point_t a;
+        bsf_point_t b;
+        float ex;
+        float ey;
+        float len;
+        k = 1u;
+        if (spacing < LC_NOISE_BASE) {
+            const float want = LC_NOISE_BASE / spacing; /* > 1; inf when spacing is 0 */
+            k = want < (float)m ? (size_t)want + 1u : m;
+        }
+        /* the chord's ends (the neighbours when k is 1) */
+        a = pts->pt[run[i > k ? i - k : 0u]];
+        b = pts->pt[run[i + k < m ? i + k : m - 1u]];
+        ex = b.x - a.x;
+        ey = b.y - a.y;
+        if (k > 1u) {
+            /* the point against its neighbours' midpoint, across the chord */
+            const bsf_point_t na = pts->pt[run[i - 1u]];
+            const bsf_point_t nb = pts->pt[run[i + 1u]];
+            a.x = 0.5f * (na.x + nb.x);
+            a.y = 0.5f * (na.y + nb.y);
+        }
+        len = sqrtf(ex * ex + ey * ey);
         if (len > 0.0f) {
             const float d = fabsf(ex * (q.y - a.y) - ey * (q.x - a.x)) / len;
             if (d <= LC_NOISE_CLIP) {
                 sum += d;
                 ++n;
+                if (k > 1u) {
+                    /* cosine of the incidence: sine of the chord's angle to the ray */
+                    const float cos_inc = fabsf(ex * q.y - ey * q.x) / (len * r);
+                    if (cos_inc >= BSF_GRAZING_MIN_SIN) {
+                        dense_sum += d;
+                        dense_cos += cos_inc;
+                    }
+                }
             }
         }
-        a = q; /* the window moves by one point */
-        q = b;
+    }
+    if (dense_cos > 0.0f) {
+        *along_ray = dense_sum / (dense_cos * LC_NOISE_MEAN_ABS);
     }
     return n > 0u ? sum / ((float)n * LC_NOISE_MEAN_ABS) : 0.0f;
 }
@@ -1195,12 +1500,21 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
     return nb;
 }
 
+/* Position of beam b on the pass, which starts at beam start (0, or past the
+ * seam's cut on a full-circle scan of count beams). */
+static size_t pass_pos(size_t b, size_t start, size_t count)
+{
+    return b >= start ? b - start : b + count - start;
+}
+
 /* Two keypoints of one run on one corner: beams closer than the points a
  * side needs, or intersections within apex_slack of each other. */
-static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf_lc_params_t *p)
+static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const lc_ctx_t *c)
 {
-    return (size_t)a->index + p->min_side_points >= (size_t)b->index ||
-           dist2(a->point, b->point) <= p->apex_slack * p->apex_slack;
+    const size_t count = c->pts->count;
+    return pass_pos(a->index, c->start, count) + c->p->min_side_points >=
+               pass_pos(b->index, c->start, count) ||
+           dist2(a->point, b->point) <= c->p->apex_slack * c->p->apex_slack;
 }
 
 /* Append kp, or merge it into the previous keypoint of the same run (from
@@ -1208,9 +1522,9 @@ static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const bsf
  * mirrors the previous keypoint even when out is full, so the count does not
  * depend on out_cap. */
 static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, bsf_keypoint_t *last,
-                 const bsf_keypoint_t *kp, const bsf_lc_params_t *p)
+                 const bsf_keypoint_t *kp, const lc_ctx_t *c)
 {
-    if (*n > first && too_close(last, kp, p)) {
+    if (*n > first && too_close(last, kp, c)) {
         if (kp->score > last->score) {
             *last = *kp;
             if (*n - 1u < out_cap) {
@@ -1232,8 +1546,14 @@ static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, b
 static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *out, size_t out_cap,
                        size_t *n_found)
 {
-    const float sigma = run_noise(c->pts, w->run, m);
-    float tol = c->p->split_sigmas * sigma;
+    float along_ray;
+    const float sigma = run_noise(c->pts, w->run, m, &along_ray);
+    /* Where the beams are dense, a wall that faces the sensor has many
+     * points whose noise across it is the whole range noise, above the
+     * run's average across its surfaces (lowered by the walls seen
+     * obliquely): split at that average, noise alone would cut such a wall
+     * every few points, near a corner into pieces too short to judge it. */
+    float tol = c->p->split_sigmas * (along_ray > sigma ? along_ray : sigma);
     size_t nb;
     size_t j;
     unsigned pass;
@@ -1244,7 +1564,8 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     if (tol < c->p->split_min) {
         tol = c->p->split_min;
     }
-    c->noise2 = sigma * sigma;
+    c->noise2 =
+        sigma * sigma > c->p->floor * c->p->floor ? sigma * sigma : c->p->floor * c->p->floor;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
@@ -1317,7 +1638,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                     continue; /* cannot happen: same judgement as in the pass */
                 }
             }
-            keep(out, out_cap, n_found, first, &last, &kp, c->p);
+            keep(out, out_cap, n_found, first, &last, &kp, c);
         }
         return;
     }
@@ -1325,7 +1646,7 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
         if (judge(c, lo, w->brk[j], hi, m, &kp) == LC_CORNER) {
-            keep(out, out_cap, n_found, first, &last, &kp, c->p);
+            keep(out, out_cap, n_found, first, &last, &kp, c);
         }
     }
 }
@@ -1393,6 +1714,56 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
     return i;
 }
 
+/* Point b continues the run that ends at point a: within the jump radius,
+ * or (join_grazing) the next beam on one wall seen at grazing incidence
+ * (never through the seam of a full-circle scan). */
+static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+{
+    return within_jump(pts, p, a, b) ||
+           (p->join_grazing && a + 1u == b && bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP));
+}
+
+/* Where the pass over a full-circle scan starts: the first valid beam (from
+ * 0) that does not continue the run of the valid beam before it on the ring,
+ * so that no run is cut at the seam; 0 when every step joins (one closed
+ * surface all round: the seam then cuts it, as on a scan that is no ring). */
+static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
+{
+    size_t prev = pts->count;
+    size_t i;
+    for (i = pts->count; i > 0u; --i) {
+        if (pts->valid[i - 1u]) {
+            prev = i - 1u;
+            break;
+        }
+    }
+    if (prev == pts->count) {
+        return 0u;
+    }
+    for (i = 0; i < pts->count; ++i) {
+        if (!pts->valid[i]) {
+            continue;
+        }
+        if (i != prev && !lc_joins(pts, p, prev, i) && past_occluder(pts, p, prev, i) == i) {
+            return i;
+        }
+        prev = i;
+    }
+    return 0u;
+}
+
+/* Reverse out[lo, hi). */
+static void reverse_keypoints(bsf_keypoint_t *out, size_t lo, size_t hi)
+{
+    while (hi > lo + 1u) {
+        const bsf_keypoint_t t = out[lo];
+        out[lo] = out[hi - 1u];
+        out[hi - 1u] = t;
+        ++lo;
+        --hi;
+    }
+}
+
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
 {
@@ -1401,6 +1772,8 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     size_t n_found = 0;
     size_t m = 0;
     size_t i;
+    size_t step;
+    size_t start;
     if (n_out != NULL) {
         *n_out = 0u;
     }
@@ -1424,19 +1797,20 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.sin_min_turn = bsf_sinf(p->min_turn);
     c.noise2 = 0.0f;
     blocks_detach(&c);
-    for (i = 0; i <= pts->count; ++i) {
-        int close_run = i == pts->count;
+    start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
+    c.start = start;
+    for (step = 0; step <= pts->count; ++step) {
+        int close_run = step == pts->count;
+        i = close_run ? 0u : (start + step < pts->count ? start + step : start + step - pts->count);
         if (!close_run && !pts->valid[i]) {
             continue;
         }
         if (!close_run && m > 0u) {
-            close_run = !within_jump(pts, p, work->run[m - 1u], i) &&
-                        !(p->join_grazing && work->run[m - 1u] + 1u == i &&
-                          bsf_grazing_join(pts, i - 1u, BSF_GRAZING_LC_CAP));
+            close_run = !lc_joins(pts, p, work->run[m - 1u], i);
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
-                if (j > i) {
-                    i = j - 1u; /* the run resumes at j */
+                if (j > i && step + (j - i) < pts->count) {
+                    step += j - i - 1u; /* the run resumes at j */
                     continue;
                 }
             }
@@ -1447,9 +1821,21 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             }
             m = 0;
         }
-        if (i < pts->count) {
+        if (step < pts->count) {
             work->run[m++] = (uint16_t)i;
         }
+    }
+    if (start > 0u) {
+        /* Found from the pass's start on: the corners before beam start
+         * (those past the seam) go first, so out stays in beam order. */
+        const size_t n_kept = n_found < out_cap ? n_found : out_cap;
+        size_t n_after = 0u;
+        while (n_after < n_kept && out[n_after].index >= start) {
+            ++n_after;
+        }
+        reverse_keypoints(out, 0u, n_after);
+        reverse_keypoints(out, n_after, n_kept);
+        reverse_keypoints(out, 0u, n_kept);
     }
     *n_out = n_found;
     return n_found > out_cap ? BSF_ERR_CAPACITY : BSF_OK;

@@ -34,7 +34,7 @@ bsf_sved_params_t bsf_sved_params_default(void)
     p.max_gap_beams = 16u;
     p.radius_max = 1.0f;
     p.reject_mixed = 1u;
-    p.join_grazing = 0u;
+    p.join_grazing = 1u;
     return p;
 }
 
@@ -276,14 +276,257 @@ static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, f
     return 1;
 }
 
+/* Beam i + k (any sign) into *j, wrapping on a ring; 0 when that beam is
+ * outside the scan or invalid. */
+static int neighbour_beam(const bsf_points_t *pts, size_t i, long k, int ring, size_t *j)
+{
+    const long n = (long)pts->count;
+    long m = (long)i + k;
+    if (m < 0 || m >= n) {
+        if (!ring || k <= -n || k >= n) {
+            return 0;
+        }
+        m = m < 0 ? m + n : m - n;
+    }
+    if (!pts->valid[(size_t)m]) {
+        return 0;
+    }
+    *j = (size_t)m;
+    return 1;
+}
+
+/* The "on neither surface" route of the mixed-pixel rule looks at up to
+ * SEG_MIXED_WINDOW returns on each side of a beam, consecutive ones within
+ * the segmentation radius of each other (one surface). It fits a line to
+ * all of them but the nearest, so that the nearest can show whether the
+ * surface reaches the beam unbroken; a side of fewer than SEG_MIXED_MIN_SIDE
+ * such returns is too short to judge. */
+#define SEG_MIXED_WINDOW 10
+#define SEG_MIXED_MIN_SIDE 8
+
+/* Squared noise floor of that route (3 mm: ranges quantised to a centimetre
+ * scatter by about this much), so noise-free ranges do not make every
+ * rounding error a mixed pixel. */
+#define SEG_MIXED_FLOOR2 (0.003f * 0.003f)
+
+/* How far off a side's line a return lies, in standard deviations of its
+ * distance from that line extrapolated past the returns it was fitted to.
+ * 4 leaves a real end return on its line but for a chance of about one in
+ * 15 000 (more when a side's own scatter underestimates the noise). */
+#define SEG_MIXED_SIGMAS2 16.0f
+
+/* A return is no mixed pixel when the nearest return of the run it lies
+ * off is off that run's line too, on the same side, by more than 1 /
+ * SEG_MIXED_TURN of its own offset: the run may turn there (a short surface
+ * of two or three returns between two walls, its first return too near the
+ * turn to show it). A mixed pixel's neighbour scatters about the line. */
+#define SEG_MIXED_TURN 4.0f
+
+/* A side's line through the returns beside beam i, the nearest left out. */
+typedef struct {
+    float cx, cy;   /* centroid */
+    float nx, ny;   /* unit normal */
+    float var;      /* noise variance estimated from its residual */
+    float reach_i;  /* variance of beam i's distance from it, in noise variances */
+    float d_near;   /* signed distance of the nearest return from it */
+    float reach_nr; /* the same variance for the nearest return */
+    int n;          /* returns, the nearest included */
+} side_line_t;
+
+/* Signed distance of p from line l. */
+static float side_distance(const side_line_t *l, bsf_point_t p)
+{
+    return l->nx * (p.x - l->cx) + l->ny * (p.y - l->cy);
+}
+
+/* The total least-squares line through the returns on side dir (-1: the
+ * beams before i, +1: after) of beam i, all but the nearest; only l->n is
+ * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
+static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
+                      side_line_t *l)
+{
+    bsf_point_t w[SEG_MIXED_WINDOW];
+    float sxx = 0.0f;
+    float sxy = 0.0f;
+    float syy = 0.0f;
+    float half_diff;
+    float lam;
+    float m;
+    float spread;
+    int k;
+    l->n = 0;
+    l->cx = 0.0f;
+    l->cy = 0.0f;
+    l->nx = 0.0f;
+    l->ny = 1.0f;
+    l->var = 0.0f;
+    l->reach_i = 1.0f;
+    l->reach_nr = 1.0f;
+    l->d_near = 0.0f;
+    const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
+    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
+        size_t j;
+        if (inside) {
+            /* most beams: no wrap, only validity */
+            j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
+            if (!pts->valid[j]) {
+                break;
+            }
+        } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+            break;
+        }
+        /* beam i's radius for every step (worked out once per beam) */
+        if (l->n > 0) {
+            const float dx = pts->pt[j].x - w[l->n - 1].x;
+            const float dy = pts->pt[j].y - w[l->n - 1].y;
+            if (!beam_within(rad, dx * dx + dy * dy)) {
+                break; /* a depth jump: the surface ends */
+            }
+        }
+        w[l->n] = pts->pt[j];
+        if (l->n > 0) {
+            l->cx += w[l->n].x;
+            l->cy += w[l->n].y;
+        }
+        l->n++;
+    }
+    if (l->n < SEG_MIXED_MIN_SIDE) {
+        return; /* too short to judge (side_judged): no line needed */
+    }
+    m = (float)(l->n - 1);
+    l->cx /= m;
+    l->cy /= m;
+    for (k = 1; k < l->n; ++k) {
+        const float dx = w[k].x - l->cx;
+        const float dy = w[k].y - l->cy;
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    /* Smallest eigenvalue of the scatter matrix (the squared residual of the
+     * best line) and its eigenvector (the line's normal). */
+    half_diff = 0.5f * (sxx - syy);
+    lam = 0.5f * (sxx + syy) - sqrtf(half_diff * half_diff + sxy * sxy);
+    if (lam < 0.0f) {
+        lam = 0.0f;
+    }
+    if (half_diff >= 0.0f) {
+        l->nx = sxy; /* x spreads more: the normal is mostly along y */
+        l->ny = lam - sxx;
+    } else {
+        l->nx = lam - syy;
+        l->ny = sxy;
+    }
+    {
+        const float len2 = l->nx * l->nx + l->ny * l->ny;
+        if (!(len2 > 0.0f)) {
+            /* an axis-aligned line: the normal is the axis of less spread */
+            l->nx = half_diff >= 0.0f ? 0.0f : 1.0f;
+            l->ny = half_diff >= 0.0f ? 1.0f : 0.0f;
+        } else {
+            const float inv = 1.0f / sqrtf(len2);
+            l->nx *= inv;
+            l->ny *= inv;
+        }
+    }
+    l->var = lam / (m - 2.0f);
+    /* Fitted returns at beam steps 2..n from beam i: a return's own noise,
+     * the line's at its centroid and its slope's over the distance in steps
+     * from the centroid (step (n + 2) / 2), spread = sum of squared steps. */
+    spread = m * (m * m - 1.0f) / 12.0f;
+    {
+        const float t_i = 0.5f * (m + 3.0f);
+        const float t_nr = t_i - 1.0f;
+        l->reach_i = 1.0f + 1.0f / m + t_i * t_i / spread;
+        l->reach_nr = 1.0f + 1.0f / m + t_nr * t_nr / spread;
+    }
+    l->d_near = side_distance(l, w[0]);
+}
+
+/* Beam i lies off side line l by more than the noise explains (variance
+ * var), towards the sensor when toward_sensor, else away from it. */
+static int off_side_line(const bsf_points_t *pts, size_t i, const side_line_t *l, float var,
+                         int toward_sensor)
+{
+    const float d = side_distance(l, pts->pt[i]);
+    float d_sensor;
+    if (!(d * d > SEG_MIXED_SIGMAS2 * l->reach_i * var)) {
+        return 0;
+    }
+    d_sensor = -(l->nx * l->cx + l->ny * l->cy); /* the sensor's side of the line */
+    return toward_sensor ? (d > 0.0f) == (d_sensor > 0.0f) : (d > 0.0f) != (d_sensor > 0.0f);
+}
+
+/* The side's surface reaches the beam next to i unbroken: enough returns,
+ * the nearest on the line of the others. */
+static int side_judged(const side_line_t *l, float var)
+{
+    return l->n >= SEG_MIXED_MIN_SIDE &&
+           l->d_near * l->d_near <= SEG_MIXED_SIGMAS2 * l->reach_nr * var;
+}
+
+/* Beam i, strictly between its neighbours in range at a depth jump, lies on
+ * neither surface. The surface nearer to it in range (the one it would join)
+ * must be a long straight run reaching beam i's neighbour unbroken, and beam
+ * i must lie off its line towards the other surface, not as the second step
+ * of a run turning away at that neighbour (the neighbour off the line too,
+ * on the same side, by a quarter of beam i's offset: a short surface between
+ * two walls). The other surface may be anything (a pillar, a small object):
+ * beam i lies beyond the radius of its nearest return and does not go on
+ * along a line through its next two (a wall seen at grazing incidence).
+ * near_before: the surface before beam i is the nearer in range;
+ * before_is_farther: it is farther from the sensor. */
+static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
+                              int near_before, int before_is_farther)
+{
+    side_line_t near;
+    float var;
+    float d;
+    size_t o[3] = {0u, 0u, 0u};
+    int k;
+    const int near_dir = near_before ? -1 : 1;
+    /* the near run lies farther from the sensor than beam i exactly when
+     * it is the before run and that is the farther one, or neither */
+    const int near_is_farther = near_before == before_is_farther;
+    side_line(pts, i, near_dir, ring, rad, &near);
+    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
+        return 0;
+    }
+    d = side_distance(&near, pts->pt[i]);
+    if ((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d)) {
+        return 0;
+    }
+    for (k = 0; k < 3; ++k) {
+        if (!neighbour_beam(pts, i, (long)(-near_dir) * (long)(k + 1), ring, &o[k])) {
+            break;
+        }
+    }
+    if (k == 0) {
+        return 0;
+    }
+    {
+        const float dx = pts->pt[o[0]].x - pts->pt[i].x;
+        const float dy = pts->pt[o[0]].y - pts->pt[i].y;
+        if (beam_within(rad, dx * dx + dy * dy)) {
+            return 0;
+        }
+    }
+    return !(k == 3 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
+             bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]]));
+}
+
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
 {
-    float r[5];
+    /* zeroed: r[0] and r[4] are read only when have_outer says they were
+     * set, which some compilers cannot see */
+    float r[5] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     float lo;
     float hi;
     float jump;
+    int have_outer;
     int k;
     if (i >= 2u && i + 2u < pts->count) {
         /* Inside the scan (most beams): the cheap tests first. */
@@ -297,13 +540,14 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         r[3] = rg[3];
         lo = r[1] < r[3] ? r[1] : r[3];
         hi = r[1] < r[3] ? r[3] : r[1];
-        if (!(r[2] > lo && r[2] < hi) || !((v[0] != 0u) & (v[4] != 0u))) {
+        if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
+        have_outer = (v[0] != 0u) & (v[4] != 0u);
         r[0] = rg[0];
         r[4] = rg[4];
     } else {
-        for (k = -2; k <= 2; ++k) {
+        for (k = -1; k <= 1; ++k) {
             if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
                 return 0;
             }
@@ -313,13 +557,27 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         if (!(r[2] > lo && r[2] < hi)) {
             return 0;
         }
+        have_outer =
+            neighbour_range(pts, i, -2, ring, &r[0]) && neighbour_range(pts, i, 2, ring, &r[4]);
     }
     jump = hi - lo;
     if (beam_within(rad, jump * jump)) {
         return 0;
     }
-    return fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
-           r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump;
+    if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
+        r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
+        return 1;
+    }
+    /* Near one surface in range: a mixed pixel only when it lies on neither.
+     * Both runs must go on past beam i's neighbours (steps within the
+     * radius): a wall seen at grazing incidence, whose steps are wider, is no
+     * run to judge, and is most of what reaches this point. */
+    if (!have_outer || !beam_within(rad, (r[1] - r[0]) * (r[1] - r[0])) ||
+        !beam_within(rad, (r[4] - r[3]) * (r[4] - r[3]))) {
+        return 0;
+    }
+    return on_neither_surface(pts, i, ring, rad, r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi,
+                              r[1] > r[2]);
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */

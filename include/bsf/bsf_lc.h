@@ -9,7 +9,15 @@
  *  1. split the run where a point lies farther than a tolerance from the chord
  *     of its piece (Douglas-Peucker without recursion); the tolerance is
  *     split_sigmas times the run's noise, estimated from how far each point
- *     lies from the chord of its two neighbours, and at least split_min;
+ *     lies from the chord of its two neighbours, and at least split_min.
+ *     Where the beams are denser than 5 cm at the point's range, the
+ *     chord's direction comes from the points 5 cm of beams either side
+ *     (the neighbours' chord would point anywhere at centimetre noise), and
+ *     the tolerance is split_sigmas times the noise along the rays there
+ *     when that is larger: a wall facing the sensor has many points with
+ *     the whole range noise across it, which the run's average across its
+ *     surfaces (lowered by walls seen obliquely) would split every few
+ *     points;
  *  2. judge every split point with the two pieces beside it (each cut to
  *     max_side metres from the apex): fit a total-least-squares line to each
  *     side (the apex left out) and keep the split as a corner only when
@@ -46,8 +54,28 @@
  *     its neighbours' sides, so a side never reaches across a shallow corner
  *     the tests could not confirm into the next wall (where its line's
  *     residual would grow and cost that neighbour its corner too);
+ *     once the lines turn by min_turn, and before their other tests, a split
+ *     where a side's line does not explain its points within the noise
+ *     (2 (n - 2) + 6.25 noise variances) is judged as a crease, where a
+ *     curved wall meets a wall or another curved wall: each side is its
+ *     line, or its circle when that cuts the line's residual by 25 noise
+ *     variances, has at least 10 points, spans at most 60 deg and fits
+ *     within the noise itself; the split is a corner when the best circle
+ *     over both sides leaves curve_ratio times the two pieces' squared
+ *     residual (counted at no less than the noise) plus the floor, no depth
+ *     jump lies in the window, and the pieces cross near the apex (as near
+ *     as the lines must) at min_turn or more. The circles of one pillar, or
+ *     of a wall of varying curvature, touch rather than cross, so these get
+ *     no corner. Where a side is round, the two lines' intersection would
+ *     lie off the crease even when they pass;
  *  3. report each corner at its apex beam, with the intersection of the two
- *     lines as its position (PDM starts the vertex there and keeps it there).
+ *     lines (of the crease's pieces) as its position (PDM starts the vertex
+ *     there and keeps it there).
+ * On a full-circle scan (bsf_points_full_circle) the pass starts at the first
+ * beam where a run breaks anyway, so a run goes on through the seam between
+ * the last and the first beam and a corner straight behind the sensor is
+ * judged as one ahead is (a closed surface all round, with no break, is cut
+ * at the seam).
  * Thresholds are absolute or relative to the estimated noise; none depends
  * on the other corners of the scan. Cost is linear in beams per split level.
  */
@@ -80,11 +108,11 @@ typedef struct {
     uint8_t join_grazing;     /**< 1: a run goes on across a step wider than the jump radius
                                    (at most max_side) where four consecutive returns through it
                                    lie on one line, a wall seen at grazing incidence, or where
-                                   such a wall starts at a corner; 0 (default): it does not */
+                                   such a wall starts at a corner (default); 0: it does not */
     uint8_t corner_evidence;  /**< 1: a split the curve_ratio test rejects is still a corner
                                    when the best smooth curve misses the points by far more
                                    than the noise explains (a likelihood-ratio test, see
-                                   above); 0 (default): curve_ratio alone */
+                                   above; default); 0: curve_ratio alone */
 } bsf_lc_params_t;
 
 /** The defaults listed beside each field of bsf_lc_params_t. */
@@ -131,11 +159,13 @@ typedef struct {
  * Detect corners. Keypoints come out ascending by beam index, with point =
  * the two-line intersection (sensor frame), orientation = the direction of
  * the corner's bisector (radians), radius = the longer side used (metres) and
- * score = the curve-to-lines residual ratio (higher = sharper evidence).
+ * score = the curve-to-lines residual ratio (curve to pieces for a crease;
+ * higher = sharper evidence).
  * @return BSF_OK; BSF_ERR_ARG for NULL pointers (out may be NULL when out_cap
  *         is 0); BSF_ERR_PARAM for bad parameters; BSF_ERR_CAPACITY when
  *         pts->count > BSF_MAX_POINTS or more than out_cap corners were found
- *         (out holds the first out_cap, *n_out the total).
+ *         (out holds the first out_cap, counted from where the pass starts on a
+ *         full-circle scan, in beam order; *n_out the total).
  */
 BSF_NODISCARD bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p,
                                          bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,

@@ -56,8 +56,9 @@ typedef struct {
  *    joins no segment, so it cannot bend or bridge either surface.
  *  - join_grazing: a wall seen at grazing incidence returns one point every
  *    half metre or more at 7 m, farther apart than the radius, yet on a line
- *    to millimetres; such steps join the current segment (off by default:
- *    it finds more corners but lets curves stray farther, docs/GROUND_TRUTH.md).
+ *    to millimetres; such steps join the current segment (on by default, off
+ *    in the paper's rule: the corners of such walls are found,
+ *    docs/GROUND_TRUTH.md).
  */
 typedef struct {
     float a;                     /**< distance threshold at range 0, metres, finite, > 0 */
@@ -74,7 +75,7 @@ typedef struct {
                                than the radius (at most radius_max, used when radius_max > 0)
                                where four consecutive returns through the step lie on one line,
                                a wall seen at grazing incidence, or where such a wall starts at
-                               a corner; 0 (default and the paper): it does not */
+                               a corner (default); 0 (the paper): it does not */
 } bsf_sved_params_t;
 
 /** Largest lookback of bsf_sved_params_t. */
@@ -90,7 +91,7 @@ typedef struct {
 /**
  * SVED defaults (what the extractor uses unless told otherwise): the paper's
  * a = 0.2 m, b = 0.07 /m, min_segment_points = 5, plus lookback 4,
- * max_gap_beams 16, radius_max 1.0 m, reject_mixed 1 and join_grazing 0 (docs/TABLE1.md has
+ * max_gap_beams 16, radius_max 1.0 m, reject_mixed 1 and join_grazing 1 (docs/TABLE1.md has
  * the measurements behind each value).
  */
 bsf_sved_params_t bsf_sved_params_default(void);
@@ -154,10 +155,28 @@ BSF_NODISCARD bsf_status_t bsf_segment_sved(const bsf_points_t *pts,
  *
  * Mixed pixel: valid beam i whose neighbours i-2..i+2 are valid, whose range
  * lies strictly between those of beams i-1 and i+1, which jump by
- * J = |rho(i+1) - rho(i-1)| > the radius at rho(i), while the range steps
- * i-2 -> i-1 and i+1 -> i+2 are both below J / 4 (two flat surfaces on
- * either side, unlike a wall seen at a grazing angle whose steps grow
- * smoothly), and which is more than J / 8 from both neighbours in range.
+ * J = |rho(i+1) - rho(i-1)| > the radius at rho(i), and either
+ *  - the range steps i-2 -> i-1 and i+1 -> i+2 are both below J / 4 (two
+ *    flat surfaces on either side, unlike a wall seen at a grazing angle
+ *    whose steps grow smoothly), and beam i is more than J / 8 from both
+ *    neighbours in range; or
+ *  - it lies on neither surface, however near one of them in range: the
+ *    range steps i-2 -> i-1 and i+1 -> i+2 are both within the radius at
+ *    rho(i) (a run goes on each side; a wall seen at grazing incidence has
+ *    wider steps); on the side nearer to beam i in range, at least 8
+ *    consecutive returns (up to 10) step within that radius, the nearest
+ *    lies on the total least-squares line of the others, and beam i lies
+ *    off that line, towards the other surface, by more than 4 standard
+ *    deviations of its extrapolated distance (the noise taken from the
+ *    line's residual, at least 3 mm), while the nearest return does not lie
+ *    off it on the same side by a quarter of that (the run turning there);
+ *    and beam i lies beyond the radius from its neighbour on the other side
+ *    and does not go on along a line through that neighbour and the next
+ *    two. A return at a surface's real end lies on that surface's line and
+ *    stays; so does a return beside a run too short or bent to judge (a
+ *    small object, a corner next to beam i). A single return of a third
+ *    surface beyond a corner, between the two in range and off both, looks
+ *    the same as a mixed pixel and goes too.
  *
  * Full-circle scans (bsf_points_full_circle): the pass starts after the
  * widest step between cyclically consecutive valid points, so a surface

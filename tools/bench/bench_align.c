@@ -439,39 +439,7 @@ static int to_receiver(const uint8_t *buf, size_t len)
  * (as bench_map measures the final map). */
 static long final_map_bytes(const bsf_pose_t *last)
 {
-    const size_t n = bsf_map_feature_count(&g_map);
-    uint32_t bytes0, max_id = 0, last_next = 0u;
-    size_t i;
-    int guard = 0;
-    if (n == 0u) {
-        return 0;
-    }
-    for (i = 0; i < n; ++i) {
-        uint32_t id = 0;
-        if (bsf_map_feature_q(&g_map, i, NULL, NULL, 0u, &id) >= 0 && id > max_id) {
-            max_id = id;
-        }
-    }
-    memcpy(&g_map_copy, &g_map, sizeof g_map);
-    g_map_copy.params.snapshot_budget = SNAP_BUDGET;
-    g_map_copy.snapshot_next = 0u;
-    g_map_copy.snapshot_pos = 0u;
-    g_map_copy.params.frame_interval = 1u;
-    bytes0 = g_map_copy.stats.record_bytes[4];
-    memset(&g_empty, 0, sizeof g_empty);
-    while (guard++ < 100000) {
-        size_t len = 0;
-        if (bsf_map_fuse(&g_map_copy, &g_empty, last) < 0 ||
-            bsf_map_encode(&g_map_copy, NULL, g_buf, sizeof g_buf, &len) != BSF_OK || len == 0u) {
-            return -1;
-        }
-        if ((g_map_copy.snapshot_pos == 0u && g_map_copy.snapshot_next > max_id) ||
-            g_map_copy.snapshot_next < last_next) {
-            break;
-        }
-        last_next = g_map_copy.snapshot_next;
-    }
-    return (long)(g_map_copy.stats.record_bytes[4] - bytes0);
+    return mg_map_once_bytes(&g_map_copy, &g_map, last, SNAP_BUDGET);
 }
 
 /* Curve length of the receiver's final map. */

@@ -113,7 +113,6 @@ typedef struct {
 static bsf_extractor_t g_ex;
 static bsf_map_t g_map;
 static bsf_map_t g_map_copy;
-static bsf_result_t g_empty;   /* a scan without features */
 static bsf_pose_t g_last_pose; /* the pose of the last scan fused */
 static long g_pose_every = 1;  /* --pose-every */
 static unsigned long g_fused;  /* scans fused in the current column */
@@ -401,70 +400,15 @@ static int fuse_scan(column_t *col, double px, double py, double pth)
  * Features the robot forgot are not in it: the table scales the bytes by
  * the receiver's control points over the robot's. */
 #define SNAP_BUDGET 128u
-#define SNAP_WARMUP 8
-#define SNAP_STATES 8192
 static int map_once_bytes(column_t *col)
 {
-    /* after the robot's pending changes are out, the snapshot round robin of
-     * a map that no longer changes is periodic in its state (next id, next
-     * point), recorded after each frame until one repeats. Within a round
-     * the state only grows (ids, then points); a state not above the one
-     * before means the round wrapped in that frame. One period holds as many
-     * whole rounds as it wraps, every feature once per round (a map smaller
-     * than one frame's budget, sent more than once per frame, reads high). */
-    static uint32_t st_next[SNAP_STATES], st_bytes[SNAP_STATES];
-    static uint16_t st_pos[SNAP_STATES], st_wraps[SNAP_STATES];
-    size_t n_st = 0;
-    unsigned wraps = 0;
-    int guard = 0;
-    if (bsf_map_feature_count(&g_map) == 0u) {
-        return 0;
+    const long b = mg_map_once_bytes(&g_map_copy, &g_map, &g_last_pose, SNAP_BUDGET);
+    if (b < 0) {
+        return -1;
     }
-    memcpy(&g_map_copy, &g_map, sizeof g_map);
-    g_map_copy.params.snapshot_budget = SNAP_BUDGET;
-    g_map_copy.snapshot_next = 0u;
-    g_map_copy.snapshot_pos = 0u;
-    g_map_copy.params.frame_interval = 1u;
-    memset(&g_empty, 0, sizeof g_empty);
-    while (guard++ < 100000) {
-        size_t len = 0;
-        size_t k;
-        /* a scan without features lets the frame interval pass */
-        if (bsf_map_fuse(&g_map_copy, &g_empty, &g_last_pose) < 0 ||
-            bsf_map_encode(&g_map_copy, NULL, g_buf, BSF_MAP_FRAME_MAX_SIZE, &len) != BSF_OK ||
-            len == 0u) {
-            return -1;
-        }
-        if (guard < SNAP_WARMUP || bsf_map_pending(&g_map_copy)) {
-            continue;
-        }
-        if (n_st > 0u && (g_map_copy.snapshot_next < st_next[n_st - 1u] ||
-                          (g_map_copy.snapshot_next == st_next[n_st - 1u] &&
-                           g_map_copy.snapshot_pos <= st_pos[n_st - 1u]))) {
-            ++wraps;
-        }
-        for (k = 0; k < n_st; ++k) {
-            if (st_next[k] == g_map_copy.snapshot_next && st_pos[k] == g_map_copy.snapshot_pos) {
-                const unsigned rounds = wraps - st_wraps[k];
-                if (rounds == 0u) {
-                    return -1;
-                }
-                col->map_once_bytes =
-                    (size_t)(g_map_copy.stats.record_bytes[4] - st_bytes[k]) / rounds;
-                col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
-                return 0;
-            }
-        }
-        if (n_st == SNAP_STATES) {
-            return -1;
-        }
-        st_next[n_st] = g_map_copy.snapshot_next;
-        st_pos[n_st] = g_map_copy.snapshot_pos;
-        st_bytes[n_st] = g_map_copy.stats.record_bytes[4];
-        st_wraps[n_st] = (uint16_t)wraps;
-        ++n_st;
-    }
-    return -1;
+    col->map_once_bytes = (size_t)b;
+    col->map_once_missing = (unsigned long)g_map.stats.n_forgotten;
+    return 0;
 }
 
 /* The receiver's final map as curves; robot and receiver compared value for value. */

@@ -6,9 +6,10 @@
  *
  *   bench_truth                  full table (docs/GROUND_TRUTH.md)
  *   bench_truth --quick --check  small run that fails (exit 1) when a target is missed (ctest)
- *   options: --poses N, --paper (paper-faithful configuration), --grazing (SVED and
- *            LC join walls seen at grazing incidence), --evidence (LC's corner
- *            evidence test, bsf_lc_params_t.corner_evidence), --datasets DIR
+ *   options: --poses N, --paper (paper-faithful configuration), --grazing / --no-grazing
+ *            (SVED and LC join walls seen at grazing incidence; on by default),
+ *            --evidence / --no-evidence (LC's corner evidence test,
+ *            bsf_lc_params_t.corner_evidence; on by default), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
@@ -68,19 +69,22 @@ static int16_t hits[BSF_MAX_POINTS];
 static bsf_truth_acc_t acc;
 
 static int paper_mode = 0;
-static int grazing_mode = 0;  /* --grazing: join walls seen at grazing incidence */
-static int evidence_mode = 0; /* --evidence: LC's corner evidence test */
+/* 1 --grazing, 0 --no-grazing, -1 the default: SVED's and LC's joins of walls
+ * seen at grazing incidence */
+static int grazing_mode = -1;
+/* 1 --evidence, 0 --no-evidence, -1 the default: LC's corner evidence test */
+static int evidence_mode = -1;
 
 static bsf_params_t make_params(void)
 {
-    bsf_params_t p =
-        bsf_params_default(paper_mode ? BSF_METHOD_FALKO_SVED_PDM : BSF_METHOD_DEFAULT);
-    if (grazing_mode) {
-        p.sved.join_grazing = 1u;
-        p.lc.join_grazing = 1u;
+    bsf_params_t p = paper_mode ? bsf_params_paper(BSF_METHOD_FALKO_SVED_PDM)
+                                : bsf_params_default(BSF_METHOD_DEFAULT);
+    if (grazing_mode >= 0) {
+        p.sved.join_grazing = (uint8_t)grazing_mode;
+        p.lc.join_grazing = (uint8_t)grazing_mode;
     }
-    if (evidence_mode) {
-        p.lc.corner_evidence = 1u;
+    if (evidence_mode >= 0) {
+        p.lc.corner_evidence = (uint8_t)evidence_mode;
     }
     return p;
 }
@@ -404,8 +408,12 @@ int main(int argc, char **argv)
             paper_mode = 1;
         } else if (strcmp(argv[a], "--grazing") == 0) {
             grazing_mode = 1;
+        } else if (strcmp(argv[a], "--no-grazing") == 0) {
+            grazing_mode = 0;
         } else if (strcmp(argv[a], "--evidence") == 0) {
             evidence_mode = 1;
+        } else if (strcmp(argv[a], "--no-evidence") == 0) {
+            evidence_mode = 0;
         } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
             n_poses = strtol(argv[++a], NULL, 10);
         } else if (strcmp(argv[a], "--datasets") == 0 && a + 1 < argc) {
@@ -418,7 +426,8 @@ int main(int argc, char **argv)
             only_noise = strtod(argv[++a], NULL) / 1000.0;
         } else {
             fprintf(stderr,
-                    "usage: %s [--quick] [--check] [--verbose] [--paper] [--grazing] [--evidence] "
+                    "usage: %s [--quick] [--check] [--verbose] [--paper] [--[no-]grazing] "
+                    "[--[no-]evidence] "
                     "[--poses N] "
                     "[--scene NAME] "
                     "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",

@@ -53,8 +53,9 @@ double bsf_truth_quantile(const bsf_truth_hist_t *h, double q)
     return h->max;
 }
 
-/* Where a straight wall meets a circle, or a wall ends on another (world
- * frame): real creases of the geometry that the corner list does not hold. */
+/* Where a straight wall meets a circle, two circles cross, or a wall ends on
+ * another (world frame): real creases of the geometry that the corner list
+ * does not hold. */
 static size_t creases(const bsf_scene_t *sc, double *xy, size_t cap)
 {
     size_t n = 0;
@@ -117,6 +118,37 @@ static size_t creases(const bsf_scene_t *sc, double *xy, size_t cap)
                 if (t >= 0.0 && t <= 1.0 && n < cap) {
                     xy[2u * n] = s->x0 + t * dx;
                     xy[2u * n + 1u] = s->y0 + t * dy;
+                    ++n;
+                }
+            }
+        }
+    }
+    /* Where two circles cross (a bulge on a round wall). */
+    for (a = 0; a < sc->n_shapes; ++a) {
+        const bsf_shape_t *s = &sc->shape[a];
+        if (s->kind != BSF_SHAPE_CIRCLE) {
+            continue;
+        }
+        for (b = a + 1u; b < sc->n_shapes; ++b) {
+            const bsf_shape_t *c = &sc->shape[b];
+            const double dx = c->x0 - s->x0;
+            const double dy = c->y0 - s->y0;
+            const double d = sqrt(dx * dx + dy * dy);
+            double along, h2;
+            int k;
+            if (c->kind != BSF_SHAPE_CIRCLE || !(d > 0.0)) {
+                continue;
+            }
+            along = (s->r * s->r - c->r * c->r + d * d) / (2.0 * d);
+            h2 = s->r * s->r - along * along;
+            if (h2 < 0.0) {
+                continue;
+            }
+            for (k = -1; k <= 1; k += 2) {
+                if (n < cap) {
+                    const double h = (double)k * sqrt(h2);
+                    xy[2u * n] = s->x0 + (along * dx - h * dy) / d;
+                    xy[2u * n + 1u] = s->y0 + (along * dy + h * dx) / d;
                     ++n;
                 }
             }

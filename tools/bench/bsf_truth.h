@@ -24,8 +24,8 @@
  *    lies within BSF_TRUTH_MATCH of it; recall = found / visible.
  *  - Precision = vertices within BSF_TRUTH_MATCH of any true corner (visible or
  *    not) / vertices, leaving out the vertices that sit where a straight wall
- *    meets a curved one or ends on another wall (a T-junction): real creases,
- *    but not listed corners.
+ *    meets a curved one, two curved walls cross, or a wall ends on another (a
+ *    T-junction): real creases, but not listed corners.
  *  - Position error: distance from each found corner to its nearest vertex.
  *  - Curve distance: every feature's curve sampled BSF_TRUTH_SAMPLES_PER_SPAN
  *    times per span, distance of each sample to the nearest true surface.

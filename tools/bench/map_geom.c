@@ -625,3 +625,63 @@ int mg_grid_baseline(const mg_points_t *pts, double cell, const char *pgm_gz_pat
     free(rows);
     return rc;
 }
+
+/* Frames before the state is recorded, so the robot's pending changes are out. */
+#define MG_SNAP_WARMUP 8
+#define MG_SNAP_STATES 8192
+
+long mg_map_once_bytes(bsf_map_t *copy, const bsf_map_t *map, const bsf_pose_t *pose,
+                       uint16_t budget)
+{
+    static uint32_t st_next[MG_SNAP_STATES], st_bytes[MG_SNAP_STATES];
+    static uint16_t st_pos[MG_SNAP_STATES], st_wraps[MG_SNAP_STATES];
+    static uint8_t buf[BSF_MAP_FRAME_MAX_SIZE];
+    static bsf_result_t empty;
+    size_t n_st = 0;
+    unsigned wraps = 0;
+    int guard = 0;
+    if (bsf_map_feature_count(map) == 0u) {
+        return 0;
+    }
+    memcpy(copy, map, sizeof *map);
+    copy->params.snapshot_budget = budget;
+    copy->snapshot_next = 0u;
+    copy->snapshot_pos = 0u;
+    copy->params.frame_interval = 1u;
+    memset(&empty, 0, sizeof empty);
+    while (guard++ < 100000) {
+        size_t len = 0;
+        size_t k;
+        /* a scan without features lets the frame interval pass */
+        if (bsf_map_fuse(copy, &empty, pose) < 0 ||
+            bsf_map_encode(copy, NULL, buf, sizeof buf, &len) != BSF_OK || len == 0u) {
+            return -1;
+        }
+        if (guard < MG_SNAP_WARMUP || bsf_map_pending(copy)) {
+            continue;
+        }
+        if (n_st > 0u && (copy->snapshot_next < st_next[n_st - 1u] ||
+                          (copy->snapshot_next == st_next[n_st - 1u] &&
+                           copy->snapshot_pos <= st_pos[n_st - 1u]))) {
+            ++wraps;
+        }
+        for (k = 0; k < n_st; ++k) {
+            if (st_next[k] == copy->snapshot_next && st_pos[k] == copy->snapshot_pos) {
+                const unsigned rounds = wraps - st_wraps[k];
+                if (rounds == 0u) {
+                    return -1;
+                }
+                return (long)((copy->stats.record_bytes[4] - st_bytes[k]) / rounds);
+            }
+        }
+        if (n_st == MG_SNAP_STATES) {
+            return -1;
+        }
+        st_next[n_st] = copy->snapshot_next;
+        st_pos[n_st] = copy->snapshot_pos;
+        st_bytes[n_st] = copy->stats.record_bytes[4];
+        st_wraps[n_st] = (uint16_t)wraps;
+        ++n_st;
+    }
+    return -1;
+}

@@ -136,4 +136,16 @@ int mg_grid_baseline(const mg_points_t *pts, double cell, const char *pgm_gz_pat
 /** Bytes of buf gzip'd (zlib level 9, gzip wrapper); 0 on failure. */
 size_t mg_gzip_size(const uint8_t *buf, size_t n);
 
+/** Bytes of one round of the snapshot round robin over every feature the
+ *  robot holds: the snapshot records only (no frame headers), written into
+ *  `copy` (a copy of `map`, changed) in frames of `budget` snapshot bytes,
+ *  fusing empty scans at `pose` in between. The round robin of a map that no
+ *  longer changes is periodic in its state (next id, next point), recorded
+ *  after each frame until one repeats; a state not above the one before
+ *  means the round wrapped in that frame, and one period holds as many whole
+ *  rounds as it wraps (a map smaller than one frame's budget, sent more than
+ *  once per frame, reads high). -1 on failure. */
+long mg_map_once_bytes(bsf_map_t *copy, const bsf_map_t *map, const bsf_pose_t *pose,
+                       uint16_t budget);
+
 #endif /* BSF_MAP_GEOM_H */
