@@ -71,6 +71,20 @@ static inline int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
     return s2 > 0.0f && along > 0.0f && along <= 1.5f * s2 && off * off <= 0.25f * s2 * s2;
 }
 
+/* The last valid beam, the one before beam 0 on the ring of a full-circle
+ * scan (where SVED's and LC's passes look for their start), or pts->count
+ * when no beam is valid. */
+static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
+{
+    size_t i;
+    for (i = pts->count; i > 0u; --i) {
+        if (pts->valid[i - 1u]) {
+            return i - 1u;
+        }
+    }
+    return pts->count;
+}
+
 /* Largest step LC's runs join this way, metres: SVED's default radius cap,
  * so runs and segments go on across the same steps. */
 #define BSF_GRAZING_LC_CAP 1.0f

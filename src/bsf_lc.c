@@ -1729,14 +1729,8 @@ static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a,
  * surface all round: the seam then cuts it, as on a scan that is no ring). */
 static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
 {
-    size_t prev = pts->count;
+    size_t prev = bsf_last_valid_beam(pts);
     size_t i;
-    for (i = pts->count; i > 0u; --i) {
-        if (pts->valid[i - 1u]) {
-            prev = i - 1u;
-            break;
-        }
-    }
     if (prev == pts->count) {
         return 0u;
     }

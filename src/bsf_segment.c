@@ -615,14 +615,8 @@ static int close_open(seg_sink_t *sink, const open_seg_t *s, uint16_t *label, si
  * 0 when every step joins (one closed loop: then nothing wraps). */
 static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float cap2)
 {
-    size_t prev = pts->count;
+    size_t prev = bsf_last_valid_beam(pts);
     size_t i;
-    for (i = pts->count; i > 0u; --i) {
-        if (pts->valid[i - 1u]) {
-            prev = i - 1u;
-            break;
-        }
-    }
     if (prev == pts->count) {
         return 0u;
     }

@@ -36,27 +36,33 @@ void tearDown(void)
 {
 }
 
-/* Scan the scene from (x, y, heading) with n beams over fov and noise sigma,
- * run LC with its defaults; returns the keypoint count. */
-static size_t detect(double x, double y, double heading, size_t n, double fov, double sigma)
+/* Scan the scene with lidar lid and noise sigma, run LC with its defaults
+ * (join_grazing and corner_evidence as set); returns the keypoint count. */
+static size_t detect_lidar(bsf_lidar_t *lid, double sigma)
 {
-    bsf_lidar_t lid = bsf_lidar_default(x, y, heading, n, fov);
     bsf_scene_rng_t rng;
     bsf_scan_t scan;
     bsf_lc_params_t p = bsf_lc_params_default();
     size_t n_out = 0;
     p.join_grazing = (uint8_t)join_grazing;
     p.corner_evidence = (uint8_t)corner_evidence;
-    lid.noise_sigma = sigma;
-    lid.range_max = range_max;
-    lid.no_return = (float)(range_max + 1.0);
+    lid->noise_sigma = sigma;
+    lid->range_max = range_max;
+    lid->no_return = (float)(range_max + 1.0);
     bsf_scene_rng_seed(&rng, 7u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, &rng, ranges, NULL, BSF_MAX_POINTS));
-    scan = bsf_scene_lidar_scan(&lid, ranges);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, lid, &rng, ranges, NULL, BSF_MAX_POINTS));
+    scan = bsf_scene_lidar_scan(lid, ranges);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
     TEST_ASSERT_EQUAL_INT(BSF_OK,
                           bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
     return n_out;
+}
+
+/* Scan the scene from (x, y, heading) with n beams over fov and noise sigma. */
+static size_t detect(double x, double y, double heading, size_t n, double fov, double sigma)
+{
+    bsf_lidar_t lid = bsf_lidar_default(x, y, heading, n, fov);
+    return detect_lidar(&lid, sigma);
 }
 
 /* As detect(), on a full-circle sensor of n beams (2 pi / n apart) whose
@@ -64,22 +70,11 @@ static size_t detect(double x, double y, double heading, size_t n, double fov, d
 static size_t detect_ring(double x, double y, double heading, size_t n, double sigma)
 {
     bsf_lidar_t lid = bsf_lidar_default(x, y, heading, n, 2.0 * PI);
-    bsf_scene_rng_t rng;
-    bsf_scan_t scan;
-    bsf_lc_params_t p = bsf_lc_params_default();
-    size_t n_out = 0;
+    size_t n_out;
     lid.angle_increment = 2.0 * PI / (double)n;
     lid.angle_min = -PI + 0.5 * lid.angle_increment;
-    lid.noise_sigma = sigma;
-    lid.range_max = range_max;
-    lid.no_return = (float)(range_max + 1.0);
-    bsf_scene_rng_seed(&rng, 7u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, &rng, ranges, NULL, BSF_MAX_POINTS));
-    scan = bsf_scene_lidar_scan(&lid, ranges);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    n_out = detect_lidar(&lid, sigma);
     TEST_ASSERT_TRUE(bsf_points_full_circle(&points));
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
     return n_out;
 }
 
@@ -122,6 +117,8 @@ static void test_a_corner_behind_a_full_circle_sensor_is_found_across_the_seam(v
     size_t k;
     int behind = -1;
     int ahead = -1;
+    join_grazing = 1; /* the library's defaults */
+    corner_evidence = 1;
     TEST_ASSERT_EQUAL_INT(BSF_OK,
                           bsf_scene_add_corner(&scene, -4.0, 0.0, -0.35 * PI, 3.0, 0.35 * PI, 3.0));
     TEST_ASSERT_EQUAL_INT(BSF_OK,
