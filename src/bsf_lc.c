@@ -77,6 +77,14 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
     return BSF_OK;
 }
 
+/* judge's two verdicts are inlined into it, their one caller: one copy of
+ * the window's set-up (code size). */
+#if defined(__GNUC__) || defined(__clang__)
+#define LC_ALWAYS_INLINE static inline __attribute__((always_inline))
+#else
+#define LC_ALWAYS_INLINE static inline
+#endif
+
 /* A total-least-squares line: centroid, unit direction, squared residual. */
 typedef struct {
     float mx, my;
@@ -1023,14 +1031,10 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
 /* The two-line verdict on the split at apex, window a0..b1, sides' lines la
  * and lb (which turn by at least min_turn: cross is their cross product)
  * whose intersection must lie within reach of the apex: LC_CORNER with the
- * intersection in *xo and the evidence in *score, else the verdict. Inlined
- * into judge, its one caller (code size). */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((always_inline))
-#endif
-static inline lc_verdict_t
-judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_t *la,
-            const lc_line_t *lb, float cross, float reach, bsf_point_t *xo, float *score)
+ * intersection in *xo and the evidence in *score, else the verdict. */
+LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1,
+                                          const lc_line_t *la, const lc_line_t *lb, float cross,
+                                          float reach, bsf_point_t *xo, float *score)
 {
     const bsf_point_t *rp = c->rel;
     float t, extent, rss_curve, rss_circle, rss_lines;
@@ -1188,13 +1192,10 @@ static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
  * an angle of min_turn or more. A round pillar or a smooth wall of varying
  * curvature fails the last: the circles of its two sides touch, they do not
  * cross. LC_CORNER with the crossing in *xo and the evidence in *score,
- * else v. Inlined into judge, its one caller (code size). */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((always_inline))
-#endif
-static inline lc_verdict_t
-judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line_t *la,
-             const lc_line_t *lb, float reach, lc_verdict_t v, bsf_point_t *xo, float *score)
+ * else LC_MERGE. */
+LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1,
+                                           const lc_line_t *la, const lc_line_t *lb, float reach,
+                                           bsf_point_t *xo, float *score)
 {
     const size_t n = b1 - a0 + 1u;
     const float noise_var = c->noise2;
@@ -1212,24 +1213,24 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
         const lc_line_t *l = k ? lb : la;
         if (l->rss > piece_bound((float)(l->n - 2u), noise_var)) {
             if (l->n < LC_CREASE_ROUND_POINTS) {
-                return v;
+                return LC_MERGE;
             }
             round = 1;
         }
     }
     if (!round) {
-        return v;
+        return LC_MERGE;
     }
     round = 0;
     for (k = 0; k < 2; ++k) {
         if (!fit_piece(c, k ? apex + 1u : a0, k ? b1 : apex - 1u, k ? lb : la, noise_var, &pc[k])) {
-            return v; /* a side fits no piece */
+            return LC_MERGE; /* a side fits no piece */
         }
         rss_pieces += pc[k].rss;
         round |= pc[k].round;
     }
     if (!round) {
-        return v; /* two lines: judged already */
+        return LC_MERGE; /* two lines: judged already */
     }
     /* One smooth curve over both sides: the geometrically fitted circle (a
      * line is its limit; none exists when the points lie on a line, which
@@ -1242,7 +1243,7 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
     }
     if (!(rss_curve > c->p->curve_ratio * rss_pieces + (float)n * c->p->floor * c->p->floor) ||
         !window_joined(c, a0, b1, noise_var)) {
-        return v; /* (or a depth jump inside the window: no crease of one surface) */
+        return LC_MERGE; /* (or a depth jump inside the window: no crease of one surface) */
     }
     /* Newton steps from the apex on the pieces' distances; the last round
      * only checks that they still cross at min_turn there */
@@ -1253,7 +1254,7 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
         }
         det = gx[0] * gy[1] - gy[0] * gx[1];
         if (!(fabsf(det) >= c->sin_min_turn)) {
-            return v;
+            return LC_MERGE;
         }
         if (step == LC_CREASE_STEPS) {
             break;
@@ -1262,7 +1263,7 @@ judge_crease(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1, const lc_line
         x.x -= (f[0] * gy[1] - f[1] * gy[0]) / det;
         x.y -= (gx[0] * f[1] - gx[1] * f[0]) / det;
         if (!(x.x * x.x + x.y * x.y <= reach * reach)) {
-            return v;
+            return LC_MERGE;
         }
     }
     *xo = x;
@@ -1351,7 +1352,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     /* A crease first: where a side is round, the lines' intersection lies
      * off the vertex even when two lines pass (a 5 m arc against a wall at
      * 1 cm noise: 4 cm along the wall). */
-    v = judge_crease(c, a0, apex, b1, &la, &lb, reach, LC_MERGE, &x, &score);
+    v = judge_crease(c, a0, apex, b1, &la, &lb, reach, &x, &score);
     if (v != LC_CORNER) {
         v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, &x, &score);
     }
@@ -1767,7 +1768,6 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     size_t m = 0;
     size_t i;
     size_t step;
-    size_t start;
     if (n_out != NULL) {
         *n_out = 0u;
     }
@@ -1791,11 +1791,12 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.sin_min_turn = bsf_sinf(p->min_turn);
     c.noise2 = 0.0f;
     blocks_detach(&c);
-    start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
-    c.start = start;
+    c.start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
     for (step = 0; step <= pts->count; ++step) {
         int close_run = step == pts->count;
-        i = close_run ? 0u : (start + step < pts->count ? start + step : start + step - pts->count);
+        i = close_run
+                ? 0u
+                : (c.start + step < pts->count ? c.start + step : c.start + step - pts->count);
         if (!close_run && !pts->valid[i]) {
             continue;
         }
@@ -1819,12 +1820,12 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             work->run[m++] = (uint16_t)i;
         }
     }
-    if (start > 0u) {
+    if (c.start > 0u) {
         /* Found from the pass's start on: the corners before beam start
          * (those past the seam) go first, so out stays in beam order. */
         const size_t n_kept = n_found < out_cap ? n_found : out_cap;
         size_t n_after = 0u;
-        while (n_after < n_kept && out[n_after].index >= start) {
+        while (n_after < n_kept && out[n_after].index >= c.start) {
             ++n_after;
         }
         reverse_keypoints(out, 0u, n_after);

@@ -245,37 +245,6 @@ static inline int beam_within(beam_radius_t *r, float d2)
     return beam_within_slow(r, d2);
 }
 
-/* Range of beam i + k (k in -2..2) into *r, wrapping on a ring; 0 when that
- * beam is outside the scan or invalid. */
-static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, float *r)
-{
-    const size_t n = pts->count;
-    size_t j;
-    if (k < 0) {
-        const size_t back = (size_t)(-k);
-        if (i >= back) {
-            j = i - back;
-        } else if (ring) {
-            j = i + n - back;
-        } else {
-            return 0;
-        }
-    } else {
-        j = i + (size_t)k;
-        if (j >= n) {
-            if (!ring) {
-                return 0;
-            }
-            j -= n;
-        }
-    }
-    if (!pts->valid[j]) {
-        return 0;
-    }
-    *r = pts->range[j];
-    return 1;
-}
-
 /* Beam i + k (any sign) into *j, wrapping on a ring; 0 when that beam is
  * outside the scan or invalid. */
 static int neighbour_beam(const bsf_points_t *pts, size_t i, long k, int ring, size_t *j)
@@ -292,6 +261,17 @@ static int neighbour_beam(const bsf_points_t *pts, size_t i, long k, int ring, s
         return 0;
     }
     *j = (size_t)m;
+    return 1;
+}
+
+/* Range of beam i + k into *r, as neighbour_beam finds it. */
+static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, float *r)
+{
+    size_t j;
+    if (!neighbour_beam(pts, i, (long)k, ring, &j)) {
+        return 0;
+    }
+    *r = pts->range[j];
     return 1;
 }
 
