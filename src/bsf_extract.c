@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
 
+#include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
@@ -58,6 +60,7 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     }
     p.no_return = bsf_no_return_params_default();
     p.split_dist = BSF_SPLIT_DIST_DEFAULT;
+    p.trim_tails = 1u;
     p.clock = NULL;
     p.clock_user = NULL;
     p.clock_hz = 0u;
@@ -70,6 +73,7 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     p.sved = bsf_sved_params_paper();
     p.no_return.min_run = 0u;
     p.split_dist = 0.0f;
+    p.trim_tails = 0u;
     /* The first release's refinement target, so the paper-faithful rows of
      * bsf table1 are the numbers that release printed. */
     p.pdm.target_rms = 0.015f;
@@ -85,7 +89,7 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
     }
     if ((p->clock != NULL && p->clock_hz == 0u) || !(p->no_return.code >= 0.0f) ||
         !(p->no_return.code <= 3.402823466e38f) || !(p->split_dist >= 0.0f) ||
-        !(p->split_dist <= BSF_FIT_MAX_COORD)) {
+        !(p->split_dist <= BSF_FIT_MAX_COORD) || p->trim_tails > 1u) {
         return BSF_ERR_PARAM;
     }
     if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
@@ -329,6 +333,111 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * its vertices into ex->scratch.seg.use.fit.vertex_pos: interest beams inside the segment that
  * are not among its first two or last two points (the rule of
  * bsf_segment_classify). Returns the number of points. */
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Points of the straight run beside a segment end that judge it (tail_end):
+ * enough for a noise estimate with six degrees of freedom. */
+#define TAIL_RUN 8u
+
+/* Is the end return p[0] of a segment a tail: a return on another surface,
+ * nearer the sensor, that the straight run p[step], p[2 step], ... beside
+ * it (step +1 or -1) does not explain? At a concave corner seen at grazing
+ * incidence the next wall often gives a single return before the corner,
+ * which no corner test can confirm, and a curve bent to reach it swings
+ * through free space (half a metre past a corridor's end wall on the
+ * ground-truth scenes). It is one when the run's line (total least squares)
+ * misses p[0] by more than split_sigmas standard errors of a new point on
+ * it (the run's scatter per degree of freedom and the line's own error at
+ * p[0]) and at least split_min, on the sensor's side, with a turn of at
+ * least min_turn. Only the sensor's side: a convex surface's last returns
+ * (a pillar's silhouette) bend away from the sensor and still lie on it. */
+static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t *lc)
+{
+    float mx = 0.0f;
+    float my = 0.0f;
+    float sxx = 0.0f;
+    float sxy = 0.0f;
+    float syy = 0.0f;
+    float res = 0.0f;
+    float stt = 0.0f;
+    float ux;
+    float uy;
+    float len;
+    float t0;
+    float d0;
+    float tol;
+    float sx;
+    float sy;
+    size_t k;
+    for (k = 1u; k <= TAIL_RUN; ++k) {
+        mx += p[(ptrdiff_t)k * step].x;
+        my += p[(ptrdiff_t)k * step].y;
+    }
+    mx *= 1.0f / (float)TAIL_RUN;
+    my *= 1.0f / (float)TAIL_RUN;
+    for (k = 1u; k <= TAIL_RUN; ++k) {
+        const float dx = p[(ptrdiff_t)k * step].x - mx;
+        const float dy = p[(ptrdiff_t)k * step].y - my;
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    /* The major axis: half the angle of (sxx - syy, 2 sxy). */
+    len = sqrtf((sxx - syy) * (sxx - syy) + 4.0f * sxy * sxy);
+    ux = sxx - syy + len;
+    uy = 2.0f * sxy;
+    if (!(ux * ux + uy * uy > 0.0f)) {
+        ux = 2.0f * sxy;
+        uy = syy - sxx + len;
+    }
+    len = sqrtf(ux * ux + uy * uy);
+    if (!(len > 0.0f)) {
+        return 0; /* the run's points coincide */
+    }
+    ux /= len;
+    uy /= len;
+    for (k = 1u; k <= TAIL_RUN; ++k) {
+        const float dx = p[(ptrdiff_t)k * step].x - mx;
+        const float dy = p[(ptrdiff_t)k * step].y - my;
+        const float r = dy * ux - dx * uy;
+        const float t = dx * ux + dy * uy;
+        res += r * r;
+        stt += t * t;
+    }
+    t0 = (p[0].x - mx) * ux + (p[0].y - my) * uy;
+    d0 = (p[0].y - my) * ux - (p[0].x - mx) * uy;
+    tol = lc->split_sigmas * sqrtf(res / (float)(TAIL_RUN - 2u) *
+                                   (1.0f + 1.0f / (float)TAIL_RUN + t0 * t0 / stt));
+    tol = tol > lc->split_min ? tol : lc->split_min;
+    sx = p[0].x - p[step].x;
+    sy = p[0].y - p[step].y;
+    /* The sensor (the origin) lies on the side of the line where
+     * -(my ux - mx uy) is positive. */
+    return d0 * (mx * uy - my * ux) > 0.0f && fabsf(d0) > tol &&
+           d0 * d0 > sinf(lc->min_turn) * sinf(lc->min_turn) * (sx * sx + sy * sy);
+}
+
+/* The first and last of the n gathered points to fit (LC with trim_tails):
+ * a tail (tail_end) is left off unless LC has a corner within the run
+ * beside it, which already bends the curve there. */
+static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo,
+                       size_t *hi)
+{
+    const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
+    const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
+    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
+        n < 2u * TAIL_RUN + 1u) {
+        return;
+    }
+    if ((n_vertex == 0u || pos[0] > TAIL_RUN + 1u) && tail_end(pts, 1, &ex->params.lc)) {
+        *lo = 1u;
+    }
+    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + TAIL_RUN + 2u < n) &&
+        tail_end(&pts[n - 1u], -1, &ex->params.lc)) {
+        *hi = n - 2u;
+    }
+}
+#endif
+
 static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
 {
     size_t n = 0u;
@@ -526,6 +635,8 @@ static void append_feature(bsf_result_t *res, uint16_t first_beam, uint16_t last
 static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
                                size_t n_vertex, bsf_result_t *res)
 {
+    size_t lo0 = 0u;
+    size_t hi0 = n - 1u;
     uint16_t lo[SPLIT_STACK];
     uint16_t hi[SPLIT_STACK];
     const uint16_t features0 = res->n_features;
@@ -534,8 +645,11 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     const uint32_t nctrl0 = res->stats.n_ctrl;
     int may_split = 1;
     size_t depth = 1u;
-    lo[0] = 0u;
-    hi[0] = (uint16_t)(n - 1u);
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+    trim_tails(ex, n, n_vertex, &lo0, &hi0);
+#endif
+    lo[0] = (uint16_t)lo0;
+    hi[0] = (uint16_t)hi0;
     while (depth > 0u) {
         const size_t a = lo[depth - 1u];
         const size_t b = hi[depth - 1u];
@@ -553,13 +667,13 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
             res->n_ctrl = ctrl0;
             res->stats.n_in_features = in0;
             res->stats.n_ctrl = nctrl0;
-            if (st == BSF_ERR_BUFFER || (a == 0u && b + 1u == n)) {
+            if (st == BSF_ERR_BUFFER || (a == lo0 && b == hi0)) {
                 return st;
             }
             may_split = 0; /* start again: the whole segment, unsplit */
             depth = 1u;
-            lo[0] = 0u;
-            hi[0] = (uint16_t)(n - 1u);
+            lo[0] = (uint16_t)lo0;
+            hi[0] = (uint16_t)hi0;
             continue;
         }
         if (may_split && depth + 2u <= SPLIT_STACK) {
@@ -572,6 +686,9 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
             hi[depth++] = (uint16_t)(cut - 1u);
         } else if (a == 0u && b + 1u == n) {
             append_feature(res, s->first, s->last, s->n_points, s->kind, n_ctrl, e_curve);
+        } else if (a == lo0 && b == hi0) {
+            append_feature(res, beam_of_point(ex, s, a), beam_of_point(ex, s, b),
+                           (uint16_t)(b + 1u - a), s->kind, n_ctrl, e_curve);
         } else {
             append_feature(
                 res, beam_of_point(ex, s, a), beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),

@@ -72,6 +72,16 @@ typedef struct {
      *  the features. Metres, >= 0; 0 turns it off (bsf_params_paper).
      *  Default 0.25. */
     float split_dist;
+    /** LC-SVED-PDM: 1 (default) leaves a segment's end return out of its
+     *  feature when the straight run of 8 returns beside it misses it, on
+     *  the sensor's side, by more than split_sigmas standard errors (the
+     *  run's own scatter) and lc.split_min, turning by lc.min_turn or more:
+     *  a single return on the next wall past a concave corner seen at
+     *  grazing incidence, or on an occluder. A curve bent to reach it swings
+     *  through free space. Segments of at least 17 returns, and not where LC
+     *  has a corner within the run. The return counts as wasted in Γ.
+     *  0 keeps every return (bsf_params_paper). */
+    uint8_t trim_tails;
     bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
     void *clock_user;   /**< passed to clock */
     uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */

@@ -9,7 +9,8 @@
  *   options: --poses N, --paper (paper-faithful configuration), --grazing / --no-grazing
  *            (SVED and LC join walls seen at grazing incidence; on by default),
  *            --evidence / --no-evidence (LC's corner evidence test,
- *            bsf_lc_params_t.corner_evidence; on by default), --datasets DIR
+ *            bsf_lc_params_t.corner_evidence; on by default), --tails / --no-tails
+ *            (bsf_params_t.trim_tails; on by default), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
@@ -74,6 +75,8 @@ static int paper_mode = 0;
 static int grazing_mode = -1;
 /* 1 --evidence, 0 --no-evidence, -1 the default: LC's corner evidence test */
 static int evidence_mode = -1;
+/* 1 --tails, 0 --no-tails, -1 the default: tail returns left off segment ends */
+static int tails_mode = -1;
 
 static bsf_params_t make_params(void)
 {
@@ -85,6 +88,9 @@ static bsf_params_t make_params(void)
     }
     if (evidence_mode >= 0) {
         p.lc.corner_evidence = (uint8_t)evidence_mode;
+    }
+    if (tails_mode >= 0) {
+        p.trim_tails = (uint8_t)tails_mode;
     }
     return p;
 }
@@ -414,6 +420,10 @@ int main(int argc, char **argv)
             evidence_mode = 1;
         } else if (strcmp(argv[a], "--no-evidence") == 0) {
             evidence_mode = 0;
+        } else if (strcmp(argv[a], "--tails") == 0) {
+            tails_mode = 1;
+        } else if (strcmp(argv[a], "--no-tails") == 0) {
+            tails_mode = 0;
         } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
             n_poses = strtol(argv[++a], NULL, 10);
         } else if (strcmp(argv[a], "--datasets") == 0 && a + 1 < argc) {
@@ -427,7 +437,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr,
                     "usage: %s [--quick] [--check] [--verbose] [--paper] [--[no-]grazing] "
-                    "[--[no-]evidence] "
+                    "[--[no-]evidence] [--[no-]tails] "
                     "[--poses N] "
                     "[--scene NAME] "
                     "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
@@ -442,9 +452,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_truth: --poses must be >= 1\n");
         return 2;
     }
-    printf("bench_truth: %s configuration%s%s, %ld poses per row\n",
+    printf("bench_truth: %s configuration%s%s%s, %ld poses per row\n",
            paper_mode ? "paper-faithful" : "default", grazing_mode ? " with grazing joins" : "",
-           evidence_mode ? " with LC's corner evidence test" : "", n_poses);
+           evidence_mode ? " with LC's corner evidence test" : "",
+           tails_mode ? " with tail returns left off" : "", n_poses);
     print_header();
     for (w = 0; w < N_SCENES; ++w) {
         if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {
