@@ -405,8 +405,8 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t 
     }
     t0 = (p[0].x - mx) * ux + (p[0].y - my) * uy;
     d0 = (p[0].y - my) * ux - (p[0].x - mx) * uy;
-    tol = lc->split_sigmas * sqrtf(res / (float)(TAIL_RUN - 2u) *
-                                   (1.0f + 1.0f / (float)TAIL_RUN + t0 * t0 / stt));
+    tol = lc->split_sigmas *
+          sqrtf(res / (float)(TAIL_RUN - 2u) * (1.0f + 1.0f / (float)TAIL_RUN + t0 * t0 / stt));
     tol = tol > lc->split_min ? tol : lc->split_min;
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
@@ -419,8 +419,7 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end) is left off unless LC has a corner within the run
  * beside it, which already bends the curve there. */
-static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo,
-                       size_t *hi)
+static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
 {
     const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
