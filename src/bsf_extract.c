@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_math.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -352,68 +353,57 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * (a pillar's silhouette) bend away from the sensor and still lie on it. */
 static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t *lc)
 {
-    float mx = 0.0f;
-    float my = 0.0f;
-    float sxx = 0.0f;
-    float sxy = 0.0f;
-    float syy = 0.0f;
-    float res = 0.0f;
-    float stt = 0.0f;
-    float ux;
-    float uy;
-    float len;
-    float t0;
-    float d0;
-    float tol;
-    float sx;
-    float sy;
+    /* Sums relative to p[step], which keeps them small. */
+    const bsf_point_t o = p[step];
+    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
+    float h, lmax, lmin, ux, uy, t0, d0, tol, ex, ey;
     size_t k;
     for (k = 1u; k <= TAIL_RUN; ++k) {
-        mx += p[(ptrdiff_t)k * step].x;
-        my += p[(ptrdiff_t)k * step].y;
-    }
-    mx *= 1.0f / (float)TAIL_RUN;
-    my *= 1.0f / (float)TAIL_RUN;
-    for (k = 1u; k <= TAIL_RUN; ++k) {
-        const float dx = p[(ptrdiff_t)k * step].x - mx;
-        const float dy = p[(ptrdiff_t)k * step].y - my;
+        const float dx = p[(ptrdiff_t)k * step].x - o.x;
+        const float dy = p[(ptrdiff_t)k * step].y - o.y;
+        sx += dx;
+        sy += dy;
         sxx += dx * dx;
         sxy += dx * dy;
         syy += dy * dy;
     }
-    /* The major axis: half the angle of (sxx - syy, 2 sxy). */
-    len = sqrtf((sxx - syy) * (sxx - syy) + 4.0f * sxy * sxy);
-    ux = sxx - syy + len;
-    uy = 2.0f * sxy;
-    if (!(ux * ux + uy * uy > 0.0f)) {
-        ux = 2.0f * sxy;
-        uy = syy - sxx + len;
+    sx *= 1.0f / (float)TAIL_RUN;
+    sy *= 1.0f / (float)TAIL_RUN;
+    sxx -= (float)TAIL_RUN * sx * sx;
+    sxy -= (float)TAIL_RUN * sx * sy;
+    syy -= (float)TAIL_RUN * sy * sy;
+    /* The scatter's eigenvalues: the spread along the line (lmax) and the
+     * residual sum of squares across it (lmin); the line runs along the
+     * eigenvector of lmax. */
+    h = sqrtf((sxx - syy) * (sxx - syy) + 4.0f * sxy * sxy);
+    lmax = 0.5f * (sxx + syy + h);
+    lmin = 0.5f * (sxx + syy - h);
+    ux = lmax - syy;
+    uy = sxy;
+    if (sxx < syy) {
+        ux = sxy;
+        uy = lmax - sxx;
     }
-    len = sqrtf(ux * ux + uy * uy);
-    if (!(len > 0.0f)) {
+    h = sqrtf(ux * ux + uy * uy);
+    if (!(h > 0.0f)) {
         return 0; /* the run's points coincide */
     }
-    ux /= len;
-    uy /= len;
-    for (k = 1u; k <= TAIL_RUN; ++k) {
-        const float dx = p[(ptrdiff_t)k * step].x - mx;
-        const float dy = p[(ptrdiff_t)k * step].y - my;
-        const float r = dy * ux - dx * uy;
-        const float t = dx * ux + dy * uy;
-        res += r * r;
-        stt += t * t;
-    }
-    t0 = (p[0].x - mx) * ux + (p[0].y - my) * uy;
-    d0 = (p[0].y - my) * ux - (p[0].x - mx) * uy;
-    tol = lc->split_sigmas *
-          sqrtf(res / (float)(TAIL_RUN - 2u) * (1.0f + 1.0f / (float)TAIL_RUN + t0 * t0 / stt));
+    ux /= h;
+    uy /= h;
+    ex = p[0].x - o.x - sx;
+    ey = p[0].y - o.y - sy;
+    t0 = ex * ux + ey * uy;
+    d0 = ey * ux - ex * uy;
+    tol = lc->split_sigmas * sqrtf((lmin > 0.0f ? lmin : 0.0f) / (float)(TAIL_RUN - 2u) *
+                                   (1.0f + 1.0f / (float)TAIL_RUN + t0 * t0 / lmax));
     tol = tol > lc->split_min ? tol : lc->split_min;
-    sx = p[0].x - p[step].x;
-    sy = p[0].y - p[step].y;
-    /* The sensor (the origin) lies on the side of the line where
-     * -(my ux - mx uy) is positive. */
-    return d0 * (mx * uy - my * ux) > 0.0f && fabsf(d0) > tol &&
-           d0 * d0 > sinf(lc->min_turn) * sinf(lc->min_turn) * (sx * sx + sy * sy);
+    ex = p[0].x - o.x;
+    ey = p[0].y - o.y;
+    /* The sensor (the origin) lies on the side where the centroid's offset
+     * -(cy ux - cx uy) is positive. */
+    h = bsf_sinf(lc->min_turn);
+    return d0 * ((o.x + sx) * uy - (o.y + sy) * ux) > 0.0f && fabsf(d0) > tol &&
+           d0 * d0 > h * h * (ex * ex + ey * ey);
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
@@ -683,15 +673,15 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
             hi[depth++] = (uint16_t)b;
             lo[depth] = (uint16_t)a;
             hi[depth++] = (uint16_t)(cut - 1u);
-        } else if (a == 0u && b + 1u == n) {
-            append_feature(res, s->first, s->last, s->n_points, s->kind, n_ctrl, e_curve);
-        } else if (a == lo0 && b == hi0) {
-            append_feature(res, beam_of_point(ex, s, a), beam_of_point(ex, s, b),
-                           (uint16_t)(b + 1u - a), s->kind, n_ctrl, e_curve);
         } else {
-            append_feature(
-                res, beam_of_point(ex, s, a), beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
-                (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl, e_curve);
+            /* The whole segment (less its tails) keeps its kind; a piece is
+             * auxiliary when it holds a vertex. */
+            append_feature(res, beam_of_point(ex, s, a), beam_of_point(ex, s, b),
+                           (uint16_t)(b + 1u - a),
+                           a == lo0 && b == hi0
+                               ? s->kind
+                               : (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK),
+                           n_ctrl, e_curve);
         }
     }
     return BSF_OK;
