@@ -111,12 +111,80 @@ static inline int bsf_grazing_run4(const bsf_points_t *pts, size_t i)
            bsf_grazing_triple(p[i + 1u], p[i + 2u], p[i + 3u]);
 }
 
+/* The middle return p1 lies where its ray crosses the chord p0-p2, to
+ * within BSF_GRAZING_LINE_TOL along that ray (range noise moves a return
+ * along its ray). Nearly edge-on, the distance from the chord alone tests
+ * little: the chord runs almost along p1's ray, so a return anywhere on it
+ * (a mixed pixel, an object behind) passes near the chord. */
+static inline int bsf_grazing_on_ray(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
+{
+    const float cx = p2.x - p0.x;
+    const float cy = p2.y - p0.y;
+    const float off = (p1.x - p0.x) * cy - (p1.y - p0.y) * cx; /* |c| times the distance */
+    const float ray = cx * p1.y - cy * p1.x;                   /* |c| |p1| sin(chord, ray) */
+    return off * off * (p1.x * p1.x + p1.y * p1.y) <=
+           BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * ray * ray;
+}
+
+/* Points i..i + 2 (valid beams) on one line, tested along the rays as well. */
+static inline int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
+{
+    const bsf_point_t *p = pts->pt;
+    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
+           bsf_grazing_triple(p[i], p[i + 1u], p[i + 2u]) &&
+           bsf_grazing_on_ray(p[i], p[i + 1u], p[i + 2u]);
+}
+
+/* Points s..s + 3 lie on one line (along the rays too) that starts at a
+ * corner: s - 3..s - 1 lie on another line, whose last return s - 1 is no
+ * step of the first (their steps differ, or they turn) yet lies just
+ * behind s on it (bsf_grazing_entry), within cap of s + 1. With dir -1 the
+ * mirror image: s..s - 3 end at the corner s + 1. */
+static inline int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, float cap)
+{
+    const bsf_point_t *p = pts->pt;
+    if (s < 3u) {
+        return 0;
+    }
+    if (dir > 0) {
+        const size_t c = s - 1u; /* the corner's return */
+        return bsf_grazing_line3(pts, s - 3u) && !bsf_grazing_triple(p[s - 2u], p[c], p[s]) &&
+               bsf_grazing_line3(pts, s) && bsf_grazing_line3(pts, s + 1u) &&
+               bsf_grazing_entry(p[c], p[s], p[s + 1u]) && bsf_grazing_within(p[c], p[s + 1u], cap);
+    }
+    {
+        const size_t c = s + 1u;
+        return bsf_grazing_line3(pts, c) && !bsf_grazing_triple(p[s], p[c], p[s + 2u]) &&
+               bsf_grazing_line3(pts, s - 2u) && bsf_grazing_line3(pts, s - 3u) &&
+               bsf_grazing_entry(p[c], p[s], p[s - 1u]) && bsf_grazing_within(p[c], p[s - 1u], cap);
+    }
+}
+
+/* The step between beams a and a + 1 is the step onto such a corner run or
+ * one of its own (a run of four from its corner, see bsf_grazing_join). */
+static inline int bsf_grazing_at_corner(const bsf_points_t *pts, size_t a, float cap)
+{
+    size_t k;
+    for (k = 0; k < 4u; ++k) {
+        if ((a + 1u >= k && bsf_grazing_corner_run(pts, a + 1u - k, 1, cap)) ||
+            bsf_grazing_corner_run(pts, a + k, -1, cap)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* Beams a and a + 1 (both valid, no wrap) continue one grazing wall, their
  * step at most cap metres (see the top of this file). One collinear triple
  * is not enough: a mixed pixel halfway across a depth jump lies on the
  * chord of its neighbours too, but the surfaces either side do not go on
- * along that line, so four consecutive returns must be collinear. */
-static inline int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap)
+ * along that line, so four consecutive returns must be collinear. Nearer
+ * edge-on than BSF_GRAZING_MIN_SIN, only with at_corners and only the
+ * first four returns of a wall that starts at a corner (or the last four
+ * of one that ends at one), the step onto that corner included: that
+ * corner is visible (three returns on a line fix the wall), and four
+ * returns from it leave no room for a long wall to close a door. */
+static inline int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners)
 {
     const size_t b = a + 1u;
     const bsf_point_t *p = pts->pt;
@@ -136,7 +204,7 @@ static inline int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap)
         const float cr = dx * p[b].y - dy * p[b].x;
         const float rb2 = p[b].x * p[b].x + p[b].y * p[b].y;
         if (!(cr * cr >= BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN * (dx * dx + dy * dy) * rb2)) {
-            return 0;
+            return at_corners && bsf_grazing_at_corner(pts, a, cap);
         }
     }
     if ((a >= 2u && bsf_grazing_run4(pts, a - 2u)) || (a >= 1u && bsf_grazing_run4(pts, a - 1u)) ||
