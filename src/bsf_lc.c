@@ -1178,18 +1178,20 @@ static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
     return len - s->k.r;
 }
 
-/* Side a..b (line l) is round: its line leaves more than the noise explains
- * (piece_bound) and a circle no more. judge_crease takes such a side as a
- * piece only with LC_CREASE_ROUND_POINTS points; a shorter one (a few
- * returns on a pillar or a bulge where it meets a wall) still passes
- * side_straight, whose curve_ratio test needs more points to see a curve,
- * and the two lines then cross a beam step or two off the crease, on the
- * other wall: a vertex where the surface has none. */
-static int side_round(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
+/* Side a..b (line l) is a short round side: fewer points than judge_crease
+ * takes as a circle (LC_CREASE_ROUND_POINTS), its line leaving more than
+ * the noise explains (piece_bound), a circle no more. judge_crease stops at
+ * such a side (no crease), yet side_straight, whose curve_ratio test needs
+ * more points to see a curve, passes it, and the two lines then cross a
+ * beam step or two off the crease, on the other wall (a few returns on a
+ * pillar or a bulge where it meets a wall): a vertex where the surface has
+ * none. */
+static int side_short_round(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
 {
     lc_circle_t k;
     const size_t n = b - a + 1u;
-    if (n <= 3u || !(l->rss > piece_bound((float)(n - 2u), c->noise2))) {
+    if (n <= 3u || n >= LC_CREASE_ROUND_POINTS ||
+        !(l->rss > piece_bound((float)(n - 2u), c->noise2))) {
         return 0;
     }
     return side_curve(c, a, b, l, c->noise2, piece_bound((float)(n - 3u), c->noise2), 0u, &k) >=
@@ -1371,10 +1373,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * off the vertex even when two lines pass (a 5 m arc against a wall at
      * 1 cm noise: 4 cm along the wall). */
     v = judge_crease(c, a0, apex, b1, &la, &lb, reach, &x, &score);
-    /* No crease, and a side is round: the lines' intersection would lie
-     * off the crease (side_round), so no vertex at all. */
+    /* No crease, and a side is short and round: the lines' intersection
+     * would lie off the crease (side_short_round), so no vertex at all. */
     if (v != LC_CORNER &&
-        (side_round(c, a0, apex - 1u, &la) || side_round(c, apex + 1u, b1, &lb))) {
+        (side_short_round(c, a0, apex - 1u, &la) || side_short_round(c, apex + 1u, b1, &lb))) {
         return LC_MERGE;
     }
     if (v != LC_CORNER) {

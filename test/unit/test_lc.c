@@ -245,7 +245,7 @@ static void test_a_corner_onto_a_wall_seen_nearly_edge_on_is_found_with_corner_j
  * too short for a crease's round piece, whose line the curvature of the
  * bulge puts 4 cm off its middle; that line and the wall's crossed 17 cm
  * from the crease, on the wall: a vertex where the surface has none. A
- * round side its line does not explain now gives no two-line corner. */
+ * short round side its line does not explain now gives no two-line corner. */
 static void test_no_corner_off_the_crease_of_a_round_wall_and_a_bulge(void)
 {
     static const float tail[31] = {3.0491f, 3.0445f, 3.0650f, 3.0667f, 3.1036f, 3.1211f, 3.1806f,
