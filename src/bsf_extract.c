@@ -59,6 +59,12 @@ bsf_params_t bsf_params_default(bsf_method_t method)
         p.pdm.target_rms = 0.025f;
         p.pdm.bias_window = 0u;
     }
+    if (method == BSF_METHOD_LC_SVED_PDM) {
+        /* LC finds the corner where a wall seen nearly edge-on starts, so
+         * its segments may take that wall's first returns (bsf_grazing.h);
+         * a detector that leaves no vertex there would round it off. */
+        p.sved.join_grazing = 2u;
+    }
     p.no_return = bsf_no_return_params_default();
     p.split_dist = BSF_SPLIT_DIST_DEFAULT;
     p.trim_tails = 1u;

@@ -61,7 +61,7 @@ bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p)
         !min_points_ok(p->min_segment_points) || p->max_gap_beams < 1u ||
         p->max_gap_beams > (uint16_t)BSF_MAX_POINTS || !is_finite_f(p->radius_max) ||
         !(p->radius_max == 0.0f || p->radius_max >= p->a) || p->lookback > BSF_SVED_MAX_LOOKBACK ||
-        p->reject_mixed > 1u || p->join_grazing > 1u) {
+        p->reject_mixed > 1u || p->join_grazing > 2u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -742,7 +742,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         /* A wide step from the beam before may still continue a wall seen
          * at grazing incidence (bsf_grazing.h). */
         if (best == slots && grazing && n_open > 0u && b > 0u && open[0].last + 1u == b &&
-            bsf_grazing_join(pts, b - 1u, p->radius_max)) {
+            bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u)) {
             best = 0u;
         }
         if (best == 0u) {

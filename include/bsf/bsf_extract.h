@@ -92,7 +92,9 @@ typedef struct {
  *  bsf_pdm_params_default (30 mm target plus the systematic-deviation test)
  *  except FALKO-SVED-PDM and BID-SVED-PDM, which refine on RMS alone to
  *  25 mm (bias_window 0): their keypoints miss most corners, which the test
- *  would round with control points.
+ *  would round with control points. LC-SVED-PDM segments with
+ *  join_grazing 2 (bsf_sved_params_t): LC puts the vertex where a wall seen
+ *  nearly edge-on starts at a corner.
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
  *  stored, which bsf_extractor_init then refuses. */
 bsf_params_t bsf_params_default(bsf_method_t method);

@@ -74,8 +74,11 @@ typedef struct {
     uint8_t join_grazing; /**< 1: a point also joins the current segment across a step wider
                                than the radius (at most radius_max, used when radius_max > 0)
                                where four consecutive returns through the step lie on one line,
-                               a wall seen at grazing incidence, or where such a wall starts at
-                               a corner (default); 0 (the paper): it does not */
+                               a wall seen at grazing incidence (up to 80 deg), or where such a
+                               wall starts at a corner (default); 2: also the first four
+                               returns of a wall seen nearer edge-on, when they start at a
+                               corner (or the last four, ending at one): the default of
+                               lc-sved-pdm, whose corners end there; 0 (the paper): none */
 } bsf_sved_params_t;
 
 /** Largest lookback of bsf_sved_params_t. */

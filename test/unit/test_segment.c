@@ -732,6 +732,41 @@ static void test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segme
     TEST_ASSERT_TRUE(corner_onto_grazing_wall(0, &n_valid) > 1u || n_wasted > 0u);
 }
 
+/* SVED with every extension on a room corner 3 m away whose second wall is
+ * seen at 83 deg incidence (1 deg beams, 1 cm noise): its first returns
+ * are 0.35-0.5 m apart, nearer edge-on than grazing joins go (80 deg), so
+ * with join_grazing 1 they break off the corner's segment; with 2 the
+ * first four of them, which start at the corner, join it and the rest of
+ * the wall follows: one segment holds every return. */
+static size_t corner_onto_wall_seen_nearly_edge_on(int join_grazing, size_t *n_valid)
+{
+    bsf_lidar_t l = bsf_lidar_default(0.0, 0.03, 0.0, 271u, 1.5 * 3.14159265358979);
+    bsf_scene_rng_t rng;
+    bsf_sved_params_t p = bsf_sved_params_default();
+    p.join_grazing = (uint8_t)join_grazing;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 3.0, 0.4, -0.5 * 3.14159265358979,
+                                                       4.0, 3.14159265358979, 2.0));
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&rng, 11u);
+    shoot(&l, &rng);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
+                                                            NULL, &n_segs, &n_wasted));
+    check_partition();
+    *n_valid = points.n_valid;
+    return n_segs;
+}
+
+static void test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corner(void)
+{
+    size_t n_valid = 0;
+    TEST_ASSERT_EQUAL_size_t(1u, corner_onto_wall_seen_nearly_edge_on(2, &n_valid));
+    TEST_ASSERT_EQUAL_size_t(0u, n_wasted);
+    TEST_ASSERT_EQUAL_size_t(n_valid, segs[0].n_points);
+    TEST_ASSERT_TRUE(n_valid > 40u);
+    TEST_ASSERT_TRUE(corner_onto_wall_seen_nearly_edge_on(1, &n_valid) > 1u || n_wasted > 0u);
+}
+
 /* A lone reading halfway across a depth jump lies on the chord of its two
  * neighbours, but the surfaces either side do not go on along that line:
  * grazing joins do not bridge it (mixed-pixel rejection off, so only the
@@ -869,6 +904,8 @@ static void test_bad_parameters_are_refused(void)
     TEST_ASSERT_EQUAL_UINT8(0u, bsf_sved_params_paper().join_grazing);
     sp = sd;
     sp.join_grazing = 2u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_sved_params_check(&sp));
+    sp.join_grazing = 3u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
 
     rp = rd;
@@ -1004,6 +1041,7 @@ int main(void)
     RUN_TEST(test_single_valid_beam_is_wasted_or_kept_with_min_one);
     RUN_TEST(test_null_arguments_are_refused);
     RUN_TEST(test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segment);
+    RUN_TEST(test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corner);
     RUN_TEST(test_sved_grazing_joins_do_not_bridge_a_depth_jump_through_a_mixed_reading);
     RUN_TEST(test_sved_rejects_a_mixed_pixel_near_one_surface_and_keeps_a_real_end);
     RUN_TEST(test_bad_parameters_are_refused);

@@ -285,6 +285,76 @@ static int walls_seen_sparse(const bsf_scene_corner_t *c, const bsf_lidar_t *lid
     return 1;
 }
 
+/* For a missed corner (--verbose): each wall's returns from the one nearest
+ * the vertex outwards (up to 7): beam, range, the feature holding it (999:
+ * none), and the step to the next return with the sine of its angle to
+ * that return's ray (below 0.17 the wall is seen more than 80 deg off its
+ * normal). */
+static void print_corner_walls(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                               const float *ranges, const int16_t *hit_shape,
+                               const bsf_result_t *res)
+{
+    const size_t n = lidar->n_beams;
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const int wall = side == 0 ? c->shape_a : c->shape_b;
+        double dmin = 1e300;
+        size_t start = n, i, b;
+        int dir, best_dir = 0;
+        for (i = 0; i < n; ++i) {
+            if (hit_shape[i] == wall) {
+                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
+                const double d =
+                    hypot((double)ranges[i] * cos(a) - c->x, (double)ranges[i] * sin(a) - c->y);
+                if (d < dmin) {
+                    dmin = d;
+                    start = i;
+                }
+            }
+        }
+        if (start == n) {
+            printf("   wall %d: no hits\n", wall);
+            continue;
+        }
+        for (dir = -1; dir <= 1; dir += 2) {
+            size_t bb = (start + n + (size_t)dir) % n;
+            if (hit_shape[bb] == wall) {
+                best_dir = dir;
+            }
+        }
+        printf("   wall %d, nearest return %.3f m from the vertex", wall, dmin);
+        b = start;
+        for (i = 0; i < 7 && hit_shape[b] == wall; ++i) {
+            const double a = lidar->angle_min + (double)b * lidar->angle_increment;
+            const double px = (double)ranges[b] * cos(a), py = (double)ranges[b] * sin(a);
+            const size_t nb = (b + n + (size_t)best_dir) % n;
+            const double a2 = lidar->angle_min + (double)nb * lidar->angle_increment;
+            const double qx = (double)ranges[nb] * cos(a2), qy = (double)ranges[nb] * sin(a2);
+            const double st = hypot(qx - px, qy - py);
+            const double sn = fabs((qx - px) * qy - (qy - py) * qx) / (st * hypot(qx, qy));
+            size_t f, feat = 999;
+            for (f = 0; f < res->n_features; ++f) {
+                const bsf_feature_t *ft = &res->features[f];
+                const int in = ft->first_beam <= ft->last_beam
+                                   ? (b >= ft->first_beam && b <= ft->last_beam)
+                                   : (b >= ft->first_beam || b <= ft->last_beam);
+                if (in) {
+                    feat = f;
+                }
+            }
+            printf(" | b%lu r%.2f f%lu", (unsigned long)b, (double)ranges[b], (unsigned long)feat);
+            if (best_dir != 0 && hit_shape[nb] == wall) {
+                printf(" st%.2f sin%.2f", st, sn);
+            }
+            if (best_dir == 0) {
+                break;
+            }
+            b = nb;
+        }
+        printf("\n");
+    }
+}
+
 /* A convex corner: the sensor (origin of the sensor frame) stands outside
  * the wedge between the corner's two walls. */
 static int corner_convex(const bsf_scene_t *scene, const bsf_scene_corner_t *c,
@@ -378,6 +448,7 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
                 printf("missed sparse-wall corner at world (%.3f, %.3f), range %.2f m, beam %d, "
                        "angle %.0f deg, nearest vertex %.3f m\n",
                        c->wx, c->wy, c->range, c->beam, c->angle * 57.29577951, best);
+                print_corner_walls(c, lidar, ranges, hit_shape, res);
             }
             if (deg >= BSF_TRUTH_OBTUSE_MIN && deg <= BSF_TRUTH_OBTUSE_MAX) {
                 if (corner_convex(scene, c, lidar)) {
