@@ -2,6 +2,26 @@
 /* Grazing joins (bsf_grazing.h explains them): one copy for SVED and LC. */
 #include "bsf_grazing.h"
 
+int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
+{
+    const float ax = p1.x - p0.x;
+    const float ay = p1.y - p0.y;
+    const float bx = p2.x - p1.x;
+    const float by = p2.y - p1.y;
+    const float la2 = ax * ax + ay * ay;
+    const float lb2 = bx * bx + by * by;
+    const float r2 = BSF_GRAZING_STEP_RATIO * BSF_GRAZING_STEP_RATIO;
+    const float cx = p2.x - p0.x;
+    const float cy = p2.y - p0.y;
+    const float cross = ax * by - ay * bx;
+    if (!(la2 > 0.0f) || !(lb2 > 0.0f) || !(la2 <= r2 * lb2) || !(lb2 <= r2 * la2) ||
+        !(ax * bx + ay * by > 0.0f)) {
+        return 0;
+    }
+    /* distance of p1 from the chord: |cross| / |p2 - p0| */
+    return cross * cross <= BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * (cx * cx + cy * cy);
+}
+
 /* Point e lies just before the line that goes from p through q: behind p
  * by at most 1.5 steps |q - p| along it, off it by at most half a step. */
 static int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)

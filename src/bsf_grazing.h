@@ -37,25 +37,7 @@
 
 /* Points p0, p1, p2 in that order on a line: p1 between the two, within
  * BSF_GRAZING_LINE_TOL of their chord, the two steps within the ratio. */
-static inline int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
-{
-    const float ax = p1.x - p0.x;
-    const float ay = p1.y - p0.y;
-    const float bx = p2.x - p1.x;
-    const float by = p2.y - p1.y;
-    const float la2 = ax * ax + ay * ay;
-    const float lb2 = bx * bx + by * by;
-    const float r2 = BSF_GRAZING_STEP_RATIO * BSF_GRAZING_STEP_RATIO;
-    const float cx = p2.x - p0.x;
-    const float cy = p2.y - p0.y;
-    const float cross = ax * by - ay * bx;
-    if (!(la2 > 0.0f) || !(lb2 > 0.0f) || !(la2 <= r2 * lb2) || !(lb2 <= r2 * la2) ||
-        !(ax * bx + ay * by > 0.0f)) {
-        return 0;
-    }
-    /* distance of p1 from the chord: |cross| / |p2 - p0| */
-    return cross * cross <= BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * (cx * cx + cy * cy);
-}
+int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2);
 
 /* The last valid beam, the one before beam 0 on the ring of a full-circle
  * scan (where SVED's and LC's passes look for their start), or pts->count
