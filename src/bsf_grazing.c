@@ -90,20 +90,26 @@ static int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
 static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, float cap)
 {
     const bsf_point_t *p = pts->pt;
-    if (s < 3u) {
+    /* Both forms need beams s - 3..s + 3 in the scan and s - 1..s + 1
+     * valid; the cheap tests on the corner's return run first (most wide
+     * steps are depth jumps, whose far return lies nowhere near the line). */
+    if (s < 3u || s + 3u >= pts->count || !pts->valid[s - 1u] || !pts->valid[s] ||
+        !pts->valid[s + 1u]) {
         return 0;
     }
     if (dir > 0) {
         const size_t c = s - 1u; /* the corner's return */
-        return bsf_grazing_line3(pts, s - 3u) && !bsf_grazing_triple(p[s - 2u], p[c], p[s]) &&
-               bsf_grazing_line3(pts, s) && bsf_grazing_line3(pts, s + 1u) &&
-               bsf_grazing_entry(p[c], p[s], p[s + 1u]) && bsf_grazing_within(p[c], p[s + 1u], cap);
+        return bsf_grazing_within(p[c], p[s + 1u], cap) &&
+               bsf_grazing_entry(p[c], p[s], p[s + 1u]) && bsf_grazing_line3(pts, s - 3u) &&
+               !bsf_grazing_triple(p[s - 2u], p[c], p[s]) && bsf_grazing_line3(pts, s) &&
+               bsf_grazing_line3(pts, s + 1u);
     }
     {
         const size_t c = s + 1u;
-        return bsf_grazing_line3(pts, c) && !bsf_grazing_triple(p[s], p[c], p[s + 2u]) &&
-               bsf_grazing_line3(pts, s - 2u) && bsf_grazing_line3(pts, s - 3u) &&
-               bsf_grazing_entry(p[c], p[s], p[s - 1u]) && bsf_grazing_within(p[c], p[s - 1u], cap);
+        return bsf_grazing_within(p[c], p[s - 1u], cap) &&
+               bsf_grazing_entry(p[c], p[s], p[s - 1u]) && bsf_grazing_line3(pts, c) &&
+               !bsf_grazing_triple(p[s], p[c], p[s + 2u]) && bsf_grazing_line3(pts, s - 2u) &&
+               bsf_grazing_line3(pts, s - 3u);
     }
 }
 
