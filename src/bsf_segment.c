@@ -454,10 +454,16 @@ static int side_judged(const side_line_t *l, float var)
  * two walls). The other surface may be anything (a pillar, a small object):
  * beam i lies beyond the radius of its nearest return and does not go on
  * along a line through its next two (a wall seen at grazing incidence).
+ * Where the other surface steps wider than the radius (a wall seen at
+ * grazing incidence, or lone returns), one such line suffices: beam i
+ * continuing the line through its next return and the one after is a
+ * grazing wall's first return (or the last of one that ends on a corner)
+ * and stays.
  * near_before: the surface before beam i is the nearer in range;
- * before_is_farther: it is farther from the sensor. */
+ * before_is_farther: it is farther from the sensor; other_wide: the other
+ * surface's first step is wider than the radius. */
 static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
-                              int near_before, int before_is_farther)
+                              int near_before, int before_is_farther, int other_wide)
 {
     side_line_t near;
     float var;
@@ -492,8 +498,11 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
             return 0;
         }
     }
-    return !(k == 3 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
-             bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]]));
+    if (k >= 2 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
+        (other_wide || (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
+        return 0;
+    }
+    return 1;
 }
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
@@ -549,15 +558,23 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         return 1;
     }
     /* Near one surface in range: a mixed pixel only when it lies on neither.
-     * Both runs must go on past beam i's neighbours (steps within the
-     * radius): a wall seen at grazing incidence, whose steps are wider, is no
-     * run to judge, and is most of what reaches this point. */
-    if (!have_outer || !beam_within(rad, (r[1] - r[0]) * (r[1] - r[0])) ||
-        !beam_within(rad, (r[4] - r[3]) * (r[4] - r[3]))) {
+     * The run nearer in range must go on past beam i's neighbour (steps
+     * within the radius; on_neither_surface asks more of it); the other may
+     * step wider (a wall seen at grazing incidence, whose lines
+     * on_neither_surface keeps). */
+    if (!have_outer) {
         return 0;
     }
-    return on_neither_surface(pts, i, ring, rad, r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi,
-                              r[1] > r[2]);
+    {
+        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
+        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
+        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
+        if (!beam_within(rad, near_step * near_step)) {
+            return 0;
+        }
+        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
+                                  !beam_within(rad, other_step * other_step));
+    }
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */
