@@ -499,7 +499,8 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
         }
     }
     if (k >= 2 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
-        (other_wide || (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
+        (other_wide ||
+         (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
         return 0;
     }
     return 1;
