@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_segment_internal.h"
 
 #include <string.h>
 
@@ -194,6 +195,33 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* LC without the returns SVED's mixed-pixel rule will reject: a return on
+ * neither surface at a depth jump, taken into a corner's side, bends its
+ * line off the wall and costs the corner. Those beams are invalid for the
+ * detection only; ex->interest, filled after it, lists them meanwhile (at
+ * most BSF_MAX_KEYPOINTS, in beam order; LC sees any beyond). */
+static bsf_status_t detect_lc(bsf_extractor_t *ex)
+{
+    size_t n = 0u;
+    size_t k;
+    bsf_status_t st;
+    if (ex->params.sved.reject_mixed) {
+        n = bsf_sved_mixed_beams(&ex->points, &ex->params.sved, ex->interest, BSF_MAX_KEYPOINTS);
+        n = n < (size_t)BSF_MAX_KEYPOINTS ? n : (size_t)BSF_MAX_KEYPOINTS;
+        for (k = 0; k < n; ++k) {
+            ex->points.valid[ex->interest[k]] = 0u;
+        }
+    }
+    st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
+                       BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    for (k = 0; k < n; ++k) {
+        ex->points.valid[ex->interest[k]] = 1u;
+    }
+    return st;
+}
+#endif
+
 static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     bsf_status_t st = BSF_OK;
@@ -207,10 +235,7 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
         break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    case BSF_METHOD_LC_SVED_PDM:
-        st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
-                           BSF_MAX_KEYPOINTS, &ex->n_keypoints);
-        break;
+    case BSF_METHOD_LC_SVED_PDM: st = detect_lc(ex); break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     case BSF_METHOD_BID_SVED_PDM:

@@ -5,6 +5,7 @@
 
 #include "bsf_grazing.h"
 #include "bsf_math.h"
+#include "bsf_segment_internal.h"
 
 #define BSF_SEG_PI_F 3.14159265f
 
@@ -506,6 +507,21 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     return 1;
 }
 
+/* Beam i continues a wall seen at grazing incidence from the beam before it
+ * or into the beam after it (bsf_grazing_join: four returns on a line
+ * through the step, within the radius cap), whose steps can be as wide as a
+ * quarter of the jump beside it. Never through the seam of a full circle. */
+static int on_grazing_wall(const bsf_points_t *pts, size_t i, const beam_radius_t *rad)
+{
+    float cap;
+    if (!(rad->cap2 > 0.0f)) {
+        return 0;
+    }
+    cap = sqrtf(rad->cap2);
+    return (i > 0u && bsf_grazing_join(pts, i - 1u, cap)) ||
+           (i + 1u < pts->count && bsf_grazing_join(pts, i, cap));
+}
+
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
@@ -576,6 +592,44 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
                                   !beam_within(rad, other_step * other_step));
     }
+}
+
+/* The radius test's constants of params p for beam_within (the cap on when
+ * extensions is set). */
+static void beam_radius_init(beam_radius_t *rad, const bsf_sved_params_t *p, int extensions)
+{
+    rad->a2 = p->a * p->a;
+    rad->two_b = 2.0f * p->b;
+    rad->cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
+    rad->rho = 0.0f;
+    rad->lower = 0.0f;
+    rad->upper = 0.0f;
+    rad->limit = 0.0f;
+    rad->have_bounds = 0;
+    rad->have_limit = 0;
+}
+
+size_t bsf_sved_mixed_beams(const bsf_points_t *pts, const bsf_sved_params_t *p, uint16_t *out,
+                            size_t cap)
+{
+    const int ring = bsf_points_full_circle(pts);
+    beam_radius_t rad;
+    size_t n = 0;
+    size_t b;
+    beam_radius_init(&rad, p, 1);
+    for (b = 0; b < pts->count; ++b) {
+        if (!pts->valid[b]) {
+            continue;
+        }
+        beam_radius_start(&rad, pts->range[b]);
+        if (is_mixed_pixel(pts, b, ring, &rad) && !on_grazing_wall(pts, b, &rad)) {
+            if (n < cap) {
+                out[n] = (uint16_t)b;
+            }
+            ++n;
+        }
+    }
+    return n;
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */
@@ -667,22 +721,14 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         return BSF_ERR_PARAM;
     }
     sink.min_points = p->min_segment_points;
-    a2 = p->a * p->a;
-    two_b = 2.0f * p->b;
-    cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
+    beam_radius_init(&rad, p, extensions);
+    a2 = rad.a2;
+    two_b = rad.two_b;
+    cap2 = rad.cap2;
     slots = extensions ? 1u + (size_t)p->lookback : 1u;
     reject_mixed = extensions && p->reject_mixed;
     grazing = extensions && p->join_grazing && p->radius_max > 0.0f;
     ring = extensions && bsf_points_full_circle(pts);
-    rad.a2 = a2;
-    rad.two_b = two_b;
-    rad.cap2 = cap2;
-    rad.rho = 0.0f;
-    rad.lower = 0.0f;
-    rad.upper = 0.0f;
-    rad.limit = 0.0f;
-    rad.have_bounds = 0;
-    rad.have_limit = 0;
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
