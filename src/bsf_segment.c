@@ -507,20 +507,10 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     return 1;
 }
 
-/* Beam i continues a wall seen at grazing incidence from the beam before it
- * or into the beam after it (bsf_grazing_join: four returns on a line
- * through the step, within the radius cap), whose steps can be as wide as a
- * quarter of the jump beside it. Never through the seam of a full circle. */
-static int on_grazing_wall(const bsf_points_t *pts, size_t i, const beam_radius_t *rad)
-{
-    float cap;
-    if (!(rad->cap2 > 0.0f)) {
-        return 0;
-    }
-    cap = sqrtf(rad->cap2);
-    return (i > 0u && bsf_grazing_join(pts, i - 1u, cap)) ||
-           (i + 1u < pts->count && bsf_grazing_join(pts, i, cap));
-}
+/* What is_mixed_pixel found: a return halfway between two flat surfaces,
+ * or one off the line of a long run beside it (on_neither_surface). */
+#define MIXED_BETWEEN 1
+#define MIXED_OFF_A_LINE 2
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
@@ -572,7 +562,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     }
     if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
         r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
-        return 1;
+        return MIXED_BETWEEN;
     }
     /* Near one surface in range: a mixed pixel only when it lies on neither.
      * The run nearer in range must go on past beam i's neighbour (steps
@@ -590,7 +580,9 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
             return 0;
         }
         return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
-                                  !beam_within(rad, other_step * other_step));
+                                  !beam_within(rad, other_step * other_step))
+                   ? MIXED_OFF_A_LINE
+                   : 0;
     }
 }
 
@@ -622,7 +614,7 @@ size_t bsf_sved_mixed_beams(const bsf_points_t *pts, const bsf_sved_params_t *p,
             continue;
         }
         beam_radius_start(&rad, pts->range[b]);
-        if (is_mixed_pixel(pts, b, ring, &rad) && !on_grazing_wall(pts, b, &rad)) {
+        if (is_mixed_pixel(pts, b, ring, &rad) == MIXED_OFF_A_LINE) {
             if (n < cap) {
                 out[n] = (uint16_t)b;
             }
