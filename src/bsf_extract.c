@@ -196,28 +196,31 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
 }
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-/* LC without the returns SVED's mixed-pixel rule will reject: a return on
- * neither surface at a depth jump, taken into a corner's side, bends its
- * line off the wall and costs the corner. Those beams are invalid for the
- * detection only; ex->interest, filled after it, lists them meanwhile (at
- * most BSF_MAX_KEYPOINTS, in beam order; LC sees any beyond). */
+/* Beams ex->interest[0..n) valid (1) or not (0). */
+static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
+{
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        ex->points.valid[ex->interest[k]] = valid;
+    }
+}
+
+/* LC without the returns SVED's mixed-pixel rule will reject off the line
+ * of a long run: such a return, taken into a corner's side, bends its line
+ * off the wall and costs the corner. Those beams are invalid for the
+ * detection only; ex->interest, filled after it, lists them meanwhile (the
+ * first BSF_MAX_KEYPOINTS in beam order; LC sees any beyond). */
 static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
     size_t n = 0u;
-    size_t k;
     bsf_status_t st;
     if (ex->params.sved.reject_mixed) {
         n = bsf_sved_mixed_beams(&ex->points, &ex->params.sved, ex->interest, BSF_MAX_KEYPOINTS);
-        n = n < (size_t)BSF_MAX_KEYPOINTS ? n : (size_t)BSF_MAX_KEYPOINTS;
-        for (k = 0; k < n; ++k) {
-            ex->points.valid[ex->interest[k]] = 0u;
-        }
     }
+    set_valid(ex, n, 0u);
     st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
                        BSF_MAX_KEYPOINTS, &ex->n_keypoints);
-    for (k = 0; k < n; ++k) {
-        ex->points.valid[ex->interest[k]] = 1u;
-    }
+    set_valid(ex, n, 1u);
     return st;
 }
 #endif

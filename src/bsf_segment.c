@@ -586,13 +586,12 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     }
 }
 
-/* The radius test's constants of params p for beam_within (the cap on when
- * extensions is set). */
-static void beam_radius_init(beam_radius_t *rad, const bsf_sved_params_t *p, int extensions)
+/* The radius test's constants for beam_within. */
+static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float cap2)
 {
-    rad->a2 = p->a * p->a;
-    rad->two_b = 2.0f * p->b;
-    rad->cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
+    rad->a2 = a2;
+    rad->two_b = two_b;
+    rad->cap2 = cap2;
     rad->rho = 0.0f;
     rad->lower = 0.0f;
     rad->upper = 0.0f;
@@ -608,17 +607,13 @@ size_t bsf_sved_mixed_beams(const bsf_points_t *pts, const bsf_sved_params_t *p,
     beam_radius_t rad;
     size_t n = 0;
     size_t b;
-    beam_radius_init(&rad, p, 1);
-    for (b = 0; b < pts->count; ++b) {
-        if (!pts->valid[b]) {
-            continue;
-        }
-        beam_radius_start(&rad, pts->range[b]);
-        if (is_mixed_pixel(pts, b, ring, &rad) == MIXED_OFF_A_LINE) {
-            if (n < cap) {
-                out[n] = (uint16_t)b;
+    beam_radius_init(&rad, p->a * p->a, 2.0f * p->b, p->radius_max * p->radius_max);
+    for (b = 0; b < pts->count && n < cap; ++b) {
+        if (pts->valid[b]) {
+            beam_radius_start(&rad, pts->range[b]);
+            if (is_mixed_pixel(pts, b, ring, &rad) == MIXED_OFF_A_LINE) {
+                out[n++] = (uint16_t)b;
             }
-            ++n;
         }
     }
     return n;
@@ -713,14 +708,14 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         return BSF_ERR_PARAM;
     }
     sink.min_points = p->min_segment_points;
-    beam_radius_init(&rad, p, extensions);
-    a2 = rad.a2;
-    two_b = rad.two_b;
-    cap2 = rad.cap2;
+    a2 = p->a * p->a;
+    two_b = 2.0f * p->b;
+    cap2 = extensions ? p->radius_max * p->radius_max : 0.0f;
     slots = extensions ? 1u + (size_t)p->lookback : 1u;
     reject_mixed = extensions && p->reject_mixed;
     grazing = extensions && p->join_grazing && p->radius_max > 0.0f;
     ring = extensions && bsf_points_full_circle(pts);
+    beam_radius_init(&rad, a2, two_b, cap2);
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
