@@ -195,6 +195,19 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
+/* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
+ * once before LC and used by segmentation, or NULL when the method finds
+ * none or they do not fit. They live in ex->segments, unused until
+ * segmentation fills it. */
+static uint8_t *mixed_marks(bsf_extractor_t *ex)
+{
+    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
+        sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
+        return NULL;
+    }
+    return (uint8_t *)(void *)ex->segments;
+}
+
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
 /* Beams ex->interest[0..n) valid (1) or not (0). */
 static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
@@ -212,10 +225,12 @@ static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
  * first BSF_MAX_KEYPOINTS in beam order; LC sees any beyond). */
 static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
+    uint8_t *marks = mixed_marks(ex);
     size_t n = 0u;
     bsf_status_t st;
-    if (ex->params.sved.reject_mixed) {
-        n = bsf_sved_mixed_beams(&ex->points, &ex->params.sved, ex->interest, BSF_MAX_KEYPOINTS);
+    if (marks != NULL) {
+        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, marks, ex->interest,
+                                 BSF_MAX_KEYPOINTS);
     }
     set_valid(ex, n, 0u);
     st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
@@ -339,8 +354,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
             }
         }
     } else {
-        st = bsf_segment_sved_labelled(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                       ex->scratch.seg.label, &n_all, NULL);
+        st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
+                                     ex->scratch.seg.label, mixed_marks(ex), &n_all);
     }
     if (st != BSF_OK) {
         return st;

@@ -2,6 +2,7 @@
 #include "bsf/bsf_segment.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "bsf_grazing.h"
 #include "bsf_math.h"
@@ -475,15 +476,7 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     /* the near run lies farther from the sensor than beam i exactly when
      * it is the before run and that is the farther one, or neither */
     const int near_is_farther = near_before == before_is_farther;
-    side_line(pts, i, near_dir, ring, rad, &near);
-    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
-    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
-        return 0;
-    }
-    d = side_distance(&near, pts->pt[i]);
-    if ((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d)) {
-        return 0;
-    }
+    /* The other side first: its tests are cheaper than the line fit. */
     for (k = 0; k < 3; ++k) {
         if (!neighbour_beam(pts, i, (long)(-near_dir) * (long)(k + 1), ring, &o[k])) {
             break;
@@ -504,7 +497,13 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
          (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
         return 0;
     }
-    return 1;
+    side_line(pts, i, near_dir, ring, rad, &near);
+    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
+        return 0;
+    }
+    d = side_distance(&near, pts->pt[i]);
+    return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
 
 /* What is_mixed_pixel found: a return halfway between two flat surfaces,
@@ -600,20 +599,27 @@ static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float ca
     rad->have_limit = 0;
 }
 
-size_t bsf_sved_mixed_beams(const bsf_points_t *pts, const bsf_sved_params_t *p, uint16_t *out,
-                            size_t cap)
+size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
+                            uint16_t *off_line, size_t cap)
 {
     const int ring = bsf_points_full_circle(pts);
     beam_radius_t rad;
     size_t n = 0;
     size_t b;
     beam_radius_init(&rad, p->a * p->a, 2.0f * p->b, p->radius_max * p->radius_max);
-    for (b = 0; b < pts->count && n < cap; ++b) {
-        if (pts->valid[b]) {
-            beam_radius_start(&rad, pts->range[b]);
-            if (is_mixed_pixel(pts, b, ring, &rad) == MIXED_OFF_A_LINE) {
-                out[n++] = (uint16_t)b;
-            }
+    memset(marks, 0, (pts->count + 7u) / 8u);
+    for (b = 0; b < pts->count; ++b) {
+        int kind;
+        if (!pts->valid[b]) {
+            continue;
+        }
+        beam_radius_start(&rad, pts->range[b]);
+        kind = is_mixed_pixel(pts, b, ring, &rad);
+        if (kind != 0) {
+            marks[b / 8u] = (uint8_t)(marks[b / 8u] | (1u << (b % 8u)));
+        }
+        if (kind == MIXED_OFF_A_LINE && n < cap) {
+            off_line[n++] = (uint16_t)b;
         }
     }
     return n;
@@ -679,7 +685,7 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
  * extension fields say (checked, then ignored), and no full-circle pass. */
 static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
                              bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
-                             size_t *n_out, size_t *n_wasted_points)
+                             const uint8_t *marks, size_t *n_out, size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
@@ -739,7 +745,8 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         }
         rho = pts->range[b];
         beam_radius_start(&rad, rho);
-        if (reject_mixed && is_mixed_pixel(pts, b, ring, &rad)) {
+        if (reject_mixed && (marks != NULL ? (marks[b / 8u] >> (b % 8u)) & 1u
+                                           : (unsigned)is_mixed_pixel(pts, b, ring, &rad))) {
             sink.n_wasted++;
             continue;
         }
@@ -857,14 +864,21 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
                               bsf_segment_t *out, size_t cap, size_t *n_out,
                               size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, NULL, 0, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, NULL, 0, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                        bsf_segment_t *out, size_t cap, uint16_t *label,
                                        size_t *n_out, size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, label, 1, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, label, 1, NULL, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                                     bsf_segment_t *out, size_t cap, uint16_t *label,
+                                     const uint8_t *marks, size_t *n_out)
+{
+    return sved_run(pts, params, out, cap, label, 1, marks, n_out, NULL);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,

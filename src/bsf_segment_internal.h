@@ -8,12 +8,20 @@
 
 #include "bsf/bsf_segment.h"
 
-/* The beams of pts that bsf_segment_sved_labelled rejects as mixed pixels
- * off the line of a long run beside them (its second route), with params p
- * (trusted: checked by the caller; reject_mixed is not looked at),
- * ascending, into out[0..cap); returns how many it stored (it stops at
- * cap). */
-size_t bsf_sved_mixed_beams(const bsf_points_t *pts, const bsf_sved_params_t *p, uint16_t *out,
-                            size_t cap);
+/* SVED's mixed-pixel rule (bsf_segment_sved_labelled) on every beam of pts
+ * with params p (trusted: checked by the caller; reject_mixed is not looked
+ * at): bit b % 8 of marks[b / 8] set when it rejects beam b ((count + 7) / 8
+ * bytes written), and the beams it rejects off the line of a long run
+ * beside them (its second route) into off_line[0..cap), ascending; returns
+ * how many of those it stored. */
+size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
+                            uint16_t *off_line, size_t cap);
+
+/* bsf_segment_sved_labelled with the mixed pixels that
+ * bsf_sved_mixed_marks marked on the same points and params (marks not
+ * NULL), rather than finding them again; no count of wasted points. */
+bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                                     bsf_segment_t *out, size_t cap, uint16_t *label,
+                                     const uint8_t *marks, size_t *n_out);
 
 #endif /* BSF_SEGMENT_INTERNAL_H */
