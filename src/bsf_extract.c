@@ -197,8 +197,8 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
 
 /* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
  * once before LC and used by segmentation, or NULL when the method finds
- * none or they do not fit. They live in ex->segments, unused until
- * segmentation fills it. */
+ * none or they do not fit (caps with few segments: SVED then finds them
+ * again). They live in ex->segments, unused until segmentation fills it. */
 static uint8_t *mixed_marks(bsf_extractor_t *ex)
 {
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
@@ -225,11 +225,10 @@ static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
  * first BSF_MAX_KEYPOINTS in beam order; LC sees any beyond). */
 static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
-    uint8_t *marks = mixed_marks(ex);
     size_t n = 0u;
     bsf_status_t st;
-    if (marks != NULL) {
-        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, marks, ex->interest,
+    if (ex->params.sved.reject_mixed) {
+        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
                                  BSF_MAX_KEYPOINTS);
     }
     set_valid(ex, n, 0u);

@@ -607,7 +607,9 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
     size_t n = 0;
     size_t b;
     beam_radius_init(&rad, p->a * p->a, 2.0f * p->b, p->radius_max * p->radius_max);
-    memset(marks, 0, (pts->count + 7u) / 8u);
+    if (marks != NULL) {
+        memset(marks, 0, (pts->count + 7u) / 8u);
+    }
     for (b = 0; b < pts->count; ++b) {
         int kind;
         if (!pts->valid[b]) {
@@ -615,7 +617,7 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
         }
         beam_radius_start(&rad, pts->range[b]);
         kind = is_mixed_pixel(pts, b, ring, &rad);
-        if (kind != 0) {
+        if (kind != 0 && marks != NULL) {
             marks[b / 8u] = (uint8_t)(marks[b / 8u] | (1u << (b % 8u)));
         }
         if (kind == MIXED_OFF_A_LINE && n < cap) {

@@ -11,7 +11,7 @@
 /* SVED's mixed-pixel rule (bsf_segment_sved_labelled) on every beam of pts
  * with params p (trusted: checked by the caller; reject_mixed is not looked
  * at): bit b % 8 of marks[b / 8] set when it rejects beam b ((count + 7) / 8
- * bytes written), and the beams it rejects off the line of a long run
+ * bytes written; marks may be NULL), and the beams it rejects off the line of a long run
  * beside them (its second route) into off_line[0..cap), ascending; returns
  * how many of those it stored. */
 size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
