@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
 #include "bsf_math.h"
+#include "bsf_segment_internal.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -205,6 +206,50 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
+/* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
+ * once before LC and used by segmentation, or NULL when the method finds
+ * none or they do not fit (caps with few segments: SVED then finds them
+ * again). They live in ex->segments, unused until segmentation fills it. */
+static uint8_t *mixed_marks(bsf_extractor_t *ex)
+{
+    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
+        sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
+        return NULL;
+    }
+    return (uint8_t *)(void *)ex->segments;
+}
+
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Beams ex->interest[0..n) valid (1) or not (0). */
+static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
+{
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        ex->points.valid[ex->interest[k]] = valid;
+    }
+}
+
+/* LC without the returns SVED's mixed-pixel rule will reject off the line
+ * of a long run: such a return, taken into a corner's side, bends its line
+ * off the wall and costs the corner. Those beams are invalid for the
+ * detection only; ex->interest, filled after it, lists them meanwhile (the
+ * first BSF_MAX_KEYPOINTS in beam order; LC sees any beyond). */
+static bsf_status_t detect_lc(bsf_extractor_t *ex)
+{
+    size_t n = 0u;
+    bsf_status_t st;
+    if (ex->params.sved.reject_mixed) {
+        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
+                                 BSF_MAX_KEYPOINTS);
+    }
+    set_valid(ex, n, 0u);
+    st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
+                       BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    set_valid(ex, n, 1u);
+    return st;
+}
+#endif
+
 static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     bsf_status_t st = BSF_OK;
@@ -218,10 +263,7 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
         break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    case BSF_METHOD_LC_SVED_PDM:
-        st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
-                           BSF_MAX_KEYPOINTS, &ex->n_keypoints);
-        break;
+    case BSF_METHOD_LC_SVED_PDM: st = detect_lc(ex); break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     case BSF_METHOD_BID_SVED_PDM:
@@ -322,8 +364,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
             }
         }
     } else {
-        st = bsf_segment_sved_labelled(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                       ex->scratch.seg.label, &n_all, NULL);
+        st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
+                                     ex->scratch.seg.label, mixed_marks(ex), &n_all);
     }
     if (st != BSF_OK) {
         return st;

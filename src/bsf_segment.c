@@ -2,9 +2,11 @@
 #include "bsf/bsf_segment.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "bsf_grazing.h"
 #include "bsf_math.h"
+#include "bsf_segment_internal.h"
 
 #define BSF_SEG_PI_F 3.14159265f
 
@@ -454,10 +456,16 @@ static int side_judged(const side_line_t *l, float var)
  * two walls). The other surface may be anything (a pillar, a small object):
  * beam i lies beyond the radius of its nearest return and does not go on
  * along a line through its next two (a wall seen at grazing incidence).
+ * Where the other surface steps wider than the radius (a wall seen at
+ * grazing incidence, or lone returns), one such line suffices: beam i
+ * continuing the line through its next return and the one after is a
+ * grazing wall's first return (or the last of one that ends on a corner)
+ * and stays.
  * near_before: the surface before beam i is the nearer in range;
- * before_is_farther: it is farther from the sensor. */
+ * before_is_farther: it is farther from the sensor; other_wide: the other
+ * surface's first step is wider than the radius. */
 static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
-                              int near_before, int before_is_farther)
+                              int near_before, int before_is_farther, int other_wide)
 {
     side_line_t near;
     float var;
@@ -468,15 +476,7 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     /* the near run lies farther from the sensor than beam i exactly when
      * it is the before run and that is the farther one, or neither */
     const int near_is_farther = near_before == before_is_farther;
-    side_line(pts, i, near_dir, ring, rad, &near);
-    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
-    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
-        return 0;
-    }
-    d = side_distance(&near, pts->pt[i]);
-    if ((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d)) {
-        return 0;
-    }
+    /* The other side first: its tests are cheaper than the line fit. */
     for (k = 0; k < 3; ++k) {
         if (!neighbour_beam(pts, i, (long)(-near_dir) * (long)(k + 1), ring, &o[k])) {
             break;
@@ -492,9 +492,24 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
             return 0;
         }
     }
-    return !(k == 3 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
-             bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]]));
+    if (k >= 2 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
+        (other_wide ||
+         (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
+        return 0;
+    }
+    side_line(pts, i, near_dir, ring, rad, &near);
+    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
+        return 0;
+    }
+    d = side_distance(&near, pts->pt[i]);
+    return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
+
+/* What is_mixed_pixel found: a return halfway between two flat surfaces,
+ * or one off the line of a long run beside it (on_neither_surface). */
+#define MIXED_BETWEEN 1
+#define MIXED_OFF_A_LINE 2
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
@@ -546,18 +561,70 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     }
     if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
         r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
-        return 1;
+        return MIXED_BETWEEN;
     }
     /* Near one surface in range: a mixed pixel only when it lies on neither.
-     * Both runs must go on past beam i's neighbours (steps within the
-     * radius): a wall seen at grazing incidence, whose steps are wider, is no
-     * run to judge, and is most of what reaches this point. */
-    if (!have_outer || !beam_within(rad, (r[1] - r[0]) * (r[1] - r[0])) ||
-        !beam_within(rad, (r[4] - r[3]) * (r[4] - r[3]))) {
+     * The run nearer in range must go on past beam i's neighbour (steps
+     * within the radius; on_neither_surface asks more of it); the other may
+     * step wider (a wall seen at grazing incidence, whose lines
+     * on_neither_surface keeps). */
+    if (!have_outer) {
         return 0;
     }
-    return on_neither_surface(pts, i, ring, rad, r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi,
-                              r[1] > r[2]);
+    {
+        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
+        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
+        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
+        if (!beam_within(rad, near_step * near_step)) {
+            return 0;
+        }
+        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
+                                  !beam_within(rad, other_step * other_step))
+                   ? MIXED_OFF_A_LINE
+                   : 0;
+    }
+}
+
+/* The radius test's constants for beam_within. */
+static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float cap2)
+{
+    rad->a2 = a2;
+    rad->two_b = two_b;
+    rad->cap2 = cap2;
+    rad->rho = 0.0f;
+    rad->lower = 0.0f;
+    rad->upper = 0.0f;
+    rad->limit = 0.0f;
+    rad->have_bounds = 0;
+    rad->have_limit = 0;
+}
+
+size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
+                            uint16_t *off_line, size_t cap)
+{
+    const int ring = bsf_points_full_circle(pts);
+    beam_radius_t rad;
+    size_t n = 0;
+    size_t b;
+    beam_radius_init(&rad, p->a * p->a, 2.0f * p->b, p->radius_max * p->radius_max);
+    if (marks != NULL) {
+        memset(marks, 0, (pts->count + 7u) / 8u);
+    }
+    for (b = 0; b < pts->count; ++b) {
+        int kind;
+        if (!pts->valid[b]) {
+            continue;
+        }
+        beam_radius_start(&rad, pts->range[b]);
+        kind = is_mixed_pixel(pts, b, ring, &rad);
+        if (kind != 0 && marks != NULL) {
+            marks[b / 8u] = (uint8_t)(marks[b / 8u] | (1u << (b % 8u)));
+        }
+        if (kind == MIXED_OFF_A_LINE && n < cap) {
+            off_line[n++] = (uint16_t)b;
+        }
+    }
+    return n;
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */
@@ -620,7 +687,7 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
  * extension fields say (checked, then ignored), and no full-circle pass. */
 static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
                              bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
-                             size_t *n_out, size_t *n_wasted_points)
+                             const uint8_t *marks, size_t *n_out, size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
@@ -656,15 +723,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     reject_mixed = extensions && p->reject_mixed;
     grazing = extensions && p->join_grazing && p->radius_max > 0.0f;
     ring = extensions && bsf_points_full_circle(pts);
-    rad.a2 = a2;
-    rad.two_b = two_b;
-    rad.cap2 = cap2;
-    rad.rho = 0.0f;
-    rad.lower = 0.0f;
-    rad.upper = 0.0f;
-    rad.limit = 0.0f;
-    rad.have_bounds = 0;
-    rad.have_limit = 0;
+    beam_radius_init(&rad, a2, two_b, cap2);
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
@@ -688,7 +747,8 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         }
         rho = pts->range[b];
         beam_radius_start(&rad, rho);
-        if (reject_mixed && is_mixed_pixel(pts, b, ring, &rad)) {
+        if (reject_mixed && (marks != NULL ? (marks[b / 8u] >> (b % 8u)) & 1u
+                                           : (unsigned)is_mixed_pixel(pts, b, ring, &rad))) {
             sink.n_wasted++;
             continue;
         }
@@ -806,14 +866,21 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
                               bsf_segment_t *out, size_t cap, size_t *n_out,
                               size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, NULL, 0, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, NULL, 0, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                        bsf_segment_t *out, size_t cap, uint16_t *label,
                                        size_t *n_out, size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, label, 1, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, label, 1, NULL, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                                     bsf_segment_t *out, size_t cap, uint16_t *label,
+                                     const uint8_t *marks, size_t *n_out)
+{
+    return sved_run(pts, params, out, cap, label, 1, marks, n_out, NULL);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,

@@ -35,7 +35,10 @@ BSF_BEGIN_DECLS
  * intersection: it finds the corners FALKO misses (FALKO's neighbourhood and
  * its per-scan relative score hide most corners beyond 3 m and lone corners)
  * and places them where the walls meet (docs/DESIGN.md, Why LC is the default;
- * docs/GROUND_TRUTH.md has the numbers).
+ * docs/GROUND_TRUTH.md has the numbers). With SVED's reject_mixed on, LC
+ * runs without the mixed pixels SVED finds off the line of a long run
+ * (bsf_segment_sved_labelled; at most BSF_MAX_KEYPOINTS per scan), so that
+ * none ends a corner's side off its wall.
  */
 typedef enum {
     BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM */
