@@ -386,11 +386,6 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 /* Points of the straight run beside a segment end that judge it (tail_end):
  * enough for a noise estimate with six degrees of freedom. */
 #define TAIL_RUN 8u
-/* Variance of a new return one step past the run, off the run's line, in
- * noise variances, for evenly spaced returns: 1 + 1/m + t^2 / sum of
- * squared steps, t = (m + 1) / 2 steps from the centroid, the sum
- * m (m^2 - 1) / 12 (m = TAIL_RUN). */
-#define TAIL_REACH (1.0f + 1.0f / 8.0f + 4.5f * 4.5f / 42.0f)
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
  * nearer the sensor, that the straight run p[step], p[2 step], ... beside
@@ -398,61 +393,36 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * incidence the next wall often gives a single return before the corner,
  * which no corner test can confirm, and a curve bent to reach it swings
  * through free space (half a metre past a corridor's end wall on the
- * ground-truth scenes). It is one when the run's line (total least squares)
- * misses p[0] by more than split_sigmas standard errors of a new point on
- * it (the run's scatter per degree of freedom and the line's own error one
- * step past its end, TAIL_REACH) and at least split_min, on the sensor's
- * side, with a turn of at least min_turn. Only the sensor's side: a convex surface's last returns
- * (a pillar's silhouette) bend away from the sensor and still lie on it. */
+ * ground-truth scenes). It is one when the run's line (total least squares,
+ * SVED's side line) misses p[0] by more than split_sigmas standard errors
+ * of a new return one step past the run (the run's scatter per degree of
+ * freedom and the line's own error there) and at least split_min, on the
+ * sensor's side, with a turn of at least min_turn. Only the sensor's side:
+ * a convex surface's last returns (a pillar's silhouette) bend away from
+ * the sensor and still lie on it. */
 static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t *lc)
 {
-    /* Sums relative to p[step], which keeps them small. */
-    const bsf_point_t o = p[step];
-    float sx = 0.0f, sy = 0.0f, sxx = 0.0f, sxy = 0.0f, syy = 0.0f;
-    float h, lmax, ux, uy, d0, tol2, ex, ey;
+    bsf_point_t w[TAIL_RUN + 1u];
+    bsf_side_line_t l;
+    float d2;
+    float sx;
+    float sy;
+    float s;
     size_t k;
-    for (k = 1u; k <= TAIL_RUN; ++k) {
-        const float dx = p[(ptrdiff_t)k * step].x - o.x;
-        const float dy = p[(ptrdiff_t)k * step].y - o.y;
-        sx += dx;
-        sy += dy;
-        sxx += dx * dx;
-        sxy += dx * dy;
-        syy += dy * dy;
+    for (k = 0; k <= TAIL_RUN; ++k) {
+        w[k] = p[(ptrdiff_t)k * step];
     }
-    sx *= 1.0f / (float)TAIL_RUN;
-    sy *= 1.0f / (float)TAIL_RUN;
-    sxx -= (float)TAIL_RUN * sx * sx;
-    sxy -= (float)TAIL_RUN * sx * sy;
-    syy -= (float)TAIL_RUN * sy * sy;
-    /* The scatter's eigenvalues: the spread along the line (lmax) and the
-     * residual sum of squares across it (lmin); the line runs along the
-     * eigenvector of lmax. */
-    h = sqrtf((sxx - syy) * (sxx - syy) + 4.0f * sxy * sxy);
-    lmax = 0.5f * (sxx + syy + h);
-    ux = lmax - syy;
-    uy = sxy;
-    if (sxx < syy) {
-        ux = sxy;
-        uy = lmax - sxx;
-    }
-    /* u is not normalised: distances along its normal come out times
-     * |u|, so the bounds are scaled by |u|^2 (0 when the run's points
-     * coincide, and then nothing passes). */
-    h = ux * ux + uy * uy;
-    ex = p[0].x - o.x;
-    ey = p[0].y - o.y;
-    d0 = (ey - sy) * ux - (ex - sx) * uy;
-    /* lmin = trace - lmax: the residual sum of squares across the line,
-     * over the run's TAIL_RUN - 2 degrees of freedom */
-    tol2 = lc->split_sigmas * lc->split_sigmas * (sxx + syy - lmax) *
-           (TAIL_REACH / (float)(TAIL_RUN - 2u));
-    tol2 = h * (tol2 > lc->split_min * lc->split_min ? tol2 : lc->split_min * lc->split_min);
-    lmax = bsf_sinf(lc->min_turn);
-    /* The sensor (the origin) lies on the side where the centroid's offset
-     * -(cy ux - cx uy) is positive. */
-    return d0 * ((o.x + sx) * uy - (o.y + sy) * ux) > 0.0f && d0 * d0 > tol2 &&
-           d0 * d0 > lmax * lmax * h * (ex * ex + ey * ey);
+    l.n = (int)TAIL_RUN + 1;
+    bsf_side_fit(w, &l);
+    d2 = l.d_near * l.d_near;
+    sx = p[0].x - p[step].x;
+    sy = p[0].y - p[step].y;
+    s = bsf_sinf(lc->min_turn);
+    /* The sensor (the origin) lies on the side of the line where
+     * -(nx cx + ny cy) is positive. */
+    return l.d_near * (l.nx * l.cx + l.ny * l.cy) < 0.0f &&
+           d2 > lc->split_sigmas * lc->split_sigmas * l.reach_nr * l.var &&
+           d2 > lc->split_min * lc->split_min && d2 > s * s * (sx * sx + sy * sy);
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):

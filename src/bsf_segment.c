@@ -304,30 +304,8 @@ static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, f
  * turn to show it). A mixed pixel's neighbour scatters about the line. */
 #define SEG_MIXED_TURN 4.0f
 
-/* A side's line through the returns beside beam i, the nearest left out. */
-typedef struct {
-    float cx, cy;   /* centroid */
-    float nx, ny;   /* unit normal */
-    float var;      /* noise variance estimated from its residual */
-    float reach_i;  /* variance of beam i's distance from it, in noise variances */
-    float d_near;   /* signed distance of the nearest return from it */
-    float reach_nr; /* the same variance for the nearest return */
-    int n;          /* returns, the nearest included */
-} side_line_t;
-
-/* Signed distance of p from line l. */
-static float side_distance(const side_line_t *l, bsf_point_t p)
+void bsf_side_fit(const bsf_point_t *w, bsf_side_line_t *l)
 {
-    return l->nx * (p.x - l->cx) + l->ny * (p.y - l->cy);
-}
-
-/* The total least-squares line through the returns on side dir (-1: the
- * beams before i, +1: after) of beam i, all but the nearest; only l->n is
- * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
-static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
-                      side_line_t *l)
-{
-    bsf_point_t w[SEG_MIXED_WINDOW];
     float sxx = 0.0f;
     float sxy = 0.0f;
     float syy = 0.0f;
@@ -336,44 +314,11 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
     float m;
     float spread;
     int k;
-    l->n = 0;
     l->cx = 0.0f;
     l->cy = 0.0f;
-    l->nx = 0.0f;
-    l->ny = 1.0f;
-    l->var = 0.0f;
-    l->reach_i = 1.0f;
-    l->reach_nr = 1.0f;
-    l->d_near = 0.0f;
-    const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
-    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
-        size_t j;
-        if (inside) {
-            /* most beams: no wrap, only validity */
-            j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
-            if (!pts->valid[j]) {
-                break;
-            }
-        } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
-            break;
-        }
-        /* beam i's radius for every step (worked out once per beam) */
-        if (l->n > 0) {
-            const float dx = pts->pt[j].x - w[l->n - 1].x;
-            const float dy = pts->pt[j].y - w[l->n - 1].y;
-            if (!beam_within(rad, dx * dx + dy * dy)) {
-                break; /* a depth jump: the surface ends */
-            }
-        }
-        w[l->n] = pts->pt[j];
-        if (l->n > 0) {
-            l->cx += w[l->n].x;
-            l->cy += w[l->n].y;
-        }
-        l->n++;
-    }
-    if (l->n < SEG_MIXED_MIN_SIDE) {
-        return; /* too short to judge (side_judged): no line needed */
+    for (k = 1; k < l->n; ++k) {
+        l->cx += w[k].x;
+        l->cy += w[k].y;
     }
     m = (float)(l->n - 1);
     l->cx /= m;
@@ -422,15 +367,60 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
         l->reach_i = 1.0f + 1.0f / m + t_i * t_i / spread;
         l->reach_nr = 1.0f + 1.0f / m + t_nr * t_nr / spread;
     }
-    l->d_near = side_distance(l, w[0]);
+    l->d_near = bsf_side_distance(l, w[0]);
+}
+
+/* The total least-squares line through the returns on side dir (-1: the
+ * beams before i, +1: after) of beam i, all but the nearest; only l->n is
+ * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
+static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
+                      bsf_side_line_t *l)
+{
+    bsf_point_t w[SEG_MIXED_WINDOW];
+    int k;
+    l->n = 0;
+    l->cx = 0.0f;
+    l->cy = 0.0f;
+    l->nx = 0.0f;
+    l->ny = 1.0f;
+    l->var = 0.0f;
+    l->reach_i = 1.0f;
+    l->reach_nr = 1.0f;
+    l->d_near = 0.0f;
+    const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
+    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
+        size_t j;
+        if (inside) {
+            /* most beams: no wrap, only validity */
+            j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
+            if (!pts->valid[j]) {
+                break;
+            }
+        } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+            break;
+        }
+        /* beam i's radius for every step (worked out once per beam) */
+        if (l->n > 0) {
+            const float dx = pts->pt[j].x - w[l->n - 1].x;
+            const float dy = pts->pt[j].y - w[l->n - 1].y;
+            if (!beam_within(rad, dx * dx + dy * dy)) {
+                break; /* a depth jump: the surface ends */
+            }
+        }
+        w[l->n] = pts->pt[j];
+        l->n++;
+    }
+    if (l->n >= SEG_MIXED_MIN_SIDE) {
+        bsf_side_fit(w, l);
+    }
 }
 
 /* Beam i lies off side line l by more than the noise explains (variance
  * var), towards the sensor when toward_sensor, else away from it. */
-static int off_side_line(const bsf_points_t *pts, size_t i, const side_line_t *l, float var,
+static int off_side_line(const bsf_points_t *pts, size_t i, const bsf_side_line_t *l, float var,
                          int toward_sensor)
 {
-    const float d = side_distance(l, pts->pt[i]);
+    const float d = bsf_side_distance(l, pts->pt[i]);
     float d_sensor;
     if (!(d * d > SEG_MIXED_SIGMAS2 * l->reach_i * var)) {
         return 0;
@@ -441,7 +431,7 @@ static int off_side_line(const bsf_points_t *pts, size_t i, const side_line_t *l
 
 /* The side's surface reaches the beam next to i unbroken: enough returns,
  * the nearest on the line of the others. */
-static int side_judged(const side_line_t *l, float var)
+static int side_judged(const bsf_side_line_t *l, float var)
 {
     return l->n >= SEG_MIXED_MIN_SIDE &&
            l->d_near * l->d_near <= SEG_MIXED_SIGMAS2 * l->reach_nr * var;
@@ -467,7 +457,7 @@ static int side_judged(const side_line_t *l, float var)
 static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
                               int near_before, int before_is_farther, int other_wide)
 {
-    side_line_t near;
+    bsf_side_line_t near;
     float var;
     float d;
     size_t o[3] = {0u, 0u, 0u};
@@ -502,7 +492,7 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
         return 0;
     }
-    d = side_distance(&near, pts->pt[i]);
+    d = bsf_side_distance(&near, pts->pt[i]);
     return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
 
