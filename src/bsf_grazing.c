@@ -2,6 +2,8 @@
 /* Grazing joins (bsf_grazing.h explains them): one copy for SVED and LC. */
 #include "bsf_grazing.h"
 
+#include <stddef.h>
+
 int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
 {
     const float ax = p1.x - p0.x;
@@ -90,27 +92,23 @@ static int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
 static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, float cap)
 {
     const bsf_point_t *p = pts->pt;
+    const ptrdiff_t d = dir;
+    size_t c;
     /* Both forms need beams s - 3..s + 3 in the scan and s - 1..s + 1
      * valid; the cheap tests on the corner's return run first (most wide
-     * steps are depth jumps, whose far return lies nowhere near the line). */
+     * steps are depth jumps, whose far return lies nowhere near the line).
+     * Each triple is tested in ascending beam order, as the lines are. */
     if (s < 3u || s + 3u >= pts->count || !pts->valid[s - 1u] || !pts->valid[s] ||
         !pts->valid[s + 1u]) {
         return 0;
     }
-    if (dir > 0) {
-        const size_t c = s - 1u; /* the corner's return */
-        return bsf_grazing_within(p[c], p[s + 1u], cap) &&
-               bsf_grazing_entry(p[c], p[s], p[s + 1u]) && bsf_grazing_line3(pts, s - 3u) &&
-               !bsf_grazing_triple(p[s - 2u], p[c], p[s]) && bsf_grazing_line3(pts, s) &&
-               bsf_grazing_line3(pts, s + 1u);
-    }
-    {
-        const size_t c = s + 1u;
-        return bsf_grazing_within(p[c], p[s - 1u], cap) &&
-               bsf_grazing_entry(p[c], p[s], p[s - 1u]) && bsf_grazing_line3(pts, c) &&
-               !bsf_grazing_triple(p[s], p[c], p[s + 2u]) && bsf_grazing_line3(pts, s - 2u) &&
-               bsf_grazing_line3(pts, s - 3u);
-    }
+    c = (size_t)((ptrdiff_t)s - d); /* the corner's return */
+    return bsf_grazing_within(p[c], p[(ptrdiff_t)s + d], cap) &&
+           bsf_grazing_entry(p[c], p[s], p[(ptrdiff_t)s + d]) &&
+           bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
+           !bsf_grazing_triple(p[(ptrdiff_t)c - d], p[c], p[s]) &&
+           bsf_grazing_line3(pts, d > 0 ? s : s - 2u) &&
+           bsf_grazing_line3(pts, d > 0 ? s + 1u : s - 3u);
 }
 
 /* The step between beams a and a + 1 is the step onto such a corner run or
