@@ -3,7 +3,6 @@
 #include "bsf_math.h"
 #include "bsf_segment_internal.h"
 
-#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -378,10 +377,6 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
                                          ex->scratch.seg.label, ex->interest, ex->n_keypoints);
 }
 
-/* Gather a segment's valid points into ex->scratch.seg.use.fit.seg_points and the positions of
- * its vertices into ex->scratch.seg.use.fit.vertex_pos: interest beams inside the segment that
- * are not among its first two or last two points (the rule of
- * bsf_segment_classify). Returns the number of points. */
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
 /* Points of the straight run beside a segment end that judge it (tail_end):
  * enough for a noise estimate with six degrees of freedom. */
@@ -445,6 +440,11 @@ static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, siz
     }
 }
 #endif
+
+/* Gather a segment's valid points into ex->scratch.seg.use.fit.seg_points and the positions of
+ * its vertices into ex->scratch.seg.use.fit.vertex_pos: interest beams inside the segment that
+ * are not among its first two or last two points (the rule of
+ * bsf_segment_classify). Returns the number of points. */
 
 static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
 {
