@@ -1,6 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_math.h"
+#include "bsf_segment_internal.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
@@ -56,8 +59,15 @@ bsf_params_t bsf_params_default(bsf_method_t method)
         p.pdm.target_rms = 0.025f;
         p.pdm.bias_window = 0u;
     }
+    if (method == BSF_METHOD_LC_SVED_PDM) {
+        /* LC finds the corner where a wall seen nearly edge-on starts, so
+         * its segments may take that wall's first returns (bsf_grazing.h);
+         * a detector that leaves no vertex there would round it off. */
+        p.sved.join_grazing = 2u;
+    }
     p.no_return = bsf_no_return_params_default();
     p.split_dist = BSF_SPLIT_DIST_DEFAULT;
+    p.trim_tails = 1u;
     p.clock = NULL;
     p.clock_user = NULL;
     p.clock_hz = 0u;
@@ -70,6 +80,7 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     p.sved = bsf_sved_params_paper();
     p.no_return.min_run = 0u;
     p.split_dist = 0.0f;
+    p.trim_tails = 0u;
     /* The first release's refinement target, so the paper-faithful rows of
      * bsf table1 are the numbers that release printed. */
     p.pdm.target_rms = 0.015f;
@@ -85,7 +96,7 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
     }
     if ((p->clock != NULL && p->clock_hz == 0u) || !(p->no_return.code >= 0.0f) ||
         !(p->no_return.code <= 3.402823466e38f) || !(p->split_dist >= 0.0f) ||
-        !(p->split_dist <= BSF_FIT_MAX_COORD)) {
+        !(p->split_dist <= BSF_FIT_MAX_COORD) || p->trim_tails > 1u) {
         return BSF_ERR_PARAM;
     }
     if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
@@ -194,6 +205,50 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
+/* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
+ * once before LC and used by segmentation, or NULL when the method finds
+ * none or they do not fit (caps with few segments: SVED then finds them
+ * again). They live in ex->segments, unused until segmentation fills it. */
+static uint8_t *mixed_marks(bsf_extractor_t *ex)
+{
+    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
+        sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
+        return NULL;
+    }
+    return (uint8_t *)(void *)ex->segments;
+}
+
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Beams ex->interest[0..n) valid (1) or not (0). */
+static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
+{
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        ex->points.valid[ex->interest[k]] = valid;
+    }
+}
+
+/* LC without the returns SVED's mixed-pixel rule will reject off the line
+ * of a long run: such a return, taken into a corner's side, bends its line
+ * off the wall and costs the corner. Those beams are invalid for the
+ * detection only; ex->interest, filled after it, lists them meanwhile (the
+ * first BSF_MAX_KEYPOINTS in beam order; LC sees any beyond). */
+static bsf_status_t detect_lc(bsf_extractor_t *ex)
+{
+    size_t n = 0u;
+    bsf_status_t st;
+    if (ex->params.sved.reject_mixed) {
+        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
+                                 BSF_MAX_KEYPOINTS);
+    }
+    set_valid(ex, n, 0u);
+    st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
+                       BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    set_valid(ex, n, 1u);
+    return st;
+}
+#endif
+
 static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     bsf_status_t st = BSF_OK;
@@ -207,10 +262,7 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
         break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    case BSF_METHOD_LC_SVED_PDM:
-        st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
-                           BSF_MAX_KEYPOINTS, &ex->n_keypoints);
-        break;
+    case BSF_METHOD_LC_SVED_PDM: st = detect_lc(ex); break;
 #endif
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     case BSF_METHOD_BID_SVED_PDM:
@@ -311,8 +363,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
             }
         }
     } else {
-        st = bsf_segment_sved_labelled(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                       ex->scratch.seg.label, &n_all, NULL);
+        st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
+                                     ex->scratch.seg.label, mixed_marks(ex), &n_all);
     }
     if (st != BSF_OK) {
         return st;
@@ -325,10 +377,75 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
                                          ex->scratch.seg.label, ex->interest, ex->n_keypoints);
 }
 
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Points of the straight run beside a segment end that judge it (tail_end):
+ * enough for a noise estimate with six degrees of freedom. */
+#define TAIL_RUN 8u
+
+/* Is the end return p[0] of a segment a tail: a return on another surface,
+ * nearer the sensor, that the straight run p[step], p[2 step], ... beside
+ * it (step +1 or -1) does not explain? At a concave corner seen at grazing
+ * incidence the next wall often gives a single return before the corner,
+ * which no corner test can confirm, and a curve bent to reach it swings
+ * through free space (half a metre past a corridor's end wall on the
+ * ground-truth scenes). It is one when the run's line (total least squares,
+ * SVED's side line) misses p[0] by more than split_sigmas standard errors
+ * of a new return one step past the run (the run's scatter per degree of
+ * freedom and the line's own error there) and at least split_min, on the
+ * sensor's side, with a turn of at least min_turn. Only the sensor's side:
+ * a convex surface's last returns (a pillar's silhouette) bend away from
+ * the sensor and still lie on it. */
+static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t *lc)
+{
+    bsf_point_t w[TAIL_RUN + 1u];
+    bsf_side_line_t l;
+    float d2;
+    float sx;
+    float sy;
+    float s;
+    size_t k;
+    for (k = 0; k <= TAIL_RUN; ++k) {
+        w[k] = p[(ptrdiff_t)k * step];
+    }
+    l.n = (int)TAIL_RUN + 1;
+    bsf_side_fit(w, &l);
+    d2 = l.d_near * l.d_near;
+    sx = p[0].x - p[step].x;
+    sy = p[0].y - p[step].y;
+    s = bsf_sinf(lc->min_turn);
+    /* The sensor (the origin) lies on the side of the line where
+     * -(nx cx + ny cy) is positive. */
+    return l.d_near * (l.nx * l.cx + l.ny * l.cy) < 0.0f &&
+           d2 > lc->split_sigmas * lc->split_sigmas * l.reach_nr * l.var &&
+           d2 > lc->split_min * lc->split_min && d2 > s * s * (sx * sx + sy * sy);
+}
+
+/* The first and last of the n gathered points to fit (LC with trim_tails):
+ * a tail (tail_end) is left off unless LC has a corner within the run
+ * beside it, which already bends the curve there. */
+static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
+{
+    const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
+    const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
+    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
+        n < 2u * TAIL_RUN + 1u) {
+        return;
+    }
+    if ((n_vertex == 0u || pos[0] > TAIL_RUN + 1u) && tail_end(pts, 1, &ex->params.lc)) {
+        *lo = 1u;
+    }
+    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + TAIL_RUN + 2u < n) &&
+        tail_end(&pts[n - 1u], -1, &ex->params.lc)) {
+        *hi = n - 2u;
+    }
+}
+#endif
+
 /* Gather a segment's valid points into ex->scratch.seg.use.fit.seg_points and the positions of
  * its vertices into ex->scratch.seg.use.fit.vertex_pos: interest beams inside the segment that
  * are not among its first two or last two points (the rule of
  * bsf_segment_classify). Returns the number of points. */
+
 static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
 {
     size_t n = 0u;
@@ -526,6 +643,8 @@ static void append_feature(bsf_result_t *res, uint16_t first_beam, uint16_t last
 static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
                                size_t n_vertex, bsf_result_t *res)
 {
+    size_t lo0 = 0u;
+    size_t hi0 = n - 1u;
     uint16_t lo[SPLIT_STACK];
     uint16_t hi[SPLIT_STACK];
     const uint16_t features0 = res->n_features;
@@ -534,8 +653,11 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     const uint32_t nctrl0 = res->stats.n_ctrl;
     int may_split = 1;
     size_t depth = 1u;
-    lo[0] = 0u;
-    hi[0] = (uint16_t)(n - 1u);
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+    trim_tails(ex, n, n_vertex, &lo0, &hi0);
+#endif
+    lo[0] = (uint16_t)lo0;
+    hi[0] = (uint16_t)hi0;
     while (depth > 0u) {
         const size_t a = lo[depth - 1u];
         const size_t b = hi[depth - 1u];
@@ -553,13 +675,13 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
             res->n_ctrl = ctrl0;
             res->stats.n_in_features = in0;
             res->stats.n_ctrl = nctrl0;
-            if (st == BSF_ERR_BUFFER || (a == 0u && b + 1u == n)) {
+            if (st == BSF_ERR_BUFFER || (a == lo0 && b == hi0)) {
                 return st;
             }
             may_split = 0; /* start again: the whole segment, unsplit */
             depth = 1u;
-            lo[0] = 0u;
-            hi[0] = (uint16_t)(n - 1u);
+            lo[0] = (uint16_t)lo0;
+            hi[0] = (uint16_t)hi0;
             continue;
         }
         if (may_split && depth + 2u <= SPLIT_STACK) {
@@ -570,12 +692,15 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
             hi[depth++] = (uint16_t)b;
             lo[depth] = (uint16_t)a;
             hi[depth++] = (uint16_t)(cut - 1u);
-        } else if (a == 0u && b + 1u == n) {
-            append_feature(res, s->first, s->last, s->n_points, s->kind, n_ctrl, e_curve);
         } else {
-            append_feature(
-                res, beam_of_point(ex, s, a), beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
-                (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl, e_curve);
+            /* The whole segment (less its tails) keeps its kind; a piece is
+             * auxiliary when it holds a vertex. */
+            append_feature(res, beam_of_point(ex, s, a), beam_of_point(ex, s, b),
+                           (uint16_t)(b + 1u - a),
+                           a == lo0 && b == hi0
+                               ? s->kind
+                               : (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK),
+                           n_ctrl, e_curve);
         }
     }
     return BSF_OK;

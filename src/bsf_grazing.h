@@ -37,39 +37,7 @@
 
 /* Points p0, p1, p2 in that order on a line: p1 between the two, within
  * BSF_GRAZING_LINE_TOL of their chord, the two steps within the ratio. */
-static inline int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
-{
-    const float ax = p1.x - p0.x;
-    const float ay = p1.y - p0.y;
-    const float bx = p2.x - p1.x;
-    const float by = p2.y - p1.y;
-    const float la2 = ax * ax + ay * ay;
-    const float lb2 = bx * bx + by * by;
-    const float r2 = BSF_GRAZING_STEP_RATIO * BSF_GRAZING_STEP_RATIO;
-    const float cx = p2.x - p0.x;
-    const float cy = p2.y - p0.y;
-    const float cross = ax * by - ay * bx;
-    if (!(la2 > 0.0f) || !(lb2 > 0.0f) || !(la2 <= r2 * lb2) || !(lb2 <= r2 * la2) ||
-        !(ax * bx + ay * by > 0.0f)) {
-        return 0;
-    }
-    /* distance of p1 from the chord: |cross| / |p2 - p0| */
-    return cross * cross <= BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * (cx * cx + cy * cy);
-}
-
-/* Point e lies just before the line that goes from p through q: behind p
- * by at most 1.5 steps |q - p| along it, off it by at most half a step. */
-static inline int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
-{
-    const float ux = q.x - p.x;
-    const float uy = q.y - p.y;
-    const float s2 = ux * ux + uy * uy;
-    const float ex = p.x - e.x;
-    const float ey = p.y - e.y;
-    const float along = ex * ux + ey * uy; /* times |q - p| */
-    const float off = ex * uy - ey * ux;   /* times |q - p| */
-    return s2 > 0.0f && along > 0.0f && along <= 1.5f * s2 && off * off <= 0.25f * s2 * s2;
-}
+int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2);
 
 /* The last valid beam, the one before beam 0 on the ring of a full-circle
  * scan (where SVED's and LC's passes look for their start), or pts->count
@@ -89,68 +57,16 @@ static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
  * so runs and segments go on across the same steps. */
 #define BSF_GRAZING_LC_CAP 1.0f
 
-/* |q - p| <= cap */
-static inline int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
-{
-    const float dx = q.x - p.x;
-    const float dy = q.y - p.y;
-    return dx * dx + dy * dy <= cap * cap;
-}
-
-static inline int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
-{
-    return i < pts->count && pts->valid[i] != 0u;
-}
-
-/* Points i..i + 3 (valid beams) lie on one line: both triples collinear. */
-static inline int bsf_grazing_run4(const bsf_points_t *pts, size_t i)
-{
-    const bsf_point_t *p = pts->pt;
-    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
-           bsf_grazing_ok(pts, i + 3u) && bsf_grazing_triple(p[i], p[i + 1u], p[i + 2u]) &&
-           bsf_grazing_triple(p[i + 1u], p[i + 2u], p[i + 3u]);
-}
-
 /* Beams a and a + 1 (both valid, no wrap) continue one grazing wall, their
  * step at most cap metres (see the top of this file). One collinear triple
  * is not enough: a mixed pixel halfway across a depth jump lies on the
  * chord of its neighbours too, but the surfaces either side do not go on
- * along that line, so four consecutive returns must be collinear. */
-static inline int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap)
-{
-    const size_t b = a + 1u;
-    const bsf_point_t *p = pts->pt;
-    float dx;
-    float dy;
-    if (!bsf_grazing_ok(pts, a) || !bsf_grazing_ok(pts, b)) {
-        return 0;
-    }
-    dx = p[b].x - p[a].x;
-    dy = p[b].y - p[a].y;
-    if (!(dx * dx + dy * dy <= cap * cap)) {
-        return 0;
-    }
-    {
-        /* sin of the angle between the step and beam b's ray (the sensor
-         * is at the origin) */
-        const float cr = dx * p[b].y - dy * p[b].x;
-        const float rb2 = p[b].x * p[b].x + p[b].y * p[b].y;
-        if (!(cr * cr >= BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN * (dx * dx + dy * dy) * rb2)) {
-            return 0;
-        }
-    }
-    if ((a >= 2u && bsf_grazing_run4(pts, a - 2u)) || (a >= 1u && bsf_grazing_run4(pts, a - 1u)) ||
-        bsf_grazing_run4(pts, a)) {
-        return 1;
-    }
-    /* a corner turning onto the wall that starts at b, or off the one that
-     * ends at a */
-    if (bsf_grazing_run4(pts, b) && bsf_grazing_entry(p[a], p[b], p[b + 1u]) &&
-        bsf_grazing_within(p[a], p[b + 2u], cap)) {
-        return 1;
-    }
-    return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]) &&
-           bsf_grazing_within(p[b], p[a - 2u], cap);
-}
+ * along that line, so four consecutive returns must be collinear. Nearer
+ * edge-on than BSF_GRAZING_MIN_SIN, only with at_corners and only the
+ * first four returns of a wall that starts at a corner (or the last four
+ * of one that ends at one), the step onto that corner included: that
+ * corner is visible (three returns on a line fix the wall), and four
+ * returns from it leave no room for a long wall to close a door. */
+int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners);
 
 #endif

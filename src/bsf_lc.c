@@ -51,7 +51,7 @@ bsf_lc_params_t bsf_lc_params_default(void)
      * side within max_side of the apex, so the beam spacing, not the range,
      * decides how far corners are found (about 57 m at 0.5 deg beams). */
     p.max_range = FLT_MAX;
-    p.join_grazing = 1u;
+    p.join_grazing = 2u;
     p.corner_evidence = 1u;
     return p;
 }
@@ -70,7 +70,7 @@ bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
         !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
         !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
         !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
-        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 1u ||
+        p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 2u ||
         p->corner_evidence > 1u) {
         return BSF_ERR_PARAM;
     }
@@ -1178,6 +1178,26 @@ static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
     return len - s->k.r;
 }
 
+/* Side a..b (line l) is a short round side: fewer points than judge_crease
+ * takes as a circle (LC_CREASE_ROUND_POINTS), its line leaving more than
+ * the noise explains (piece_bound), a circle no more. judge_crease stops at
+ * such a side (no crease), yet side_straight, whose curve_ratio test needs
+ * more points to see a curve, passes it, and the two lines then cross a
+ * beam step or two off the crease, on the other wall (a few returns on a
+ * pillar or a bulge where it meets a wall): a vertex where the surface has
+ * none. */
+static int side_short_round(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l)
+{
+    lc_circle_t k;
+    const size_t n = b - a + 1u;
+    if (n <= 3u || n >= LC_CREASE_ROUND_POINTS ||
+        !(l->rss > piece_bound((float)(n - 2u), c->noise2))) {
+        return 0;
+    }
+    return side_curve(c, a, b, l, c->noise2, piece_bound((float)(n - 3u), c->noise2), 0u, &k) >=
+           0.0f;
+}
+
 /* Newton steps towards the crossing of a crease's pieces nearest the apex. */
 #define LC_CREASE_STEPS 6u
 
@@ -1353,6 +1373,12 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * off the vertex even when two lines pass (a 5 m arc against a wall at
      * 1 cm noise: 4 cm along the wall). */
     v = judge_crease(c, a0, apex, b1, &la, &lb, reach, &x, &score);
+    /* No crease, and a side is short and round: the lines' intersection
+     * would lie off the crease (side_short_round), so no vertex at all. */
+    if (v != LC_CORNER &&
+        (side_short_round(c, a0, apex - 1u, &la) || side_short_round(c, apex + 1u, b1, &lb))) {
+        return LC_MERGE;
+    }
     if (v != LC_CORNER) {
         v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, &x, &score);
     }
@@ -1721,7 +1747,8 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
 static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
 {
     return within_jump(pts, p, a, b) ||
-           (p->join_grazing && a + 1u == b && bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP));
+           (p->join_grazing && a + 1u == b &&
+            bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u));
 }
 
 /* Where the pass over a full-circle scan starts: the first valid beam (from

@@ -2,9 +2,11 @@
 #include "bsf/bsf_segment.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "bsf_grazing.h"
 #include "bsf_math.h"
+#include "bsf_segment_internal.h"
 
 #define BSF_SEG_PI_F 3.14159265f
 
@@ -61,7 +63,7 @@ bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p)
         !min_points_ok(p->min_segment_points) || p->max_gap_beams < 1u ||
         p->max_gap_beams > (uint16_t)BSF_MAX_POINTS || !is_finite_f(p->radius_max) ||
         !(p->radius_max == 0.0f || p->radius_max >= p->a) || p->lookback > BSF_SVED_MAX_LOOKBACK ||
-        p->reject_mixed > 1u || p->join_grazing > 1u) {
+        p->reject_mixed > 1u || p->join_grazing > 2u) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
@@ -302,30 +304,8 @@ static int neighbour_range(const bsf_points_t *pts, size_t i, int k, int ring, f
  * turn to show it). A mixed pixel's neighbour scatters about the line. */
 #define SEG_MIXED_TURN 4.0f
 
-/* A side's line through the returns beside beam i, the nearest left out. */
-typedef struct {
-    float cx, cy;   /* centroid */
-    float nx, ny;   /* unit normal */
-    float var;      /* noise variance estimated from its residual */
-    float reach_i;  /* variance of beam i's distance from it, in noise variances */
-    float d_near;   /* signed distance of the nearest return from it */
-    float reach_nr; /* the same variance for the nearest return */
-    int n;          /* returns, the nearest included */
-} side_line_t;
-
-/* Signed distance of p from line l. */
-static float side_distance(const side_line_t *l, bsf_point_t p)
+void bsf_side_fit(const bsf_point_t *w, bsf_side_line_t *l)
 {
-    return l->nx * (p.x - l->cx) + l->ny * (p.y - l->cy);
-}
-
-/* The total least-squares line through the returns on side dir (-1: the
- * beams before i, +1: after) of beam i, all but the nearest; only l->n is
- * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
-static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
-                      side_line_t *l)
-{
-    bsf_point_t w[SEG_MIXED_WINDOW];
     float sxx = 0.0f;
     float sxy = 0.0f;
     float syy = 0.0f;
@@ -334,44 +314,11 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
     float m;
     float spread;
     int k;
-    l->n = 0;
     l->cx = 0.0f;
     l->cy = 0.0f;
-    l->nx = 0.0f;
-    l->ny = 1.0f;
-    l->var = 0.0f;
-    l->reach_i = 1.0f;
-    l->reach_nr = 1.0f;
-    l->d_near = 0.0f;
-    const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
-    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
-        size_t j;
-        if (inside) {
-            /* most beams: no wrap, only validity */
-            j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
-            if (!pts->valid[j]) {
-                break;
-            }
-        } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
-            break;
-        }
-        /* beam i's radius for every step (worked out once per beam) */
-        if (l->n > 0) {
-            const float dx = pts->pt[j].x - w[l->n - 1].x;
-            const float dy = pts->pt[j].y - w[l->n - 1].y;
-            if (!beam_within(rad, dx * dx + dy * dy)) {
-                break; /* a depth jump: the surface ends */
-            }
-        }
-        w[l->n] = pts->pt[j];
-        if (l->n > 0) {
-            l->cx += w[l->n].x;
-            l->cy += w[l->n].y;
-        }
-        l->n++;
-    }
-    if (l->n < SEG_MIXED_MIN_SIDE) {
-        return; /* too short to judge (side_judged): no line needed */
+    for (k = 1; k < l->n; ++k) {
+        l->cx += w[k].x;
+        l->cy += w[k].y;
     }
     m = (float)(l->n - 1);
     l->cx /= m;
@@ -420,15 +367,60 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
         l->reach_i = 1.0f + 1.0f / m + t_i * t_i / spread;
         l->reach_nr = 1.0f + 1.0f / m + t_nr * t_nr / spread;
     }
-    l->d_near = side_distance(l, w[0]);
+    l->d_near = bsf_side_distance(l, w[0]);
+}
+
+/* The total least-squares line through the returns on side dir (-1: the
+ * beams before i, +1: after) of beam i, all but the nearest; only l->n is
+ * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
+static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
+                      bsf_side_line_t *l)
+{
+    bsf_point_t w[SEG_MIXED_WINDOW];
+    int k;
+    l->n = 0;
+    l->cx = 0.0f;
+    l->cy = 0.0f;
+    l->nx = 0.0f;
+    l->ny = 1.0f;
+    l->var = 0.0f;
+    l->reach_i = 1.0f;
+    l->reach_nr = 1.0f;
+    l->d_near = 0.0f;
+    const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
+    for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
+        size_t j;
+        if (inside) {
+            /* most beams: no wrap, only validity */
+            j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
+            if (!pts->valid[j]) {
+                break;
+            }
+        } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+            break;
+        }
+        /* beam i's radius for every step (worked out once per beam) */
+        if (l->n > 0) {
+            const float dx = pts->pt[j].x - w[l->n - 1].x;
+            const float dy = pts->pt[j].y - w[l->n - 1].y;
+            if (!beam_within(rad, dx * dx + dy * dy)) {
+                break; /* a depth jump: the surface ends */
+            }
+        }
+        w[l->n] = pts->pt[j];
+        l->n++;
+    }
+    if (l->n >= SEG_MIXED_MIN_SIDE) {
+        bsf_side_fit(w, l);
+    }
 }
 
 /* Beam i lies off side line l by more than the noise explains (variance
  * var), towards the sensor when toward_sensor, else away from it. */
-static int off_side_line(const bsf_points_t *pts, size_t i, const side_line_t *l, float var,
+static int off_side_line(const bsf_points_t *pts, size_t i, const bsf_side_line_t *l, float var,
                          int toward_sensor)
 {
-    const float d = side_distance(l, pts->pt[i]);
+    const float d = bsf_side_distance(l, pts->pt[i]);
     float d_sensor;
     if (!(d * d > SEG_MIXED_SIGMAS2 * l->reach_i * var)) {
         return 0;
@@ -439,7 +431,7 @@ static int off_side_line(const bsf_points_t *pts, size_t i, const side_line_t *l
 
 /* The side's surface reaches the beam next to i unbroken: enough returns,
  * the nearest on the line of the others. */
-static int side_judged(const side_line_t *l, float var)
+static int side_judged(const bsf_side_line_t *l, float var)
 {
     return l->n >= SEG_MIXED_MIN_SIDE &&
            l->d_near * l->d_near <= SEG_MIXED_SIGMAS2 * l->reach_nr * var;
@@ -454,12 +446,18 @@ static int side_judged(const side_line_t *l, float var)
  * two walls). The other surface may be anything (a pillar, a small object):
  * beam i lies beyond the radius of its nearest return and does not go on
  * along a line through its next two (a wall seen at grazing incidence).
+ * Where the other surface steps wider than the radius (a wall seen at
+ * grazing incidence, or lone returns), one such line suffices: beam i
+ * continuing the line through its next return and the one after is a
+ * grazing wall's first return (or the last of one that ends on a corner)
+ * and stays.
  * near_before: the surface before beam i is the nearer in range;
- * before_is_farther: it is farther from the sensor. */
+ * before_is_farther: it is farther from the sensor; other_wide: the other
+ * surface's first step is wider than the radius. */
 static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
-                              int near_before, int before_is_farther)
+                              int near_before, int before_is_farther, int other_wide)
 {
-    side_line_t near;
+    bsf_side_line_t near;
     float var;
     float d;
     size_t o[3] = {0u, 0u, 0u};
@@ -468,15 +466,7 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     /* the near run lies farther from the sensor than beam i exactly when
      * it is the before run and that is the farther one, or neither */
     const int near_is_farther = near_before == before_is_farther;
-    side_line(pts, i, near_dir, ring, rad, &near);
-    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
-    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
-        return 0;
-    }
-    d = side_distance(&near, pts->pt[i]);
-    if ((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d)) {
-        return 0;
-    }
+    /* The other side first: its tests are cheaper than the line fit. */
     for (k = 0; k < 3; ++k) {
         if (!neighbour_beam(pts, i, (long)(-near_dir) * (long)(k + 1), ring, &o[k])) {
             break;
@@ -492,9 +482,24 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
             return 0;
         }
     }
-    return !(k == 3 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
-             bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]]));
+    if (k >= 2 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
+        (other_wide ||
+         (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
+        return 0;
+    }
+    side_line(pts, i, near_dir, ring, rad, &near);
+    var = near.var > SEG_MIXED_FLOOR2 ? near.var : SEG_MIXED_FLOOR2;
+    if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
+        return 0;
+    }
+    d = bsf_side_distance(&near, pts->pt[i]);
+    return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
+
+/* What is_mixed_pixel found: a return halfway between two flat surfaces,
+ * or one off the line of a long run beside it (on_neither_surface). */
+#define MIXED_BETWEEN 1
+#define MIXED_OFF_A_LINE 2
 
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
@@ -546,18 +551,70 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     }
     if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
         r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
-        return 1;
+        return MIXED_BETWEEN;
     }
     /* Near one surface in range: a mixed pixel only when it lies on neither.
-     * Both runs must go on past beam i's neighbours (steps within the
-     * radius): a wall seen at grazing incidence, whose steps are wider, is no
-     * run to judge, and is most of what reaches this point. */
-    if (!have_outer || !beam_within(rad, (r[1] - r[0]) * (r[1] - r[0])) ||
-        !beam_within(rad, (r[4] - r[3]) * (r[4] - r[3]))) {
+     * The run nearer in range must go on past beam i's neighbour (steps
+     * within the radius; on_neither_surface asks more of it); the other may
+     * step wider (a wall seen at grazing incidence, whose lines
+     * on_neither_surface keeps). */
+    if (!have_outer) {
         return 0;
     }
-    return on_neither_surface(pts, i, ring, rad, r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi,
-                              r[1] > r[2]);
+    {
+        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
+        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
+        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
+        if (!beam_within(rad, near_step * near_step)) {
+            return 0;
+        }
+        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
+                                  !beam_within(rad, other_step * other_step))
+                   ? MIXED_OFF_A_LINE
+                   : 0;
+    }
+}
+
+/* The radius test's constants for beam_within. */
+static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float cap2)
+{
+    rad->a2 = a2;
+    rad->two_b = two_b;
+    rad->cap2 = cap2;
+    rad->rho = 0.0f;
+    rad->lower = 0.0f;
+    rad->upper = 0.0f;
+    rad->limit = 0.0f;
+    rad->have_bounds = 0;
+    rad->have_limit = 0;
+}
+
+size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
+                            uint16_t *off_line, size_t cap)
+{
+    const int ring = bsf_points_full_circle(pts);
+    beam_radius_t rad;
+    size_t n = 0;
+    size_t b;
+    beam_radius_init(&rad, p->a * p->a, 2.0f * p->b, p->radius_max * p->radius_max);
+    if (marks != NULL) {
+        memset(marks, 0, (pts->count + 7u) / 8u);
+    }
+    for (b = 0; b < pts->count; ++b) {
+        int kind;
+        if (!pts->valid[b]) {
+            continue;
+        }
+        beam_radius_start(&rad, pts->range[b]);
+        kind = is_mixed_pixel(pts, b, ring, &rad);
+        if (kind != 0 && marks != NULL) {
+            marks[b / 8u] = (uint8_t)(marks[b / 8u] | (1u << (b % 8u)));
+        }
+        if (kind == MIXED_OFF_A_LINE && n < cap) {
+            off_line[n++] = (uint16_t)b;
+        }
+    }
+    return n;
 }
 
 /* Output order: by first beam, a segment wrapping through the seam last. */
@@ -620,7 +677,7 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
  * extension fields say (checked, then ignored), and no full-circle pass. */
 static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
                              bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
-                             size_t *n_out, size_t *n_wasted_points)
+                             const uint8_t *marks, size_t *n_out, size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
@@ -656,15 +713,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     reject_mixed = extensions && p->reject_mixed;
     grazing = extensions && p->join_grazing && p->radius_max > 0.0f;
     ring = extensions && bsf_points_full_circle(pts);
-    rad.a2 = a2;
-    rad.two_b = two_b;
-    rad.cap2 = cap2;
-    rad.rho = 0.0f;
-    rad.lower = 0.0f;
-    rad.upper = 0.0f;
-    rad.limit = 0.0f;
-    rad.have_bounds = 0;
-    rad.have_limit = 0;
+    beam_radius_init(&rad, a2, two_b, cap2);
     if (label != NULL) {
         for (j = 0; j < pts->count; ++j) {
             label[j] = (uint16_t)BSF_SEG_NONE;
@@ -688,7 +737,8 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         }
         rho = pts->range[b];
         beam_radius_start(&rad, rho);
-        if (reject_mixed && is_mixed_pixel(pts, b, ring, &rad)) {
+        if (reject_mixed && (marks != NULL ? (marks[b / 8u] >> (b % 8u)) & 1u
+                                           : (unsigned)is_mixed_pixel(pts, b, ring, &rad))) {
             sink.n_wasted++;
             continue;
         }
@@ -742,7 +792,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         /* A wide step from the beam before may still continue a wall seen
          * at grazing incidence (bsf_grazing.h). */
         if (best == slots && grazing && n_open > 0u && b > 0u && open[0].last + 1u == b &&
-            bsf_grazing_join(pts, b - 1u, p->radius_max)) {
+            bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u)) {
             best = 0u;
         }
         if (best == 0u) {
@@ -806,14 +856,21 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
                               bsf_segment_t *out, size_t cap, size_t *n_out,
                               size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, NULL, 0, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, NULL, 0, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                        bsf_segment_t *out, size_t cap, uint16_t *label,
                                        size_t *n_out, size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, label, 1, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, label, 1, NULL, n_out, n_wasted_points);
+}
+
+bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
+                                     bsf_segment_t *out, size_t cap, uint16_t *label,
+                                     const uint8_t *marks, size_t *n_out)
+{
+    return sved_run(pts, params, out, cap, label, 1, marks, n_out, NULL);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,

@@ -35,7 +35,10 @@ BSF_BEGIN_DECLS
  * intersection: it finds the corners FALKO misses (FALKO's neighbourhood and
  * its per-scan relative score hide most corners beyond 3 m and lone corners)
  * and places them where the walls meet (docs/DESIGN.md, Why LC is the default;
- * docs/GROUND_TRUTH.md has the numbers).
+ * docs/GROUND_TRUTH.md has the numbers). With SVED's reject_mixed on, LC
+ * runs without the mixed pixels SVED finds off the line of a long run
+ * (bsf_segment_sved_labelled; at most BSF_MAX_KEYPOINTS per scan), so that
+ * none ends a corner's side off its wall.
  */
 typedef enum {
     BSF_METHOD_FALKO_SVED_PDM = 0, /**< the paper's proposal: FALKO corners, SVED, PDM */
@@ -72,6 +75,16 @@ typedef struct {
      *  the features. Metres, >= 0; 0 turns it off (bsf_params_paper).
      *  Default 0.25. */
     float split_dist;
+    /** LC-SVED-PDM: 1 (default) leaves a segment's end return out of its
+     *  feature when the straight run of 8 returns beside it misses it, on
+     *  the sensor's side, by more than split_sigmas standard errors (the
+     *  run's own scatter) and lc.split_min, turning by lc.min_turn or more:
+     *  a single return on the next wall past a concave corner seen at
+     *  grazing incidence, or on an occluder. A curve bent to reach it swings
+     *  through free space. Segments of at least 17 returns, and not where LC
+     *  has a corner within the run. The return counts as wasted in Γ.
+     *  0 keeps every return (bsf_params_paper). */
+    uint8_t trim_tails;
     bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
     void *clock_user;   /**< passed to clock */
     uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */
@@ -82,7 +95,9 @@ typedef struct {
  *  bsf_pdm_params_default (30 mm target plus the systematic-deviation test)
  *  except FALKO-SVED-PDM and BID-SVED-PDM, which refine on RMS alone to
  *  25 mm (bias_window 0): their keypoints miss most corners, which the test
- *  would round with control points.
+ *  would round with control points. LC-SVED-PDM segments with
+ *  join_grazing 2 (bsf_sved_params_t): LC puts the vertex where a wall seen
+ *  nearly edge-on starts at a corner.
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
  *  stored, which bsf_extractor_init then refuses. */
 bsf_params_t bsf_params_default(bsf_method_t method);

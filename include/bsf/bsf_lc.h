@@ -106,9 +106,12 @@ typedef struct {
     uint16_t min_side_points; /**< points needed on each side, apex excluded, >= 2 (3); one
                                    fewer where a side reaches the end of its run */
     uint8_t join_grazing;     /**< 1: a run goes on across a step wider than the jump radius
-                                   (at most max_side) where four consecutive returns through it
-                                   lie on one line, a wall seen at grazing incidence, or where
-                                   such a wall starts at a corner (default); 0: it does not */
+                                   (at most 1 m) where four consecutive returns through it
+                                   lie on one line, a wall seen at grazing incidence (up to
+                                   80 deg), or where such a wall starts at a corner; 2
+                                   (default): also the first four returns of a wall seen
+                                   nearer edge-on, when they start at a corner (or the last
+                                   four, ending at one); 0: it does not */
     uint8_t corner_evidence;  /**< 1: a split the curve_ratio test rejects is still a corner
                                    when the best smooth curve misses the points by far more
                                    than the noise explains (a likelihood-ratio test, see
@@ -121,7 +124,7 @@ bsf_lc_params_t bsf_lc_params_default(void);
 /** @return BSF_OK; BSF_ERR_ARG for NULL; BSF_ERR_PARAM when a value is not
  *  finite or out of range (jump_a, split_min, max_side, curve_ratio, max_range > 0;
  *  jump_b, floor, apex_slack, min_side_len >= 0; split_sigmas >= 0; min_turn in (0, pi/2);
- *  min_side_points in 2..64; join_grazing and corner_evidence 0 or 1). */
+ *  min_side_points in 2..64; join_grazing 0..2; corner_evidence 0 or 1). */
 BSF_NODISCARD bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p);
 
 /** Points of a run per summary block of bsf_lc_work_t. */

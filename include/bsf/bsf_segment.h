@@ -74,8 +74,11 @@ typedef struct {
     uint8_t join_grazing; /**< 1: a point also joins the current segment across a step wider
                                than the radius (at most radius_max, used when radius_max > 0)
                                where four consecutive returns through the step lie on one line,
-                               a wall seen at grazing incidence, or where such a wall starts at
-                               a corner (default); 0 (the paper): it does not */
+                               a wall seen at grazing incidence (up to 80 deg), or where such a
+                               wall starts at a corner (default); 2: also the first four
+                               returns of a wall seen nearer edge-on, when they start at a
+                               corner (or the last four, ending at one): the default of
+                               lc-sved-pdm, whose corners end there; 0 (the paper): none */
 } bsf_sved_params_t;
 
 /** Largest lookback of bsf_sved_params_t. */
@@ -160,23 +163,27 @@ BSF_NODISCARD bsf_status_t bsf_segment_sved(const bsf_points_t *pts,
  *    flat surfaces on either side, unlike a wall seen at a grazing angle
  *    whose steps grow smoothly), and beam i is more than J / 8 from both
  *    neighbours in range; or
- *  - it lies on neither surface, however near one of them in range: the
- *    range steps i-2 -> i-1 and i+1 -> i+2 are both within the radius at
- *    rho(i) (a run goes on each side; a wall seen at grazing incidence has
- *    wider steps); on the side nearer to beam i in range, at least 8
- *    consecutive returns (up to 10) step within that radius, the nearest
- *    lies on the total least-squares line of the others, and beam i lies
- *    off that line, towards the other surface, by more than 4 standard
- *    deviations of its extrapolated distance (the noise taken from the
- *    line's residual, at least 3 mm), while the nearest return does not lie
- *    off it on the same side by a quarter of that (the run turning there);
- *    and beam i lies beyond the radius from its neighbour on the other side
- *    and does not go on along a line through that neighbour and the next
- *    two. A return at a surface's real end lies on that surface's line and
- *    stays; so does a return beside a run too short or bent to judge (a
- *    small object, a corner next to beam i). A single return of a third
+ *  - it lies on neither surface, however near one of them in range: on
+ *    the side nearer to beam i in range, at least 8 consecutive returns (up
+ *    to 10) step within the radius at rho(i), the nearest lies on the total
+ *    least-squares line of the others, and beam i lies off that line,
+ *    towards the other surface, by more than 4 standard deviations of its
+ *    extrapolated distance (the noise taken from the line's residual, at
+ *    least 3 mm), while the nearest return does not lie off it on the same
+ *    side by a quarter of that (the run turning there); and beam i lies
+ *    beyond the radius from its neighbour on the other side and does not go
+ *    on along a line through that neighbour and the next one (where the
+ *    other side's first range step is within the radius: and the one after,
+ *    both collinear; where it is wider, a wall seen at grazing incidence or
+ *    lone returns, the first line suffices). A return at a surface's real
+ *    end lies on that surface's line and stays; so does a return beside a
+ *    run too short or bent to judge (a small object, a corner next to beam
+ *    i), and the first return of a grazing wall. A single return of a third
  *    surface beyond a corner, between the two in range and off both, looks
  *    the same as a mixed pixel and goes too.
+ *    bsf_extract's LC (the default method) does not see the returns this
+ *    second route rejects either (the first route has no noise scale: at
+ *    3 cm noise it takes real returns at small depth steps too).
  *
  * Full-circle scans (bsf_points_full_circle): the pass starts after the
  * widest step between cyclically consecutive valid points, so a surface

@@ -13,6 +13,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
@@ -131,6 +132,136 @@ static void test_office_curves_never_stray_far_from_the_walls(void)
     TEST_ASSERT_TRUE_MESSAGE(s.curve_max <= 0.08, "a curve strays more than 8 cm from the walls");
 }
 
+/* The oracle (bsf_truth_oracle_vertex): two total-least-squares lines
+ * through the returns that truly lie on each wall. On a noiseless scan those
+ * returns lie exactly on the walls, so the lines are the walls and the
+ * oracle's vertex is the corner itself: any return of another surface, a
+ * wrong fit or a wrong intersection would put it off. */
+static void test_oracle_is_exact_without_noise(void)
+{
+    static bsf_scene_t sc;
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
+    long k;
+    bsf_scene_demo_office(&sc);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    bsf_truth_acc_init(&acc);
+    for (k = 0; k < N_POSES; ++k) {
+        double x, y, th;
+        bsf_lidar_t lid;
+        bsf_scan_t scan;
+        bsf_scene_demo_pose(k, N_POSES, &x, &y, &th);
+        lid = bsf_lidar_default(x, y, th, 361u, 1.5 * PI);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&sc, &lid, NULL, clean, hits, BSF_MAX_POINTS));
+        scan = bsf_scene_lidar_scan(&lid, clean);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &scan, &res));
+        TEST_ASSERT_EQUAL_INT(
+            0, bsf_truth_add_oracle(&acc, &sc, &lid, clean, hits, clean, NULL, &res));
+    }
+    printf("oracle without noise: %lu corners, largest error %.2e m, %lu undefined\n",
+           (unsigned long)acc.oracle_err_all.n, acc.oracle_err_all.max,
+           (unsigned long)acc.oracle_undefined);
+    TEST_ASSERT_TRUE(acc.oracle_err_all.n >= 20u);
+    TEST_ASSERT_TRUE(acc.oracle_err_found.n >= 10u);
+    TEST_ASSERT_TRUE(acc.oracle_err_found.n <= acc.oracle_err_all.n);
+    TEST_ASSERT_TRUE_MESSAGE(acc.oracle_err_all.max <= 1e-5, "oracle off a corner without noise");
+}
+
+/* A corner of the noisy office whose walls have at least four returns each
+ * (whole runs); fills *cn and the oracle's vertex. */
+static int noisy_corner(const bsf_scene_t *sc, const bsf_lidar_t *lid, bsf_scene_corner_t *cn,
+                        double *ox, double *oy)
+{
+    static bsf_scene_corner_t corners[256];
+    size_t n = 0;
+    size_t k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(sc, lid, corners, 256u, &n));
+    for (k = 0; k < n; ++k) {
+        int n_side[2];
+        if (corners[k].visible && corners[k].range <= 6.0 &&
+            bsf_truth_oracle_vertex(&corners[k], lid, clean, hits, ranges, NULL, 0.0, ox, oy,
+                                    n_side, NULL) == 0 &&
+            n_side[0] >= 4 && n_side[1] >= 4) {
+            *cn = corners[k];
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* The oracle takes the returns of the corner's two walls and no other, leaves
+ * out a beam marked as a mixed pixel, and reaches as far as it is told. */
+static void test_oracle_takes_only_its_walls_returns(void)
+{
+    static bsf_scene_t sc;
+    static float unmixed[BSF_MAX_POINTS];
+    bsf_scene_rng_t rng;
+    bsf_scene_corner_t cn;
+    bsf_lidar_t lid;
+    double x, y, th, ox, oy, qx, qy, o0;
+    int n_whole[2], n_near[2];
+    double len_whole[2], len_near[2];
+    size_t i;
+    size_t near_beam = 0;
+    size_t other_beam = 0;
+    double dmin = 1e300;
+    bsf_scene_demo_office(&sc);
+    bsf_scene_rng_seed(&rng, 5u);
+    bsf_scene_demo_pose(3, 10, &x, &y, &th);
+    lid = bsf_lidar_default(x, y, th, 361u, 1.5 * PI);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&sc, &lid, NULL, clean, hits, BSF_MAX_POINTS));
+    for (i = 0; i < 361u; ++i) {
+        ranges[i] = clean[i];
+        if (hits[i] >= 0) {
+            ranges[i] = (float)((double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng));
+        }
+    }
+    TEST_ASSERT_TRUE(noisy_corner(&sc, &lid, &cn, &ox, &oy));
+    o0 = hypot(ox - cn.x, oy - cn.y);
+    printf("oracle at 1 cm noise: %.4f m off the corner at range %.2f m\n", o0, cn.range);
+    /* noise moves it, but by millimetres */
+    TEST_ASSERT_TRUE(o0 > 1e-5 && o0 < 0.02);
+    /* the return on the first wall nearest the corner; a beam on neither wall */
+    for (i = 0; i < 361u; ++i) {
+        const double a = lid.angle_min + (double)i * lid.angle_increment;
+        const double d = hypot((double)clean[i] * cos(a) - cn.x, (double)clean[i] * sin(a) - cn.y);
+        if (hits[i] == cn.shape_a && d < dmin) {
+            dmin = d;
+            near_beam = i;
+        }
+        if (hits[i] >= 0 && hits[i] != cn.shape_a && hits[i] != cn.shape_b) {
+            other_beam = i;
+        }
+    }
+    TEST_ASSERT_TRUE(hits[other_beam] >= 0);
+    /* another surface's return does not count */
+    ranges[other_beam] += 0.5f;
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.0, &qx,
+                                                     &qy, NULL, NULL));
+    TEST_ASSERT_TRUE(qx == ox && qy == oy);
+    /* the wall's own return does */
+    memcpy(unmixed, ranges, sizeof ranges);
+    ranges[near_beam] += 0.5f;
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.0, &qx,
+                                                     &qy, NULL, NULL));
+    TEST_ASSERT_TRUE(hypot(qx - cn.x, qy - cn.y) > o0 + 0.02);
+    /* unless it is marked as a mixed pixel (its range not what the wall gave) */
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, unmixed, 0.0,
+                                                     &qx, &qy, NULL, NULL));
+    TEST_ASSERT_TRUE(hypot(qx - cn.x, qy - cn.y) < 0.02);
+    /* reach: returns within 0.6 m of the corner only */
+    memcpy(ranges, unmixed, sizeof ranges);
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.0, &qx,
+                                                     &qy, n_whole, len_whole));
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.6, &qx,
+                                                     &qy, n_near, len_near));
+    for (i = 0; i < 2u; ++i) {
+        TEST_ASSERT_TRUE(len_near[i] <= 0.6);
+        TEST_ASSERT_TRUE(n_near[i] <= n_whole[i]);
+        TEST_ASSERT_TRUE(len_near[i] <= len_whole[i]);
+    }
+    TEST_ASSERT_TRUE(n_near[0] < n_whole[0] || n_near[1] < n_whole[1]);
+}
+
 int main(void)
 {
     bsf_truth_verbose = getenv("TRUTH_VERBOSE") != NULL;
@@ -139,5 +270,7 @@ int main(void)
     RUN_TEST(test_office_181_beams_finds_most_corners);
     RUN_TEST(test_office_vertices_sit_on_the_corners);
     RUN_TEST(test_office_curves_never_stray_far_from_the_walls);
+    RUN_TEST(test_oracle_is_exact_without_noise);
+    RUN_TEST(test_oracle_takes_only_its_walls_returns);
     return UNITY_END();
 }

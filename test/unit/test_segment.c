@@ -732,6 +732,41 @@ static void test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segme
     TEST_ASSERT_TRUE(corner_onto_grazing_wall(0, &n_valid) > 1u || n_wasted > 0u);
 }
 
+/* SVED with every extension on a room corner 3 m away whose second wall is
+ * seen at 83 deg incidence (1 deg beams, 1 cm noise): its first returns
+ * are 0.35-0.5 m apart, nearer edge-on than grazing joins go (80 deg), so
+ * with join_grazing 1 they break off the corner's segment; with 2 the
+ * first four of them, which start at the corner, join it and the rest of
+ * the wall follows: one segment holds every return. */
+static size_t corner_onto_wall_seen_nearly_edge_on(int join_grazing, size_t *n_valid)
+{
+    bsf_lidar_t l = bsf_lidar_default(0.0, 0.03, 0.0, 271u, 1.5 * 3.14159265358979);
+    bsf_scene_rng_t rng;
+    bsf_sved_params_t p = bsf_sved_params_default();
+    p.join_grazing = (uint8_t)join_grazing;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 3.0, 0.4, -0.5 * 3.14159265358979,
+                                                       4.0, 3.14159265358979, 2.0));
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&rng, 11u);
+    shoot(&l, &rng);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
+                                                            NULL, &n_segs, &n_wasted));
+    check_partition();
+    *n_valid = points.n_valid;
+    return n_segs;
+}
+
+static void test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corner(void)
+{
+    size_t n_valid = 0;
+    TEST_ASSERT_EQUAL_size_t(1u, corner_onto_wall_seen_nearly_edge_on(2, &n_valid));
+    TEST_ASSERT_EQUAL_size_t(0u, n_wasted);
+    TEST_ASSERT_EQUAL_size_t(n_valid, segs[0].n_points);
+    TEST_ASSERT_TRUE(n_valid > 40u);
+    TEST_ASSERT_TRUE(corner_onto_wall_seen_nearly_edge_on(1, &n_valid) > 1u || n_wasted > 0u);
+}
+
 /* A lone reading halfway across a depth jump lies on the chord of its two
  * neighbours, but the surfaces either side do not go on along that line:
  * grazing joins do not bridge it (mixed-pixel rejection off, so only the
@@ -832,6 +867,89 @@ static void test_sved_rejects_a_mixed_pixel_near_one_surface_and_keeps_a_real_en
     TEST_ASSERT_EQUAL_UINT16(20u, segs[1].first);
 }
 
+/* Beams 0..19 see a wall 2 m ahead (1 degree per beam from -60 degrees);
+ * beams 20..28 a wall seen at 70-78 deg incidence that starts `start`
+ * metres out along beam 20 and recedes (range steps of 0.35-0.9 m, wider
+ * than the radius); beams 29..39 no return. Beam 20 reads `blend` metres
+ * when positive (a mixed pixel between the two walls), else the grazing
+ * wall. */
+static void wall_then_grazing_wall(double start, double blend, double sigma, bsf_scene_rng_t *rng)
+{
+    const double th0 = -PI_D / 3.0 + 20.0 * PI_D / 180.0;
+    const double px = start * cos(th0);
+    const double py = start * sin(th0);
+    const double dx = cos(th0 + 20.0 * PI_D / 180.0);
+    const double dy = sin(th0 + 20.0 * PI_D / 180.0);
+    size_t i;
+    for (i = 0; i < 40u; ++i) {
+        const double theta = -PI_D / 3.0 + (double)i * PI_D / 180.0;
+        double r;
+        if (i < 20u) {
+            r = 2.0 / cos(theta);
+        } else if (i < 29u) {
+            /* the ray's crossing with the line through (px, py) along (dx, dy) */
+            r = (px * dy - py * dx) / (cos(theta) * dy - sin(theta) * dx);
+        } else {
+            r = 40.0; /* beyond range_max: no return */
+        }
+        if (i == 20u && blend > 0.0) {
+            r = blend;
+        }
+        ranges[i] = (float)(r < 30.0 ? r + sigma * bsf_scene_rng_gauss(rng) : r);
+    }
+    points_from_ranges(40u);
+}
+
+/* A mixed pixel beside the end of a long straight run, where the surface
+ * on its other side is a wall seen at grazing incidence (its steps wider
+ * than the radius), joins no segment: it lies off the run's line and on no
+ * line with the grazing wall's next returns. The grazing wall's own first
+ * return, at the same depth jump, stays, and the wall stays one segment.
+ * Without noise, and over 200 scans at 1 cm noise (the blend went in all
+ * of them with this seed; the bound leaves room for rounding elsewhere). */
+static void test_sved_rejects_a_mixed_pixel_between_a_run_and_a_grazing_wall(void)
+{
+    bsf_sved_params_t p = bsf_sved_params_default();
+    uint16_t label[40];
+    bsf_scene_rng_t rng;
+    const double start = 7.0;
+    const double blend = 2.0 / cos(40.0 * PI_D / 180.0) + 0.25;
+    int trial;
+    int rejected = 0;
+    size_t i;
+    bsf_scene_rng_seed(&rng, 5u);
+    for (trial = 0; trial <= 200; ++trial) {
+        const double sigma = trial == 0 ? 0.0 : 0.01;
+        wall_then_grazing_wall(start, blend, sigma, &rng);
+        /* the grazing wall steps wider (in range) than the radius at the
+         * blend, and the blend lies within J / 8 of the near wall */
+        TEST_ASSERT_TRUE((double)(points.range[22] - points.range[21]) > sved_threshold(20u));
+        TEST_ASSERT_TRUE(points.range[20] - points.range[19] <
+                         0.125f * (points.range[21] - points.range[19]));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
+                                                                label, &n_segs, &n_wasted));
+        check_partition();
+        TEST_ASSERT_EQUAL_UINT16(0u, label[19]);
+        if (label[20] == BSF_SEG_NONE) {
+            ++rejected;
+        } else {
+            TEST_ASSERT_TRUE(trial > 0);
+        }
+        for (i = 22u; i < 29u; ++i) {
+            TEST_ASSERT_EQUAL_UINT16(21u, label[i]); /* one grazing wall from beam 21 */
+        }
+
+        wall_then_grazing_wall(start, 0.0, sigma, &rng);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
+                                                                label, &n_segs, &n_wasted));
+        check_partition();
+        for (i = 20u; i < 29u; ++i) {
+            TEST_ASSERT_EQUAL_UINT16(20u, label[i]); /* the wall's first return stays */
+        }
+    }
+    TEST_ASSERT_TRUE(rejected >= 190);
+}
+
 static void test_bad_parameters_are_refused(void)
 {
     const bsf_sved_params_t sd = bsf_sved_params_default();
@@ -869,6 +987,8 @@ static void test_bad_parameters_are_refused(void)
     TEST_ASSERT_EQUAL_UINT8(0u, bsf_sved_params_paper().join_grazing);
     sp = sd;
     sp.join_grazing = 2u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_sved_params_check(&sp));
+    sp.join_grazing = 3u;
     TEST_ASSERT_EQUAL_INT(BSF_ERR_PARAM, bsf_sved_params_check(&sp));
 
     rp = rd;
@@ -1004,8 +1124,10 @@ int main(void)
     RUN_TEST(test_single_valid_beam_is_wasted_or_kept_with_min_one);
     RUN_TEST(test_null_arguments_are_refused);
     RUN_TEST(test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segment);
+    RUN_TEST(test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corner);
     RUN_TEST(test_sved_grazing_joins_do_not_bridge_a_depth_jump_through_a_mixed_reading);
     RUN_TEST(test_sved_rejects_a_mixed_pixel_near_one_surface_and_keeps_a_real_end);
+    RUN_TEST(test_sved_rejects_a_mixed_pixel_between_a_run_and_a_grazing_wall);
     RUN_TEST(test_bad_parameters_are_refused);
     RUN_TEST(test_nan_coordinates_in_hand_made_points_do_not_join);
     RUN_TEST(test_more_kept_segments_than_cap_is_a_capacity_error);

@@ -9,11 +9,15 @@
  *   options: --poses N, --paper (paper-faithful configuration), --grazing / --no-grazing
  *            (SVED and LC join walls seen at grazing incidence; on by default),
  *            --evidence / --no-evidence (LC's corner evidence test,
- *            bsf_lc_params_t.corner_evidence; on by default), --datasets DIR
+ *            bsf_lc_params_t.corner_evidence; on by default), --tails / --no-tails
+ *            (bsf_params_t.trim_tails; on by default), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
- *            false vertex and stray curve); BENCH_TRUTH_DUMP=K prints pose K's ranges,
- *            features and keypoints (for debugging one scan)
+ *            false vertex and stray curve), --oracle-reach M (how far from the vertex
+ *            the oracle's lines take returns, metres; 0: the whole run; default LC's
+ *            max_side); BENCH_TRUTH_DUMP=K prints pose K's ranges, features and
+ *            keypoints (for debugging one scan); BENCH_TRUTH_ORACLE_LOG=FILE writes one
+ *            line per sparse-rule corner (bsf_truth_add_oracle)
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -65,6 +69,7 @@ static bsf_extractor_t ex;
 static bsf_result_t res;
 static float ranges[BSF_MAX_POINTS];
 static float clean[BSF_MAX_POINTS];
+static float unmixed[BSF_MAX_POINTS]; /* ranges before mixed pixels, for the oracle */
 static int16_t hits[BSF_MAX_POINTS];
 static bsf_truth_acc_t acc;
 
@@ -74,6 +79,8 @@ static int paper_mode = 0;
 static int grazing_mode = -1;
 /* 1 --evidence, 0 --no-evidence, -1 the default: LC's corner evidence test */
 static int evidence_mode = -1;
+/* 1 --tails, 0 --no-tails, -1 the default: tail returns left off segment ends */
+static int tails_mode = -1;
 
 static bsf_params_t make_params(void)
 {
@@ -85,6 +92,9 @@ static bsf_params_t make_params(void)
     }
     if (evidence_mode >= 0) {
         p.lc.corner_evidence = (uint8_t)evidence_mode;
+    }
+    if (tails_mode >= 0) {
+        p.trim_tails = (uint8_t)tails_mode;
     }
     return p;
 }
@@ -179,6 +189,7 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
                 ranges[i] = (float)(r < 0.0 ? 0.0 : r);
             }
         }
+        memcpy(unmixed, ranges, sen->beams * sizeof ranges[0]);
         if (nz->mixed) {
             (void)bsf_scene_mixed_pixels(ranges, sen->beams, lid.no_return, 0.3, 0.5, &rng);
         }
@@ -220,7 +231,11 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
                        (double)ex.keypoints[f2].point.x, (double)ex.keypoints[f2].point.y);
             }
         }
-        if (bsf_truth_add(&acc, &sc, &lid, clean, hits, &res, bytes, t1 - t0) != 0) {
+        bsf_truth_oracle_keypoints = ex.keypoints;
+        bsf_truth_oracle_n_keypoints = res.stats.n_keypoints;
+        if (bsf_truth_add(&acc, &sc, &lid, clean, hits, &res, bytes, t1 - t0) != 0 ||
+            bsf_truth_add_oracle(&acc, &sc, &lid, clean, hits, ranges, nz->mixed ? unmixed : NULL,
+                                 &res) != 0) {
             return -1;
         }
     }
@@ -236,10 +251,10 @@ static void print_header(void)
         "cm | curve rms/p99/max cm | stray>5cm | Gamma | eta | bytes/scan | us/scan | failed "
         "| sparse: visible | recall | 3-6m | verr med/p90 cm | obtuse cvx (n) | obtuse ccv (n) | "
         "seam behind (n) "
-        "| ahead (n) |\n");
+        "| ahead (n) | oracle med/p90 cm | oracle all med/p90 cm |\n");
     printf(
         "|---|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:"
-        "|---:|---|---|---|---|---|\n");
+        "|---:|---|---|---|---|---|---|---|\n");
 }
 
 static void print_row(int which, const sensor_t *sen, const noise_t *nz,
@@ -248,7 +263,9 @@ static void print_row(int which, const sensor_t *sen, const noise_t *nz,
     printf(
         "| %s | %s | %s | %lu | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.2f / %.2f / %.2f | "
         "%.2f / %.2f / %.2f | %.1f%% | %.1f%% | %.3f | %.0f | %.0f | %ld | %lu | %.1f%% | %.1f%% "
-        "| %.2f / %.2f | %.0f%% (%lu) | %.0f%% (%lu) | %.0f%% (%lu) | %.0f%% (%lu) |\n",
+        "| %.2f / %.2f | %.0f%% (%lu) | %.0f%% (%lu) | %.0f%% (%lu) | %.0f%% (%lu) | %.2f / %.2f | "
+        "%.2f / %.2f "
+        "|\n",
         scene_names[which], sen->name, nz->name, (unsigned long)s->visible, 100.0 * s->recall,
         100.0 * s->recall_band[0], 100.0 * s->recall_band[1], 100.0 * s->recall_band[2],
         100.0 * s->precision, 100.0 * s->verr_median, 100.0 * s->verr_p90, 100.0 * s->verr_max,
@@ -259,7 +276,8 @@ static void print_row(int which, const sensor_t *sen, const noise_t *nz,
         100.0 * s->recall_obtuse, (unsigned long)s->obtuse_visible,
         100.0 * s->recall_obtuse_concave, (unsigned long)s->obtuse_concave_visible,
         100.0 * s->recall_behind, (unsigned long)s->behind_visible, 100.0 * s->recall_ahead,
-        (unsigned long)s->ahead_visible);
+        (unsigned long)s->ahead_visible, 100.0 * s->oracle_found_median,
+        100.0 * s->oracle_found_p90, 100.0 * s->oracle_all_median, 100.0 * s->oracle_all_p90);
 }
 
 /* The targets of docs/GROUND_TRUTH.md for office-like scenes (the demo office and the
@@ -393,6 +411,9 @@ int main(int argc, char **argv)
     long only_sensor = -1;
     double only_noise = -1.0;
     int missed = 0;
+    char oracle_key[64];
+    double oracle_reach = 0.0;
+    int oracle_reach_set = 0;
     int a;
     int w;
     size_t si;
@@ -414,6 +435,17 @@ int main(int argc, char **argv)
             evidence_mode = 1;
         } else if (strcmp(argv[a], "--no-evidence") == 0) {
             evidence_mode = 0;
+        } else if (strcmp(argv[a], "--tails") == 0) {
+            tails_mode = 1;
+        } else if (strcmp(argv[a], "--no-tails") == 0) {
+            tails_mode = 0;
+        } else if (strcmp(argv[a], "--oracle-reach") == 0 && a + 1 < argc) {
+            char *end = NULL;
+            oracle_reach = strtod(argv[++a], &end);
+            oracle_reach_set = 1;
+            if (end == argv[a] || *end != '\0') {
+                oracle_reach = -1.0;
+            }
         } else if (strcmp(argv[a], "--poses") == 0 && a + 1 < argc) {
             n_poses = strtol(argv[++a], NULL, 10);
         } else if (strcmp(argv[a], "--datasets") == 0 && a + 1 < argc) {
@@ -427,8 +459,8 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr,
                     "usage: %s [--quick] [--check] [--verbose] [--paper] [--[no-]grazing] "
-                    "[--[no-]evidence] "
-                    "[--poses N] "
+                    "[--[no-]evidence] [--[no-]tails] "
+                    "[--poses N] [--oracle-reach M] "
                     "[--scene NAME] "
                     "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
                     argv[0]);
@@ -438,13 +470,29 @@ int main(int argc, char **argv)
     if (n_poses < 0) {
         n_poses = quick ? 16 : 80;
     }
+    if (!(oracle_reach >= 0.0)) {
+        fprintf(stderr, "bench_truth: --oracle-reach must be a number of metres >= 0\n");
+        return 2;
+    }
+    /* The oracle's sides reach as far as LC's line fits do, unless told. */
+    bsf_truth_oracle_reach =
+        oracle_reach > 0.0 ? oracle_reach
+                           : (oracle_reach_set ? 0.0 : (double)bsf_lc_params_default().max_side);
+    if (getenv("BENCH_TRUTH_ORACLE_LOG") != NULL) {
+        bsf_truth_oracle_log = fopen(getenv("BENCH_TRUTH_ORACLE_LOG"), "w");
+        if (bsf_truth_oracle_log == NULL) {
+            fprintf(stderr, "bench_truth: cannot write %s\n", getenv("BENCH_TRUTH_ORACLE_LOG"));
+            return 2;
+        }
+    }
     if (n_poses < 1) {
         fprintf(stderr, "bench_truth: --poses must be >= 1\n");
         return 2;
     }
-    printf("bench_truth: %s configuration%s%s, %ld poses per row\n",
+    printf("bench_truth: %s configuration%s%s%s, %ld poses per row\n",
            paper_mode ? "paper-faithful" : "default", grazing_mode ? " with grazing joins" : "",
-           evidence_mode ? " with LC's corner evidence test" : "", n_poses);
+           evidence_mode ? " with LC's corner evidence test" : "",
+           tails_mode ? " with tail returns left off" : "", n_poses);
     print_header();
     for (w = 0; w < N_SCENES; ++w) {
         if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {
@@ -470,6 +518,9 @@ int main(int argc, char **argv)
                 if (quick && !(noises[ni].sigma == 0.01 && !noises[ni].mixed)) {
                     continue;
                 }
+                snprintf(oracle_key, sizeof oracle_key, "%s %s %s", scene_names[w],
+                         sensors[si].name, noises[ni].name);
+                bsf_truth_oracle_key = oracle_key;
                 if (run_config(w, &sensors[si], &noises[ni], n_poses, &s, &failed) != 0) {
                     return 1;
                 }
@@ -488,6 +539,9 @@ int main(int argc, char **argv)
     }
     if (datasets != NULL && run_datasets(datasets) != 0) {
         return 1;
+    }
+    if (bsf_truth_oracle_log != NULL) {
+        fclose(bsf_truth_oracle_log);
     }
     if (check) {
         printf("%d target(s) missed\n", missed);

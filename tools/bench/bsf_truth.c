@@ -285,6 +285,76 @@ static int walls_seen_sparse(const bsf_scene_corner_t *c, const bsf_lidar_t *lid
     return 1;
 }
 
+/* For a missed corner (--verbose): each wall's returns from the one nearest
+ * the vertex outwards (up to 7): beam, range, the feature holding it (999:
+ * none), and the step to the next return with the sine of its angle to
+ * that return's ray (below 0.17 the wall is seen more than 80 deg off its
+ * normal). */
+static void print_corner_walls(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                               const float *ranges, const int16_t *hit_shape,
+                               const bsf_result_t *res)
+{
+    const size_t n = lidar->n_beams;
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const int wall = side == 0 ? c->shape_a : c->shape_b;
+        double dmin = 1e300;
+        size_t start = n, i, b;
+        int dir, best_dir = 0;
+        for (i = 0; i < n; ++i) {
+            if (hit_shape[i] == wall) {
+                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
+                const double d =
+                    hypot((double)ranges[i] * cos(a) - c->x, (double)ranges[i] * sin(a) - c->y);
+                if (d < dmin) {
+                    dmin = d;
+                    start = i;
+                }
+            }
+        }
+        if (start == n) {
+            printf("   wall %d: no hits\n", wall);
+            continue;
+        }
+        for (dir = -1; dir <= 1; dir += 2) {
+            size_t bb = (start + n + (size_t)dir) % n;
+            if (hit_shape[bb] == wall) {
+                best_dir = dir;
+            }
+        }
+        printf("   wall %d, nearest return %.3f m from the vertex", wall, dmin);
+        b = start;
+        for (i = 0; i < 7 && hit_shape[b] == wall; ++i) {
+            const double a = lidar->angle_min + (double)b * lidar->angle_increment;
+            const double px = (double)ranges[b] * cos(a), py = (double)ranges[b] * sin(a);
+            const size_t nb = (b + n + (size_t)best_dir) % n;
+            const double a2 = lidar->angle_min + (double)nb * lidar->angle_increment;
+            const double qx = (double)ranges[nb] * cos(a2), qy = (double)ranges[nb] * sin(a2);
+            const double st = hypot(qx - px, qy - py);
+            const double sn = fabs((qx - px) * qy - (qy - py) * qx) / (st * hypot(qx, qy));
+            size_t f, feat = 999;
+            for (f = 0; f < res->n_features; ++f) {
+                const bsf_feature_t *ft = &res->features[f];
+                const int in = ft->first_beam <= ft->last_beam
+                                   ? (b >= ft->first_beam && b <= ft->last_beam)
+                                   : (b >= ft->first_beam || b <= ft->last_beam);
+                if (in) {
+                    feat = f;
+                }
+            }
+            printf(" | b%lu r%.2f f%lu", (unsigned long)b, (double)ranges[b], (unsigned long)feat);
+            if (best_dir != 0 && hit_shape[nb] == wall) {
+                printf(" st%.2f sin%.2f", st, sn);
+            }
+            if (best_dir == 0) {
+                break;
+            }
+            b = nb;
+        }
+        printf("\n");
+    }
+}
+
 /* A convex corner: the sensor (origin of the sensor frame) stands outside
  * the wedge between the corner's two walls. */
 static int corner_convex(const bsf_scene_t *scene, const bsf_scene_corner_t *c,
@@ -378,6 +448,7 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
                 printf("missed sparse-wall corner at world (%.3f, %.3f), range %.2f m, beam %d, "
                        "angle %.0f deg, nearest vertex %.3f m\n",
                        c->wx, c->wy, c->range, c->beam, c->angle * 57.29577951, best);
+                print_corner_walls(c, lidar, ranges, hit_shape, res);
             }
             if (deg >= BSF_TRUTH_OBTUSE_MIN && deg <= BSF_TRUTH_OBTUSE_MAX) {
                 if (corner_convex(scene, c, lidar)) {
@@ -546,6 +617,10 @@ void bsf_truth_summary(const bsf_truth_acc_t *acc, bsf_truth_summary_t *s)
     s->recall_sparse = ratio(found, vis);
     s->verr_sparse_median = bsf_truth_quantile(&acc->vertex_err_sparse, 0.5);
     s->verr_sparse_p90 = bsf_truth_quantile(&acc->vertex_err_sparse, 0.9);
+    s->oracle_found_median = bsf_truth_quantile(&acc->oracle_err_found, 0.5);
+    s->oracle_found_p90 = bsf_truth_quantile(&acc->oracle_err_found, 0.9);
+    s->oracle_all_median = bsf_truth_quantile(&acc->oracle_err_all, 0.5);
+    s->oracle_all_p90 = bsf_truth_quantile(&acc->oracle_err_all, 0.9);
     s->obtuse_visible = acc->obtuse_visible;
     s->recall_obtuse = ratio(acc->obtuse_found, acc->obtuse_visible);
     s->obtuse_concave_visible = acc->obtuse_concave_visible;
@@ -566,4 +641,207 @@ void bsf_truth_summary(const bsf_truth_acc_t *acc, bsf_truth_summary_t *s)
     s->eta = ratio(acc->n_ctrl, acc->n_in_features);
     s->bytes_per_scan = acc->scans > 0u ? (double)acc->bytes / (double)acc->scans : 0.0;
     s->us_per_scan = acc->scans > 0u ? acc->time_ns / 1000.0 / (double)acc->scans : 0.0;
+}
+
+double bsf_truth_oracle_reach = 0.0;
+FILE *bsf_truth_oracle_log = NULL;
+const char *bsf_truth_oracle_key = "";
+const bsf_keypoint_t *bsf_truth_oracle_keypoints = NULL;
+size_t bsf_truth_oracle_n_keypoints = 0;
+
+/* Sums of one side's points for its total-least-squares line. */
+typedef struct {
+    double n, sx, sy, sxx, sxy, syy;
+} oracle_sums_t;
+
+/* The line through the sums' points: unit normal (nx, ny) and offset d,
+ * nx x + ny y = d. 0, or -1 with fewer than 2 points. */
+static int oracle_line(const oracle_sums_t *s, double *nx, double *ny, double *d)
+{
+    double mx, my, cxx, cxy, cyy, theta;
+    if (s->n < 2.0) {
+        return -1;
+    }
+    mx = s->sx / s->n;
+    my = s->sy / s->n;
+    cxx = s->sxx / s->n - mx * mx;
+    cxy = s->sxy / s->n - mx * my;
+    cyy = s->syy / s->n - my * my;
+    /* direction of largest spread; the normal is across it */
+    theta = 0.5 * atan2(2.0 * cxy, cxx - cyy);
+    *nx = -sin(theta);
+    *ny = cos(theta);
+    *d = *nx * mx + *ny * my;
+    return 0;
+}
+
+/* Beam b of a wall's run into the oracle's sums. Returns 1 when the beam
+ * lies beyond reach (the walk stops: along a straight wall, the beams after
+ * it are farther still), else 0. A mixed pixel is skipped. */
+static int oracle_take(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, const float *clean,
+                       const float *measured, const float *unmixed, double reach, size_t b,
+                       oracle_sums_t *s, double *len)
+{
+    const double a = lidar->angle_min + (double)b * lidar->angle_increment;
+    const double d = hypot((double)clean[b] * cos(a) - c->x, (double)clean[b] * sin(a) - c->y);
+    double px, py;
+    if (reach > 0.0 && d > reach) {
+        return 1;
+    }
+    if (unmixed != NULL && measured[b] != unmixed[b]) {
+        return 0; /* a mixed pixel: no return of this wall */
+    }
+    px = (double)measured[b] * cos(a);
+    py = (double)measured[b] * sin(a);
+    s->n += 1.0;
+    s->sx += px;
+    s->sy += py;
+    s->sxx += px * px;
+    s->sxy += px * py;
+    s->syy += py * py;
+    *len = d > *len ? d : *len;
+    return 0;
+}
+
+int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                            const float *clean, const int16_t *hit_shape, const float *measured,
+                            const float *unmixed, double reach, double *x, double *y, int n_side[2],
+                            double len_side[2])
+{
+    const size_t n = lidar->n_beams;
+    const int ring = fabs(fabs(lidar->angle_increment) * (double)n - 6.283185307179586) <=
+                     fabs(lidar->angle_increment);
+    double nx[2], ny[2], dd[2], det;
+    int side;
+    for (side = 0; side < 2; ++side) {
+        const int wall = side == 0 ? c->shape_a : c->shape_b;
+        oracle_sums_t s = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        double dmin = 1e300;
+        double len = 0.0;
+        size_t start = n;
+        size_t i;
+        int dir;
+        for (i = 0; i < n; ++i) {
+            if (hit_shape[i] == wall) {
+                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
+                const double d =
+                    hypot((double)clean[i] * cos(a) - c->x, (double)clean[i] * sin(a) - c->y);
+                if (d < dmin) {
+                    dmin = d;
+                    start = i;
+                }
+            }
+        }
+        if (start == n) {
+            return -1;
+        }
+        if (oracle_take(c, lidar, clean, measured, unmixed, reach, start, &s, &len) == 0) {
+            /* the run either way from the start beam, as the sparse-wall rule walks it */
+            for (dir = -1; dir <= 1; dir += 2) {
+                size_t b = start;
+                size_t steps;
+                for (steps = 1; steps < n; ++steps) {
+                    if (dir < 0) {
+                        if (b == 0u && !ring) {
+                            break;
+                        }
+                        b = b == 0u ? n - 1u : b - 1u;
+                    } else {
+                        if (b + 1u == n && !ring) {
+                            break;
+                        }
+                        b = b + 1u == n ? 0u : b + 1u;
+                    }
+                    if (hit_shape[b] != wall || b == start ||
+                        oracle_take(c, lidar, clean, measured, unmixed, reach, b, &s, &len) != 0) {
+                        break;
+                    }
+                }
+            }
+        }
+        if (n_side != NULL) {
+            n_side[side] = (int)s.n;
+        }
+        if (len_side != NULL) {
+            len_side[side] = len;
+        }
+        if (oracle_line(&s, &nx[side], &ny[side], &dd[side]) != 0) {
+            return -1;
+        }
+    }
+    det = nx[0] * ny[1] - ny[0] * nx[1];
+    if (!(fabs(det) > 1e-12)) {
+        return -1;
+    }
+    *x = (dd[0] * ny[1] - ny[0] * dd[1]) / det;
+    *y = (nx[0] * dd[1] - dd[0] * nx[1]) / det;
+    return 0;
+}
+
+int bsf_truth_add_oracle(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                         const float *clean, const int16_t *hit_shape, const float *measured,
+                         const float *unmixed, const bsf_result_t *res)
+{
+    static bsf_scene_corner_t corners[TRUTH_MAX_CORNERS];
+    size_t n_corners = 0;
+    size_t k;
+    size_t j;
+    if (bsf_scene_corners(scene, lidar, corners, TRUTH_MAX_CORNERS, &n_corners) != BSF_OK) {
+        return -1;
+    }
+    for (k = 0; k < n_corners; ++k) {
+        const bsf_scene_corner_t *c = &corners[k];
+        double best = 1e300;
+        double bx = 0.0;
+        double by = 0.0;
+        double ox;
+        double oy;
+        double err;
+        int n_side[2] = {0, 0};
+        double len_side[2] = {0.0, 0.0};
+        if (!c->visible || c->range > BSF_TRUTH_RANGE_MAX ||
+            !walls_seen_sparse(c, lidar, clean, hit_shape)) {
+            continue;
+        }
+        for (j = 0; j < res->n_ctrl; ++j) {
+            if (res->ctrl_is_vertex[j]) {
+                const double d =
+                    hypot((double)res->ctrl[j].x - c->x, (double)res->ctrl[j].y - c->y);
+                if (d < best) {
+                    best = d;
+                    bx = (double)res->ctrl[j].x;
+                    by = (double)res->ctrl[j].y;
+                }
+            }
+        }
+        if (bsf_truth_oracle_vertex(c, lidar, clean, hit_shape, measured, unmixed,
+                                    bsf_truth_oracle_reach, &ox, &oy, n_side, len_side) != 0) {
+            acc->oracle_undefined++;
+            continue;
+        }
+        err = hypot(ox - c->x, oy - c->y);
+        hist_add(&acc->oracle_err_all, err);
+        if (best <= BSF_TRUTH_MATCH) {
+            hist_add(&acc->oracle_err_found, err);
+        }
+        if (bsf_truth_oracle_log != NULL) {
+            double kp_err = bsf_truth_oracle_keypoints != NULL ? 1e300 : -1.0;
+            for (j = 0; bsf_truth_oracle_keypoints != NULL && j < bsf_truth_oracle_n_keypoints;
+                 ++j) {
+                const double d = hypot((double)bsf_truth_oracle_keypoints[j].point.x - c->x,
+                                       (double)bsf_truth_oracle_keypoints[j].point.y - c->y);
+                kp_err = d < kp_err ? d : kp_err;
+            }
+            fprintf(bsf_truth_oracle_log,
+                    "%s %d %.5f %.5f %.5f %.1f %d %.3f %d %d %.3f %.3f %d %.5f %lu %.3f %.3f\n",
+                    bsf_truth_oracle_key, best <= BSF_TRUTH_MATCH,
+                    best <= BSF_TRUTH_MATCH ? best : -1.0, err,
+                    best <= BSF_TRUTH_MATCH ? hypot(bx - ox, by - oy) : -1.0,
+                    c->angle * 57.29577951308232, corner_convex(scene, c, lidar), c->range,
+                    n_side[0], n_side[1], len_side[0], len_side[1],
+                    walls_seen(c, lidar, clean, hit_shape), kp_err,
+                    (unsigned long)(acc->scans > 0u ? acc->scans - 1u : 0u), c->wx, c->wy);
+        }
+    }
+    return 0;
 }

@@ -35,6 +35,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
@@ -91,6 +92,13 @@ typedef struct {
     uint64_t scans;
     uint64_t n_valid, n_in_features, n_ctrl, bytes;
     double time_ns;
+    /* The oracle of the sparse-wall rule (bsf_truth_add_oracle): its vertex
+     * error on the corners bsf found (the set of vertex_err_sparse) and on
+     * every sparse-rule corner; corners it cannot place (a side with fewer
+     * than 2 clean returns, or parallel lines). */
+    bsf_truth_hist_t oracle_err_found;
+    bsf_truth_hist_t oracle_err_all;
+    uint64_t oracle_undefined;
 } bsf_truth_acc_t;
 
 /** Non-zero: bsf_truth_add prints every false vertex (bench_truth --verbose). */
@@ -115,6 +123,58 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
 int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
                           const float *ranges, const int16_t *hit_shape);
 
+/**
+ * The oracle of a corner: the best estimate of its vertex the data allow
+ * without priors. Each of its two walls gets a total-least-squares line
+ * through exactly the returns that truly lie on it (the scene's labels):
+ * from the hit on that wall nearest the vertex, the consecutive beams that hit
+ * the wall (through the seam of a full-circle scan), as the sparse-wall rule
+ * walks them, up to `reach` metres from the vertex (their true positions; 0
+ * or less: the whole run); the vertex is the lines' intersection.
+ * `measured` are the ranges the extractor saw; `unmixed` the same before
+ * mixed pixels were added (NULL when none were): a beam whose two differ is
+ * no return of the wall and is left out. clean and hit_shape are the scan as
+ * simulated. On success *x, *y get the vertex (sensor frame) and, when not
+ * NULL, n_side the returns used on each wall (shape_a, shape_b) and
+ * len_side how far the farthest reaches from the vertex.
+ * @return 0; -1 when a wall has fewer than 2 usable returns or the lines are
+ *         parallel.
+ */
+int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                            const float *clean, const int16_t *hit_shape, const float *measured,
+                            const float *unmixed, double reach, double *x, double *y, int n_side[2],
+                            double len_side[2]);
+
+/** How far the oracle's sides reach from the vertex (bsf_truth_oracle_vertex),
+ *  metres; 0: the whole run of returns. bench_truth sets LC's max_side. */
+extern double bsf_truth_oracle_reach;
+
+/** When not NULL, bsf_truth_add_oracle writes one line per sparse-rule corner
+ *  to it (bench_truth BENCH_TRUTH_ORACLE_LOG=FILE), prefixed with
+ *  bsf_truth_oracle_key: found, bsf's and the oracle's vertex errors, the
+ *  distance between the two, angle, convexity, range, returns and extent of
+ *  each side, whether the corner passes the first rule, the nearest
+ *  keypoint's distance to it (-1 without keypoints). */
+extern FILE *bsf_truth_oracle_log;
+extern const char *bsf_truth_oracle_key;
+/** The extractor's keypoints of the scan judged (sensor frame), or NULL: the
+ *  log then also gives the nearest keypoint's distance to each corner (LC's
+ *  two-line intersection, the vertex's anchor). */
+extern const bsf_keypoint_t *bsf_truth_oracle_keypoints;
+extern size_t bsf_truth_oracle_n_keypoints;
+
+/**
+ * Add the oracle's vertex error (bsf_truth_oracle_vertex with
+ * bsf_truth_oracle_reach) for every corner visible under the sparse-wall rule
+ * to acc: oracle_err_all, and oracle_err_found for those that res has a vertex
+ * within BSF_TRUTH_MATCH of (the corners of vertex_err_sparse). Arguments as
+ * bsf_truth_add and bsf_truth_oracle_vertex. Returns 0, or -1 when the scene
+ * has more than 256 corners.
+ */
+int bsf_truth_add_oracle(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
+                         const float *clean, const int16_t *hit_shape, const float *measured,
+                         const float *unmixed, const bsf_result_t *res);
+
 /** Quantile q in [0,1] of a histogram (upper bin edge), metres; 0 when empty. */
 double bsf_truth_quantile(const bsf_truth_hist_t *h, double q);
 
@@ -125,6 +185,9 @@ typedef struct {
     double recall_sparse; /* the same, sparse-wall rule */
     double recall_sparse_band[BSF_TRUTH_BANDS];
     double verr_sparse_median, verr_sparse_p90;
+    /* the oracle (bsf_truth_add_oracle): on bsf's found corners, on all */
+    double oracle_found_median, oracle_found_p90;
+    double oracle_all_median, oracle_all_p90;
     double recall_obtuse, recall_obtuse_concave, recall_behind, recall_ahead;
     uint64_t visible_sparse, obtuse_visible, obtuse_concave_visible, behind_visible, ahead_visible;
     double precision;

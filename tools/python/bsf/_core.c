@@ -160,6 +160,7 @@ static const param_desc_t g_params[] = {
     PARAM("pdm_bias_window", pdm.bias_window, PT_U8),
     PARAM("pdm_bias_ratio", pdm.bias_ratio, PT_FLOAT),
     PARAM("split_dist", split_dist, PT_FLOAT),
+    PARAM("trim_tails", trim_tails, PT_U8),
 };
 #define N_PARAMS (sizeof g_params / sizeof g_params[0])
 

@@ -1,0 +1,163 @@
+/* SPDX-License-Identifier: MIT */
+/* Grazing joins (bsf_grazing.h explains them): one copy for SVED and LC. */
+#include "bsf_grazing.h"
+
+#include <stddef.h>
+
+int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
+{
+    const float ax = p1.x - p0.x;
+    const float ay = p1.y - p0.y;
+    const float bx = p2.x - p1.x;
+    const float by = p2.y - p1.y;
+    const float la2 = ax * ax + ay * ay;
+    const float lb2 = bx * bx + by * by;
+    const float r2 = BSF_GRAZING_STEP_RATIO * BSF_GRAZING_STEP_RATIO;
+    const float cx = p2.x - p0.x;
+    const float cy = p2.y - p0.y;
+    const float cross = ax * by - ay * bx;
+    if (!(la2 > 0.0f) || !(lb2 > 0.0f) || !(la2 <= r2 * lb2) || !(lb2 <= r2 * la2) ||
+        !(ax * bx + ay * by > 0.0f)) {
+        return 0;
+    }
+    /* distance of p1 from the chord: |cross| / |p2 - p0| */
+    return cross * cross <= BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * (cx * cx + cy * cy);
+}
+
+/* Point e lies just before the line that goes from p through q: behind p
+ * by at most 1.5 steps |q - p| along it, off it by at most half a step. */
+static int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
+{
+    const float ux = q.x - p.x;
+    const float uy = q.y - p.y;
+    const float s2 = ux * ux + uy * uy;
+    const float ex = p.x - e.x;
+    const float ey = p.y - e.y;
+    const float along = ex * ux + ey * uy; /* times |q - p| */
+    const float off = ex * uy - ey * ux;   /* times |q - p| */
+    return s2 > 0.0f && along > 0.0f && along <= 1.5f * s2 && off * off <= 0.25f * s2 * s2;
+}
+
+/* |q - p| <= cap */
+static int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
+{
+    const float dx = q.x - p.x;
+    const float dy = q.y - p.y;
+    return dx * dx + dy * dy <= cap * cap;
+}
+
+static int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
+{
+    return i < pts->count && pts->valid[i] != 0u;
+}
+
+/* Points i..i + 3 (valid beams) lie on one line: both triples collinear. */
+static int bsf_grazing_run4(const bsf_points_t *pts, size_t i)
+{
+    const bsf_point_t *p = pts->pt;
+    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
+           bsf_grazing_ok(pts, i + 3u) && bsf_grazing_triple(p[i], p[i + 1u], p[i + 2u]) &&
+           bsf_grazing_triple(p[i + 1u], p[i + 2u], p[i + 3u]);
+}
+
+/* The middle return p1 lies where its ray crosses the chord p0-p2, to
+ * within BSF_GRAZING_LINE_TOL along that ray (range noise moves a return
+ * along its ray). Nearly edge-on, the distance from the chord alone tests
+ * little: the chord runs almost along p1's ray, so a return anywhere on it
+ * (a mixed pixel, an object behind) passes near the chord. */
+static int bsf_grazing_on_ray(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
+{
+    const float cx = p2.x - p0.x;
+    const float cy = p2.y - p0.y;
+    const float off = (p1.x - p0.x) * cy - (p1.y - p0.y) * cx; /* |c| times the distance */
+    const float ray = cx * p1.y - cy * p1.x;                   /* |c| |p1| sin(chord, ray) */
+    return off * off * (p1.x * p1.x + p1.y * p1.y) <=
+           BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * ray * ray;
+}
+
+/* Points i..i + 2 (valid beams) on one line, tested along the rays as well. */
+static int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
+{
+    const bsf_point_t *p = pts->pt;
+    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
+           bsf_grazing_triple(p[i], p[i + 1u], p[i + 2u]) &&
+           bsf_grazing_on_ray(p[i], p[i + 1u], p[i + 2u]);
+}
+
+/* Points s..s + 3 lie on one line (along the rays too) that starts at a
+ * corner: s - 3..s - 1 lie on another line, whose last return s - 1 is no
+ * step of the first (their steps differ, or they turn) yet lies just
+ * behind s on it (bsf_grazing_entry), within cap of s + 1. With dir -1 the
+ * mirror image: s..s - 3 end at the corner s + 1. */
+static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, float cap)
+{
+    const bsf_point_t *p = pts->pt;
+    const ptrdiff_t d = dir;
+    size_t c;
+    /* Both forms need beams s - 3..s + 3 in the scan and s - 1..s + 1
+     * valid; the cheap tests on the corner's return run first (most wide
+     * steps are depth jumps, whose far return lies nowhere near the line).
+     * Each triple is tested in ascending beam order, as the lines are. */
+    if (s < 3u || s + 3u >= pts->count || !pts->valid[s - 1u] || !pts->valid[s] ||
+        !pts->valid[s + 1u]) {
+        return 0;
+    }
+    c = (size_t)((ptrdiff_t)s - d); /* the corner's return */
+    return bsf_grazing_within(p[c], p[(ptrdiff_t)s + d], cap) &&
+           bsf_grazing_entry(p[c], p[s], p[(ptrdiff_t)s + d]) &&
+           bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
+           !bsf_grazing_triple(p[(ptrdiff_t)c - d], p[c], p[s]) &&
+           bsf_grazing_line3(pts, d > 0 ? s : s - 2u) &&
+           bsf_grazing_line3(pts, d > 0 ? s + 1u : s - 3u);
+}
+
+/* The step between beams a and a + 1 is the step onto such a corner run or
+ * one of its own (a run of four from its corner, see bsf_grazing_join). */
+static int bsf_grazing_at_corner(const bsf_points_t *pts, size_t a, float cap)
+{
+    size_t k;
+    for (k = 0; k < 4u; ++k) {
+        if ((a + 1u >= k && bsf_grazing_corner_run(pts, a + 1u - k, 1, cap)) ||
+            bsf_grazing_corner_run(pts, a + k, -1, cap)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners)
+{
+    const size_t b = a + 1u;
+    const bsf_point_t *p = pts->pt;
+    float dx;
+    float dy;
+    if (!bsf_grazing_ok(pts, a) || !bsf_grazing_ok(pts, b)) {
+        return 0;
+    }
+    dx = p[b].x - p[a].x;
+    dy = p[b].y - p[a].y;
+    if (!(dx * dx + dy * dy <= cap * cap)) {
+        return 0;
+    }
+    {
+        /* sin of the angle between the step and beam b's ray (the sensor
+         * is at the origin) */
+        const float cr = dx * p[b].y - dy * p[b].x;
+        const float rb2 = p[b].x * p[b].x + p[b].y * p[b].y;
+        if (!(cr * cr >= BSF_GRAZING_MIN_SIN * BSF_GRAZING_MIN_SIN * (dx * dx + dy * dy) * rb2)) {
+            return at_corners && bsf_grazing_at_corner(pts, a, cap);
+        }
+    }
+    if ((a >= 2u && bsf_grazing_run4(pts, a - 2u)) || (a >= 1u && bsf_grazing_run4(pts, a - 1u)) ||
+        bsf_grazing_run4(pts, a)) {
+        return 1;
+    }
+    /* a corner turning onto the wall that starts at b, or off the one that
+     * ends at a */
+    if (bsf_grazing_run4(pts, b) && bsf_grazing_entry(p[a], p[b], p[b + 1u]) &&
+        bsf_grazing_within(p[a], p[b + 2u], cap)) {
+        return 1;
+    }
+    return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]) &&
+           bsf_grazing_within(p[b], p[a - 2u], cap);
+}
