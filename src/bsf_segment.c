@@ -605,6 +605,22 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
         if (!pts->valid[b]) {
             continue;
         }
+#if !BSF_CONFIG_COMPACT
+        if (b >= 2u && b + 2u < pts->count) {
+            /* is_mixed_pixel's first tests, inline (not in the compact
+             * build, which keeps one copy): most returns lie on a surface
+             * whose range changes by less than the radius's floor from one
+             * neighbour to the other (same float operations). */
+            const float r0 = pts->range[b - 1u];
+            const float r2 = pts->range[b + 1u];
+            const float lo = r0 < r2 ? r0 : r2;
+            const float hi = r0 < r2 ? r2 : r0;
+            if (!pts->valid[b - 1u] || !pts->valid[b + 1u] ||
+                !(pts->range[b] > lo && pts->range[b] < hi) || (hi - lo) * (hi - lo) <= rad.a2) {
+                continue;
+            }
+        }
+#endif
         beam_radius_start(&rad, pts->range[b]);
         kind = is_mixed_pixel(pts, b, ring, &rad);
         if (kind != 0 && marks != NULL) {
