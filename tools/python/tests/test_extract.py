@@ -81,6 +81,8 @@ def test_methods_and_parameters():
     assert bsf.Extractor(sved_min_segment_points=7).params["sved_min_segment_points"] == 7
     assert bsf.default_params()["split_dist"] == pytest.approx(0.25)
     assert bsf.Extractor(split_dist=0.0).params["split_dist"] == 0.0
+    assert bsf.default_params()["trim_tails"] == 1
+    assert bsf.Extractor(trim_tails=0).params["trim_tails"] == 0
 
 
 def test_timing_off_gives_zero_time():
@@ -132,6 +134,8 @@ def test_bad_method_and_parameters():
         bsf.extract(r, 0.0, 0.01, 0.05, 30.0, sved_a=math.nan)
     with pytest.raises(TypeError, match="integer"):
         bsf.extract(r, 0.0, 0.01, 0.05, 30.0, sved_min_segment_points=2.5)
+    with pytest.raises(bsf.BsfError):
+        bsf.extract(r, 0.0, 0.01, 0.05, 30.0, trim_tails=2)
 
 
 def test_bsf_error_is_a_value_error_with_status():
