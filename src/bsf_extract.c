@@ -694,9 +694,11 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
             hi[depth++] = (uint16_t)(cut - 1u);
         } else {
             /* The whole segment (less its tails) keeps its kind; a piece is
-             * auxiliary when it holds a vertex. */
-            append_feature(res, beam_of_point(ex, s, a), beam_of_point(ex, s, b),
-                           (uint16_t)(b + 1u - a),
+             * auxiliary when it holds a vertex. The segment's last beam is
+             * known: no walk through it (the first is beam_of_point's first
+             * step anyway). */
+            append_feature(res, beam_of_point(ex, s, a),
+                           b + 1u == n ? s->last : beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
                            a == lo0 && b == hi0
                                ? s->kind
                                : (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK),

@@ -501,6 +501,25 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
 #define MIXED_BETWEEN 1
 #define MIXED_OFF_A_LINE 2
 
+/* Beam i, inside the scan (2 <= i < count - 2), and both its neighbours
+ * valid, its range strictly between theirs: is_mixed_pixel's first tests.
+ * r[0..3) receives the three ranges (when valid), *lo and *hi the
+ * neighbours', the smaller first. */
+static inline int between_neighbours(const bsf_points_t *pts, size_t i, float *r, float *lo,
+                                     float *hi)
+{
+    const uint8_t *v = &pts->valid[i - 1u];
+    if (!((v[0] != 0u) & (v[1] != 0u) & (v[2] != 0u))) {
+        return 0;
+    }
+    r[0] = pts->range[i - 1u];
+    r[1] = pts->range[i];
+    r[2] = pts->range[i + 1u];
+    *lo = r[0] < r[2] ? r[0] : r[2];
+    *hi = r[0] < r[2] ? r[2] : r[0];
+    return r[1] > *lo && r[1] < *hi;
+}
+
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
@@ -517,15 +536,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         /* Inside the scan (most beams): the cheap tests first. */
         const uint8_t *v = &pts->valid[i - 2u];
         const float *rg = &pts->range[i - 2u];
-        if (!((v[1] != 0u) & (v[2] != 0u) & (v[3] != 0u))) {
-            return 0;
-        }
-        r[1] = rg[1];
-        r[2] = rg[2];
-        r[3] = rg[3];
-        lo = r[1] < r[3] ? r[1] : r[3];
-        hi = r[1] < r[3] ? r[3] : r[1];
-        if (!(r[2] > lo && r[2] < hi)) {
+        if (!between_neighbours(pts, i, &r[1], &lo, &hi)) {
             return 0;
         }
         have_outer = (v[0] != 0u) & (v[4] != 0u);
@@ -607,16 +618,14 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
         }
 #if !BSF_CONFIG_COMPACT
         if (b >= 2u && b + 2u < pts->count) {
-            /* is_mixed_pixel's first tests, inline (not in the compact
-             * build, which keeps one copy): most returns lie on a surface
-             * whose range changes by less than the radius's floor from one
-             * neighbour to the other (same float operations). */
-            const float r0 = pts->range[b - 1u];
-            const float r2 = pts->range[b + 1u];
-            const float lo = r0 < r2 ? r0 : r2;
-            const float hi = r0 < r2 ? r2 : r0;
-            if (!pts->valid[b - 1u] || !pts->valid[b + 1u] ||
-                !(pts->range[b] > lo && pts->range[b] < hi) || (hi - lo) * (hi - lo) <= rad.a2) {
+            /* is_mixed_pixel's first tests before its call (not in the
+             * compact build, which keeps one copy): most returns lie on a
+             * surface whose range changes by less than the radius's floor
+             * from one neighbour to the other. */
+            float r3[3];
+            float lo;
+            float hi;
+            if (!between_neighbours(pts, b, r3, &lo, &hi) || (hi - lo) * (hi - lo) <= rad.a2) {
                 continue;
             }
         }

@@ -699,19 +699,20 @@ static void test_null_arguments_are_refused(void)
     TEST_ASSERT_EQUAL_INT(BSF_ERR_ARG, bsf_rpos_params_check(NULL));
 }
 
-/* SVED with every extension on a room corner 7 m away whose second wall is
- * seen at 77 deg incidence (returns 0.4 m apart near the corner, wider than
- * the radius there): with grazing joins both walls are one segment that
- * holds every return; without, the wall's first returns break off. */
-static size_t corner_onto_grazing_wall(int join_grazing, size_t *n_valid)
+/* SVED with every extension and join_grazing as given on a room corner at
+ * (cx, cy) whose walls run 4 m down the -y axis and side_len m along -x,
+ * seen from (0, y0) with n_beams over 270 deg and 1 cm noise; returns the
+ * segment count, *n_valid the valid returns. */
+static size_t sved_on_corner(int join_grazing, size_t n_beams, double y0, double cx, double cy,
+                             double side_len, size_t *n_valid)
 {
-    bsf_lidar_t l = bsf_lidar_default(0.0, 0.0, 0.0, 361u, 1.5 * 3.14159265358979);
+    bsf_lidar_t l = bsf_lidar_default(0.0, y0, 0.0, n_beams, 1.5 * 3.14159265358979);
     bsf_scene_rng_t rng;
     bsf_sved_params_t p = bsf_sved_params_default();
     p.join_grazing = (uint8_t)join_grazing;
     bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 7.0, 1.6, -0.5 * 3.14159265358979,
-                                                       4.0, 3.14159265358979, 4.0));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, cx, cy, -0.5 * 3.14159265358979, 4.0,
+                                                       3.14159265358979, side_len));
     l.noise_sigma = 0.01;
     bsf_scene_rng_seed(&rng, 11u);
     shoot(&l, &rng);
@@ -720,6 +721,15 @@ static size_t corner_onto_grazing_wall(int join_grazing, size_t *n_valid)
     check_partition();
     *n_valid = points.n_valid;
     return n_segs;
+}
+
+/* A room corner 7 m away whose second wall is seen at 77 deg incidence
+ * (returns 0.4 m apart near the corner, wider than the radius there): with
+ * grazing joins both walls are one segment that holds every return;
+ * without, the wall's first returns break off. */
+static size_t corner_onto_grazing_wall(int join_grazing, size_t *n_valid)
+{
+    return sved_on_corner(join_grazing, 361u, 0.0, 7.0, 1.6, 4.0, n_valid);
 }
 
 static void test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segment(void)
@@ -732,29 +742,15 @@ static void test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segme
     TEST_ASSERT_TRUE(corner_onto_grazing_wall(0, &n_valid) > 1u || n_wasted > 0u);
 }
 
-/* SVED with every extension on a room corner 3 m away whose second wall is
- * seen at 83 deg incidence (1 deg beams, 1 cm noise): its first returns
- * are 0.35-0.5 m apart, nearer edge-on than grazing joins go (80 deg), so
- * with join_grazing 1 they break off the corner's segment; with 2 the
- * first four of them, which start at the corner, join it and the rest of
- * the wall follows: one segment holds every return. */
+/* A room corner 3 m away whose second wall is seen at 83 deg incidence
+ * (1 deg beams): its first returns are 0.35-0.5 m apart, nearer edge-on
+ * than grazing joins go (80 deg), so with join_grazing 1 they break off the
+ * corner's segment; with 2 the first four of them, which start at the
+ * corner, join it and the rest of the wall follows: one segment holds every
+ * return. */
 static size_t corner_onto_wall_seen_nearly_edge_on(int join_grazing, size_t *n_valid)
 {
-    bsf_lidar_t l = bsf_lidar_default(0.0, 0.03, 0.0, 271u, 1.5 * 3.14159265358979);
-    bsf_scene_rng_t rng;
-    bsf_sved_params_t p = bsf_sved_params_default();
-    p.join_grazing = (uint8_t)join_grazing;
-    bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_corner(&scene, 3.0, 0.4, -0.5 * 3.14159265358979,
-                                                       4.0, 3.14159265358979, 2.0));
-    l.noise_sigma = 0.01;
-    bsf_scene_rng_seed(&rng, 11u);
-    shoot(&l, &rng);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_segment_sved_labelled(&points, &p, segs, BSF_MAX_SEGMENTS,
-                                                            NULL, &n_segs, &n_wasted));
-    check_partition();
-    *n_valid = points.n_valid;
-    return n_segs;
+    return sved_on_corner(join_grazing, 271u, 0.03, 3.0, 0.4, 2.0, n_valid);
 }
 
 static void test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corner(void)

@@ -157,6 +157,54 @@ static size_t creases(const bsf_scene_t *sc, double *xy, size_t cap)
     return n;
 }
 
+/* The beam of the return on shape `wall` nearest corner c (lidar->n_beams
+ * when the wall has none); *dmin receives its distance. */
+static size_t nearest_wall_return(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                                  const float *ranges, const int16_t *hit_shape, int wall,
+                                  double *dmin)
+{
+    size_t start = lidar->n_beams;
+    size_t i;
+    *dmin = 1e300;
+    for (i = 0; i < lidar->n_beams; ++i) {
+        if (hit_shape[i] == wall) {
+            const double a = lidar->angle_min + (double)i * lidar->angle_increment;
+            const double d =
+                hypot((double)ranges[i] * cos(a) - c->x, (double)ranges[i] * sin(a) - c->y);
+            if (d < *dmin) {
+                *dmin = d;
+                start = i;
+            }
+        }
+    }
+    return start;
+}
+
+/* The scan's beams close a full circle. */
+static int full_ring(const bsf_lidar_t *lidar)
+{
+    return fabs(fabs(lidar->angle_increment) * (double)lidar->n_beams - 6.283185307179586) <=
+           fabs(lidar->angle_increment);
+}
+
+/* *b one beam further in direction dir (-1 or +1), through the seam of a
+ * ring; 0 at the end of a scan that is not one. */
+static int step_beam(size_t *b, int dir, size_t n, int ring)
+{
+    if (dir < 0) {
+        if (*b == 0u && !ring) {
+            return 0;
+        }
+        *b = *b == 0u ? n - 1u : *b - 1u;
+    } else {
+        if (*b + 1u == n && !ring) {
+            return 0;
+        }
+        *b = *b + 1u == n ? 0u : *b + 1u;
+    }
+    return 1;
+}
+
 /* Each wall of corner c seen over some length (see bsf_truth.h). */
 static int walls_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, const float *ranges,
                       const int16_t *hit_shape)
@@ -226,49 +274,23 @@ static int walls_seen_sparse(const bsf_scene_corner_t *c, const bsf_lidar_t *lid
                              const float *ranges, const int16_t *hit_shape)
 {
     const size_t n = lidar->n_beams;
-    const int ring = fabs(fabs(lidar->angle_increment) * (double)n - 2.0 * 3.14159265358979) <=
-                     fabs(lidar->angle_increment);
+    const int ring = full_ring(lidar);
     int side;
     for (side = 0; side < 2; ++side) {
         const int wall = side == 0 ? c->shape_a : c->shape_b;
-        double dmin = 1e300;
-        size_t start = n;
-        size_t i;
+        double reach;
+        const size_t start = nearest_wall_return(c, lidar, ranges, hit_shape, wall, &reach);
         int dir;
         int run = 1;
-        double reach = 0.0;
-        for (i = 0; i < n; ++i) {
-            if (hit_shape[i] == wall) {
-                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
-                const double d =
-                    hypot((double)ranges[i] * cos(a) - c->x, (double)ranges[i] * sin(a) - c->y);
-                if (d < dmin) {
-                    dmin = d;
-                    start = i;
-                }
-            }
-        }
         if (start == n) {
             return 0;
         }
-        reach = dmin;
         for (dir = -1; dir <= 1; dir += 2) {
             size_t b = start;
             size_t steps;
-            for (steps = 1; steps < n; ++steps) {
+            for (steps = 1; steps < n && step_beam(&b, dir, n, ring); ++steps) {
                 double a;
                 double d;
-                if (dir < 0) {
-                    if (b == 0u && !ring) {
-                        break;
-                    }
-                    b = b == 0u ? n - 1u : b - 1u;
-                } else {
-                    if (b + 1u == n && !ring) {
-                        break;
-                    }
-                    b = b + 1u == n ? 0u : b + 1u;
-                }
                 if (hit_shape[b] != wall || b == start) {
                     break;
                 }
@@ -298,20 +320,10 @@ static void print_corner_walls(const bsf_scene_corner_t *c, const bsf_lidar_t *l
     int side;
     for (side = 0; side < 2; ++side) {
         const int wall = side == 0 ? c->shape_a : c->shape_b;
-        double dmin = 1e300;
-        size_t start = n, i, b;
+        double dmin;
+        const size_t start = nearest_wall_return(c, lidar, ranges, hit_shape, wall, &dmin);
+        size_t i, b;
         int dir, best_dir = 0;
-        for (i = 0; i < n; ++i) {
-            if (hit_shape[i] == wall) {
-                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
-                const double d =
-                    hypot((double)ranges[i] * cos(a) - c->x, (double)ranges[i] * sin(a) - c->y);
-                if (d < dmin) {
-                    dmin = d;
-                    start = i;
-                }
-            }
-        }
         if (start == n) {
             printf("   wall %d: no hits\n", wall);
             continue;
@@ -709,29 +721,16 @@ int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lida
                             double len_side[2])
 {
     const size_t n = lidar->n_beams;
-    const int ring = fabs(fabs(lidar->angle_increment) * (double)n - 6.283185307179586) <=
-                     fabs(lidar->angle_increment);
+    const int ring = full_ring(lidar);
     double nx[2], ny[2], dd[2], det;
     int side;
     for (side = 0; side < 2; ++side) {
         const int wall = side == 0 ? c->shape_a : c->shape_b;
         oracle_sums_t s = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-        double dmin = 1e300;
+        double dmin;
         double len = 0.0;
-        size_t start = n;
-        size_t i;
+        const size_t start = nearest_wall_return(c, lidar, clean, hit_shape, wall, &dmin);
         int dir;
-        for (i = 0; i < n; ++i) {
-            if (hit_shape[i] == wall) {
-                const double a = lidar->angle_min + (double)i * lidar->angle_increment;
-                const double d =
-                    hypot((double)clean[i] * cos(a) - c->x, (double)clean[i] * sin(a) - c->y);
-                if (d < dmin) {
-                    dmin = d;
-                    start = i;
-                }
-            }
-        }
         if (start == n) {
             return -1;
         }
@@ -740,18 +739,7 @@ int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lida
             for (dir = -1; dir <= 1; dir += 2) {
                 size_t b = start;
                 size_t steps;
-                for (steps = 1; steps < n; ++steps) {
-                    if (dir < 0) {
-                        if (b == 0u && !ring) {
-                            break;
-                        }
-                        b = b == 0u ? n - 1u : b - 1u;
-                    } else {
-                        if (b + 1u == n && !ring) {
-                            break;
-                        }
-                        b = b + 1u == n ? 0u : b + 1u;
-                    }
+                for (steps = 1; steps < n && step_beam(&b, dir, n, ring); ++steps) {
                     if (hit_shape[b] != wall || b == start ||
                         oracle_take(c, lidar, clean, measured, unmixed, reach, b, &s, &len) != 0) {
                         break;
