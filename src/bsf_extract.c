@@ -590,6 +590,9 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
     const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
+    const size_t n = b + 1u - a;
+    bsf_pdm_params_t pdm = ex->params.pdm;
+    bsf_pdm_info_t info;
     size_t v0 = 0u;
     size_t v1;
     size_t i;
@@ -607,11 +610,28 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] - a);
     }
-    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], b + 1u - a, &pos[v0],
+    if (ex->params.fit_passes != 0u) {
+        /* The passes left per point left (fit_passes), at least one: the
+         * first solve runs anyway. */
+        const uint32_t share = ex->scratch.seg.use.fit.passes_left /
+                               (ex->scratch.seg.use.fit.points_left > n
+                                    ? ex->scratch.seg.use.fit.points_left
+                                    : (uint32_t)n);
+        pdm.max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
+    }
+    info.iterations = 0u;
+    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], n, &pos[v0],
                               anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
-                              &ex->params.pdm, &ex->scratch.seg.use.fit.pdm,
-                              &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl],
-                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, NULL);
+                              &pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
+                              &res->ctrl_is_vertex[res->n_ctrl],
+                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, &info);
+    {
+        /* What this fit spent, failed or not, counts against the scan. */
+        const uint32_t spent = info.iterations * (uint32_t)n;
+        uint32_t *left = &ex->scratch.seg.use.fit.passes_left;
+        *left = spent < *left ? *left - spent : 0u;
+        res->stats.n_fit_visits += spent;
+    }
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] + a);
     }
@@ -730,7 +750,11 @@ static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf
         return BSF_ERR_DEGENERATE; /* as PDM and LSBA say for too few points */
     }
     if (!USES_RPOS(ex)) {
-        return fit_pieces(ex, s, n, n_vertex, res);
+        st = fit_pieces(ex, s, n, n_vertex, res);
+        ex->scratch.seg.use.fit.points_left -= ex->scratch.seg.use.fit.points_left > n
+                                                   ? (uint32_t)n
+                                                   : ex->scratch.seg.use.fit.points_left;
+        return st;
     }
     st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
     if (st != BSF_OK) {
@@ -822,9 +846,11 @@ static void put_features_in_beam_order(bsf_result_t *res)
  * the segments that cover the most points first, so what is left out is
  * the small stuff. A segment that does not fit is cut; smaller ones may
  * still fit after it. */
-static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res)
+static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res, uint32_t points)
 {
     size_t si = ex->n_segments;
+    /* The passes the first attempt spent stay spent. */
+    ex->scratch.seg.use.fit.points_left = points;
     res->n_features = 0u;
     res->n_ctrl = 0u;
     res->stats.n_in_features = 0u;
@@ -850,11 +876,17 @@ static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res)
 
 static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
 {
+    uint32_t points = 0u;
     size_t si;
+    for (si = 0; si < ex->n_segments; ++si) {
+        points += ex->segments[si].n_points;
+    }
+    ex->scratch.seg.use.fit.points_left = points;
+    ex->scratch.seg.use.fit.passes_left = (uint32_t)ex->params.fit_passes * points;
     for (si = 0; si < ex->n_segments; ++si) {
         const bsf_status_t st = fit_segment(ex, &ex->segments[si], res);
         if (st == BSF_ERR_BUFFER) {
-            fit_largest_first(ex, res);
+            fit_largest_first(ex, res, points);
             break;
         }
         if (st != BSF_OK) {

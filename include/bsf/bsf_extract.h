@@ -85,6 +85,17 @@ typedef struct {
      *  has a corner within the run. The return counts as wasted in Γ.
      *  0 keeps every return (bsf_params_paper). */
     uint8_t trim_tails;
+    /** The three PDM methods: a bound on the fit's work per scan, for
+     *  firmware that must keep up with a dense LIDAR in its worst scan
+     *  (docs/PERFORMANCE.md, "A bound on the fit's work"). The scan spends
+     *  about this many footpoint passes per point it fits, on average, on
+     *  refinement near the target: each fit may use the passes still left
+     *  per point still to fit (bsf_pdm_params_t.max_passes, at least one;
+     *  what a fit leaves unused goes to the later ones). A fragment still
+     *  more than twice pdm.target_rms from its points grows past it. A fit
+     *  stopped early keeps fewer control points and a larger E_curve;
+     *  stats.n_fit_visits counts the work. 0 (default): no bound. */
+    uint8_t fit_passes;
     bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
     void *clock_user;   /**< passed to clock */
     uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */
@@ -146,6 +157,8 @@ typedef struct {
                     uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
                     bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
                     bsf_pdm_work_t pdm;
+                    uint32_t passes_left; /**< point visits the scan may still spend (fit_passes) */
+                    uint32_t points_left; /**< points of the segments still to fit */
                 } fit;
             } use;
         } seg;

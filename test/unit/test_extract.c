@@ -623,6 +623,54 @@ static void test_a_tail_return_past_a_concave_corner_is_left_off_the_feature(voi
     TEST_ASSERT_TRUE(wasted_on <= wasted_off + 2u * 12u);
 }
 
+/* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
+ * on dense scans whose fits climb near the target, and the curves it leaves
+ * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
+static void test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls(void)
+{
+    static const double pose[3][3] = {{2.0, 1.5, 0.4}, {6.5, 1.2, 2.0}, {1.5, 5.0, -0.8}};
+    uint32_t free_visits = 0u;
+    uint32_t returns = 0u;
+    int k;
+    build_l_room();
+    for (k = 0; k < 3; ++k) {
+        bsf_lidar_t l = bsf_lidar_default(pose[k][0], pose[k][1], pose[k][2], 1081u, 4.71238898);
+        uint32_t visits[2];
+        uint32_t in_features[2];
+        double max_d[2];
+        int bounded;
+        l.angle_increment = 4.71238898 / 1080.0;
+        l.noise_sigma = 0.01;
+        for (bounded = 0; bounded <= 1; ++bounded) {
+            bsf_scene_rng_t rng;
+            bsf_scan_t s = scan_of(&l);
+            bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
+            double rms;
+            TEST_ASSERT_EQUAL_UINT8(0u, p.fit_passes);
+            p.fit_passes = bounded ? 3u : 0u;
+            bsf_scene_rng_seed(&rng, 60u + (uint64_t)k);
+            TEST_ASSERT_EQUAL_INT(BSF_OK,
+                                  bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+            curve_to_truth(&l, &rms, &max_d[bounded]);
+            visits[bounded] = res.stats.n_fit_visits;
+            in_features[bounded] = res.stats.n_in_features;
+        }
+        printf("L-room pose %d, %u valid returns: fit visits %u (%.1f per return), curve max "
+               "%.3f m; fit_passes 3: %u (%.1f), %.3f m\n",
+               k, (unsigned)res.stats.n_valid, (unsigned)visits[0],
+               (double)visits[0] / (double)res.stats.n_valid, max_d[0], (unsigned)visits[1],
+               (double)visits[1] / (double)res.stats.n_valid, max_d[1]);
+        free_visits += visits[0];
+        returns += res.stats.n_valid;
+        TEST_ASSERT_TRUE(visits[1] <= 3u * res.stats.n_valid);
+        TEST_ASSERT_EQUAL_UINT32(in_features[0], in_features[1]); /* no return dropped */
+        TEST_ASSERT_TRUE(max_d[1] < 0.03);
+    }
+    TEST_ASSERT_TRUE(free_visits > 6u * returns); /* the free fits climb: the bound has work */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -639,5 +687,6 @@ int main(void)
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
     RUN_TEST(test_method_names_round_trip);
+    RUN_TEST(test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls);
     return UNITY_END();
 }
