@@ -613,10 +613,10 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     if (ex->params.fit_passes != 0u) {
         /* The passes left per point left (fit_passes), at least one: the
          * first solve runs anyway. */
-        const uint32_t share = ex->scratch.seg.use.fit.passes_left /
-                               (ex->scratch.seg.use.fit.points_left > n
-                                    ? ex->scratch.seg.use.fit.points_left
-                                    : (uint32_t)n);
+        const uint32_t share =
+            ex->scratch.seg.use.fit.passes_left / (ex->scratch.seg.use.fit.points_left > n
+                                                       ? ex->scratch.seg.use.fit.points_left
+                                                       : (uint32_t)n);
         pdm.max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
     }
     info.iterations = 0u;

@@ -528,14 +528,14 @@ static void test_max_passes_bounds_the_climb_near_the_target(void)
     float e_free = -1.0f;
     float e_capped = -1.0f;
     uint16_t cap;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
-                                              BSF_MAX_CTRL_PER_FEATURE, &n_free, &e_free,
-                                              &free_info));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                      BSF_MAX_CTRL_PER_FEATURE, &n_free, &e_free, &free_info));
     for (cap = 1u; cap <= 3u; ++cap) {
         params.max_passes = cap;
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
-                                                  BSF_MAX_CTRL_PER_FEATURE, &n_capped, &e_capped,
-                                                  &capped));
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                          BSF_MAX_CTRL_PER_FEATURE, &n_capped, &e_capped, &capped));
         printf("noisy arc: %u passes, %u ctrl, E %.4f m; max_passes %u: %u passes, %u ctrl, "
                "E %.4f m\n",
                (unsigned)free_info.iterations, (unsigned)n_free, (double)e_free, (unsigned)cap,
