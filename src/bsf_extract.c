@@ -244,6 +244,7 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
     set_valid(ex, n, 0u);
     st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
                        BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    ex->noise2 = ex->scratch.lc.noise2; /* segmentation reuses the scratch */
     set_valid(ex, n, 1u);
     return st;
 }
@@ -378,24 +379,33 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-/* Points of the straight run beside a segment end that judge it (tail_end):
- * enough for a noise estimate with six degrees of freedom. */
+/* Points of the straight run beside a segment end that judge it (tail_end),
+ * at most: enough for a noise estimate of its own with six degrees of
+ * freedom. */
 #define TAIL_RUN 8u
+/* The shortest run: a segment of fewer than TAIL_MIN_RUN + 2 returns
+ * (the run, the end judged, the other end left out of the run) is not
+ * judged. */
+#define TAIL_MIN_RUN 5u
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
- * nearer the sensor, that the straight run p[step], p[2 step], ... beside
+ * nearer the sensor, that the straight run p[step], ... p[run step] beside
  * it (step +1 or -1) does not explain? At a concave corner seen at grazing
  * incidence the next wall often gives a single return before the corner,
  * which no corner test can confirm, and a curve bent to reach it swings
  * through free space (half a metre past a corridor's end wall on the
  * ground-truth scenes). It is one when the run's line (total least squares,
  * SVED's side line) misses p[0] by more than split_sigmas standard errors
- * of a new return one step past the run (the run's scatter per degree of
- * freedom and the line's own error there) and at least split_min, on the
- * sensor's side, with a turn of at least min_turn. Only the sensor's side:
- * a convex surface's last returns (a pillar's silhouette) bend away from
- * the sensor and still lie on it. */
-static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t *lc)
+ * of a new return one step past the run (the noise variance: the run's
+ * scatter per degree of freedom, at least the scan's noise2 from LC, and
+ * the line's own error there) and at least split_min, on the sensor's
+ * side, with a turn of at least min_turn. Only the sensor's side: a convex
+ * surface's last returns (a pillar's silhouette) bend away from the sensor
+ * and still lie on it. The scan's noise keeps a short run, whose own
+ * scatter over a few degrees of freedom is often far below the noise by
+ * chance, from taking real returns for tails. */
+static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t run, float noise2,
+                    const bsf_lc_params_t *lc)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
@@ -404,11 +414,14 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t 
     float sy;
     float s;
     size_t k;
-    for (k = 0; k <= TAIL_RUN; ++k) {
+    for (k = 0; k <= run; ++k) {
         w[k] = p[(ptrdiff_t)k * step];
     }
-    l.n = (int)TAIL_RUN + 1;
+    l.n = (int)run + 1;
     bsf_side_fit(w, &l);
+    if (l.var < noise2) {
+        l.var = noise2;
+    }
     d2 = l.d_near * l.d_near;
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
@@ -421,21 +434,24 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t 
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
- * a tail (tail_end) is left off unless LC has a corner within the run
- * beside it, which already bends the curve there. */
+ * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
+ * that leaves the other end out) is left off unless LC has a corner within
+ * that run, which already bends the curve there. */
 static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
 {
     const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
+    const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < 2u * TAIL_RUN + 1u) {
+        n < TAIL_MIN_RUN + 2u) {
         return;
     }
-    if ((n_vertex == 0u || pos[0] > TAIL_RUN + 1u) && tail_end(pts, 1, &ex->params.lc)) {
+    if ((n_vertex == 0u || pos[0] > run + 1u) &&
+        tail_end(pts, 1, run, ex->noise2, &ex->params.lc)) {
         *lo = 1u;
     }
-    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + TAIL_RUN + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, &ex->params.lc)) {
+    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
+        tail_end(&pts[n - 1u], -1, run, ex->noise2, &ex->params.lc)) {
         *hi = n - 2u;
     }
 }

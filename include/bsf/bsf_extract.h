@@ -165,6 +165,7 @@ typedef struct {
     } scratch;
     size_t n_keypoints;
     size_t n_segments;
+    float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
     uint32_t ready; /**< set by a successful init */
 } bsf_extractor_t;
 
