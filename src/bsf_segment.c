@@ -387,11 +387,15 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
     l->reach_i = 1.0f;
     l->reach_nr = 1.0f;
     l->d_near = 0.0f;
+#if !BSF_CONFIG_COMPACT
     const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
+#endif
     for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
         size_t j;
+#if !BSF_CONFIG_COMPACT
         if (inside) {
-            /* most beams: no wrap, only validity */
+            /* most beams: no wrap, only validity (neighbour_beam's answer;
+             * the compact build keeps only the general path) */
             j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
             if (!pts->valid[j]) {
                 break;
@@ -399,6 +403,11 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
         } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
             break;
         }
+#else
+        if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+            break;
+        }
+#endif
         /* beam i's radius for every step (worked out once per beam) */
         if (l->n > 0) {
             const float dx = pts->pt[j].x - w[l->n - 1].x;
@@ -532,8 +541,11 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     float jump;
     int have_outer;
     int k;
+#if !BSF_CONFIG_COMPACT
     if (i >= 2u && i + 2u < pts->count) {
-        /* Inside the scan (most beams): the cheap tests first. */
+        /* Inside the scan (most beams): the cheap tests first, with the
+         * answers of the general path below (which the compact build
+         * keeps alone). */
         const uint8_t *v = &pts->valid[i - 2u];
         const float *rg = &pts->range[i - 2u];
         if (!between_neighbours(pts, i, &r[1], &lo, &hi)) {
@@ -542,7 +554,9 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         have_outer = (v[0] != 0u) & (v[4] != 0u);
         r[0] = rg[0];
         r[4] = rg[4];
-    } else {
+    } else
+#endif
+    {
         for (k = -1; k <= 1; ++k) {
             if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
                 return 0;
