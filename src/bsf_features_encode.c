@@ -148,9 +148,11 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
     if (s + 1u >= n || vtx[s + 1u] == 0u) {
         return 0;
     }
+#if !BSF_CONFIG_COMPACT
     if (memcmp(&p[s], &p[s + 1u], sizeof p[s]) == 0) {
-        return 1; /* the usual copy: the same bits quantise alike */
+        return 1; /* the usual copy: the same bits quantise alike (the test below's answer) */
     }
+#endif
     return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
 }
 
