@@ -541,11 +541,8 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     float jump;
     int have_outer;
     int k;
-#if !BSF_CONFIG_COMPACT
     if (i >= 2u && i + 2u < pts->count) {
-        /* Inside the scan (most beams): the cheap tests first, with the
-         * answers of the general path below (which the compact build
-         * keeps alone). */
+        /* Inside the scan (most beams): the cheap tests first. */
         const uint8_t *v = &pts->valid[i - 2u];
         const float *rg = &pts->range[i - 2u];
         if (!between_neighbours(pts, i, &r[1], &lo, &hi)) {
@@ -554,9 +551,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         have_outer = (v[0] != 0u) & (v[4] != 0u);
         r[0] = rg[0];
         r[4] = rg[4];
-    } else
-#endif
-    {
+    } else {
         for (k = -1; k <= 1; ++k) {
             if (!neighbour_range(pts, i, k, ring, &r[k + 2])) {
                 return 0;
