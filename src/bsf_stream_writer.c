@@ -242,9 +242,7 @@ static bsf_status_t job_direct(bsf_enc_job_t *job, uint8_t *buf, size_t *out_len
 bsf_status_t bsf_enc_job_encode(bsf_enc_job_t *job, uint8_t *buf, size_t cap, size_t *out_len)
 {
     const bsf_status_t st = job_plan(job);
-#if !BSF_CONFIG_COMPACT
     size_t body;
-#endif
     stream_t s;
     if (st != BSF_OK) {
         *out_len = 0u;
@@ -257,16 +255,11 @@ bsf_status_t bsf_enc_job_encode(bsf_enc_job_t *job, uint8_t *buf, size_t cap, si
         return job_direct(job, buf, out_len);
     }
 #endif
-#if !BSF_CONFIG_COMPACT
     body = ((size_t)bsf_enc_job_bits(job) + 7u) / 8u + BSF_FRAME_CRC_SIZE;
     if (body < 254u) {
         *out_len = body + 2u; /* exact: no block reaches 254 bytes */
-    } else
-#endif
-    {
-        /* count (the compact variant always: the bound above is its answer
-         * for a short body) */
-        stream_init(&s);
+    } else {
+        stream_init(&s); /* count */
         job_stream(job, &s);
         *out_len = s.pos;
     }
