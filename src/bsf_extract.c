@@ -45,11 +45,21 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     bsf_params_t p;
     memset(&p, 0, sizeof p);
     p.method = method;
+    /* A method left out of the build (BSF_CONFIG_METHODS) keeps its
+     * parameters zero: nothing reads them, and their defaults stay unlinked. */
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_FALKO
     p.falko = bsf_falko_params_default();
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
     p.lc = bsf_lc_params_default();
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     p.bid = bsf_bid_params_default();
+#endif
     p.sved = bsf_sved_params_default();
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_RPOS
     p.rpos = bsf_rpos_params_default();
+#endif
     bsf_pdm_params_default(&p.pdm);
     if (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM) {
         /* Keypoint detectors that miss most corners (docs/GROUND_TRUTH.md):

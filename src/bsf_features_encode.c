@@ -103,6 +103,10 @@ ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
  * again. */
 #define VALUE_HEAD 3u
 #define VALUE_KEEP 144u
+/* Whether the planning run keeps values for the writing runs at all: speed
+ * only, the compact build makes every feature's values again (the same
+ * values: the same quantisation of the same points). */
+#define VALUES_KEPT (!BSF_CONFIG_COMPACT)
 #define VALUE_TABLE (VALUE_KEEP + VALUE_HEAD + 2u * BSF_MAX_CTRL_PER_FEATURE)
 
 ENC_INLINE uint32_t zigzag32(int32_t v)
@@ -131,11 +135,14 @@ ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
     const int32_t den = 2 * (int32_t)k;
     const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;
     int32_t q;
+#if !BSF_CONFIG_COMPACT
     if (k == 1u) {
         /* the usual case, a fragment with one precision point: floor(num / 2)
-         * as a shift of num + 2^31, which is not negative */
+         * as a shift of num + 2^31, which is not negative (the division
+         * below gives the same; the compact build keeps that alone) */
         return a + ((int32_t)(((uint32_t)num ^ 0x80000000u) >> 1) - 0x40000000);
     }
+#endif
     q = num / den;
     return a + (num - q * den < 0 ? q - 1 : q); /* floor */
 }
@@ -148,9 +155,11 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
     if (s + 1u >= n || vtx[s + 1u] == 0u) {
         return 0;
     }
+#if !BSF_CONFIG_COMPACT
     if (memcmp(&p[s], &p[s + 1u], sizeof p[s]) == 0) {
-        return 1; /* the usual copy: the same bits quantise alike */
+        return 1; /* the usual copy: the same bits quantise alike (the test below's answer) */
     }
+#endif
     return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
 }
 
@@ -493,7 +502,7 @@ static bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table, plan_t 
         if (n_values == 0u) {
             return BSF_ERR_ARG;
         }
-        if (n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
+        if (VALUES_KEPT && n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
             head[0] = n_values / 2u;
             head[1] = (uint32_t)mask;
             head[2] = (uint32_t)(mask >> 32);
@@ -587,7 +596,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         uint64_t mask;
         uint32_t n_unique;
         const uint32_t *values = table;
-        if (i < pl->n_cached) {
+        if (VALUES_KEPT && i < pl->n_cached) {
             n_unique = table[used];
             mask = table[used + 1u] | ((uint64_t)table[used + 2u] << 32);
             values = table + used + VALUE_HEAD;

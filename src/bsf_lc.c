@@ -1490,22 +1490,14 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        if (len > 0.0f) {
-            for (i = a + 1u; i < b; ++i) {
-                const bsf_point_t q = pts->pt[w->run[i]];
-                const float d = fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len;
-                if (d > dmax) {
-                    dmax = d;
-                    imax = i;
-                }
-            }
-        } else {
-            for (i = a + 1u; i < b; ++i) {
-                const float d = sqrtf(dist2(pts->pt[w->run[i]], pa));
-                if (d > dmax) {
-                    dmax = d;
-                    imax = i;
-                }
+        for (i = a + 1u; i < b; ++i) {
+            const bsf_point_t q = pts->pt[w->run[i]];
+            /* distance from the chord, or from its end when it has no length */
+            const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
+                                       : sqrtf(dist2(q, pa));
+            if (d > dmax) {
+                dmax = d;
+                imax = i;
             }
         }
         if (dmax > tol) {

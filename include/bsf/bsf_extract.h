@@ -110,7 +110,11 @@ typedef struct {
  *  join_grazing 2 (bsf_sved_params_t): LC puts the vertex where a wall seen
  *  nearly edge-on starts at a corner.
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
- *  stored, which bsf_extractor_init then refuses. */
+ *  stored, which bsf_extractor_init then refuses. In a build without some
+ *  methods (BSF_CONFIG_METHODS), their own parameter structs (falko, bid,
+ *  lc, rpos) are left zero: those methods are refused, and a caller that
+ *  uses a detector directly takes its defaults from its own
+ *  bsf_*_params_default. */
 bsf_params_t bsf_params_default(bsf_method_t method);
 
 /** The paper-faithful configuration of a method: as bsf_params_default but
