@@ -103,10 +103,6 @@ ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
  * again. */
 #define VALUE_HEAD 3u
 #define VALUE_KEEP 144u
-/* Whether the planning run keeps values for the writing runs at all: speed
- * only, the compact build makes every feature's values again (the same
- * values: the same quantisation of the same points). */
-#define VALUES_KEPT (!BSF_CONFIG_COMPACT)
 #define VALUE_TABLE (VALUE_KEEP + VALUE_HEAD + 2u * BSF_MAX_CTRL_PER_FEATURE)
 
 ENC_INLINE uint32_t zigzag32(int32_t v)
@@ -502,7 +498,7 @@ static bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table, plan_t 
         if (n_values == 0u) {
             return BSF_ERR_ARG;
         }
-        if (VALUES_KEPT && n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
+        if (n_cached == i && used + VALUE_HEAD + n_values <= VALUE_KEEP) {
             head[0] = n_values / 2u;
             head[1] = (uint32_t)mask;
             head[2] = (uint32_t)(mask >> 32);
@@ -596,7 +592,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         uint64_t mask;
         uint32_t n_unique;
         const uint32_t *values = table;
-        if (VALUES_KEPT && i < pl->n_cached) {
+        if (i < pl->n_cached) {
             n_unique = table[used];
             mask = table[used + 1u] | ((uint64_t)table[used + 2u] << 32);
             values = table + used + VALUE_HEAD;
