@@ -617,8 +617,10 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
     const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
     const size_t n = b + 1u - a;
-    bsf_pdm_params_t pdm = ex->params.pdm;
-    bsf_pdm_info_t info;
+    /* This fit's parameters and outcome live in the scratch, not on the
+     * stack of the deepest call chain. */
+    bsf_pdm_params_t *pdm = &ex->scratch.seg.use.fit.pdm_params;
+    bsf_pdm_info_t *info = &ex->scratch.seg.use.fit.pdm_info;
     size_t v0 = 0u;
     size_t v1;
     size_t i;
@@ -636,6 +638,7 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] - a);
     }
+    *pdm = ex->params.pdm;
     if (ex->params.fit_passes != 0u) {
         /* The passes left per point left (fit_passes), at least one: the
          * first solve runs anyway. */
@@ -643,17 +646,17 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
             ex->scratch.seg.use.fit.passes_left / (ex->scratch.seg.use.fit.points_left > n
                                                        ? ex->scratch.seg.use.fit.points_left
                                                        : (uint32_t)n);
-        pdm.max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
+        pdm->max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
     }
-    info.iterations = 0u;
+    info->iterations = 0u;
     st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], n, &pos[v0],
                               anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
-                              &pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
+                              pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
                               &res->ctrl_is_vertex[res->n_ctrl],
-                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, &info);
+                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, info);
     {
         /* What this fit spent, failed or not, counts against the scan. */
-        const uint32_t spent = info.iterations * (uint32_t)n;
+        const uint32_t spent = info->iterations * (uint32_t)n;
         uint32_t *left = &ex->scratch.seg.use.fit.passes_left;
         *left = spent < *left ? *left - spent : 0u;
         res->stats.n_fit_visits += spent;

@@ -161,6 +161,8 @@ typedef struct {
                     uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
                     bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
                     bsf_pdm_work_t pdm;
+                    bsf_pdm_params_t pdm_params; /**< the fit's: params.pdm, max_passes set */
+                    bsf_pdm_info_t pdm_info;     /**< the fit's outcome */
                     uint32_t passes_left; /**< point visits the scan may still spend (fit_passes) */
                     uint32_t points_left; /**< points of the segments still to fit */
                 } fit;
