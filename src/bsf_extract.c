@@ -45,11 +45,21 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     bsf_params_t p;
     memset(&p, 0, sizeof p);
     p.method = method;
+    /* A method left out of the build (BSF_CONFIG_METHODS) keeps its
+     * parameters zero: nothing reads them, and their defaults stay unlinked. */
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_FALKO
     p.falko = bsf_falko_params_default();
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
     p.lc = bsf_lc_params_default();
+#endif
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_BID
     p.bid = bsf_bid_params_default();
+#endif
     p.sved = bsf_sved_params_default();
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_RPOS
     p.rpos = bsf_rpos_params_default();
+#endif
     bsf_pdm_params_default(&p.pdm);
     if (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM) {
         /* Keypoint detectors that miss most corners (docs/GROUND_TRUTH.md):
@@ -244,6 +254,7 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
     set_valid(ex, n, 0u);
     st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
                        BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    ex->noise2 = ex->scratch.lc.noise2; /* segmentation reuses the scratch */
     set_valid(ex, n, 1u);
     return st;
 }
@@ -378,24 +389,33 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-/* Points of the straight run beside a segment end that judge it (tail_end):
- * enough for a noise estimate with six degrees of freedom. */
+/* Points of the straight run beside a segment end that judge it (tail_end),
+ * at most: enough for a noise estimate of its own with six degrees of
+ * freedom. */
 #define TAIL_RUN 8u
+/* The shortest run: a segment of fewer than TAIL_MIN_RUN + 2 returns
+ * (the run, the end judged, the other end left out of the run) is not
+ * judged. */
+#define TAIL_MIN_RUN 5u
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
- * nearer the sensor, that the straight run p[step], p[2 step], ... beside
+ * nearer the sensor, that the straight run p[step], ... p[run step] beside
  * it (step +1 or -1) does not explain? At a concave corner seen at grazing
  * incidence the next wall often gives a single return before the corner,
  * which no corner test can confirm, and a curve bent to reach it swings
  * through free space (half a metre past a corridor's end wall on the
  * ground-truth scenes). It is one when the run's line (total least squares,
  * SVED's side line) misses p[0] by more than split_sigmas standard errors
- * of a new return one step past the run (the run's scatter per degree of
- * freedom and the line's own error there) and at least split_min, on the
- * sensor's side, with a turn of at least min_turn. Only the sensor's side:
- * a convex surface's last returns (a pillar's silhouette) bend away from
- * the sensor and still lie on it. */
-static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t *lc)
+ * of a new return one step past the run (the noise variance: the run's
+ * scatter per degree of freedom, at least the scan's noise2 from LC, and
+ * the line's own error there) and at least split_min, on the sensor's
+ * side, with a turn of at least min_turn. Only the sensor's side: a convex
+ * surface's last returns (a pillar's silhouette) bend away from the sensor
+ * and still lie on it. The scan's noise keeps a short run, whose own
+ * scatter over a few degrees of freedom is often far below the noise by
+ * chance, from taking real returns for tails. */
+static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t run, float noise2,
+                    const bsf_lc_params_t *lc)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
@@ -404,11 +424,14 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t 
     float sy;
     float s;
     size_t k;
-    for (k = 0; k <= TAIL_RUN; ++k) {
+    for (k = 0; k <= run; ++k) {
         w[k] = p[(ptrdiff_t)k * step];
     }
-    l.n = (int)TAIL_RUN + 1;
+    l.n = (int)run + 1;
     bsf_side_fit(w, &l);
+    if (l.var < noise2) {
+        l.var = noise2;
+    }
     d2 = l.d_near * l.d_near;
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
@@ -421,21 +444,24 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, const bsf_lc_params_t 
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
- * a tail (tail_end) is left off unless LC has a corner within the run
- * beside it, which already bends the curve there. */
+ * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
+ * that leaves the other end out) is left off unless LC has a corner within
+ * that run, which already bends the curve there. */
 static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
 {
     const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
+    const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < 2u * TAIL_RUN + 1u) {
+        n < TAIL_MIN_RUN + 2u) {
         return;
     }
-    if ((n_vertex == 0u || pos[0] > TAIL_RUN + 1u) && tail_end(pts, 1, &ex->params.lc)) {
+    if ((n_vertex == 0u || pos[0] > run + 1u) &&
+        tail_end(pts, 1, run, ex->noise2, &ex->params.lc)) {
         *lo = 1u;
     }
-    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + TAIL_RUN + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, &ex->params.lc)) {
+    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
+        tail_end(&pts[n - 1u], -1, run, ex->noise2, &ex->params.lc)) {
         *hi = n - 2u;
     }
 }
@@ -590,6 +616,11 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
     const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
+    const size_t n = b + 1u - a;
+    /* This fit's parameters and outcome live in the scratch, not on the
+     * stack of the deepest call chain. */
+    bsf_pdm_params_t *pdm = &ex->scratch.seg.use.fit.pdm_params;
+    bsf_pdm_info_t *info = &ex->scratch.seg.use.fit.pdm_info;
     size_t v0 = 0u;
     size_t v1;
     size_t i;
@@ -607,11 +638,29 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] - a);
     }
-    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], b + 1u - a, &pos[v0],
+    *pdm = ex->params.pdm;
+    if (ex->params.fit_passes != 0u) {
+        /* The passes left per point left (fit_passes), at least one: the
+         * first solve runs anyway. */
+        const uint32_t share =
+            ex->scratch.seg.use.fit.passes_left / (ex->scratch.seg.use.fit.points_left > n
+                                                       ? ex->scratch.seg.use.fit.points_left
+                                                       : (uint32_t)n);
+        pdm->max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
+    }
+    info->iterations = 0u;
+    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], n, &pos[v0],
                               anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
-                              &ex->params.pdm, &ex->scratch.seg.use.fit.pdm,
-                              &res->ctrl[res->n_ctrl], &res->ctrl_is_vertex[res->n_ctrl],
-                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, NULL);
+                              pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
+                              &res->ctrl_is_vertex[res->n_ctrl],
+                              (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, info);
+    {
+        /* What this fit spent, failed or not, counts against the scan. */
+        const uint32_t spent = info->iterations * (uint32_t)n;
+        uint32_t *left = &ex->scratch.seg.use.fit.passes_left;
+        *left = spent < *left ? *left - spent : 0u;
+        res->stats.n_fit_visits += spent;
+    }
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] + a);
     }
@@ -730,7 +779,11 @@ static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf
         return BSF_ERR_DEGENERATE; /* as PDM and LSBA say for too few points */
     }
     if (!USES_RPOS(ex)) {
-        return fit_pieces(ex, s, n, n_vertex, res);
+        st = fit_pieces(ex, s, n, n_vertex, res);
+        ex->scratch.seg.use.fit.points_left -= ex->scratch.seg.use.fit.points_left > n
+                                                   ? (uint32_t)n
+                                                   : ex->scratch.seg.use.fit.points_left;
+        return st;
     }
     st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);
     if (st != BSF_OK) {
@@ -822,9 +875,11 @@ static void put_features_in_beam_order(bsf_result_t *res)
  * the segments that cover the most points first, so what is left out is
  * the small stuff. A segment that does not fit is cut; smaller ones may
  * still fit after it. */
-static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res)
+static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res, uint32_t points)
 {
     size_t si = ex->n_segments;
+    /* The passes the first attempt spent stay spent. */
+    ex->scratch.seg.use.fit.points_left = points;
     res->n_features = 0u;
     res->n_ctrl = 0u;
     res->stats.n_in_features = 0u;
@@ -850,11 +905,17 @@ static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res)
 
 static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
 {
+    uint32_t points = 0u;
     size_t si;
+    for (si = 0; si < ex->n_segments; ++si) {
+        points += ex->segments[si].n_points;
+    }
+    ex->scratch.seg.use.fit.points_left = points;
+    ex->scratch.seg.use.fit.passes_left = (uint32_t)ex->params.fit_passes * points;
     for (si = 0; si < ex->n_segments; ++si) {
         const bsf_status_t st = fit_segment(ex, &ex->segments[si], res);
         if (st == BSF_ERR_BUFFER) {
-            fit_largest_first(ex, res);
+            fit_largest_first(ex, res, points);
             break;
         }
         if (st != BSF_OK) {

@@ -131,11 +131,14 @@ ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
     const int32_t den = 2 * (int32_t)k;
     const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;
     int32_t q;
+#if !BSF_CONFIG_COMPACT
     if (k == 1u) {
         /* the usual case, a fragment with one precision point: floor(num / 2)
-         * as a shift of num + 2^31, which is not negative */
+         * as a shift of num + 2^31, which is not negative (the division
+         * below gives the same; the compact build keeps that alone) */
         return a + ((int32_t)(((uint32_t)num ^ 0x80000000u) >> 1) - 0x40000000);
     }
+#endif
     q = num / den;
     return a + (num - q * den < 0 ? q - 1 : q); /* floor */
 }
@@ -148,9 +151,11 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
     if (s + 1u >= n || vtx[s + 1u] == 0u) {
         return 0;
     }
+#if !BSF_CONFIG_COMPACT
     if (memcmp(&p[s], &p[s + 1u], sizeof p[s]) == 0) {
-        return 1; /* the usual copy: the same bits quantise alike */
+        return 1; /* the usual copy: the same bits quantise alike (the test below's answer) */
     }
+#endif
     return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
 }
 

@@ -101,8 +101,9 @@ typedef struct {
     bsf_point_t o;    /* origin of the current judgement (the apex point) */
     bsf_point_t *rel; /* run points minus o, filled by judge for its window */
     float sin_min_turn;
-    float noise2; /* the current run's noise variance (run_noise squared), at least floor^2 */
-    size_t start; /* beam where the pass starts (ring_start, else 0) */
+    float noise2;       /* the current run's noise variance (run_noise squared), at least floor^2 */
+    float noise_points; /* points of the runs judged (their noise: bsf_lc_work_t.noise2) */
+    size_t start;       /* beam where the pass starts (ring_start, else 0) */
 #if !BSF_CONFIG_COMPACT
     /* room for block summaries of the current run, or NULL (short runs);
      * built when a judge first needs them */
@@ -1489,22 +1490,14 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        if (len > 0.0f) {
-            for (i = a + 1u; i < b; ++i) {
-                const bsf_point_t q = pts->pt[w->run[i]];
-                const float d = fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len;
-                if (d > dmax) {
-                    dmax = d;
-                    imax = i;
-                }
-            }
-        } else {
-            for (i = a + 1u; i < b; ++i) {
-                const float d = sqrtf(dist2(pts->pt[w->run[i]], pa));
-                if (d > dmax) {
-                    dmax = d;
-                    imax = i;
-                }
+        for (i = a + 1u; i < b; ++i) {
+            const bsf_point_t q = pts->pt[w->run[i]];
+            /* distance from the chord, or from its end when it has no length */
+            const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
+                                       : sqrtf(dist2(q, pa));
+            if (d > dmax) {
+                dmax = d;
+                imax = i;
             }
         }
         if (dmax > tol) {
@@ -1580,7 +1573,8 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
      * run's average across its surfaces (lowered by the walls seen
      * obliquely): split at that average, noise alone would cut such a wall
      * every few points, near a corner into pieces too short to judge it. */
-    float tol = c->p->split_sigmas * (along_ray > sigma ? along_ray : sigma);
+    const float split_noise = along_ray > sigma ? along_ray : sigma;
+    float tol = c->p->split_sigmas * split_noise;
     size_t nb;
     size_t j;
     unsigned pass;
@@ -1593,6 +1587,10 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
     }
     c->noise2 =
         sigma * sigma > c->p->floor * c->p->floor ? sigma * sigma : c->p->floor * c->p->floor;
+    /* The scan's noise (bsf_lc_work_t.noise2): the split tolerance's, the
+     * whole range noise where the beams are dense enough to show it. */
+    w->noise2 += (float)m * split_noise * split_noise;
+    c->noise_points += (float)m;
     blocks_attach(c, w, m);
     nb = split_run(c->pts, w, m, tol);
     first = *n_found;
@@ -1817,6 +1815,8 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     c.rel = work->rel;
     c.sin_min_turn = bsf_sinf(p->min_turn);
     c.noise2 = 0.0f;
+    work->noise2 = 0.0f;
+    c.noise_points = 0.0f;
     blocks_detach(&c);
     c.start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
     for (step = 0; step <= pts->count; ++step) {
@@ -1858,6 +1858,9 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
         reverse_keypoints(out, 0u, n_after);
         reverse_keypoints(out, n_after, n_kept);
         reverse_keypoints(out, 0u, n_kept);
+    }
+    if (c.noise_points > 0.0f) {
+        work->noise2 /= c.noise_points;
     }
     *n_out = n_found;
     return n_found > out_cap ? BSF_ERR_CAPACITY : BSF_OK;

@@ -26,7 +26,10 @@ static float pow2i(int k)
     return f;
 }
 
-float bsf_sinf(float x)
+/* sin(x) turned on by quarter_turns quarter turns: cos(x) is
+ * sin(x + pi/2), one quarter turn on in the reduced argument's quadrant, so
+ * both share one copy of the reduction and the kernels (code size). */
+static float sin_turned(float x, unsigned quarter_turns)
 {
     unsigned q;
     float r;
@@ -35,7 +38,7 @@ float bsf_sinf(float x)
         return x - x; /* NaN for NaN and +-inf */
     }
     r = bsf_trig_reduce(x, &q);
-    switch (q) {
+    switch ((q + quarter_turns) & 3u) {
     case 0u: v = bsf_sin_kernel(r); break;
     case 1u: v = bsf_cos_kernel(r); break;
     case 2u: v = -bsf_sin_kernel(r); break;
@@ -44,22 +47,14 @@ float bsf_sinf(float x)
     return bsf_clamp_unit(v);
 }
 
+float bsf_sinf(float x)
+{
+    return sin_turned(x, 0u);
+}
+
 float bsf_cosf(float x)
 {
-    unsigned q;
-    float r;
-    float v;
-    if (!(fabsf(x) <= 3.402823466e38f)) {
-        return x - x;
-    }
-    r = bsf_trig_reduce(x, &q);
-    switch (q) {
-    case 0u: v = bsf_cos_kernel(r); break;
-    case 1u: v = -bsf_sin_kernel(r); break;
-    case 2u: v = -bsf_cos_kernel(r); break;
-    default: v = bsf_sin_kernel(r); break;
-    }
-    return bsf_clamp_unit(v);
+    return sin_turned(x, 1u);
 }
 
 float bsf_expf(float x)

@@ -99,6 +99,7 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     p->refine = 1u;
     p->bias_window = 16u;
     p->bias_ratio = 0.2f;
+    p->max_passes = 0u;
 }
 
 bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
@@ -1170,8 +1171,10 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
     }
     build_layout(&s, work, t0, t1);
     start_from_arc_length(&s, work, t0, t1);
-    st = run_pdm(&s, work, p, p->max_iterations, p->refine ? p->target_rms : 0.0f, 0,
-                 &info.iterations);
+    st = run_pdm(&s, work, p,
+                 p->max_passes != 0u && p->max_passes < p->max_iterations ? p->max_passes
+                                                                          : p->max_iterations,
+                 p->refine ? p->target_rms : 0.0f, 0, &info.iterations);
     if (st != BSF_OK) {
         return st;
     }
@@ -1188,6 +1191,12 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
         }
         before = work->frag_rms[pick];
         far = before > PDM_FAR_RATIO * p->target_rms;
+        /* The cap stops the climb near the target, never the growth of a
+         * fragment still far from it: a curve cut off there could miss its
+         * points by decimetres. */
+        if (!far && p->max_passes != 0u && info.iterations + p->refine_iterations > p->max_passes) {
+            break;
+        }
         work->last_refined = (uint16_t)pick;
         /* Far from the target: several points at once, then a fresh fit of
          * the new layout from arc length. Near it: one point on the worst
@@ -1211,7 +1220,8 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
         if (far) {
             continue;
         }
-        if (!(work->frag_rms[pick] < (1.0f - PDM_COLD_GAIN) * before)) {
+        if (!(work->frag_rms[pick] < (1.0f - PDM_COLD_GAIN) * before) &&
+            (p->max_passes == 0u || info.iterations < p->max_passes)) {
             if (s.frag_stray[pick]) {
                 /* Only a lone stray point keeps the fragment above target
                  * and this point gained nothing: more points would only

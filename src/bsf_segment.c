@@ -387,11 +387,15 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
     l->reach_i = 1.0f;
     l->reach_nr = 1.0f;
     l->d_near = 0.0f;
+#if !BSF_CONFIG_COMPACT
     const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
+#endif
     for (k = 0; k < SEG_MIXED_WINDOW; ++k) {
         size_t j;
+#if !BSF_CONFIG_COMPACT
         if (inside) {
-            /* most beams: no wrap, only validity */
+            /* most beams: no wrap, only validity (neighbour_beam's answer;
+             * the compact build keeps only the general path) */
             j = dir < 0 ? i - (size_t)(k + 1) : i + (size_t)(k + 1);
             if (!pts->valid[j]) {
                 break;
@@ -399,6 +403,11 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
         } else if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
             break;
         }
+#else
+        if (!neighbour_beam(pts, i, (long)dir * (long)(k + 1), ring, &j)) {
+            break;
+        }
+#endif
         /* beam i's radius for every step (worked out once per beam) */
         if (l->n > 0) {
             const float dx = pts->pt[j].x - w[l->n - 1].x;

@@ -85,6 +85,17 @@ typedef struct {
      *  has a corner within the run. The return counts as wasted in Γ.
      *  0 keeps every return (bsf_params_paper). */
     uint8_t trim_tails;
+    /** The three PDM methods: a bound on the fit's work per scan, for
+     *  firmware that must keep up with a dense LIDAR in its worst scan
+     *  (docs/PERFORMANCE.md, "A bound on the fit's work"). The scan spends
+     *  about this many footpoint passes per point it fits, on average, on
+     *  refinement near the target: each fit may use the passes still left
+     *  per point still to fit (bsf_pdm_params_t.max_passes, at least one;
+     *  what a fit leaves unused goes to the later ones). A fragment still
+     *  more than twice pdm.target_rms from its points grows past it. A fit
+     *  stopped early keeps fewer control points and a larger E_curve;
+     *  stats.n_fit_visits counts the work. 0 (default): no bound. */
+    uint8_t fit_passes;
     bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
     void *clock_user;   /**< passed to clock */
     uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */
@@ -99,7 +110,11 @@ typedef struct {
  *  join_grazing 2 (bsf_sved_params_t): LC puts the vertex where a wall seen
  *  nearly edge-on starts at a corner.
  *  An unknown method gives the FALKO-SVED-PDM defaults with that method
- *  stored, which bsf_extractor_init then refuses. */
+ *  stored, which bsf_extractor_init then refuses. In a build without some
+ *  methods (BSF_CONFIG_METHODS), their own parameter structs (falko, bid,
+ *  lc, rpos) are left zero: those methods are refused, and a caller that
+ *  uses a detector directly takes its defaults from its own
+ *  bsf_*_params_default. */
 bsf_params_t bsf_params_default(bsf_method_t method);
 
 /** The paper-faithful configuration of a method: as bsf_params_default but
@@ -146,12 +161,17 @@ typedef struct {
                     uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
                     bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
                     bsf_pdm_work_t pdm;
+                    bsf_pdm_params_t pdm_params; /**< the fit's: params.pdm, max_passes set */
+                    bsf_pdm_info_t pdm_info;     /**< the fit's outcome */
+                    uint32_t passes_left; /**< point visits the scan may still spend (fit_passes) */
+                    uint32_t points_left; /**< points of the segments still to fit */
                 } fit;
             } use;
         } seg;
     } scratch;
     size_t n_keypoints;
     size_t n_segments;
+    float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
     uint32_t ready; /**< set by a successful init */
 } bsf_extractor_t;
 

@@ -101,6 +101,18 @@ typedef struct {
      *  (0, 1]. Default 0.2 (6 mm at the default target). Unused when
      *  bias_window is 0. */
     float bias_ratio;
+    /** Most footpoint passes over the points (bsf_pdm_info_t.iterations) of
+     *  one fit near the target, 0 for no limit (default): a bound on the
+     *  fit's time that trades closeness to target_rms for it (e_curve_out
+     *  says how close). The first solve runs at most this many iterations
+     *  (at least one); then a refinement round near the target (its
+     *  fragment within twice target_rms) is not started, and a round's
+     *  fresh fit from arc length is skipped, when it would pass the cap. A
+     *  fragment still farther from its points keeps growing past the cap
+     *  (one pass and one fit from arc length per round, at most one round
+     *  per control point): cut off there, a curve could miss its points by
+     *  decimetres. */
+    uint16_t max_passes;
 } bsf_pdm_params_t;
 
 /** Fill *p with the defaults listed in bsf_pdm_params_t (no-op for NULL). */

@@ -143,6 +143,12 @@ typedef struct {
 /** Scratch memory of bsf_lc_detect (about 24 bytes per beam; in the
  *  extractor it shares its space with the larger BID scratch). */
 typedef struct {
+    /** after bsf_lc_detect (BSF_OK or BSF_ERR_CAPACITY): the scan's noise
+     *  variance (m^2), the squares of the runs' noise estimates that set
+     *  their split tolerance (the noise across the surfaces, or the range
+     *  noise where the beams are dense) averaged over their points; 0 when
+     *  no run was long enough to judge */
+    float noise2;
     uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
     uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
     uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */

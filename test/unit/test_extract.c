@@ -623,6 +623,106 @@ static void test_a_tail_return_past_a_concave_corner_is_left_off_the_feature(voi
     TEST_ASSERT_TRUE(wasted_on <= wasted_off + 2u * 12u);
 }
 
+/* The same corridor at 1-degree beams, 1 cm noise: 14-20 m away the end
+ * wall gives a short segment of 6-12 returns, too few for the 8 returns
+ * beside each end that judge a long one, and the side wall's single return
+ * before the corner joins it. The run beside that return is then the rest
+ * of the segment, at least 5 returns, and the noise it is judged against
+ * is the scan's (LC's estimate), not the run's own scatter over so few
+ * returns. */
+static void test_a_tail_return_on_a_short_segment_is_left_off_the_feature(void)
+{
+    static const double outline[8] = {0.0, -1.0, 24.0, -1.0, 24.0, 1.0, 0.0, 1.0};
+    double worst_on = 0.0;
+    double worst_off = 0.0;
+    uint32_t wasted_on = 0u;
+    uint32_t wasted_off = 0u;
+    int pose;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 4u, 1));
+    for (pose = 0; pose < 12; ++pose) {
+        bsf_lidar_t l = bsf_lidar_default(4.0 + 0.5 * (double)pose, -0.6 + 0.1 * (double)pose, 0.0,
+                                          181u, 3.14159265);
+        int trim;
+        l.angle_increment = 3.14159265 / 180.0;
+        l.noise_sigma = 0.01;
+        for (trim = 0; trim <= 1; ++trim) {
+            bsf_scene_rng_t rng;
+            bsf_scan_t s = scan_of(&l);
+            bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+            double rms;
+            double max_d;
+            p.trim_tails = (uint8_t)trim;
+            bsf_scene_rng_seed(&rng, 70u + (uint64_t)pose);
+            TEST_ASSERT_EQUAL_INT(BSF_OK,
+                                  bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+            curve_to_truth(&l, &rms, &max_d);
+            if (trim) {
+                worst_on = max_d > worst_on ? max_d : worst_on;
+                wasted_on += res.stats.n_valid - res.stats.n_in_features;
+            } else {
+                worst_off = max_d > worst_off ? max_d : worst_off;
+                wasted_off += res.stats.n_valid - res.stats.n_in_features;
+            }
+        }
+    }
+    TEST_ASSERT_TRUE_MESSAGE(worst_off > 0.06, "the scene should show the swing it guards against");
+    TEST_ASSERT_TRUE_MESSAGE(worst_on < 0.03, "a curve swings past the corner");
+    /* Only the tails leave the features: at most one return per segment end. */
+    TEST_ASSERT_TRUE(wasted_on > wasted_off);
+    TEST_ASSERT_TRUE(wasted_on <= wasted_off + 2u * 12u);
+}
+
+/* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
+ * on dense scans whose fits climb near the target, and the curves it leaves
+ * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
+static void test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls(void)
+{
+    static const double pose[3][3] = {{2.0, 1.5, 0.4}, {6.5, 1.2, 2.0}, {1.5, 5.0, -0.8}};
+    uint32_t free_visits = 0u;
+    uint32_t returns = 0u;
+    int k;
+    build_l_room();
+    for (k = 0; k < 3; ++k) {
+        bsf_lidar_t l = bsf_lidar_default(pose[k][0], pose[k][1], pose[k][2], 1081u, 4.71238898);
+        uint32_t visits[2];
+        uint32_t in_features[2];
+        double max_d[2];
+        int bounded;
+        l.angle_increment = 4.71238898 / 1080.0;
+        l.noise_sigma = 0.01;
+        for (bounded = 0; bounded <= 1; ++bounded) {
+            bsf_scene_rng_t rng;
+            bsf_scan_t s = scan_of(&l);
+            bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
+            double rms;
+            TEST_ASSERT_EQUAL_UINT8(0u, p.fit_passes);
+            p.fit_passes = bounded ? 3u : 0u;
+            bsf_scene_rng_seed(&rng, 60u + (uint64_t)k);
+            TEST_ASSERT_EQUAL_INT(BSF_OK,
+                                  bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+            curve_to_truth(&l, &rms, &max_d[bounded]);
+            visits[bounded] = res.stats.n_fit_visits;
+            in_features[bounded] = res.stats.n_in_features;
+        }
+        printf("L-room pose %d, %u valid returns: fit visits %u (%.1f per return), curve max "
+               "%.3f m; fit_passes 3: %u (%.1f), %.3f m\n",
+               k, (unsigned)res.stats.n_valid, (unsigned)visits[0],
+               (double)visits[0] / (double)res.stats.n_valid, max_d[0], (unsigned)visits[1],
+               (double)visits[1] / (double)res.stats.n_valid, max_d[1]);
+        free_visits += visits[0];
+        returns += res.stats.n_valid;
+        TEST_ASSERT_TRUE(visits[1] <= 3u * res.stats.n_valid);
+        TEST_ASSERT_EQUAL_UINT32(in_features[0], in_features[1]); /* no return dropped */
+        TEST_ASSERT_TRUE(max_d[1] < 0.03);
+    }
+    TEST_ASSERT_TRUE(free_visits > 6u * returns); /* the free fits climb: the bound has work */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -635,9 +735,11 @@ int main(void)
     RUN_TEST(test_clock_hook_times_each_stage);
     RUN_TEST(test_the_cut_policy_splits_rough_features_and_keeps_every_point);
     RUN_TEST(test_a_tail_return_past_a_concave_corner_is_left_off_the_feature);
+    RUN_TEST(test_a_tail_return_on_a_short_segment_is_left_off_the_feature);
     RUN_TEST(test_a_mixed_pixel_at_the_end_of_a_corner_side_costs_no_corner);
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
     RUN_TEST(test_method_names_round_trip);
+    RUN_TEST(test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls);
     return UNITY_END();
 }

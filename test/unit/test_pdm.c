@@ -515,6 +515,79 @@ static void test_lone_stray_point_does_not_drive_refinement_to_the_cap(void)
     TEST_ASSERT_TRUE(worst < 0.02f);
 }
 
+/* max_passes bounds a fit's footpoint passes: the noisy arc, whose
+ * windowed-mean test climbs near the target, stops at the cap with fewer
+ * control points and a larger (finite) E_curve, never beyond it. */
+static void test_max_passes_bounds_the_climb_near_the_target(void)
+{
+    const size_t n = make_arc(0.01f);
+    bsf_pdm_info_t free_info;
+    bsf_pdm_info_t capped;
+    size_t n_free = 0;
+    size_t n_capped = 0;
+    float e_free = -1.0f;
+    float e_capped = -1.0f;
+    uint16_t cap;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                      BSF_MAX_CTRL_PER_FEATURE, &n_free, &e_free, &free_info));
+    for (cap = 1u; cap <= 3u; ++cap) {
+        params.max_passes = cap;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                          BSF_MAX_CTRL_PER_FEATURE, &n_capped, &e_capped, &capped));
+        printf("noisy arc: %u passes, %u ctrl, E %.4f m; max_passes %u: %u passes, %u ctrl, "
+               "E %.4f m\n",
+               (unsigned)free_info.iterations, (unsigned)n_free, (double)e_free, (unsigned)cap,
+               (unsigned)capped.iterations, (unsigned)n_capped, (double)e_capped);
+        TEST_ASSERT_TRUE(capped.iterations <= cap);
+        TEST_ASSERT_TRUE(n_capped <= n_free);
+        TEST_ASSERT_TRUE(e_capped >= e_free && e_capped < 2.0f * params.target_rms);
+        assert_all_finite(ctrl, n_capped);
+    }
+    TEST_ASSERT_TRUE(free_info.iterations > 3u); /* so the cap had something to cut */
+}
+
+/* The cap never stops a fragment still far from the target: a room fitted
+ * as one segment without vertices (far from the target after its first
+ * solve) still grows until its E_curve is within centimetres at
+ * max_passes 1, at the cost of more passes than the cap. */
+static void test_max_passes_never_stops_growth_far_from_the_target(void)
+{
+    static bsf_scene_t scene;
+    bsf_lidar_t l = bsf_lidar_default(2.0, 2.0, 0.3, 541u, 4.71238898);
+    bsf_scene_rng_t rng;
+    bsf_pdm_info_t info;
+    size_t n = 0;
+    size_t i;
+    size_t n_ctrl = 0;
+    float e = -1.0f;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&rng, 5u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL, BSF_MAX_POINTS));
+    for (i = 0; i < l.n_beams; ++i) {
+        const float r = room_ranges[i];
+        const float a = (float)(l.angle_min + l.angle_increment * (double)i);
+        if (r > 0.05f && r < (float)l.range_max) {
+            room_pts[n].x = r * cosf(a);
+            room_pts[n].y = r * sinf(a);
+            ++n;
+        }
+    }
+    params.max_passes = 1u;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                              BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, &info));
+    printf("room without vertices, max_passes 1: %u passes, %u ctrl, E %.4f m\n",
+           (unsigned)info.iterations, (unsigned)n_ctrl, (double)e);
+    assert_all_finite(ctrl, n_ctrl);
+    TEST_ASSERT_TRUE(info.iterations > 1u);
+    TEST_ASSERT_TRUE(e >= 0.0f && e <= 2.0f * params.target_rms);
+}
+
 static void test_degenerate_inputs_give_defined_status_and_never_nan(void)
 {
     size_t n_ctrl = 77u;
@@ -643,6 +716,8 @@ int main(void)
     RUN_TEST(test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck);
     RUN_TEST(test_dense_noisy_wall_is_not_refined_on_noise);
     RUN_TEST(test_lone_stray_point_does_not_drive_refinement_to_the_cap);
+    RUN_TEST(test_max_passes_bounds_the_climb_near_the_target);
+    RUN_TEST(test_max_passes_never_stops_growth_far_from_the_target);
     RUN_TEST(test_degenerate_inputs_give_defined_status_and_never_nan);
     RUN_TEST(test_bad_arguments_parameters_and_capacities_are_refused);
     return UNITY_END();

@@ -10,6 +10,7 @@
  *   bench_count scaling --beams N [--method NAME]     (bench_scenes.h, 20 poses)
  *   bench_count adversarial --kind pillar|clutter|long-wall [--method NAME]
  *   bench_count office --beams N [--fov360] [--method NAME]   (demo office, 8 poses)
+ *   any mode: --fit-passes K (bsf_params_t.fit_passes; default 0, no bound)
  *
  * Prints what it ran (scans, frames, features) on one line; exit 1 on any
  * failure (a scan that does not extract, a pose that is not free).
@@ -130,7 +131,8 @@ static void usage(void)
                     "       bench_count scaling --beams N [--method NAME]\n"
                     "       bench_count adversarial --kind pillar|clutter|long-wall [--method "
                     "NAME]\n"
-                    "       bench_count office --beams N [--fov360] [--method NAME]\n");
+                    "       bench_count office --beams N [--fov360] [--method NAME]\n"
+                    "       any mode: --fit-passes K (0..255, default 0: no bound)\n");
 }
 
 int main(int argc, char **argv)
@@ -142,6 +144,7 @@ int main(int argc, char **argv)
     const char *log = NULL;
     long beams = 0;
     long max_scans = 0;
+    long fit_passes = 0;
     int encode = 0, fov360 = 0, kind = -1, a;
     size_t i;
     unsigned long features = 0, frames = 0, bytes = 0;
@@ -167,6 +170,8 @@ int main(int argc, char **argv)
             beams = atol(argv[++a]);
         } else if (strcmp(argv[a], "--max-scans") == 0 && a + 1 < argc) {
             max_scans = atol(argv[++a]);
+        } else if (strcmp(argv[a], "--fit-passes") == 0 && a + 1 < argc) {
+            fit_passes = atol(argv[++a]);
         } else if (strcmp(argv[a], "--kind") == 0 && a + 1 < argc) {
             ++a;
             for (kind = 0; kind < BENCH_ADV_COUNT; ++kind) {
@@ -185,7 +190,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (max_scans < 0 || beams < 0) {
+    if (max_scans < 0 || beams < 0 || fit_passes < 0 || fit_passes > 255) {
         usage();
         return 2;
     }
@@ -230,6 +235,7 @@ int main(int argc, char **argv)
     }
 
     p = bsf_params_default(method);
+    p.fit_passes = (uint8_t)fit_passes;
     if (bsf_extractor_init(&g_ex, &p) != BSF_OK) {
         fprintf(stderr, "bench_count: %s is not available in this build\n",
                 bsf_method_name(method));

@@ -10,7 +10,8 @@
  *            (SVED and LC join walls seen at grazing incidence; on by default),
  *            --evidence / --no-evidence (LC's corner evidence test,
  *            bsf_lc_params_t.corner_evidence; on by default), --tails / --no-tails
- *            (bsf_params_t.trim_tails; on by default), --datasets DIR
+ *            (bsf_params_t.trim_tails; on by default), --fit-passes K
+ *            (bsf_params_t.fit_passes: a bound on the fit's work; default 0, none), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve), --oracle-reach M (how far from the vertex
@@ -81,6 +82,8 @@ static int grazing_mode = -1;
 static int evidence_mode = -1;
 /* 1 --tails, 0 --no-tails, -1 the default: tail returns left off segment ends */
 static int tails_mode = -1;
+/* --fit-passes K: bsf_params_t.fit_passes (0, the default: no bound) */
+static long fit_passes = 0;
 
 static bsf_params_t make_params(void)
 {
@@ -96,6 +99,7 @@ static bsf_params_t make_params(void)
     if (tails_mode >= 0) {
         p.trim_tails = (uint8_t)tails_mode;
     }
+    p.fit_passes = (uint8_t)fit_passes;
     return p;
 }
 
@@ -439,6 +443,13 @@ int main(int argc, char **argv)
             tails_mode = 1;
         } else if (strcmp(argv[a], "--no-tails") == 0) {
             tails_mode = 0;
+        } else if (strcmp(argv[a], "--fit-passes") == 0 && a + 1 < argc) {
+            char *end = NULL;
+            fit_passes = strtol(argv[++a], &end, 10);
+            if (end == argv[a] || *end != '\0' || fit_passes < 0 || fit_passes > 255) {
+                fprintf(stderr, "bench_truth: --fit-passes needs a count in 0..255\n");
+                return 2;
+            }
         } else if (strcmp(argv[a], "--oracle-reach") == 0 && a + 1 < argc) {
             char *end = NULL;
             oracle_reach = strtod(argv[++a], &end);
@@ -459,7 +470,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr,
                     "usage: %s [--quick] [--check] [--verbose] [--paper] [--[no-]grazing] "
-                    "[--[no-]evidence] [--[no-]tails] "
+                    "[--[no-]evidence] [--[no-]tails] [--fit-passes K] "
                     "[--poses N] [--oracle-reach M] "
                     "[--scene NAME] "
                     "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
@@ -489,10 +500,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_truth: --poses must be >= 1\n");
         return 2;
     }
-    printf("bench_truth: %s configuration%s%s%s, %ld poses per row\n",
+    printf("bench_truth: %s configuration%s%s%s, %ld poses per row",
            paper_mode ? "paper-faithful" : "default", grazing_mode ? " with grazing joins" : "",
            evidence_mode ? " with LC's corner evidence test" : "",
            tails_mode ? " with tail returns left off" : "", n_poses);
+    if (fit_passes > 0) {
+        printf(", at most %ld fit passes per point", fit_passes);
+    }
+    printf("\n");
     print_header();
     for (w = 0; w < N_SCENES; ++w) {
         if (only_scene != NULL && strcmp(only_scene, scene_names[w]) != 0) {

@@ -23,6 +23,8 @@ static const char extract_help[] =
     "                   that keeps recurring as the scan's isolated maximum (20 scans\n"
     "                   of evidence, halved every 64): dropped from then on); may be\n"
     "                   repeated\n"
+    "  --fit-passes K   bound the fit's work per scan: at most K footpoint passes per\n"
+    "                   fitted point on average (default 0: no bound; docs/PERFORMANCE.md)\n"
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
     "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
@@ -97,6 +99,7 @@ typedef struct {
     double range_max;  /* <= 0: from the log */
     double no_return;  /* > 0: the sensor's no-return code */
     int no_return_off; /* 1: no recognition of undeclared codes */
+    long fit_passes;   /* bsf_params_t.fit_passes (0: no bound) */
     double quant;
     long meta_every;
     int reproducible;
@@ -320,6 +323,7 @@ static int run_extract(const extract_opts_t *o)
         if (o->no_return_off) {
             p.no_return.min_run = 0u;
         }
+        p.fit_passes = (uint8_t)o->fit_passes;
         if (init_extractor_params(&p, !o->reproducible) != 0) {
             return EXIT_FAIL;
         }
@@ -653,6 +657,10 @@ int cmd_extract(int argc, char **argv)
                 o.no_return_off = 1;
             } else if (parse_float(v, 1e-3, 1e4, &o.no_return) != 0) {
                 return usage_error("--no-return needs metres > 0 or 'off', got '%s'", v);
+            }
+        } else if ((v = opt_value(argc, argv, &i, "--fit-passes", &err)) != NULL) {
+            if (parse_long(v, 0, 255, &o.fit_passes) != 0) {
+                return usage_error("--fit-passes needs a count in [0, 255], got '%s'", v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--quant", &err)) != NULL) {
             if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) !=

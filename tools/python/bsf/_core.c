@@ -159,8 +159,10 @@ static const param_desc_t g_params[] = {
     PARAM("pdm_refine", pdm.refine, PT_U8),
     PARAM("pdm_bias_window", pdm.bias_window, PT_U8),
     PARAM("pdm_bias_ratio", pdm.bias_ratio, PT_FLOAT),
+    PARAM("pdm_max_passes", pdm.max_passes, PT_U16),
     PARAM("split_dist", split_dist, PT_FLOAT),
     PARAM("trim_tails", trim_tails, PT_U8),
+    PARAM("fit_passes", fit_passes, PT_U8),
 };
 #define N_PARAMS (sizeof g_params / sizeof g_params[0])
 
@@ -370,6 +372,7 @@ static const stat_desc_t g_stats[] = {
     STAT(n_beams),         STAT(n_valid),        STAT(n_in_features), STAT(n_ctrl),
     STAT(n_features),      STAT(n_keypoints),    STAT(n_unfitted),    STAT(cut),
     STAT(n_cut_keypoints), STAT(n_cut_segments), STAT(n_cut_points),  STAT(time_ns),
+    STAT(n_fit_visits),
 };
 #define N_STATS (sizeof g_stats / sizeof g_stats[0])
 

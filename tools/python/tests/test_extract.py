@@ -85,6 +85,18 @@ def test_methods_and_parameters():
     assert bsf.Extractor(trim_tails=0).params["trim_tails"] == 0
 
 
+def test_fit_passes_bounds_the_fit_work():
+    ranges, amin, inc = synthetic_scan()
+    assert bsf.default_params()["fit_passes"] == 0
+    assert bsf.default_params()["pdm_max_passes"] == 0
+    free = bsf.extract(ranges, amin, inc, 0.05, 30.0, pdm_target_rms=0.004)
+    bounded = bsf.extract(ranges, amin, inc, 0.05, 30.0, pdm_target_rms=0.004, fit_passes=1)
+    assert free.stats.n_fit_visits > bounded.stats.n_fit_visits > 0
+    assert bounded.stats.n_in_features == free.stats.n_in_features
+    with pytest.raises((bsf.BsfError, OverflowError, ValueError)):
+        bsf.extract(ranges, amin, inc, 0.05, 30.0, fit_passes=256)
+
+
 def test_timing_off_gives_zero_time():
     ranges, amin, inc = synthetic_scan()
     assert bsf.extract(ranges, amin, inc, 0.05, 30.0, timing=False).stats.time_ns == 0
