@@ -1,5 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_grazing.h"
+#include "bsf_lc_internal.h"
 #include "bsf_math.h"
 #include "bsf_segment_internal.h"
 
@@ -228,6 +230,22 @@ static uint8_t *mixed_marks(bsf_extractor_t *ex)
     return (uint8_t *)(void *)ex->segments;
 }
 
+/* Bytes of the mixed-pixel marks at the start of ex->segments. */
+#define MIXED_MARK_BYTES (((size_t)BSF_MAX_POINTS + 7u) / 8u)
+
+/* The grazing joins' verdicts for this scan (bsf_grazing_join_memo), zeroed
+ * before LC and kept for segmentation: on the default method LC and SVED
+ * ask about many of the same wide steps. They live in ex->segments after
+ * the mixed-pixel marks; NULL for other methods or when they do not fit. */
+static uint8_t *grazing_memo(bsf_extractor_t *ex)
+{
+    if (ex->params.method != BSF_METHOD_LC_SVED_PDM ||
+        sizeof ex->segments < MIXED_MARK_BYTES + BSF_GRAZING_MEMO_BYTES((size_t)BSF_MAX_POINTS)) {
+        return NULL;
+    }
+    return (uint8_t *)(void *)ex->segments + MIXED_MARK_BYTES;
+}
+
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
 /* Beams ex->interest[0..n) valid (1) or not (0). */
 static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
@@ -247,13 +265,24 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
     size_t n = 0u;
     bsf_status_t st;
+    uint8_t *memo = grazing_memo(ex);
     if (ex->params.sved.reject_mixed) {
         n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
                                  BSF_MAX_KEYPOINTS);
     }
+    if (memo != NULL) {
+        memset(memo, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
+    }
+    /* LC's verdicts hold for SVED only on the same valid beams (none
+     * invalid for the detection) and the same question: SVED's cap and
+     * corner rule LC's. Else LC keeps none and SVED starts afresh. */
+    if (n > 0u || !(ex->params.sved.radius_max == BSF_GRAZING_LC_CAP) ||
+        (ex->params.sved.join_grazing == 2u) != (ex->params.lc.join_grazing == 2u)) {
+        memo = NULL;
+    }
     set_valid(ex, n, 0u);
-    st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
-                       BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    st = bsf_lc_detect_memo(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
+                            BSF_MAX_KEYPOINTS, &ex->n_keypoints, memo);
     ex->noise2 = ex->scratch.lc.noise2; /* segmentation reuses the scratch */
     set_valid(ex, n, 1u);
     return st;
@@ -375,7 +404,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
         }
     } else {
         st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                     ex->scratch.seg.label, mixed_marks(ex), &n_all);
+                                     ex->scratch.seg.label, mixed_marks(ex), grazing_memo(ex),
+                                     &n_all);
     }
     if (st != BSF_OK) {
         return st;

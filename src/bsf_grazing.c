@@ -161,3 +161,19 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
     return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]) &&
            bsf_grazing_within(p[b], p[a - 2u], cap);
 }
+
+int bsf_grazing_join_memo(const bsf_points_t *pts, size_t a, float cap, int at_corners,
+                          uint8_t *memo)
+{
+    const unsigned shift = 2u * (unsigned)(a % 4u);
+    unsigned v;
+    if (memo == NULL) {
+        return bsf_grazing_join(pts, a, cap, at_corners);
+    }
+    v = (memo[a / 4u] >> shift) & 3u;
+    if (v == 0u) {
+        v = 1u + (unsigned)bsf_grazing_join(pts, a, cap, at_corners);
+        memo[a / 4u] = (uint8_t)(memo[a / 4u] | (v << shift));
+    }
+    return (int)v - 1;
+}

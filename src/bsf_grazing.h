@@ -20,6 +20,7 @@
 #define BSF_GRAZING_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "bsf/bsf_scan.h"
 
@@ -68,5 +69,18 @@ static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
  * corner is visible (three returns on a line fix the wall), and four
  * returns from it leave no room for a long wall to close a door. */
 int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners);
+
+/* Bytes of a memo of bsf_grazing_join's verdicts on n beams: 2 bits per
+ * step a (0: not asked yet, 1: no, 2: yes). */
+#define BSF_GRAZING_MEMO_BYTES(n) (((n) + 3u) / 4u)
+
+/* bsf_grazing_join, each step's verdict computed once and kept in memo
+ * (NULL: none kept). Why: LC and SVED ask about many of the same wide steps,
+ * and on an edge-on step the corner runs cost hundreds of instructions. The
+ * caller zeroes memo's BSF_GRAZING_MEMO_BYTES(pts->count) bytes and keeps
+ * pts (points and valid flags), cap and at_corners the same while it is in
+ * use. */
+int bsf_grazing_join_memo(const bsf_points_t *pts, size_t a, float cap, int at_corners,
+                          uint8_t *memo);
 
 #endif

@@ -2,6 +2,7 @@
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
 #include "bsf_grazing.h"
+#include "bsf_lc_internal.h"
 #include "bsf_math.h"
 
 #include <float.h>
@@ -1742,18 +1743,20 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
 /* Point b continues the run that ends at point a: within the jump radius,
  * or (join_grazing) the next beam on one wall seen at grazing incidence
  * (never through the seam of a full-circle scan). */
-static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo,
+                    size_t a, size_t b)
 {
     return within_jump(pts, p, a, b) ||
            (p->join_grazing && a + 1u == b &&
-            bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u));
+            bsf_grazing_join_memo(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u,
+                                  grazing_memo));
 }
 
 /* Where the pass over a full-circle scan starts: the first valid beam (from
  * 0) that does not continue the run of the valid beam before it on the ring,
  * so that no run is cut at the seam; 0 when every step joins (one closed
  * surface all round: the seam then cuts it, as on a scan that is no ring). */
-static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
+static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
     size_t i;
@@ -1764,7 +1767,7 @@ static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
         if (!pts->valid[i]) {
             continue;
         }
-        if (i != prev && !lc_joins(pts, p, prev, i) && past_occluder(pts, p, prev, i) == i) {
+        if (i != prev && !lc_joins(pts, p, grazing_memo, prev, i) && past_occluder(pts, p, prev, i) == i) {
             return i;
         }
         prev = i;
@@ -1786,6 +1789,13 @@ static void reverse_keypoints(bsf_keypoint_t *out, size_t lo, size_t hi)
 
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
+{
+    return bsf_lc_detect_memo(pts, p, work, out, out_cap, n_out, NULL);
+}
+
+bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *p,
+                                bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,
+                                size_t *n_out, uint8_t *grazing_memo)
 {
     lc_ctx_t c;
     bsf_status_t st;
@@ -1818,7 +1828,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     work->noise2 = 0.0f;
     c.noise_points = 0.0f;
     blocks_detach(&c);
-    c.start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
+    c.start = bsf_points_full_circle(pts) ? ring_start(pts, p, grazing_memo) : 0u;
     for (step = 0; step <= pts->count; ++step) {
         int close_run = step == pts->count;
         i = close_run
@@ -1828,7 +1838,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            close_run = !lc_joins(pts, p, work->run[m - 1u], i);
+            close_run = !lc_joins(pts, p, grazing_memo, work->run[m - 1u], i);
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i && step + (j - i) < pts->count) {

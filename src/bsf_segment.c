@@ -711,7 +711,8 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
  * extension fields say (checked, then ignored), and no full-circle pass. */
 static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
                              bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
-                             const uint8_t *marks, size_t *n_out, size_t *n_wasted_points)
+                             const uint8_t *marks, uint8_t *grazing_memo, size_t *n_out,
+                             size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
@@ -826,7 +827,8 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         /* A wide step from the beam before may still continue a wall seen
          * at grazing incidence (bsf_grazing.h). */
         if (best == slots && grazing && n_open > 0u && b > 0u && open[0].last + 1u == b &&
-            bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u)) {
+            bsf_grazing_join_memo(pts, b - 1u, p->radius_max, p->join_grazing == 2u,
+                                  grazing_memo)) {
             best = 0u;
         }
         if (best == 0u) {
@@ -890,21 +892,22 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
                               bsf_segment_t *out, size_t cap, size_t *n_out,
                               size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, NULL, 0, NULL, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, NULL, 0, NULL, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                        bsf_segment_t *out, size_t cap, uint16_t *label,
                                        size_t *n_out, size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, label, 1, NULL, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, label, 1, NULL, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                      bsf_segment_t *out, size_t cap, uint16_t *label,
-                                     const uint8_t *marks, size_t *n_out)
+                                     const uint8_t *marks, uint8_t *grazing_memo,
+                                     size_t *n_out)
 {
-    return sved_run(pts, params, out, cap, label, 1, marks, n_out, NULL);
+    return sved_run(pts, params, out, cap, label, 1, marks, grazing_memo, n_out, NULL);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,
