@@ -105,8 +105,8 @@ static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, fl
     c = (size_t)((ptrdiff_t)s - d); /* the corner's return */
     return bsf_grazing_within(p[c], p[(ptrdiff_t)s + d], cap) &&
            bsf_grazing_entry(p[c], p[s], p[(ptrdiff_t)s + d]) &&
-           bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
            !bsf_grazing_triple(p[(ptrdiff_t)c - d], p[c], p[s]) &&
+           bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
            bsf_grazing_line3(pts, d > 0 ? s : s - 2u) &&
            bsf_grazing_line3(pts, d > 0 ? s + 1u : s - 3u);
 }
