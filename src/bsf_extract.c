@@ -217,33 +217,25 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
-/* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
- * once before LC and used by segmentation, or NULL when the method finds
- * none or they do not fit (caps with few segments: SVED then finds them
- * again). They live in ex->segments, unused until segmentation fills it. */
-static uint8_t *mixed_marks(bsf_extractor_t *ex)
+/* What LC and SVED share on the default method, found once per scan:
+ * SVED's mixed-pixel marks (bsf_sved_mixed_marks), found before LC, and
+ * the grazing joins' verdicts (bsf_grazing_join): both stages ask
+ * about many of the same wide steps. */
+typedef struct {
+    uint8_t mixed[(BSF_MAX_POINTS + 7) / 8];
+    uint8_t grazing[BSF_GRAZING_MEMO_BYTES(BSF_MAX_POINTS)];
+} scan_marks_t;
+
+/* This scan's scan_marks_t, or NULL when the method finds no mixed pixels
+ * or they do not fit (caps with few segments: each stage then works alone).
+ * They live in ex->segments, unused until segmentation fills it. */
+static scan_marks_t *scan_marks(bsf_extractor_t *ex)
 {
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
-        sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
+        sizeof ex->segments < sizeof(scan_marks_t)) {
         return NULL;
     }
-    return (uint8_t *)(void *)ex->segments;
-}
-
-/* Bytes of the mixed-pixel marks at the start of ex->segments. */
-#define MIXED_MARK_BYTES (((size_t)BSF_MAX_POINTS + 7u) / 8u)
-
-/* The grazing joins' verdicts for this scan (bsf_grazing_join_memo), zeroed
- * before LC and kept for segmentation: on the default method LC and SVED
- * ask about many of the same wide steps. They live in ex->segments after
- * the mixed-pixel marks; NULL for other methods or when they do not fit. */
-static uint8_t *grazing_memo(bsf_extractor_t *ex)
-{
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM ||
-        sizeof ex->segments < MIXED_MARK_BYTES + BSF_GRAZING_MEMO_BYTES((size_t)BSF_MAX_POINTS)) {
-        return NULL;
-    }
-    return (uint8_t *)(void *)ex->segments + MIXED_MARK_BYTES;
+    return (scan_marks_t *)(void *)ex->segments;
 }
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
@@ -265,20 +257,22 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
     size_t n = 0u;
     bsf_status_t st;
-    uint8_t *memo = grazing_memo(ex);
+    scan_marks_t *marks = scan_marks(ex);
+    uint8_t *memo = NULL;
     if (ex->params.sved.reject_mixed) {
-        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
-                                 BSF_MAX_KEYPOINTS);
+        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, marks != NULL ? marks->mixed : NULL,
+                                 ex->interest, BSF_MAX_KEYPOINTS);
     }
-    if (memo != NULL) {
-        memset(memo, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
-    }
-    /* LC's verdicts hold for SVED only on the same valid beams (none
-     * invalid for the detection) and the same question: SVED's cap and
-     * corner rule LC's. Else LC keeps none and SVED starts afresh. */
-    if (n > 0u || !(ex->params.sved.radius_max == BSF_GRAZING_LC_CAP) ||
-        (ex->params.sved.join_grazing == 2u) != (ex->params.lc.join_grazing == 2u)) {
-        memo = NULL;
+    if (marks != NULL) {
+        memset(marks->grazing, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
+        /* LC's verdicts hold for SVED only on the same valid beams (none
+         * invalid for the detection) and the same question (SVED's cap and
+         * corner rule LC's; either asks none with join_grazing 0); else LC
+         * keeps none and SVED starts afresh. */
+        if (n == 0u && ex->params.sved.join_grazing == ex->params.lc.join_grazing &&
+            ex->params.sved.radius_max == BSF_GRAZING_LC_CAP) {
+            memo = marks->grazing;
+        }
     }
     set_valid(ex, n, 0u);
     st = bsf_lc_detect_memo(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
@@ -403,9 +397,10 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
             }
         }
     } else {
+        scan_marks_t *marks = scan_marks(ex);
         st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                     ex->scratch.seg.label, mixed_marks(ex), grazing_memo(ex),
-                                     &n_all);
+                                     ex->scratch.seg.label, marks != NULL ? marks->mixed : NULL,
+                                     marks != NULL ? marks->grazing : NULL, &n_all);
     }
     if (st != BSF_OK) {
         return st;

@@ -112,7 +112,7 @@ static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, fl
 }
 
 /* The step between beams a and a + 1 is the step onto such a corner run or
- * one of its own (a run of four from its corner, see bsf_grazing_join). */
+ * one of its own (a run of four from its corner, see grazing_join_verdict). */
 static int bsf_grazing_at_corner(const bsf_points_t *pts, size_t a, float cap)
 {
     size_t k;
@@ -125,7 +125,8 @@ static int bsf_grazing_at_corner(const bsf_points_t *pts, size_t a, float cap)
     return 0;
 }
 
-int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners)
+/* bsf_grazing_join's verdict, computed. */
+static int grazing_join_verdict(const bsf_points_t *pts, size_t a, float cap, int at_corners)
 {
     const size_t b = a + 1u;
     const bsf_point_t *p = pts->pt;
@@ -162,17 +163,16 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
            bsf_grazing_within(p[b], p[a - 2u], cap);
 }
 
-int bsf_grazing_join_memo(const bsf_points_t *pts, size_t a, float cap, int at_corners,
-                          uint8_t *memo)
+int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo)
 {
     const unsigned shift = 2u * (unsigned)(a % 4u);
     unsigned v;
     if (memo == NULL) {
-        return bsf_grazing_join(pts, a, cap, at_corners);
+        return grazing_join_verdict(pts, a, cap, at_corners);
     }
     v = (memo[a / 4u] >> shift) & 3u;
     if (v == 0u) {
-        v = 1u + (unsigned)bsf_grazing_join(pts, a, cap, at_corners);
+        v = 1u + (unsigned)grazing_join_verdict(pts, a, cap, at_corners);
         memo[a / 4u] = (uint8_t)(memo[a / 4u] | (v << shift));
     }
     return (int)v - 1;

@@ -67,20 +67,16 @@ static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
  * first four returns of a wall that starts at a corner (or the last four
  * of one that ends at one), the step onto that corner included: that
  * corner is visible (three returns on a line fix the wall), and four
- * returns from it leave no room for a long wall to close a door. */
-int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners);
+ * returns from it leave no room for a long wall to close a door.
+ * memo (NULL: none) keeps each step's verdict once computed, 2 bits per
+ * step a (0: not asked yet, 1: no, 2: yes), BSF_GRAZING_MEMO_BYTES(count)
+ * bytes zeroed by the caller, who keeps pts (points and valid flags), cap
+ * and at_corners the same while it is in use. Why: LC and SVED ask about
+ * many of the same wide steps, and on a step seen edge-on the corner runs
+ * cost hundreds of instructions. */
+int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo);
 
-/* Bytes of a memo of bsf_grazing_join's verdicts on n beams: 2 bits per
- * step a (0: not asked yet, 1: no, 2: yes). */
+/* Bytes of bsf_grazing_join's memo for n beams. */
 #define BSF_GRAZING_MEMO_BYTES(n) (((n) + 3u) / 4u)
-
-/* bsf_grazing_join, each step's verdict computed once and kept in memo
- * (NULL: none kept). Why: LC and SVED ask about many of the same wide steps,
- * and on an edge-on step the corner runs cost hundreds of instructions. The
- * caller zeroes memo's BSF_GRAZING_MEMO_BYTES(pts->count) bytes and keeps
- * pts (points and valid flags), cap and at_corners the same while it is in
- * use. */
-int bsf_grazing_join_memo(const bsf_points_t *pts, size_t a, float cap, int at_corners,
-                          uint8_t *memo);
 
 #endif

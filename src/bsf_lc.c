@@ -1748,8 +1748,7 @@ static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *
 {
     return within_jump(pts, p, a, b) ||
            (p->join_grazing && a + 1u == b &&
-            bsf_grazing_join_memo(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u,
-                                  grazing_memo));
+            bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u, grazing_memo));
 }
 
 /* Where the pass over a full-circle scan starts: the first valid beam (from
@@ -1767,7 +1766,8 @@ static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p, uint
         if (!pts->valid[i]) {
             continue;
         }
-        if (i != prev && !lc_joins(pts, p, grazing_memo, prev, i) && past_occluder(pts, p, prev, i) == i) {
+        if (i != prev && !lc_joins(pts, p, grazing_memo, prev, i) &&
+            past_occluder(pts, p, prev, i) == i) {
             return i;
         }
         prev = i;

@@ -10,7 +10,7 @@
 #include "bsf/bsf_lc.h"
 
 /* bsf_lc_detect keeping its grazing joins' verdicts in grazing_memo (see
- * bsf_grazing_join_memo; NULL: none kept), so that SVED, asking about the
+ * bsf_grazing_join; NULL: none kept), so that SVED, asking about the
  * same steps on the same points, finds them there. */
 bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *p,
                                 bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,

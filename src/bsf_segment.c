@@ -827,8 +827,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         /* A wide step from the beam before may still continue a wall seen
          * at grazing incidence (bsf_grazing.h). */
         if (best == slots && grazing && n_open > 0u && b > 0u && open[0].last + 1u == b &&
-            bsf_grazing_join_memo(pts, b - 1u, p->radius_max, p->join_grazing == 2u,
-                                  grazing_memo)) {
+            bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u, grazing_memo)) {
             best = 0u;
         }
         if (best == 0u) {
@@ -904,8 +903,7 @@ bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_p
 
 bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                      bsf_segment_t *out, size_t cap, uint16_t *label,
-                                     const uint8_t *marks, uint8_t *grazing_memo,
-                                     size_t *n_out)
+                                     const uint8_t *marks, uint8_t *grazing_memo, size_t *n_out)
 {
     return sved_run(pts, params, out, cap, label, 1, marks, grazing_memo, n_out, NULL);
 }
