@@ -263,6 +263,8 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
         n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, marks != NULL ? marks->mixed : NULL,
                                  ex->interest, BSF_MAX_KEYPOINTS);
     }
+#if !BSF_CONFIG_COMPACT /* compact: LC and SVED each ask alone (sharing costs 130 bytes of code)   \
+                         */
     if (marks != NULL) {
         memset(marks->grazing, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
         /* LC's verdicts hold for SVED only on the same valid beams (none
@@ -274,6 +276,7 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
             memo = marks->grazing;
         }
     }
+#endif
     set_valid(ex, n, 0u);
     st = bsf_lc_detect_memo(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
                             BSF_MAX_KEYPOINTS, &ex->n_keypoints, memo);
@@ -400,7 +403,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
         scan_marks_t *marks = scan_marks(ex);
         st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
                                      ex->scratch.seg.label, marks != NULL ? marks->mixed : NULL,
-                                     marks != NULL ? marks->grazing : NULL, &n_all);
+                                     marks != NULL && !BSF_CONFIG_COMPACT ? marks->grazing : NULL,
+                                     &n_all);
     }
     if (st != BSF_OK) {
         return st;

@@ -165,6 +165,10 @@ static int grazing_join_verdict(const bsf_points_t *pts, size_t a, float cap, in
 
 int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo)
 {
+#if BSF_CONFIG_COMPACT /* compact: no memo (the extractor passes none) */
+    (void)memo;
+    return grazing_join_verdict(pts, a, cap, at_corners);
+#else
     const unsigned shift = 2u * (unsigned)(a % 4u);
     unsigned v;
     if (memo == NULL) {
@@ -176,4 +180,5 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
         memo[a / 4u] = (uint8_t)(memo[a / 4u] | (v << shift));
     }
     return (int)v - 1;
+#endif
 }
