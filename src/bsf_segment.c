@@ -630,11 +630,15 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
             /* is_mixed_pixel's first tests before its call (not in the
              * compact build, which keeps one copy): most returns lie on a
              * surface whose range changes by less than the radius's floor
-             * from one neighbour to the other. */
+             * from one neighbour to the other. That test first, on the
+             * ranges alone: with both neighbours valid their difference is
+             * the jump, and with either invalid the return is no mixed
+             * pixel anyway. */
+            const float step = pts->range[b + 1u] - pts->range[b - 1u];
             float r3[3];
             float lo;
             float hi;
-            if (!between_neighbours(pts, b, r3, &lo, &hi) || (hi - lo) * (hi - lo) <= rad.a2) {
+            if (step * step <= rad.a2 || !between_neighbours(pts, b, r3, &lo, &hi)) {
                 continue;
             }
         }
