@@ -263,15 +263,14 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
         n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, marks != NULL ? marks->mixed : NULL,
                                  ex->interest, BSF_MAX_KEYPOINTS);
     }
-#if !BSF_CONFIG_COMPACT /* compact: LC and SVED each ask alone (sharing costs 130 bytes of code)   \
-                         */
+    /* LC keeps its grazing joins' verdicts for SVED (not in the compact
+     * build, where this costs over 100 bytes of code: each stage asks
+     * alone). They hold for SVED only for the same question (SVED's cap and
+     * corner rule LC's; either asks none with join_grazing 0). */
+#if !BSF_CONFIG_COMPACT
     if (marks != NULL) {
         memset(marks->grazing, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
-        /* LC's verdicts hold for SVED only on the same valid beams (none
-         * invalid for the detection) and the same question (SVED's cap and
-         * corner rule LC's; either asks none with join_grazing 0); else LC
-         * keeps none and SVED starts afresh. */
-        if (n == 0u && ex->params.sved.join_grazing == ex->params.lc.join_grazing &&
+        if (ex->params.sved.join_grazing == ex->params.lc.join_grazing &&
             ex->params.sved.radius_max == BSF_GRAZING_LC_CAP) {
             memo = marks->grazing;
         }
@@ -282,6 +281,15 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
                             BSF_MAX_KEYPOINTS, &ex->n_keypoints, memo);
     ex->noise2 = ex->scratch.lc.noise2; /* segmentation reuses the scratch */
     set_valid(ex, n, 1u);
+#if !BSF_CONFIG_COMPACT
+    /* and only on the same valid beams: not those LC saw invalid */
+    if (memo != NULL) {
+        size_t k;
+        for (k = 0; k < n; ++k) {
+            bsf_grazing_memo_forget(memo, ex->interest[k], ex->points.count);
+        }
+    }
+#endif
     return st;
 }
 #endif

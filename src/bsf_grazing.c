@@ -182,3 +182,15 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
     return (int)v - 1;
 #endif
 }
+
+#if !BSF_CONFIG_COMPACT
+void bsf_grazing_memo_forget(uint8_t *memo, size_t m, size_t count)
+{
+    /* The verdict on step a reads beams a - 5 .. a + 6 (the corner runs
+     * from a - 2 .. a + 3, each three beams either side). */
+    size_t a = m >= 6u ? m - 6u : 0u;
+    for (; a <= m + 5u && a < count; ++a) {
+        memo[a / 4u] = (uint8_t)(memo[a / 4u] & ~(3u << (2u * (a % 4u))));
+    }
+}
+#endif

@@ -79,4 +79,9 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
 /* Bytes of bsf_grazing_join's memo for n beams. */
 #define BSF_GRAZING_MEMO_BYTES(n) (((n) + 3u) / 4u)
 
+/* Forget the memo's verdicts that depend on beam m (those of the steps
+ * whose tests read it: m - 6 .. m + 5), as when beam m's valid flag
+ * changes; count is pts->count. */
+void bsf_grazing_memo_forget(uint8_t *memo, size_t m, size_t count);
+
 #endif
