@@ -1723,16 +1723,43 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
 static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
 {
     const size_t span = 2u * (size_t)p->min_side_points;
+    const float x = p->jump_b * pts->range[a];
     float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
+#if !BSF_CONFIG_COMPACT
+    /* Bounds on r2 that spare the exponential, as in within_jump; computed
+     * once, when a point is beyond jump_a. */
+    float r2_lo = -1.0f;
+    float r2_hi = HUGE_VALF;
+    int have_bounds = 0;
+#endif
     size_t j;
     for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
         if (pts->valid[j]) {
             const float d2 = dist2(pts->pt[a], pts->pt[j]);
-            if (d2 > p->jump_a * p->jump_a && r2 < 0.0f) {
-                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[a]);
+            if (d2 <= p->jump_a * p->jump_a) {
+                return j;
+            }
+#if !BSF_CONFIG_COMPACT
+            if (!have_bounds && x >= 0.0f && x <= 1.0f) {
+                float lo;
+                float hi;
+                bsf_exp_bounds01(x, &lo, &hi);
+                r2_lo = (p->jump_a * lo) * (p->jump_a * lo);
+                r2_hi = (p->jump_a * hi) * (p->jump_a * hi);
+            }
+            have_bounds = 1;
+            if (d2 <= r2_lo) {
+                return j;
+            }
+            if (d2 > r2_hi) {
+                continue;
+            }
+#endif
+            if (r2 < 0.0f) {
+                const float r = p->jump_a * bsf_expf(x);
                 r2 = r * r;
             }
-            if (d2 <= p->jump_a * p->jump_a || d2 <= r2) {
+            if (d2 <= r2) {
                 return j;
             }
         }
