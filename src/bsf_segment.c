@@ -545,6 +545,14 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         /* Inside the scan (most beams): the cheap tests first. */
         const uint8_t *v = &pts->valid[i - 2u];
         const float *rg = &pts->range[i - 2u];
+#if !BSF_CONFIG_COMPACT
+        /* the jump within the radius's floor (below), on the ranges alone:
+         * with either neighbour invalid the return is no mixed pixel either */
+        const float step = rg[3] - rg[1];
+        if (step * step <= rad->a2) {
+            return 0;
+        }
+#endif
         if (!between_neighbours(pts, i, &r[1], &lo, &hi)) {
             return 0;
         }
