@@ -217,25 +217,35 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
-/* What LC and SVED share on the default method, found once per scan:
- * SVED's mixed-pixel marks (bsf_sved_mixed_marks), found before LC, and
- * the grazing joins' verdicts (bsf_grazing_join): both stages ask
- * about many of the same wide steps. */
-typedef struct {
-    uint8_t mixed[(BSF_MAX_POINTS + 7) / 8];
-    uint8_t grazing[BSF_GRAZING_MEMO_BYTES(BSF_MAX_POINTS)];
-} scan_marks_t;
+/* Bytes of SVED's mixed-pixel marks at the start of ex->segments. */
+#define MIXED_MARK_BYTES (((size_t)BSF_MAX_POINTS + 7u) / 8u)
 
-/* This scan's scan_marks_t, or NULL when the method finds no mixed pixels
- * or they do not fit (caps with few segments: each stage then works alone).
- * They live in ex->segments, unused until segmentation fills it. */
-static scan_marks_t *scan_marks(bsf_extractor_t *ex)
+/* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
+ * once before LC and used by segmentation, or NULL when the method finds
+ * none or they do not fit (caps with few segments: SVED then finds them
+ * again). They live in ex->segments, unused until segmentation fills it. */
+static uint8_t *mixed_marks(bsf_extractor_t *ex)
 {
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
-        sizeof ex->segments < sizeof(scan_marks_t)) {
+        sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
         return NULL;
     }
-    return (scan_marks_t *)(void *)ex->segments;
+    return (uint8_t *)(void *)ex->segments;
+}
+
+/* The grazing joins' verdicts for this scan (bsf_grazing_join's memo),
+ * zeroed before LC and kept for segmentation: LC and SVED ask about many of
+ * the same wide steps. After the mixed-pixel marks in ex->segments; NULL
+ * with no marks, when they do not fit beside them (many beams, few
+ * segments: each stage then asks alone), and in the compact build (over
+ * 100 bytes of code). */
+static uint8_t *grazing_memo(bsf_extractor_t *ex)
+{
+    if (BSF_CONFIG_COMPACT || mixed_marks(ex) == NULL ||
+        sizeof ex->segments < MIXED_MARK_BYTES + BSF_GRAZING_MEMO_BYTES((size_t)BSF_MAX_POINTS)) {
+        return NULL;
+    }
+    return (uint8_t *)(void *)ex->segments + MIXED_MARK_BYTES;
 }
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
@@ -257,31 +267,26 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
     size_t n = 0u;
     bsf_status_t st;
-    scan_marks_t *marks = scan_marks(ex);
-    uint8_t *memo = NULL;
+    uint8_t *memo = grazing_memo(ex);
     if (ex->params.sved.reject_mixed) {
-        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, marks != NULL ? marks->mixed : NULL,
-                                 ex->interest, BSF_MAX_KEYPOINTS);
+        n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
+                                 BSF_MAX_KEYPOINTS);
     }
-    /* LC keeps its grazing joins' verdicts for SVED (not in the compact
-     * build, where this costs over 100 bytes of code: each stage asks
-     * alone). They hold for SVED only for the same question (SVED's cap and
-     * corner rule LC's; either asks none with join_grazing 0). */
-#if !BSF_CONFIG_COMPACT
-    if (marks != NULL) {
-        memset(marks->grazing, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
-        if (ex->params.sved.join_grazing == ex->params.lc.join_grazing &&
-            ex->params.sved.radius_max == BSF_GRAZING_LC_CAP) {
-            memo = marks->grazing;
+    if (memo != NULL) {
+        memset(memo, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
+        /* LC's verdicts hold for SVED only for the same question (SVED's
+         * cap and corner rule LC's; either asks none with join_grazing 0):
+         * else LC keeps none and SVED asks alone. */
+        if (ex->params.sved.join_grazing != ex->params.lc.join_grazing ||
+            !(ex->params.sved.radius_max == BSF_GRAZING_LC_CAP)) {
+            memo = NULL;
         }
     }
-#endif
     set_valid(ex, n, 0u);
     st = bsf_lc_detect_memo(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
                             BSF_MAX_KEYPOINTS, &ex->n_keypoints, memo);
     ex->noise2 = ex->scratch.lc.noise2; /* segmentation reuses the scratch */
     set_valid(ex, n, 1u);
-#if !BSF_CONFIG_COMPACT
     /* and only on the same valid beams: not those LC saw invalid */
     if (memo != NULL) {
         size_t k;
@@ -289,7 +294,6 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
             bsf_grazing_memo_forget(memo, ex->interest[k], ex->points.count);
         }
     }
-#endif
     return st;
 }
 #endif
@@ -408,10 +412,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
             }
         }
     } else {
-        scan_marks_t *marks = scan_marks(ex);
         st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                     ex->scratch.seg.label, marks != NULL ? marks->mixed : NULL,
-                                     marks != NULL && !BSF_CONFIG_COMPACT ? marks->grazing : NULL,
+                                     ex->scratch.seg.label, mixed_marks(ex), grazing_memo(ex),
                                      &n_all);
     }
     if (st != BSF_OK) {

@@ -186,7 +186,6 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
 #endif
 }
 
-#if !BSF_CONFIG_COMPACT
 void bsf_grazing_memo_forget(uint8_t *memo, size_t m, size_t count)
 {
     /* The verdict on step a reads beams a - 5 .. a + 6 (the corner runs
@@ -196,4 +195,3 @@ void bsf_grazing_memo_forget(uint8_t *memo, size_t m, size_t count)
         memo[a / 4u] = (uint8_t)(memo[a / 4u] & ~(3u << (2u * (a % 4u))));
     }
 }
-#endif
