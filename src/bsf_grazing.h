@@ -73,7 +73,8 @@ static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
  * bytes zeroed by the caller, who keeps pts (points and valid flags), cap
  * and at_corners the same while it is in use. Why: LC and SVED ask about
  * many of the same wide steps, and on a step seen edge-on the corner runs
- * cost hundreds of instructions. */
+ * cost hundreds of instructions. The compact build ignores memo (its code
+ * would not fit the firmware's budget). */
 int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo);
 
 /* Bytes of bsf_grazing_join's memo for n beams. */
