@@ -1,5 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_grazing.h"
+#include "bsf_lc_internal.h"
 #include "bsf_math.h"
 #include "bsf_segment_internal.h"
 
@@ -215,6 +217,9 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
     return st;
 }
 
+/* Bytes of SVED's mixed-pixel marks at the start of ex->segments. */
+#define MIXED_MARK_BYTES (((size_t)BSF_MAX_POINTS + 7u) / 8u)
+
 /* SVED's mixed-pixel marks for this scan (bsf_sved_mixed_marks), found
  * once before LC and used by segmentation, or NULL when the method finds
  * none or they do not fit (caps with few segments: SVED then finds them
@@ -226,6 +231,21 @@ static uint8_t *mixed_marks(bsf_extractor_t *ex)
         return NULL;
     }
     return (uint8_t *)(void *)ex->segments;
+}
+
+/* The grazing joins' verdicts for this scan (bsf_grazing_join's memo),
+ * zeroed before LC and kept for segmentation: LC and SVED ask about many of
+ * the same wide steps. After the mixed-pixel marks in ex->segments; NULL
+ * with no marks, when they do not fit beside them (many beams, few
+ * segments: each stage then asks alone), and in the compact build (over
+ * 100 bytes of code). */
+static uint8_t *grazing_memo(bsf_extractor_t *ex)
+{
+    if (BSF_CONFIG_COMPACT || mixed_marks(ex) == NULL ||
+        sizeof ex->segments < MIXED_MARK_BYTES + BSF_GRAZING_MEMO_BYTES((size_t)BSF_MAX_POINTS)) {
+        return NULL;
+    }
+    return (uint8_t *)(void *)ex->segments + MIXED_MARK_BYTES;
 }
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
@@ -247,15 +267,33 @@ static bsf_status_t detect_lc(bsf_extractor_t *ex)
 {
     size_t n = 0u;
     bsf_status_t st;
+    uint8_t *memo = grazing_memo(ex);
     if (ex->params.sved.reject_mixed) {
         n = bsf_sved_mixed_marks(&ex->points, &ex->params.sved, mixed_marks(ex), ex->interest,
                                  BSF_MAX_KEYPOINTS);
     }
+    if (memo != NULL) {
+        memset(memo, 0, BSF_GRAZING_MEMO_BYTES(ex->points.count));
+        /* LC's verdicts hold for SVED only for the same question (SVED's
+         * cap and corner rule LC's; either asks none with join_grazing 0):
+         * else LC keeps none and SVED asks alone. */
+        if (ex->params.sved.join_grazing != ex->params.lc.join_grazing ||
+            !(ex->params.sved.radius_max == BSF_GRAZING_LC_CAP)) {
+            memo = NULL;
+        }
+    }
     set_valid(ex, n, 0u);
-    st = bsf_lc_detect(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
-                       BSF_MAX_KEYPOINTS, &ex->n_keypoints);
+    st = bsf_lc_detect_memo(&ex->points, &ex->params.lc, &ex->scratch.lc, ex->keypoints,
+                            BSF_MAX_KEYPOINTS, &ex->n_keypoints, memo);
     ex->noise2 = ex->scratch.lc.noise2; /* segmentation reuses the scratch */
     set_valid(ex, n, 1u);
+    /* and only on the same valid beams: not those LC saw invalid */
+    if (memo != NULL) {
+        size_t k;
+        for (k = 0; k < n; ++k) {
+            bsf_grazing_memo_forget(memo, ex->interest[k], ex->points.count);
+        }
+    }
     return st;
 }
 #endif
@@ -375,7 +413,8 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
         }
     } else {
         st = bsf_segment_sved_marked(&ex->points, &ex->params.sved, all, BSF_MAX_POINTS,
-                                     ex->scratch.seg.label, mixed_marks(ex), &n_all);
+                                     ex->scratch.seg.label, mixed_marks(ex), grazing_memo(ex),
+                                     &n_all);
     }
     if (st != BSF_OK) {
         return st;

@@ -87,45 +87,49 @@ static int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
 /* Points s..s + 3 lie on one line (along the rays too) that starts at a
  * corner: s - 3..s - 1 lie on another line, whose last return s - 1 is no
  * step of the first (their steps differ, or they turn) yet lies just
- * behind s on it (bsf_grazing_entry), within cap of s + 1. With dir -1 the
- * mirror image: s..s - 3 end at the corner s + 1. */
-static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir, float cap)
+ * behind s on it (bsf_grazing_entry). With dir -1 the mirror image:
+ * s..s - 3 end at the corner s + 1. The caller has checked what both
+ * forms need (bsf_grazing_run_room). */
+static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir)
 {
     const bsf_point_t *p = pts->pt;
     const ptrdiff_t d = dir;
-    size_t c;
-    /* Both forms need beams s - 3..s + 3 in the scan and s - 1..s + 1
-     * valid; the cheap tests on the corner's return run first (most wide
-     * steps are depth jumps, whose far return lies nowhere near the line).
-     * Each triple is tested in ascending beam order, as the lines are. */
-    if (s < 3u || s + 3u >= pts->count || !pts->valid[s - 1u] || !pts->valid[s] ||
-        !pts->valid[s + 1u]) {
-        return 0;
-    }
-    c = (size_t)((ptrdiff_t)s - d); /* the corner's return */
-    return bsf_grazing_within(p[c], p[(ptrdiff_t)s + d], cap) &&
-           bsf_grazing_entry(p[c], p[s], p[(ptrdiff_t)s + d]) &&
-           bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
+    const size_t c = (size_t)((ptrdiff_t)s - d); /* the corner's return */
+    return bsf_grazing_entry(p[c], p[s], p[(ptrdiff_t)s + d]) &&
            !bsf_grazing_triple(p[(ptrdiff_t)c - d], p[c], p[s]) &&
+           bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
            bsf_grazing_line3(pts, d > 0 ? s : s - 2u) &&
            bsf_grazing_line3(pts, d > 0 ? s + 1u : s - 3u);
 }
 
+/* What a corner run from s needs in either direction: beams s - 3..s + 3
+ * in the scan, s - 1..s + 1 valid, s - 1 within cap of s + 1. The cheap
+ * tests on the corner's return come first: most wide steps are depth
+ * jumps, whose far return lies nowhere near the line. */
+static int bsf_grazing_run_room(const bsf_points_t *pts, size_t s, float cap)
+{
+    return s >= 3u && s + 3u < pts->count && pts->valid[s - 1u] && pts->valid[s] &&
+           pts->valid[s + 1u] && bsf_grazing_within(pts->pt[s - 1u], pts->pt[s + 1u], cap);
+}
+
 /* The step between beams a and a + 1 is the step onto such a corner run or
- * one of its own (a run of four from its corner, see bsf_grazing_join). */
+ * one of its own (a run of four from its corner, see grazing_join_verdict):
+ * a run from s = a - 2..a + 1 onwards, or one from s = a..a + 3 back. */
 static int bsf_grazing_at_corner(const bsf_points_t *pts, size_t a, float cap)
 {
-    size_t k;
-    for (k = 0; k < 4u; ++k) {
-        if ((a + 1u >= k && bsf_grazing_corner_run(pts, a + 1u - k, 1, cap)) ||
-            bsf_grazing_corner_run(pts, a + k, -1, cap)) {
+    size_t s;
+    for (s = a >= 2u ? a - 2u : 0u; s <= a + 3u; ++s) {
+        if (bsf_grazing_run_room(pts, s, cap) &&
+            ((s <= a + 1u && bsf_grazing_corner_run(pts, s, 1)) ||
+             (s >= a && bsf_grazing_corner_run(pts, s, -1)))) {
             return 1;
         }
     }
     return 0;
 }
 
-int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners)
+/* bsf_grazing_join's verdict, computed. */
+static int grazing_join_verdict(const bsf_points_t *pts, size_t a, float cap, int at_corners)
 {
     const size_t b = a + 1u;
     const bsf_point_t *p = pts->pt;
@@ -160,4 +164,34 @@ int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corner
     }
     return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]) &&
            bsf_grazing_within(p[b], p[a - 2u], cap);
+}
+
+int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo)
+{
+#if BSF_CONFIG_COMPACT /* compact: no memo (the extractor passes none) */
+    (void)memo;
+    return grazing_join_verdict(pts, a, cap, at_corners);
+#else
+    const unsigned shift = 2u * (unsigned)(a % 4u);
+    unsigned v;
+    if (memo == NULL) {
+        return grazing_join_verdict(pts, a, cap, at_corners);
+    }
+    v = (memo[a / 4u] >> shift) & 3u;
+    if (v == 0u) {
+        v = 1u + (unsigned)grazing_join_verdict(pts, a, cap, at_corners);
+        memo[a / 4u] = (uint8_t)(memo[a / 4u] | (v << shift));
+    }
+    return (int)v - 1;
+#endif
+}
+
+void bsf_grazing_memo_forget(uint8_t *memo, size_t m, size_t count)
+{
+    /* The verdict on step a reads beams a - 5 .. a + 6 (the corner runs
+     * from a - 2 .. a + 3, each three beams either side). */
+    size_t a = m >= 6u ? m - 6u : 0u;
+    for (; a <= m + 5u && a < count; ++a) {
+        memo[a / 4u] = (uint8_t)(memo[a / 4u] & ~(3u << (2u * (a % 4u))));
+    }
 }

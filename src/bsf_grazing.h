@@ -20,6 +20,7 @@
 #define BSF_GRAZING_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "bsf/bsf_scan.h"
 
@@ -66,7 +67,22 @@ static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
  * first four returns of a wall that starts at a corner (or the last four
  * of one that ends at one), the step onto that corner included: that
  * corner is visible (three returns on a line fix the wall), and four
- * returns from it leave no room for a long wall to close a door. */
-int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners);
+ * returns from it leave no room for a long wall to close a door.
+ * memo (NULL: none) keeps each step's verdict once computed, 2 bits per
+ * step a (0: not asked yet, 1: no, 2: yes), BSF_GRAZING_MEMO_BYTES(count)
+ * bytes zeroed by the caller, who keeps pts (points and valid flags), cap
+ * and at_corners the same while it is in use. Why: LC and SVED ask about
+ * many of the same wide steps, and on a step seen edge-on the corner runs
+ * cost hundreds of instructions. The compact build ignores memo (its code
+ * would not fit the firmware's budget). */
+int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo);
+
+/* Bytes of bsf_grazing_join's memo for n beams. */
+#define BSF_GRAZING_MEMO_BYTES(n) (((n) + 3u) / 4u)
+
+/* Forget the memo's verdicts that depend on beam m (those of the steps
+ * whose tests read it: m - 6 .. m + 5), as when beam m's valid flag
+ * changes; count is pts->count. */
+void bsf_grazing_memo_forget(uint8_t *memo, size_t m, size_t count);
 
 #endif

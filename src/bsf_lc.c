@@ -2,6 +2,7 @@
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
 #include "bsf_grazing.h"
+#include "bsf_lc_internal.h"
 #include "bsf_math.h"
 
 #include <float.h>
@@ -1722,16 +1723,43 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
 static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
 {
     const size_t span = 2u * (size_t)p->min_side_points;
+    const float x = p->jump_b * pts->range[a];
     float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
+#if !BSF_CONFIG_COMPACT
+    /* Bounds on r2 that spare the exponential, as in within_jump; computed
+     * once, when a point is beyond jump_a. */
+    float r2_lo = -1.0f;
+    float r2_hi = HUGE_VALF;
+    int have_bounds = 0;
+#endif
     size_t j;
     for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
         if (pts->valid[j]) {
             const float d2 = dist2(pts->pt[a], pts->pt[j]);
-            if (d2 > p->jump_a * p->jump_a && r2 < 0.0f) {
-                const float r = p->jump_a * bsf_expf(p->jump_b * pts->range[a]);
+            if (d2 <= p->jump_a * p->jump_a) {
+                return j;
+            }
+#if !BSF_CONFIG_COMPACT
+            if (!have_bounds && x >= 0.0f && x <= 1.0f) {
+                float lo;
+                float hi;
+                bsf_exp_bounds01(x, &lo, &hi);
+                r2_lo = (p->jump_a * lo) * (p->jump_a * lo);
+                r2_hi = (p->jump_a * hi) * (p->jump_a * hi);
+            }
+            have_bounds = 1;
+            if (d2 <= r2_lo) {
+                return j;
+            }
+            if (d2 > r2_hi) {
+                continue;
+            }
+#endif
+            if (r2 < 0.0f) {
+                const float r = p->jump_a * bsf_expf(x);
                 r2 = r * r;
             }
-            if (d2 <= p->jump_a * p->jump_a || d2 <= r2) {
+            if (d2 <= r2) {
                 return j;
             }
         }
@@ -1742,18 +1770,19 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
 /* Point b continues the run that ends at point a: within the jump radius,
  * or (join_grazing) the next beam on one wall seen at grazing incidence
  * (never through the seam of a full-circle scan). */
-static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t b)
+static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo,
+                    size_t a, size_t b)
 {
     return within_jump(pts, p, a, b) ||
            (p->join_grazing && a + 1u == b &&
-            bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u));
+            bsf_grazing_join(pts, a, BSF_GRAZING_LC_CAP, p->join_grazing == 2u, grazing_memo));
 }
 
 /* Where the pass over a full-circle scan starts: the first valid beam (from
  * 0) that does not continue the run of the valid beam before it on the ring,
  * so that no run is cut at the seam; 0 when every step joins (one closed
  * surface all round: the seam then cuts it, as on a scan that is no ring). */
-static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
+static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
     size_t i;
@@ -1764,7 +1793,8 @@ static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p)
         if (!pts->valid[i]) {
             continue;
         }
-        if (i != prev && !lc_joins(pts, p, prev, i) && past_occluder(pts, p, prev, i) == i) {
+        if (i != prev && !lc_joins(pts, p, grazing_memo, prev, i) &&
+            past_occluder(pts, p, prev, i) == i) {
             return i;
         }
         prev = i;
@@ -1786,6 +1816,13 @@ static void reverse_keypoints(bsf_keypoint_t *out, size_t lo, size_t hi)
 
 bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bsf_lc_work_t *work,
                            bsf_keypoint_t *out, size_t out_cap, size_t *n_out)
+{
+    return bsf_lc_detect_memo(pts, p, work, out, out_cap, n_out, NULL);
+}
+
+bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *p,
+                                bsf_lc_work_t *work, bsf_keypoint_t *out, size_t out_cap,
+                                size_t *n_out, uint8_t *grazing_memo)
 {
     lc_ctx_t c;
     bsf_status_t st;
@@ -1818,7 +1855,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
     work->noise2 = 0.0f;
     c.noise_points = 0.0f;
     blocks_detach(&c);
-    c.start = bsf_points_full_circle(pts) ? ring_start(pts, p) : 0u;
+    c.start = bsf_points_full_circle(pts) ? ring_start(pts, p, grazing_memo) : 0u;
     for (step = 0; step <= pts->count; ++step) {
         int close_run = step == pts->count;
         i = close_run
@@ -1828,7 +1865,7 @@ bsf_status_t bsf_lc_detect(const bsf_points_t *pts, const bsf_lc_params_t *p, bs
             continue;
         }
         if (!close_run && m > 0u) {
-            close_run = !lc_joins(pts, p, work->run[m - 1u], i);
+            close_run = !lc_joins(pts, p, grazing_memo, work->run[m - 1u], i);
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i && step + (j - i) < pts->count) {

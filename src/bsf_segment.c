@@ -545,6 +545,14 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         /* Inside the scan (most beams): the cheap tests first. */
         const uint8_t *v = &pts->valid[i - 2u];
         const float *rg = &pts->range[i - 2u];
+#if !BSF_CONFIG_COMPACT
+        /* the jump within the radius's floor (below), on the ranges alone:
+         * with either neighbour invalid the return is no mixed pixel either */
+        const float step = rg[3] - rg[1];
+        if (step * step <= rad->a2) {
+            return 0;
+        }
+#endif
         if (!between_neighbours(pts, i, &r[1], &lo, &hi)) {
             return 0;
         }
@@ -630,11 +638,15 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
             /* is_mixed_pixel's first tests before its call (not in the
              * compact build, which keeps one copy): most returns lie on a
              * surface whose range changes by less than the radius's floor
-             * from one neighbour to the other. */
+             * from one neighbour to the other. That test first, on the
+             * ranges alone: with both neighbours valid their difference is
+             * the jump, and with either invalid the return is no mixed
+             * pixel anyway. */
+            const float step = pts->range[b + 1u] - pts->range[b - 1u];
             float r3[3];
             float lo;
             float hi;
-            if (!between_neighbours(pts, b, r3, &lo, &hi) || (hi - lo) * (hi - lo) <= rad.a2) {
+            if (step * step <= rad.a2 || !between_neighbours(pts, b, r3, &lo, &hi)) {
                 continue;
             }
         }
@@ -711,7 +723,8 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
  * extension fields say (checked, then ignored), and no full-circle pass. */
 static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *params,
                              bsf_segment_t *out, size_t cap, uint16_t *label, int extensions,
-                             const uint8_t *marks, size_t *n_out, size_t *n_wasted_points)
+                             const uint8_t *marks, uint8_t *grazing_memo, size_t *n_out,
+                             size_t *n_wasted_points)
 {
     const bsf_sved_params_t defaults = bsf_sved_params_default();
     const bsf_sved_params_t *p = params != NULL ? params : &defaults;
@@ -826,7 +839,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         /* A wide step from the beam before may still continue a wall seen
          * at grazing incidence (bsf_grazing.h). */
         if (best == slots && grazing && n_open > 0u && b > 0u && open[0].last + 1u == b &&
-            bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u)) {
+            bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u, grazing_memo)) {
             best = 0u;
         }
         if (best == 0u) {
@@ -890,21 +903,21 @@ bsf_status_t bsf_segment_sved(const bsf_points_t *pts, const bsf_sved_params_t *
                               bsf_segment_t *out, size_t cap, size_t *n_out,
                               size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, NULL, 0, NULL, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, NULL, 0, NULL, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_labelled(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                        bsf_segment_t *out, size_t cap, uint16_t *label,
                                        size_t *n_out, size_t *n_wasted_points)
 {
-    return sved_run(pts, params, out, cap, label, 1, NULL, n_out, n_wasted_points);
+    return sved_run(pts, params, out, cap, label, 1, NULL, NULL, n_out, n_wasted_points);
 }
 
 bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                      bsf_segment_t *out, size_t cap, uint16_t *label,
-                                     const uint8_t *marks, size_t *n_out)
+                                     const uint8_t *marks, uint8_t *grazing_memo, size_t *n_out)
 {
-    return sved_run(pts, params, out, cap, label, 1, marks, n_out, NULL);
+    return sved_run(pts, params, out, cap, label, 1, marks, grazing_memo, n_out, NULL);
 }
 
 /* |angle between u and v| <= alpha_max, i.e. u.v >= cos(alpha_max)*|u|*|v|,

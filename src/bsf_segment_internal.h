@@ -19,10 +19,12 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
 
 /* bsf_segment_sved_labelled with the mixed pixels that
  * bsf_sved_mixed_marks marked on the same points and params (marks not
- * NULL), rather than finding them again; no count of wasted points. */
+ * NULL), rather than finding them again, and its grazing joins' verdicts
+ * kept in grazing_memo (bsf_grazing_join; NULL: none kept); no count
+ * of wasted points. */
 bsf_status_t bsf_segment_sved_marked(const bsf_points_t *pts, const bsf_sved_params_t *params,
                                      bsf_segment_t *out, size_t cap, uint16_t *label,
-                                     const uint8_t *marks, size_t *n_out);
+                                     const uint8_t *marks, uint8_t *grazing_memo, size_t *n_out);
 
 /* A line through a side's returns w[1..n) (total least squares), as SVED's
  * mixed-pixel rule and the extractor's tail rule judge the return w[0]

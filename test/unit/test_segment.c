@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "bsf/bsf.h"
+#include "bsf_grazing.h"
 #include "bsf_scene.h"
 #include "unity.h"
 
@@ -763,6 +764,76 @@ static void test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corn
     TEST_ASSERT_TRUE(corner_onto_wall_seen_nearly_edge_on(1, &n_valid) > 1u || n_wasted > 0u);
 }
 
+/* bsf_grazing_join's memo: on the edge-on corner above, every step's verdict
+ * with a memo is the verdict without, the memo keeps it (1 no, 2 yes), and
+ * a step asked again is answered from the memo, not recomputed. */
+static void test_grazing_join_memo_keeps_each_verdict(void)
+{
+    uint8_t memo[BSF_GRAZING_MEMO_BYTES(BSF_MAX_POINTS)];
+    size_t n_valid = 0;
+    size_t n_yes = 0;
+    size_t n_no = 0;
+    size_t a;
+    if (BSF_CONFIG_COMPACT) {
+        TEST_IGNORE_MESSAGE("the compact build keeps no memo");
+    }
+    (void)corner_onto_wall_seen_nearly_edge_on(2, &n_valid);
+    memset(memo, 0, sizeof memo);
+    for (a = 0; a + 1u < points.count; ++a) {
+        const int plain = bsf_grazing_join(&points, a, 1.0f, 1, NULL);
+        TEST_ASSERT_EQUAL_INT(plain, bsf_grazing_join(&points, a, 1.0f, 1, memo));
+        TEST_ASSERT_EQUAL_UINT(plain ? 2u : 1u, (memo[a / 4u] >> (2u * (a % 4u))) & 3u);
+        n_yes += plain ? 1u : 0u;
+        n_no += plain ? 0u : 1u;
+    }
+    TEST_ASSERT_TRUE(n_yes > 0u);
+    TEST_ASSERT_TRUE(n_no > 0u);
+    /* every verdict flipped in the memo: the answers follow the memo */
+    for (a = 0; a + 1u < points.count; ++a) {
+        const int plain = bsf_grazing_join(&points, a, 1.0f, 1, NULL);
+        memo[a / 4u] = (uint8_t)(memo[a / 4u] ^ (3u << (2u * (a % 4u))));
+        TEST_ASSERT_EQUAL_INT(!plain, bsf_grazing_join(&points, a, 1.0f, 1, memo));
+    }
+}
+
+/* bsf_grazing_memo_forget forgets exactly the verdicts that may change when
+ * a beam turns invalid: on the edge-on corner, invalidating any one beam m
+ * changes no verdict outside the steps m - 6 .. m + 5 that it forgets, and
+ * it forgets those (and only those). */
+static void test_grazing_memo_forgets_the_verdicts_that_read_a_beam(void)
+{
+    static int before[BSF_MAX_POINTS];
+    uint8_t memo[BSF_GRAZING_MEMO_BYTES(BSF_MAX_POINTS)];
+    size_t n_valid = 0;
+    size_t n_changed = 0;
+    size_t m;
+    size_t a;
+    if (BSF_CONFIG_COMPACT) {
+        TEST_IGNORE_MESSAGE("the compact build keeps no memo");
+    }
+    (void)corner_onto_wall_seen_nearly_edge_on(2, &n_valid);
+    for (a = 0; a + 1u < points.count; ++a) {
+        before[a] = bsf_grazing_join(&points, a, 1.0f, 1, NULL);
+    }
+    for (m = 0; m < points.count; ++m) {
+        const uint8_t was_valid = points.valid[m];
+        memset(memo, 0xaa, sizeof memo); /* every verdict "yes" */
+        bsf_grazing_memo_forget(memo, m, points.count);
+        points.valid[m] = 0u;
+        for (a = 0; a + 1u < points.count; ++a) {
+            const int kept = ((memo[a / 4u] >> (2u * (a % 4u))) & 3u) != 0u;
+            const int now = bsf_grazing_join(&points, a, 1.0f, 1, NULL);
+            TEST_ASSERT_EQUAL_INT(a + 6u < m || a > m + 5u, kept);
+            if (kept) {
+                TEST_ASSERT_EQUAL_INT(before[a], now);
+            }
+            n_changed += now != before[a] ? 1u : 0u;
+        }
+        points.valid[m] = was_valid;
+    }
+    TEST_ASSERT_TRUE(n_changed > 0u); /* the scene does test the reach */
+}
+
 /* A lone reading halfway across a depth jump lies on the chord of its two
  * neighbours, but the surfaces either side do not go on along that line:
  * grazing joins do not bridge it (mixed-pixel rejection off, so only the
@@ -1121,6 +1192,8 @@ int main(void)
     RUN_TEST(test_null_arguments_are_refused);
     RUN_TEST(test_sved_grazing_joins_keep_a_corner_and_its_grazing_wall_one_segment);
     RUN_TEST(test_sved_corner_joins_keep_a_wall_seen_nearly_edge_on_with_its_corner);
+    RUN_TEST(test_grazing_join_memo_keeps_each_verdict);
+    RUN_TEST(test_grazing_memo_forgets_the_verdicts_that_read_a_beam);
     RUN_TEST(test_sved_grazing_joins_do_not_bridge_a_depth_jump_through_a_mixed_reading);
     RUN_TEST(test_sved_rejects_a_mixed_pixel_near_one_surface_and_keeps_a_real_end);
     RUN_TEST(test_sved_rejects_a_mixed_pixel_between_a_run_and_a_grazing_wall);
