@@ -819,9 +819,8 @@ static bsf_status_t fit_segment(bsf_extractor_t *ex, const bsf_segment_t *s, bsf
     }
     if (!USES_RPOS(ex)) {
         st = fit_pieces(ex, s, n, n_vertex, res);
-        ex->scratch.seg.use.fit.points_left -= ex->scratch.seg.use.fit.points_left > n
-                                                   ? (uint32_t)n
-                                                   : ex->scratch.seg.use.fit.points_left;
+        /* fit_features summed the same counts: no wrap. */
+        ex->scratch.seg.use.fit.points_left -= s->n_points;
         return st;
     }
     st = bsf_lsba_fit(ex->scratch.seg.use.fit.seg_points, n, &res->ctrl[res->n_ctrl], &e_curve);

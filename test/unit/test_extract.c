@@ -570,57 +570,69 @@ static void test_method_names_round_trip(void)
     TEST_ASSERT_NULL(bsf_method_name(BSF_METHOD_COUNT));
 }
 
-/* The far end of a corridor seen along it (0.25-degree beams, 5 mm noise):
- * the end wall gives a dense run, the side wall before the corner one
- * return at grazing incidence that joins the end wall's segment. Bent to
- * reach it, a curve swings 5-9 cm off the walls beside the corner, where
- * no return was (half a metre on the ground-truth corridor at 3200 beams);
- * with the return left off (trim_tails, the default) every curve stays
- * within a centimetre of the walls. */
-static void test_a_tail_return_past_a_concave_corner_is_left_off_the_feature(void)
+/* The far end of a 24 m corridor seen along it from 12 poses, by
+ * lc-sved-pdm with and without trim_tails: the largest distance from a
+ * curve to the true walls and the returns left out of features, each way. */
+typedef struct {
+    double worst_on, worst_off;
+    uint32_t wasted_on, wasted_off;
+} corridor_tails_t;
+
+static corridor_tails_t corridor_tails(size_t n_beams, double fov, double sigma, uint64_t seed)
 {
     static const double outline[8] = {0.0, -1.0, 24.0, -1.0, 24.0, 1.0, 0.0, 1.0};
-    double worst_on = 0.0;
-    double worst_off = 0.0;
-    uint32_t wasted_on = 0u;
-    uint32_t wasted_off = 0u;
+    corridor_tails_t t = {0.0, 0.0, 0u, 0u};
     int pose;
     bsf_scene_init(&scene);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 4u, 1));
     for (pose = 0; pose < 12; ++pose) {
         bsf_lidar_t l = bsf_lidar_default(4.0 + 0.5 * (double)pose, -0.6 + 0.1 * (double)pose, 0.0,
-                                          1081u, 4.71238898);
+                                          n_beams, fov);
         int trim;
-        l.angle_increment = 4.71238898 / 1080.0;
-        l.noise_sigma = 0.005;
+        l.angle_increment = fov / (double)(n_beams - 1u);
+        l.noise_sigma = sigma;
         for (trim = 0; trim <= 1; ++trim) {
             bsf_scene_rng_t rng;
             bsf_scan_t s = scan_of(&l);
             bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
             double rms;
             double max_d;
-            TEST_ASSERT_EQUAL_UINT8(1u, p.trim_tails);
             p.trim_tails = (uint8_t)trim;
-            bsf_scene_rng_seed(&rng, 40u + (uint64_t)pose);
+            bsf_scene_rng_seed(&rng, seed + (uint64_t)pose);
             TEST_ASSERT_EQUAL_INT(BSF_OK,
                                   bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
             TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
             TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
             curve_to_truth(&l, &rms, &max_d);
             if (trim) {
-                worst_on = max_d > worst_on ? max_d : worst_on;
-                wasted_on += res.stats.n_valid - res.stats.n_in_features;
+                t.worst_on = max_d > t.worst_on ? max_d : t.worst_on;
+                t.wasted_on += res.stats.n_valid - res.stats.n_in_features;
             } else {
-                worst_off = max_d > worst_off ? max_d : worst_off;
-                wasted_off += res.stats.n_valid - res.stats.n_in_features;
+                t.worst_off = max_d > t.worst_off ? max_d : t.worst_off;
+                t.wasted_off += res.stats.n_valid - res.stats.n_in_features;
             }
         }
     }
-    TEST_ASSERT_TRUE_MESSAGE(worst_off > 0.06, "the scene should show the swing it guards against");
-    TEST_ASSERT_TRUE_MESSAGE(worst_on < 0.02, "a curve swings past the corner");
+    return t;
+}
+
+/* 0.25-degree beams, 5 mm noise: the end wall gives a dense run, the side
+ * wall before the corner one return at grazing incidence that joins the end
+ * wall's segment. Bent to reach it, a curve swings 5-9 cm off the walls
+ * beside the corner, where no return was (half a metre on the ground-truth
+ * corridor at 3200 beams); with the return left off (trim_tails, the
+ * default) every curve stays within a centimetre of the walls. */
+static void test_a_tail_return_past_a_concave_corner_is_left_off_the_feature(void)
+{
+    corridor_tails_t t;
+    TEST_ASSERT_EQUAL_UINT8(1u, bsf_params_default(BSF_METHOD_LC_SVED_PDM).trim_tails);
+    t = corridor_tails(1081u, 4.71238898, 0.005, 40u);
+    TEST_ASSERT_TRUE_MESSAGE(t.worst_off > 0.06,
+                             "the scene should show the swing it guards against");
+    TEST_ASSERT_TRUE_MESSAGE(t.worst_on < 0.02, "a curve swings past the corner");
     /* Only the tails leave the features: at most one return per segment end. */
-    TEST_ASSERT_TRUE(wasted_on > wasted_off);
-    TEST_ASSERT_TRUE(wasted_on <= wasted_off + 2u * 12u);
+    TEST_ASSERT_TRUE(t.wasted_on > t.wasted_off);
+    TEST_ASSERT_TRUE(t.wasted_on <= t.wasted_off + 2u * 12u);
 }
 
 /* The same corridor at 1-degree beams, 1 cm noise: 14-20 m away the end
@@ -632,47 +644,13 @@ static void test_a_tail_return_past_a_concave_corner_is_left_off_the_feature(voi
  * returns. */
 static void test_a_tail_return_on_a_short_segment_is_left_off_the_feature(void)
 {
-    static const double outline[8] = {0.0, -1.0, 24.0, -1.0, 24.0, 1.0, 0.0, 1.0};
-    double worst_on = 0.0;
-    double worst_off = 0.0;
-    uint32_t wasted_on = 0u;
-    uint32_t wasted_off = 0u;
-    int pose;
-    bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, outline, 4u, 1));
-    for (pose = 0; pose < 12; ++pose) {
-        bsf_lidar_t l = bsf_lidar_default(4.0 + 0.5 * (double)pose, -0.6 + 0.1 * (double)pose, 0.0,
-                                          181u, 3.14159265);
-        int trim;
-        l.angle_increment = 3.14159265 / 180.0;
-        l.noise_sigma = 0.01;
-        for (trim = 0; trim <= 1; ++trim) {
-            bsf_scene_rng_t rng;
-            bsf_scan_t s = scan_of(&l);
-            bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
-            double rms;
-            double max_d;
-            p.trim_tails = (uint8_t)trim;
-            bsf_scene_rng_seed(&rng, 70u + (uint64_t)pose);
-            TEST_ASSERT_EQUAL_INT(BSF_OK,
-                                  bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
-            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
-            curve_to_truth(&l, &rms, &max_d);
-            if (trim) {
-                worst_on = max_d > worst_on ? max_d : worst_on;
-                wasted_on += res.stats.n_valid - res.stats.n_in_features;
-            } else {
-                worst_off = max_d > worst_off ? max_d : worst_off;
-                wasted_off += res.stats.n_valid - res.stats.n_in_features;
-            }
-        }
-    }
-    TEST_ASSERT_TRUE_MESSAGE(worst_off > 0.06, "the scene should show the swing it guards against");
-    TEST_ASSERT_TRUE_MESSAGE(worst_on < 0.03, "a curve swings past the corner");
+    const corridor_tails_t t = corridor_tails(181u, 3.14159265, 0.01, 70u);
+    TEST_ASSERT_TRUE_MESSAGE(t.worst_off > 0.06,
+                             "the scene should show the swing it guards against");
+    TEST_ASSERT_TRUE_MESSAGE(t.worst_on < 0.03, "a curve swings past the corner");
     /* Only the tails leave the features: at most one return per segment end. */
-    TEST_ASSERT_TRUE(wasted_on > wasted_off);
-    TEST_ASSERT_TRUE(wasted_on <= wasted_off + 2u * 12u);
+    TEST_ASSERT_TRUE(t.wasted_on > t.wasted_off);
+    TEST_ASSERT_TRUE(t.wasted_on <= t.wasted_off + 2u * 12u);
 }
 
 /* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)

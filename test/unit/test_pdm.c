@@ -419,35 +419,43 @@ static void test_refinement_stops_at_the_per_fragment_cap(void)
 static bsf_point_t room_pts[BSF_MAX_POINTS];
 static float room_ranges[BSF_MAX_POINTS];
 
+/* That room's valid returns from one pose into room_pts, in the sensor's
+ * frame; returns their count. */
+static size_t scan_room_with_pillar(double x, double y, double theta, uint64_t seed)
+{
+    static bsf_scene_t scene;
+    bsf_lidar_t l = bsf_lidar_default(x, y, theta, 541u, 4.71238898);
+    bsf_scene_rng_t rng;
+    size_t n = 0;
+    size_t i;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(
+        BSF_OK, bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
+    l.noise_sigma = 0.01;
+    bsf_scene_rng_seed(&rng, seed);
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL, BSF_MAX_POINTS));
+    for (i = 0; i < l.n_beams; ++i) {
+        const float r = room_ranges[i];
+        const float a = (float)(l.angle_min + l.angle_increment * (double)i);
+        if (r > 0.05f && r < (float)l.range_max) {
+            room_pts[n].x = r * cosf(a);
+            room_pts[n].y = r * sinf(a);
+            ++n;
+        }
+    }
+    return n;
+}
+
 static void test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck(void)
 {
     static const double pose[4][3] = {
         {2.0, 2.0, 0.3}, {3.0, 1.2, 1.2}, {1.5, 2.5, 2.5}, {4.0, 2.0, -0.7}};
-    static bsf_scene_t scene;
     size_t k;
-    bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(
-        BSF_OK, bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
     for (k = 0; k < 4u; ++k) {
-        bsf_lidar_t l = bsf_lidar_default(pose[k][0], pose[k][1], pose[k][2], 541u, 4.71238898);
-        bsf_scene_rng_t rng;
-        size_t n = 0;
-        size_t i;
+        const size_t n = scan_room_with_pillar(pose[k][0], pose[k][1], pose[k][2], 5u + k);
         size_t n_ctrl = 0;
         float e = -1.0f;
-        l.noise_sigma = 0.01;
-        bsf_scene_rng_seed(&rng, 5u + k);
-        TEST_ASSERT_EQUAL_INT(BSF_OK,
-                              bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL, BSF_MAX_POINTS));
-        for (i = 0; i < l.n_beams; ++i) {
-            const float r = room_ranges[i];
-            const float a = (float)(l.angle_min + l.angle_increment * (double)i);
-            if (r > 0.05f && r < (float)l.range_max) {
-                room_pts[n].x = r * cosf(a);
-                room_pts[n].y = r * sinf(a);
-                ++n;
-            }
-        }
         TEST_ASSERT_TRUE(n > 500u);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl, NULL,
                                                   BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
@@ -554,30 +562,10 @@ static void test_max_passes_bounds_the_climb_near_the_target(void)
  * max_passes 1, at the cost of more passes than the cap. */
 static void test_max_passes_never_stops_growth_far_from_the_target(void)
 {
-    static bsf_scene_t scene;
-    bsf_lidar_t l = bsf_lidar_default(2.0, 2.0, 0.3, 541u, 4.71238898);
-    bsf_scene_rng_t rng;
+    const size_t n = scan_room_with_pillar(2.0, 2.0, 0.3, 5u);
     bsf_pdm_info_t info;
-    size_t n = 0;
-    size_t i;
     size_t n_ctrl = 0;
     float e = -1.0f;
-    bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(
-        BSF_OK, bsf_scene_add_room_with_pillar(&scene, 0.0, 0.0, 8.0, 6.0, 5.0, 3.0, 0.4));
-    l.noise_sigma = 0.01;
-    bsf_scene_rng_seed(&rng, 5u);
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_scene_scan(&scene, &l, &rng, room_ranges, NULL, BSF_MAX_POINTS));
-    for (i = 0; i < l.n_beams; ++i) {
-        const float r = room_ranges[i];
-        const float a = (float)(l.angle_min + l.angle_increment * (double)i);
-        if (r > 0.05f && r < (float)l.range_max) {
-            room_pts[n].x = r * cosf(a);
-            room_pts[n].y = r * sinf(a);
-            ++n;
-        }
-    }
     params.max_passes = 1u;
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(room_pts, n, NULL, 0u, &params, &work, ctrl, NULL,
                                               BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, &info));
