@@ -1293,6 +1293,21 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
     return LC_CORNER;
 }
 
+/* Is a side of count points reaching sqrt(d2) from the apex too short to
+ * give its line a direction? The direction's standard error falls as
+ * 1 / (length sqrt(points)), so a side of more points than the need may be
+ * shorter than min_side_len (len2 squared) by the square root of their
+ * ratio, down to half of it at 4 x need: as well determined as need points
+ * over min_side_len. Only a side that runs to the end of its run can fall
+ * short at all (judge walks the others on): at fine beams, the 10 cm face
+ * of a door jamb or a recess beside a wall's end, whose corner the fit
+ * could otherwise only round off, climbing to its control-point cap. */
+static int side_too_short(float d2, size_t count, float len2, size_t need)
+{
+    const size_t capped = count < need ? need : (count > 4u * need ? 4u * need : count);
+    return d2 * (float)capped < len2 * (float)need;
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
  * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
@@ -1350,7 +1365,8 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2_once(rp[a0], ap) < len2 || dist2_once(rp[b1], ap) < len2) {
+    if (side_too_short(dist2_once(rp[a0], ap), apex - a0, len2, need) ||
+        side_too_short(dist2_once(rp[b1], ap), b1 - apex, len2, need)) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {

@@ -99,7 +99,10 @@ typedef struct {
     float floor;        /**< residual floor per point, metres (0.003) */
     float max_side;     /**< length of each side used for the line fits, metres (1.5) */
     float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
-    float min_side_len; /**< length each side must reach from the apex, metres (0.15) */
+    float min_side_len; /**< length each side must reach from the apex, metres (0.15); a
+                             side of more than min_side_points points may fall short of it
+                             by the square root of their ratio, to half at four times as
+                             many (its direction is as well determined) */
     float max_range;    /**< no corner at an apex farther than this, metres (FLT_MAX: no
                              limit; the side tests already need min_side_points points
                              within max_side of the apex, which the beam spacing decides) */

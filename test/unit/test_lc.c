@@ -573,6 +573,44 @@ static void test_the_corners_of_a_recess_are_found_with_beams_denser_than_the_no
     }
 }
 
+/* A door jamb 10 cm deep at the end of a wall, 0.85 m from a sensor of
+ * 0.25-degree beams (the default configuration: grazing joins and the
+ * evidence test): the jamb's face gives 12-18 returns, shorter than
+ * min_side_len but as many as give its direction as well as 3 returns over
+ * min_side_len would. Its corner is found at 1 cm range noise; at 3 cm no
+ * corner is made of the jamb. (Fine beams see such faces everywhere: 10
+ * returns at 2 m at 3200 beams per turn.) */
+static void test_the_corner_of_a_short_jamb_at_a_walls_end_is_found_at_fine_beams(void)
+{
+    static const double wall[6] = {-6.0, 0.8, 0.4, 0.8, 0.4, 0.7};
+    static const double far_wall[4] = {-8.0, 6.0, 8.0, 6.0};
+    int pose;
+    int found = 0;
+    int stray = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, wall, 3u, 0));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, far_wall, 2u, 0));
+    join_grazing = 1;
+    corner_evidence = 1;
+    for (pose = 0; pose < 8; ++pose) {
+        const double x = -0.35 + 0.05 * (double)pose;
+        const double heading = 0.5 * PI + 0.1 * (double)(pose - 4);
+        size_t n = detect(x, 0.0, heading, 1081u, 1.5 * PI, 0.01);
+        size_t k;
+        int hit = 0;
+        for (k = 0; k < n; ++k) {
+            hit |= dist_to(k, x, 0.0, heading, 0.4, 0.8) < 0.02;
+        }
+        found += hit;
+        n = detect(x, 0.0, heading, 1081u, 1.5 * PI, 0.03);
+        for (k = 0; k < n; ++k) {
+            stray += dist_to(k, x, 0.0, heading, 0.4, 0.8) < 0.3;
+        }
+    }
+    TEST_ASSERT_GREATER_OR_EQUAL_INT_MESSAGE(7, found,
+                                             "the jamb's corner missed in more than 1 of 8 poses");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, stray, "a corner made of the jamb at 3 cm range noise");
+}
+
 /* The scan's noise that bsf_lc_detect leaves in work.noise2 (the tail
  * rule of the extractor judges short runs against it) follows the range
  * noise of a room at 0.5-degree and 1-degree beams (within 30 %: at 3 cm
@@ -674,6 +712,7 @@ int main(void)
     RUN_TEST(test_corners_between_long_shallow_sides_are_not_lost_to_a_missed_neighbour);
     RUN_TEST(test_a_corner_behind_a_full_circle_sensor_is_found_across_the_seam);
     RUN_TEST(test_the_corners_of_a_recess_are_found_with_beams_denser_than_the_noise);
+    RUN_TEST(test_the_corner_of_a_short_jamb_at_a_walls_end_is_found_at_fine_beams);
     RUN_TEST(test_the_scans_noise_follows_the_range_noise);
     RUN_TEST(test_refused_calls);
     RUN_TEST(test_more_corners_than_room_reports_capacity_and_the_total);
