@@ -1310,15 +1310,18 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
 static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
                                  const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
 {
-    const bsf_point_t q = c->rel[short_before ? apex - 1u : apex + 1u];
     const float tol = LC_OVERSHOOT_SIGMAS * sqrtf(c->noise2);
-    /* cross products with the apex's ray, times its range */
-    const float side = c->o.x * q.y - c->o.y * q.x;
-    const float past = side > 0.0f ? c->o.y * x.x - c->o.x * x.y : c->o.x * x.y - c->o.y * x.x;
-    /* the apex (the origin) from each line */
-    const float d_long = fabsf(ll->dy * ll->mx - ll->dx * ll->my);
-    const float d_short = fabsf(ls->dy * ls->mx - ls->dx * ls->my);
-    return past > tol * c->pts->range[c->run[apex]] && d_long + tol < d_short;
+    /* the vertex's cross product with the apex's ray (its distance from the
+     * ray times the range), positive on the side of the later beams when
+     * the angles increase */
+    float past = c->o.x * x.y - c->o.y * x.x;
+    if (!short_before == (c->pts->angle_increment > 0.0f)) {
+        past = -past; /* positive away from the short side */
+    }
+    /* then the apex (the origin) from each line */
+    return past > tol * c->pts->range[c->run[apex]] &&
+           fabsf(ll->dy * ll->mx - ll->dx * ll->my) + tol <
+               fabsf(ls->dy * ls->mx - ls->dx * ls->my);
 }
 
 /* Judge the split at position apex between the pieces that start at lo and
