@@ -16,8 +16,9 @@
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve), --oracle-reach M (how far from the vertex
  *            the oracle's lines take returns, metres; 0: the whole run; default LC's
- *            max_side); BENCH_TRUTH_DUMP=K prints pose K's ranges, features and
- *            keypoints (for debugging one scan); BENCH_TRUTH_ORACLE_LOG=FILE writes one
+ *            max_side); BENCH_TRUTH_DUMP=K prints pose K's ranges (a mixed pixel that
+ *            is a hit on no wall marked "blend"), features and keypoints (for debugging
+ *            one scan); BENCH_TRUTH_ORACLE_LOG=FILE writes one
  *            line per sparse-rule corner (bsf_truth_add_oracle)
  */
 #define _POSIX_C_SOURCE 200809L
