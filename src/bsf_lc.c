@@ -1308,6 +1308,37 @@ static int side_too_short(float d2, size_t count, float len2, size_t need)
     return d2 * (float)capped < len2 * (float)need;
 }
 
+/* How far, in noise standard deviations, a vertex must lie past its apex
+ * and the apex off the short side's line (short_side_overshoots). */
+#define LC_OVERSHOOT_SIGMAS 3.0f
+
+/* A side of min_side_points - 1 returns, allowed where it runs to the end of
+ * the run, takes its line from two returns: when one is a mixed pixel (a
+ * range blended between two surfaces at a depth jump), that line turns off
+ * its wall, and the two lines meet on the other wall past the apex, short of
+ * the wall's end. The split at apex (the long side's line ll, the short
+ * side's ls, the short side before the apex when short_before) is such a
+ * corner when its vertex x (relative to the apex) lies past the apex's ray,
+ * away from the short side, and the apex lies on the long side's line, not
+ * on the short side's: a wall's return beyond its own corner. A real corner
+ * past the apex has the apex on the short side's wall. */
+static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
+                                 const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
+{
+    const float tol = LC_OVERSHOOT_SIGMAS * sqrtf(c->noise2);
+    /* the vertex's cross product with the apex's ray (its distance from the
+     * ray times the range), positive on the side of the later beams when
+     * the angles increase */
+    float past = c->o.x * x.y - c->o.y * x.x;
+    if (!short_before == (c->pts->angle_increment > 0.0f)) {
+        past = -past; /* positive away from the short side */
+    }
+    /* then the apex (the origin) from each line */
+    return past > tol * c->pts->range[c->run[apex]] &&
+           fabsf(ll->dy * ll->mx - ll->dx * ll->my) + tol <
+               fabsf(ls->dy * ls->mx - ls->dx * ls->my);
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
  * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
@@ -1400,9 +1431,17 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     if (v != LC_CORNER) {
         v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, &x, &score);
     }
-    if (v == LC_CORNER) {
-        corner_keypoint(c, a0, apex, b1, x, &la, &lb, score, kp);
+    if (v != LC_CORNER) {
+        return v;
     }
+    /* A short side at the end of the run (a mixed pixel may have turned it) */
+    if (apex - a0 < need || b1 - apex < need) {
+        const int before = apex - a0 < need;
+        if (short_side_overshoots(c, apex, before, before ? &la : &lb, before ? &lb : &la, x)) {
+            return LC_MERGE;
+        }
+    }
+    corner_keypoint(c, a0, apex, b1, x, &la, &lb, score, kp);
     return v;
 }
 

@@ -67,7 +67,12 @@
  *     as the lines must) at min_turn or more. The circles of one pillar, or
  *     of a wall of varying curvature, touch rather than cross, so these get
  *     no corner. Where a side is round, the two lines' intersection would
- *     lie off the crease even when they pass;
+ *     lie off the crease even when they pass; a side of min_side_points - 1
+ *     points (where it runs to the end of its run) gives no corner when the
+ *     intersection lies past the apex's ray, away from it, by 3 noise
+ *     standard deviations while the apex lies on the other side's line and
+ *     3 of them farther from its own: the far wall's first return beyond its
+ *     own corner, where a mixed pixel among the two points turned their line;
  *  3. report each corner at its apex beam, with the intersection of the two
  *     lines (of the crease's pieces) as its position (PDM starts the vertex
  *     there and keeps it there).

@@ -640,6 +640,59 @@ static void test_the_scans_noise_follows_the_range_noise(void)
     TEST_ASSERT_TRUE(work.noise2 == 0.0f);
 }
 
+/* LC with its defaults on the ranges[] of lidar lid as they are (no new
+ * scan); returns the keypoint count. */
+static size_t detect_ranges(const bsf_lidar_t *lid)
+{
+    const bsf_lc_params_t p = bsf_lc_params_default();
+    const bsf_scan_t scan = bsf_scene_lidar_scan(lid, ranges);
+    size_t n_out = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
+    return n_out;
+}
+
+/* A room corner 11.5 m away (the demo office's, 1 deg beams, no noise)
+ * whose first wall is seen at grazing incidence, its returns 0.4-0.5 m
+ * apart, and whose second wall faces the sensor. Mixed pixels on the first
+ * wall: its last return before the corner blended a fifth of the way from
+ * its neighbour's range to its own, and the return two before that half
+ * way, which cuts the run there. The run's first side then has two returns,
+ * its line turns off the wall, and the lines would meet on the second wall
+ * 0.5 m short of the corner: no such vertex. Without the blends the corner
+ * is found. */
+static void test_a_mixed_pixel_in_a_two_return_side_puts_no_vertex_on_the_far_wall(void)
+{
+    const bsf_scene_pose_t pose = {3.196, 3.971, 0.746};
+    bsf_lidar_t lid;
+    double sx;
+    double sy;
+    size_t n;
+    size_t k;
+    size_t last;
+    int found = 0;
+    bsf_scene_demo_office(&scene);
+    lid = bsf_lidar_default(pose.x, pose.y, pose.theta, 181u, PI);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, NULL, ranges, NULL, BSF_MAX_POINTS));
+    bsf_scene_world_to_sensor(&pose, 14.0, 0.0, &sx, &sy);
+    /* the first wall's last return: the beam just before the corner's bearing */
+    last = (size_t)((atan2(sy, sx) - lid.angle_min) / lid.angle_increment);
+    TEST_ASSERT_TRUE(last >= 3u && (double)ranges[last] < hypot(sx, sy));
+    n = detect_ranges(&lid);
+    for (k = 0; k < n; ++k) {
+        found |= hypot((double)kps[k].point.x - sx, (double)kps[k].point.y - sy) < 0.1;
+    }
+    TEST_ASSERT_TRUE_MESSAGE(found, "the corner without mixed pixels");
+    ranges[last] = ranges[last - 1u] + 0.2f * (ranges[last] - ranges[last - 1u]);
+    ranges[last - 2u] = ranges[last - 3u] + 0.5f * (ranges[last - 2u] - ranges[last - 3u]);
+    n = detect_ranges(&lid);
+    for (k = 0; k < n; ++k) {
+        const double d = hypot((double)kps[k].point.x - sx, (double)kps[k].point.y - sy);
+        TEST_ASSERT_TRUE_MESSAGE(d < 0.1 || d > 2.0, "a vertex on the wall short of its corner");
+    }
+}
+
 static void test_refused_calls(void)
 {
     bsf_lc_params_t p = bsf_lc_params_default();
@@ -714,6 +767,7 @@ int main(void)
     RUN_TEST(test_the_corners_of_a_recess_are_found_with_beams_denser_than_the_noise);
     RUN_TEST(test_the_corner_of_a_short_jamb_at_a_walls_end_is_found_at_fine_beams);
     RUN_TEST(test_the_scans_noise_follows_the_range_noise);
+    RUN_TEST(test_a_mixed_pixel_in_a_two_return_side_puts_no_vertex_on_the_far_wall);
     RUN_TEST(test_refused_calls);
     RUN_TEST(test_more_corners_than_room_reports_capacity_and_the_total);
     return UNITY_END();

@@ -16,8 +16,9 @@
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve), --oracle-reach M (how far from the vertex
  *            the oracle's lines take returns, metres; 0: the whole run; default LC's
- *            max_side); BENCH_TRUTH_DUMP=K prints pose K's ranges, features and
- *            keypoints (for debugging one scan); BENCH_TRUTH_ORACLE_LOG=FILE writes one
+ *            max_side); BENCH_TRUTH_DUMP=K prints pose K's ranges (a mixed pixel that
+ *            is a hit on no wall marked "blend"), features and keypoints (for debugging
+ *            one scan); BENCH_TRUTH_ORACLE_LOG=FILE writes one
  *            line per sparse-rule corner (bsf_truth_add_oracle)
  */
 #define _POSIX_C_SOURCE 200809L
@@ -70,8 +71,9 @@ static bsf_extractor_t ex;
 static bsf_result_t res;
 static float ranges[BSF_MAX_POINTS];
 static float clean[BSF_MAX_POINTS];
-static float unmixed[BSF_MAX_POINTS]; /* ranges before mixed pixels, for the oracle */
+static float unmixed[BSF_MAX_POINTS]; /* ranges before mixed pixels */
 static int16_t hits[BSF_MAX_POINTS];
+static int16_t on_shape[BSF_MAX_POINTS]; /* hits without the blends (bsf_truth_returns_on_shapes) */
 static bsf_truth_acc_t acc;
 
 static int paper_mode = 0;
@@ -197,6 +199,11 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
         if (nz->mixed) {
             (void)bsf_scene_mixed_pixels(ranges, sen->beams, lid.no_return, 0.3, 0.5, &rng);
         }
+        /* A blend is a return on no wall: it neither makes a corner visible
+         * nor counts in the oracle's lines (unless it lands within the
+         * noise, 3 sigma, of its own wall). */
+        (void)bsf_truth_returns_on_shapes(on_shape, hits, clean, ranges, unmixed, sen->beams,
+                                          3.0 * nz->sigma);
         scan = bsf_scene_lidar_scan(&lid, ranges);
         t0 = now_ns();
         if (bsf_extract(&ex, &scan, &res) != BSF_OK) {
@@ -216,8 +223,8 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
         if (getenv("BENCH_TRUTH_DUMP") != NULL && atol(getenv("BENCH_TRUTH_DUMP")) == k) {
             size_t f2;
             for (i = 0; i < sen->beams; ++i) {
-                printf("beam %lu range %.4f hit %d\n", (unsigned long)i, (double)ranges[i],
-                       hits[i]);
+                printf("beam %lu range %.4f hit %d%s\n", (unsigned long)i, (double)ranges[i],
+                       hits[i], on_shape[i] != hits[i] ? " blend" : "");
             }
             for (f2 = 0; f2 < res.n_features; ++f2) {
                 const bsf_feature_t *ft = &res.features[f2];
@@ -237,9 +244,8 @@ static int run_config(int which, const sensor_t *sen, const noise_t *nz, long n_
         }
         bsf_truth_oracle_keypoints = ex.keypoints;
         bsf_truth_oracle_n_keypoints = res.stats.n_keypoints;
-        if (bsf_truth_add(&acc, &sc, &lid, clean, hits, &res, bytes, t1 - t0) != 0 ||
-            bsf_truth_add_oracle(&acc, &sc, &lid, clean, hits, ranges, nz->mixed ? unmixed : NULL,
-                                 &res) != 0) {
+        if (bsf_truth_add(&acc, &sc, &lid, clean, on_shape, &res, bytes, t1 - t0) != 0 ||
+            bsf_truth_add_oracle(&acc, &sc, &lid, clean, on_shape, ranges, &res) != 0) {
             return -1;
         }
     }
