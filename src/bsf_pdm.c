@@ -281,9 +281,11 @@ static inline void sums_reset(span_sums_t *a, size_t span)
 #if BSF_CONFIG_COMPACT
     memset(a, 0, sizeof *a);
 #else
-    /* an assignment the compiler can keep in registers (SUMS_FLUSH_ACC) */
-    const span_sums_t zero = {0u, {0.0f}, {0.0f}, {0.0f}};
-    *a = zero;
+    /* stores the compiler can keep in registers (SUMS_FLUSH_ACC), where a
+     * memset, or an assignment it turns into one, stays a call */
+    a->s[0] = a->s[1] = a->s[2] = a->s[3] = a->s[4] = a->s[5] = 0.0f;
+    a->x[0] = a->x[1] = a->x[2] = 0.0f;
+    a->y[0] = a->y[1] = a->y[2] = 0.0f;
 #endif
     a->span = span;
 }
