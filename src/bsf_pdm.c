@@ -614,8 +614,8 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     /* Systematic deviation (bias_window > 0): the last bias_window signed
      * residuals of the fragment (a ring), their sum, the fragment's largest
      * |sum| and its largest squared distance. Only ring[0..bias_window) is
-     * used, so only that part is cleared. ring_wait counts the points still
-     * missing before the window is full. */
+     * used. ring_wait counts the points still missing before the window is
+     * full: while it does, ring[ring_at] is an empty slot (no memset). */
     float ring[BSF_PDM_MAX_BIAS_WINDOW];
     size_t ring_at = 0;
     size_t ring_wait = bias_window;
@@ -640,7 +640,6 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     const float give_up_total =
         give_up_rms > 0.0f ? give_up_rms * give_up_rms * (float)s->n * 0.999f : 3.0e38f;
 
-    memset(ring, 0, bias_window * sizeof ring[0]);
     if (assemble_next) {
         clear_normal_equations(s, w);
     }
@@ -808,10 +807,14 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 }
             }
             if (!slot_open) {
-                ring_sum += slot - ring[ring_at];
+                if (ring_wait > 0u) {
+                    ring_sum += slot; /* an empty slot: slot - 0 is slot */
+                    --ring_wait;
+                } else {
+                    ring_sum += slot - ring[ring_at];
+                }
                 ring[ring_at] = slot;
                 ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
-                ring_wait -= ring_wait > 0u ? 1u : 0u;
                 if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
                     window_max = fabsf(ring_sum);
                 }
@@ -838,7 +841,6 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             }
             frag_sum = best;  /* the vertex point opens the next fragment */
             point_max = best; /* far_at stays before the next fragment */
-            memset(ring, 0, bias_window * sizeof ring[0]);
             window_max = 0.0f;
             if (f + 1u < s->n_frag) {
                 ++f;
