@@ -368,11 +368,27 @@ static inline void sums_flush_copy(bsf_pdm_work_t *w, span_sums_t copy)
 #define SUMS_FLUSH_ACC(w, acc) sums_flush_copy((w), (acc))
 #endif
 
-static void clear_normal_equations(const pdm_state_t *s, bsf_pdm_work_t *w)
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline)) /* inlined, it upsets the register allocation of assemble */
+#endif
+static void
+clear_normal_equations(const pdm_state_t *s, bsf_pdm_work_t *w)
 {
+#if BSF_CONFIG_COMPACT
     memset(w->band, 0, s->n_unknown * 3u * sizeof w->band[0]);
     memset(w->rhs_x, 0, s->n_unknown * sizeof w->rhs_x[0]);
     memset(w->rhs_y, 0, s->n_unknown * sizeof w->rhs_y[0]);
+#else
+    /* one sweep of stores: a few unknowns, where three memset calls cost
+     * more than the stores themselves */
+    float *band = w->band;
+    size_t k;
+    for (k = 0; k < s->n_unknown; ++k) {
+        band[0] = band[1] = band[2] = 0.0f;
+        band += 3;
+        w->rhs_x[k] = w->rhs_y[k] = 0.0f;
+    }
+#endif
 }
 
 /* Normal equations from the current parameters alone (after a layout change,
