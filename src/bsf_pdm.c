@@ -307,6 +307,24 @@ static inline void sums_add(span_sums_t *a, float b0, float b2, float px, float 
     a->y[2] += b2 * py;
 }
 
+#if !BSF_CONFIG_COMPACT
+/* A span's six basis products (span_sums_t.s) added to the lower band. */
+static inline void band_add(bsf_pdm_work_t *w, size_t span, const float *s6)
+{
+    const uint8_t *unk = &w->unknown_of[span];
+    const size_t u0 = unk[0];
+    const size_t u1 = unk[1];
+    const size_t u2 = unk[2];
+    float *band = w->band;
+    band[u0 * 3u] += s6[0];
+    band[u1 * 3u] += s6[2];
+    band[u2 * 3u] += s6[5];
+    band[u1 * 3u + (u1 - u0)] += (u1 == u0 ? 2.0f : 1.0f) * s6[1];
+    band[u2 * 3u + (u2 - u0)] += (u2 == u0 ? 2.0f : 1.0f) * s6[3];
+    band[u2 * 3u + (u2 - u1)] += (u2 == u1 ? 2.0f : 1.0f) * s6[4];
+}
+#endif
+
 /* Add a span's sums to the lower band (stride 3) and right-hand sides. Its
  * three stored control points map to non-decreasing unknowns; at a vertex
  * two of them are one unknown, whose weight is the sum of both basis values,
@@ -317,10 +335,10 @@ static void sums_flush(bsf_pdm_work_t *w, const span_sums_t *a)
     const size_t u0 = unk[0];
     const size_t u1 = unk[1];
     const size_t u2 = unk[2];
-    float *band = w->band;
 #if BSF_CONFIG_COMPACT
     /* compact: the same additions in the same order, from tables (the three
      * diagonal products, then the three below it). */
+    float *band = w->band;
     static const uint8_t row[6] = {0u, 1u, 2u, 1u, 2u, 2u};
     static const uint8_t col[6] = {0u, 1u, 2u, 0u, 0u, 1u};
     static const uint8_t prod[6] = {0u, 2u, 5u, 1u, 3u, 4u};
@@ -338,12 +356,7 @@ static void sums_flush(bsf_pdm_work_t *w, const span_sums_t *a)
         w->rhs_y[unk[k]] += a->y[k];
     }
 #else
-    band[u0 * 3u] += a->s[0];
-    band[u1 * 3u] += a->s[2];
-    band[u2 * 3u] += a->s[5];
-    band[u1 * 3u + (u1 - u0)] += (u1 == u0 ? 2.0f : 1.0f) * a->s[1];
-    band[u2 * 3u + (u2 - u0)] += (u2 == u0 ? 2.0f : 1.0f) * a->s[3];
-    band[u2 * 3u + (u2 - u1)] += (u2 == u1 ? 2.0f : 1.0f) * a->s[4];
+    band_add(w, a->span, a->s);
     w->rhs_x[u0] += a->x[0];
     w->rhs_x[u1] += a->x[1];
     w->rhs_x[u2] += a->x[2];
@@ -516,6 +529,7 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             const float c0 = k == 0u ? 2.0f : 1.0f;
             const float c2 = k + 1u == n_span ? 2.0f : 1.0f;
             const float c1 = -(c0 + c2);
+#if BSF_CONFIG_COMPACT
             span_sums_t r;
             sums_reset(&r, k);
             r.s[0] = weight * c0 * c0;
@@ -525,6 +539,18 @@ static bsf_status_t solve_control_points(pdm_state_t *s, bsf_pdm_work_t *w)
             r.s[4] = weight * c2 * c1;
             r.s[5] = weight * c2 * c2;
             sums_flush(w, &r);
+#else
+            /* The band alone: the right-hand sides would only add +0, which
+             * leaves them as they are (sums that start at +0 never reach -0). */
+            float r[6];
+            r[0] = weight * c0 * c0;
+            r[1] = weight * c1 * c0;
+            r[2] = weight * c1 * c1;
+            r[3] = weight * c2 * c0;
+            r[4] = weight * c2 * c1;
+            r[5] = weight * c2 * c2;
+            band_add(w, k, r);
+#endif
         }
     }
     if (s->anchor != NULL) {
