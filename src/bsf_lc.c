@@ -1885,6 +1885,9 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
     size_t m = 0;
     size_t i;
     size_t step;
+#if !BSF_CONFIG_COMPACT
+    float jump_a2;
+#endif
     if (n_out != NULL) {
         *n_out = 0u;
     }
@@ -1911,6 +1914,9 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
     c.noise_points = 0.0f;
     blocks_detach(&c);
     c.start = bsf_points_full_circle(pts) ? ring_start(pts, p, grazing_memo) : 0u;
+#if !BSF_CONFIG_COMPACT
+    jump_a2 = p->jump_a * p->jump_a;
+#endif
     for (step = 0; step <= pts->count; ++step) {
         int close_run = step == pts->count;
         i = close_run
@@ -1920,7 +1926,13 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
             continue;
         }
         if (!close_run && m > 0u) {
+#if BSF_CONFIG_COMPACT
             close_run = !lc_joins(pts, p, grazing_memo, work->run[m - 1u], i);
+#else
+            /* lc_joins' first test here, as most beams pass it: no call */
+            close_run = !(dist2(pts->pt[work->run[m - 1u]], pts->pt[i]) <= jump_a2 ||
+                          lc_joins(pts, p, grazing_memo, work->run[m - 1u], i));
+#endif
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i && step + (j - i) < pts->count) {
