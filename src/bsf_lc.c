@@ -37,25 +37,28 @@
 
 bsf_lc_params_t bsf_lc_params_default(void)
 {
-    bsf_lc_params_t p;
-    p.jump_a = 0.2f;
-    p.jump_b = 0.07f;
-    p.split_min = 0.02f;
-    p.split_sigmas = 4.0f;
-    p.min_turn = 0.15f;
-    p.curve_ratio = 10.0f;
-    p.floor = 0.003f;
-    p.max_side = 1.5f;
-    p.apex_slack = 0.05f;
-    p.min_side_points = 3u;
-    p.min_side_len = 0.15f;
-    /* No range limit of its own: a corner needs min_side_points points per
-     * side within max_side of the apex, so the beam spacing, not the range,
-     * decides how far corners are found (about 57 m at 0.5 deg beams). */
-    p.max_range = FLT_MAX;
-    p.join_grazing = 2u;
-    p.corner_evidence = 1u;
-    return p;
+    /* one copy of a constant (smaller code than a store per field) */
+    static const bsf_lc_params_t defaults = {
+        .jump_a = 0.2f,
+        .jump_b = 0.07f,
+        .split_min = 0.02f,
+        .split_sigmas = 4.0f,
+        .min_turn = 0.15f,
+        .curve_ratio = 10.0f,
+        .floor = 0.003f,
+        .max_side = 1.5f,
+        .apex_slack = 0.05f,
+        .min_side_len = 0.15f,
+        /* No range limit of its own: a corner needs min_side_points points
+         * per side within max_side of the apex, so the beam spacing, not the
+         * range, decides how far corners are found (about 57 m at 0.5 deg
+         * beams). */
+        .max_range = FLT_MAX,
+        .min_side_points = 3u,
+        .join_grazing = 2u,
+        .corner_evidence = 1u,
+    };
+    return defaults;
 }
 
 /* The float parameters' ranges (bsf_floats_in_range): lower bound 0, open

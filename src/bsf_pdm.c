@@ -90,18 +90,22 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     if (p == NULL) {
         return;
     }
-    p->precision_spacing = 1.0f;
-    p->lambda_per_metre = 1e-6f;
-    p->rel_tol = 0.01f;
-    p->target_rms = 0.03f;
-    p->max_iterations = 2u;
-    p->refine_iterations = 1u;
-    p->max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE;
-    p->footpoint_steps = 1u;
-    p->refine = 1u;
-    p->bias_window = 16u;
-    p->bias_ratio = 0.2f;
-    p->max_passes = 0u;
+    /* one copy of a constant (smaller code than a store per field) */
+    static const bsf_pdm_params_t defaults = {
+        .precision_spacing = 1.0f,
+        .lambda_per_metre = 1e-6f,
+        .rel_tol = 0.01f,
+        .target_rms = 0.03f,
+        .max_iterations = 2u,
+        .refine_iterations = 1u,
+        .max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE,
+        .footpoint_steps = 1u,
+        .refine = 1u,
+        .bias_window = 16u,
+        .bias_ratio = 0.2f,
+        .max_passes = 0u,
+    };
+    *p = defaults;
 }
 
 /* The float parameters' ranges (bsf_floats_in_range). */
