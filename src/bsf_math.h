@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * bsf_math.h - internal: the transcendental functions the library needs,
- * computed with + - * / and sqrtf only.
+ * computed with + - * / and sqrtf only (and, at the end, the range table
+ * the parameter checks share).
  *
  * Why: those five operations are correctly rounded by IEEE 754 on every
  * target, while sinf, cosf, expf, atan2f and asinf differ in the last bits
