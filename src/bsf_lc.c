@@ -7,6 +7,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 /* Split-judge passes per run: each pass after the first only re-judges the
@@ -36,41 +37,57 @@
 
 bsf_lc_params_t bsf_lc_params_default(void)
 {
-    bsf_lc_params_t p;
-    p.jump_a = 0.2f;
-    p.jump_b = 0.07f;
-    p.split_min = 0.02f;
-    p.split_sigmas = 4.0f;
-    p.min_turn = 0.15f;
-    p.curve_ratio = 10.0f;
-    p.floor = 0.003f;
-    p.max_side = 1.5f;
-    p.apex_slack = 0.05f;
-    p.min_side_points = 3u;
-    p.min_side_len = 0.15f;
-    /* No range limit of its own: a corner needs min_side_points points per
-     * side within max_side of the apex, so the beam spacing, not the range,
-     * decides how far corners are found (about 57 m at 0.5 deg beams). */
-    p.max_range = FLT_MAX;
-    p.join_grazing = 2u;
-    p.corner_evidence = 1u;
-    return p;
+    /* one copy of a constant (smaller code than a store per field) */
+    static const bsf_lc_params_t defaults = {
+        .jump_a = 0.2f,
+        .jump_b = 0.07f,
+        .split_min = 0.02f,
+        .split_sigmas = 4.0f,
+        .min_turn = 0.15f,
+        .curve_ratio = 10.0f,
+        .floor = 0.003f,
+        .max_side = 1.5f,
+        .apex_slack = 0.05f,
+        .min_side_len = 0.15f,
+        /* No range limit of its own: a corner needs min_side_points points
+         * per side within max_side of the apex, so the beam spacing, not the
+         * range, decides how far corners are found (about 57 m at 0.5 deg
+         * beams). */
+        .max_range = FLT_MAX,
+        .min_side_points = 3u,
+        .join_grazing = 2u,
+        .corner_evidence = 1u,
+    };
+    return defaults;
 }
+
+/* The float parameters' ranges (bsf_floats_in_range): lower bound 0, open
+ * where a zero would stop the method. */
+#define LC_RANGE(field, hi, open)                                                                  \
+    {                                                                                              \
+        hi, (uint16_t)offsetof(bsf_lc_params_t, field), open                                       \
+    }
+static const bsf_float_range_t lc_float_ranges[] = {
+    LC_RANGE(jump_a, 1e3f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(jump_b, 10.0f, 0u),
+    LC_RANGE(split_min, 1e3f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(split_sigmas, 1e3f, 0u),
+    LC_RANGE(min_turn, 1.5707963f, BSF_RANGE_LO_OPEN | BSF_RANGE_HI_OPEN),
+    LC_RANGE(curve_ratio, 1e6f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(floor, 1e3f, 0u),
+    LC_RANGE(max_side, 1e3f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(apex_slack, 1e3f, 0u),
+    LC_RANGE(min_side_len, 1e3f, 0u),
+    LC_RANGE(max_range, INFINITY, BSF_RANGE_LO_OPEN),
+};
 
 bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
 {
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    /* Written so that NaN fails every test. */
-    if (!(p->jump_a > 0.0f && p->jump_a <= 1e3f) || !(p->jump_b >= 0.0f && p->jump_b <= 10.0f) ||
-        !(p->split_min > 0.0f && p->split_min <= 1e3f) ||
-        !(p->split_sigmas >= 0.0f && p->split_sigmas <= 1e3f) ||
-        !(p->min_turn > 0.0f && p->min_turn < 1.5707963f) ||
-        !(p->curve_ratio > 0.0f && p->curve_ratio <= 1e6f) ||
-        !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
-        !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
-        !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
+    if (!bsf_floats_in_range(p, lc_float_ranges,
+                             sizeof lc_float_ranges / sizeof lc_float_ranges[0]) ||
         p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 2u ||
         p->corner_evidence > 1u) {
         return BSF_ERR_PARAM;

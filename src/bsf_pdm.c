@@ -6,8 +6,10 @@
 #include "bsf/bsf_bspline.h"
 #include "bsf_fit_internal.h"
 #include "bsf_linalg.h"
+#include "bsf_math.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #define NO_FRAGMENT 0xFFFFu
@@ -88,36 +90,49 @@ void bsf_pdm_params_default(bsf_pdm_params_t *p)
     if (p == NULL) {
         return;
     }
-    p->precision_spacing = 1.0f;
-    p->lambda_per_metre = 1e-6f;
-    p->rel_tol = 0.01f;
-    p->target_rms = 0.03f;
-    p->max_iterations = 2u;
-    p->refine_iterations = 1u;
-    p->max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE;
-    p->footpoint_steps = 1u;
-    p->refine = 1u;
-    p->bias_window = 16u;
-    p->bias_ratio = 0.2f;
-    p->max_passes = 0u;
+    /* one copy of a constant (smaller code than a store per field) */
+    static const bsf_pdm_params_t defaults = {
+        .precision_spacing = 1.0f,
+        .lambda_per_metre = 1e-6f,
+        .rel_tol = 0.01f,
+        .target_rms = 0.03f,
+        .max_iterations = 2u,
+        .refine_iterations = 1u,
+        .max_ctrl = (uint16_t)BSF_MAX_CTRL_PER_FEATURE,
+        .footpoint_steps = 1u,
+        .refine = 1u,
+        .bias_window = 16u,
+        .bias_ratio = 0.2f,
+        .max_passes = 0u,
+    };
+    *p = defaults;
 }
+
+/* The float parameters' ranges (bsf_floats_in_range). */
+#define PDM_RANGE(field, hi, open)                                                                 \
+    {                                                                                              \
+        hi, (uint16_t)offsetof(bsf_pdm_params_t, field), open                                      \
+    }
+static const bsf_float_range_t pdm_float_ranges[] = {
+    PDM_RANGE(precision_spacing, BSF_FIT_MAX_COORD, BSF_RANGE_LO_OPEN),
+    PDM_RANGE(lambda_per_metre, 1.0f, 0u),
+    PDM_RANGE(rel_tol, 1.0f, BSF_RANGE_LO_OPEN | BSF_RANGE_HI_OPEN),
+    PDM_RANGE(target_rms, BSF_FIT_MAX_COORD, BSF_RANGE_LO_OPEN),
+    PDM_RANGE(bias_ratio, 1.0f, BSF_RANGE_LO_OPEN),
+};
 
 bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p)
 {
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    /* Written so that NaN fails every test. */
-    if (!(p->precision_spacing > 0.0f && p->precision_spacing <= BSF_FIT_MAX_COORD) ||
-        !(p->lambda_per_metre >= 0.0f && p->lambda_per_metre <= 1.0f) ||
-        !(p->rel_tol > 0.0f && p->rel_tol < 1.0f) ||
-        !(p->target_rms > 0.0f && p->target_rms <= BSF_FIT_MAX_COORD) || p->max_iterations < 1u ||
-        p->max_iterations > BSF_PDM_MAX_ITERATIONS || p->refine_iterations < 1u ||
-        p->refine_iterations > BSF_PDM_MAX_ITERATIONS || p->max_ctrl < 3u ||
-        p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
+    if (!bsf_floats_in_range(p, pdm_float_ranges,
+                             sizeof pdm_float_ranges / sizeof pdm_float_ranges[0]) ||
+        p->max_iterations < 1u || p->max_iterations > BSF_PDM_MAX_ITERATIONS ||
+        p->refine_iterations < 1u || p->refine_iterations > BSF_PDM_MAX_ITERATIONS ||
+        p->max_ctrl < 3u || p->max_ctrl > BSF_MAX_CTRL_PER_FEATURE || p->footpoint_steps < 1u ||
         p->footpoint_steps > 8u || p->refine > 1u || p->bias_window == 1u ||
-        p->bias_window > BSF_PDM_MAX_BIAS_WINDOW ||
-        !(p->bias_ratio > 0.0f && p->bias_ratio <= 1.0f)) {
+        p->bias_window > BSF_PDM_MAX_BIAS_WINDOW) {
         return BSF_ERR_PARAM;
     }
     return BSF_OK;
