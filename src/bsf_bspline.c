@@ -206,7 +206,7 @@ float bsf_footpoint_refine(const bsf_point_t *ctrl, size_t n_ctrl, bsf_point_t p
         const float g = ex * cu.x + ey * cu.y;
         const float gn = cu.x * cu.x + cu.y * cu.y;
         float h = gn + ex * cuu.x + ey * cuu.y;
-        float t_new = t_cur; /* set by the first halving step; this quiets GCC at -Os */
+        float t_new;
         float delta;
         float d = best;
         unsigned halving;
