@@ -1321,8 +1321,9 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
  * could otherwise only round off, climbing to its control-point cap. */
 static int side_too_short(float d2, size_t count, float len2, size_t need)
 {
-    const size_t capped = count < need ? need : (count > 4u * need ? 4u * need : count);
-    return d2 * (float)capped < len2 * (float)need;
+    const size_t capped = count > 4u * need ? 4u * need : count;
+    /* need points or fewer: min_side_len itself, compared as it always was */
+    return count <= need ? d2 < len2 : d2 * (float)capped < len2 * (float)need;
 }
 
 /* How far, in noise standard deviations, a vertex must lie past its apex
@@ -1336,9 +1337,10 @@ static int side_too_short(float d2, size_t count, float len2, size_t need)
  * the wall's end. The split at apex (the long side's line ll, the short
  * side's ls, the short side before the apex when short_before) is such a
  * corner when its vertex x (relative to the apex) lies past the apex's ray,
- * away from the short side, and the apex lies on the long side's line, not
- * on the short side's: a wall's return beyond its own corner. A real corner
- * past the apex has the apex on the short side's wall. */
+ * away from the short side, and the apex lies nearer the long side's line
+ * than the short side's by LC_OVERSHOOT_SIGMAS: a wall's return beyond its
+ * own corner. A real corner past the apex has the apex on the short side's
+ * wall. */
 static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
                                  const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
 {
@@ -1451,7 +1453,8 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     if (v != LC_CORNER) {
         return v;
     }
-    /* A short side at the end of the run (a mixed pixel may have turned it) */
+    /* A short side at the end of the run (a mixed pixel may have turned it);
+     * where both are short, the one before the apex is tested. */
     if (apex - a0 < need || b1 - apex < need) {
         const int before = apex - a0 < need;
         if (short_side_overshoots(c, apex, before, before ? &la : &lb, before ? &lb : &la, x)) {

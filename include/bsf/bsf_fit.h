@@ -94,7 +94,7 @@ typedef struct {
      *  (fragment RMS / sqrt(bias_window)), or (2) a point lies more than
      *  3 * target_rms from the curve. Range noise averages out over the
      *  window, a curve that bulges off a curved wall or swings off the last
-     *  points before a corner does not. With it on (and max_ctrl above 3),
+     *  points before a corner does not. With it and refine on (and max_ctrl above 3),
      *  a fragment without vertices whose first and last quarters of points
      *  (each at least 10 cm long) head more than 90 degrees apart starts
      *  with two spans instead of one: one quadratic span on a pillar's

@@ -21,7 +21,9 @@
  *  2. judge every split point with the two pieces beside it (each cut to
  *     max_side metres from the apex): fit a total-least-squares line to each
  *     side (the apex left out) and keep the split as a corner only when
- *     - each side has min_side_points points and reaches min_side_len,
+ *     - each side has min_side_points points (one fewer where it runs to
+ *       the end of its run) and reaches min_side_len (a side of more points
+ *       may fall short of it by the square root of their ratio, to half),
  *     - the lines turn by at least min_turn,
  *     - their intersection lies near the apex (within twice the local beam
  *       spacing plus apex_slack), and
@@ -70,9 +72,10 @@
  *     lie off the crease even when they pass; a side of min_side_points - 1
  *     points (where it runs to the end of its run) gives no corner when the
  *     intersection lies past the apex's ray, away from it, by 3 noise
- *     standard deviations while the apex lies on the other side's line and
- *     3 of them farther from its own: the far wall's first return beyond its
- *     own corner, where a mixed pixel among the two points turned their line;
+ *     standard deviations while the apex lies 3 of them nearer the other
+ *     side's line than its own: the far wall's first return beyond its own
+ *     corner, where a mixed pixel among the two points turned their line
+ *     (where both sides are that short, the side before the apex is tested);
  *  3. report each corner at its apex beam, with the intersection of the two
  *     lines (of the crease's pieces) as its position (PDM starts the vertex
  *     there and keeps it there).
