@@ -5,6 +5,7 @@
 #include "bsf_math.h"
 #include "bsf_segment_internal.h"
 
+#include <float.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -100,15 +101,23 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     return p;
 }
 
+/* The no-return code finite and not negative, split_dist a length
+ * (bsf_floats_in_range). */
+static const bsf_float_range_t extract_float_ranges[] = {
+    {FLT_MAX, (uint16_t)offsetof(bsf_params_t, no_return.code), 0u},
+    {BSF_FIT_MAX_COORD, (uint16_t)offsetof(bsf_params_t, split_dist), 0u},
+};
+
 bsf_status_t bsf_params_check(const bsf_params_t *p)
 {
     bsf_status_t st = BSF_OK;
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    if ((p->clock != NULL && p->clock_hz == 0u) || !(p->no_return.code >= 0.0f) ||
-        !(p->no_return.code <= 3.402823466e38f) || !(p->split_dist >= 0.0f) ||
-        !(p->split_dist <= BSF_FIT_MAX_COORD) || p->trim_tails > 1u) {
+    if ((p->clock != NULL && p->clock_hz == 0u) ||
+        !bsf_floats_in_range(p, extract_float_ranges,
+                             sizeof extract_float_ranges / sizeof extract_float_ranges[0]) ||
+        p->trim_tails > 1u) {
         return BSF_ERR_PARAM;
     }
     if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&

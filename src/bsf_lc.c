@@ -7,6 +7,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 /* Split-judge passes per run: each pass after the first only re-judges the
@@ -36,41 +37,57 @@
 
 bsf_lc_params_t bsf_lc_params_default(void)
 {
-    bsf_lc_params_t p;
-    p.jump_a = 0.2f;
-    p.jump_b = 0.07f;
-    p.split_min = 0.02f;
-    p.split_sigmas = 4.0f;
-    p.min_turn = 0.15f;
-    p.curve_ratio = 10.0f;
-    p.floor = 0.003f;
-    p.max_side = 1.5f;
-    p.apex_slack = 0.05f;
-    p.min_side_points = 3u;
-    p.min_side_len = 0.15f;
-    /* No range limit of its own: a corner needs min_side_points points per
-     * side within max_side of the apex, so the beam spacing, not the range,
-     * decides how far corners are found (about 57 m at 0.5 deg beams). */
-    p.max_range = FLT_MAX;
-    p.join_grazing = 2u;
-    p.corner_evidence = 1u;
-    return p;
+    /* one copy of a constant (smaller code than a store per field) */
+    static const bsf_lc_params_t defaults = {
+        .jump_a = 0.2f,
+        .jump_b = 0.07f,
+        .split_min = 0.02f,
+        .split_sigmas = 4.0f,
+        .min_turn = 0.15f,
+        .curve_ratio = 10.0f,
+        .floor = 0.003f,
+        .max_side = 1.5f,
+        .apex_slack = 0.05f,
+        .min_side_len = 0.15f,
+        /* No range limit of its own: a corner needs min_side_points points
+         * per side within max_side of the apex, so the beam spacing, not the
+         * range, decides how far corners are found (about 57 m at 0.5 deg
+         * beams). */
+        .max_range = FLT_MAX,
+        .min_side_points = 3u,
+        .join_grazing = 2u,
+        .corner_evidence = 1u,
+    };
+    return defaults;
 }
+
+/* The float parameters' ranges (bsf_floats_in_range): lower bound 0, open
+ * where a zero would stop the method. */
+#define LC_RANGE(field, hi, open)                                                                  \
+    {                                                                                              \
+        hi, (uint16_t)offsetof(bsf_lc_params_t, field), open                                       \
+    }
+static const bsf_float_range_t lc_float_ranges[] = {
+    LC_RANGE(jump_a, 1e3f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(jump_b, 10.0f, 0u),
+    LC_RANGE(split_min, 1e3f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(split_sigmas, 1e3f, 0u),
+    LC_RANGE(min_turn, 1.5707963f, BSF_RANGE_LO_OPEN | BSF_RANGE_HI_OPEN),
+    LC_RANGE(curve_ratio, 1e6f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(floor, 1e3f, 0u),
+    LC_RANGE(max_side, 1e3f, BSF_RANGE_LO_OPEN),
+    LC_RANGE(apex_slack, 1e3f, 0u),
+    LC_RANGE(min_side_len, 1e3f, 0u),
+    LC_RANGE(max_range, INFINITY, BSF_RANGE_LO_OPEN),
+};
 
 bsf_status_t bsf_lc_params_check(const bsf_lc_params_t *p)
 {
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    /* Written so that NaN fails every test. */
-    if (!(p->jump_a > 0.0f && p->jump_a <= 1e3f) || !(p->jump_b >= 0.0f && p->jump_b <= 10.0f) ||
-        !(p->split_min > 0.0f && p->split_min <= 1e3f) ||
-        !(p->split_sigmas >= 0.0f && p->split_sigmas <= 1e3f) ||
-        !(p->min_turn > 0.0f && p->min_turn < 1.5707963f) ||
-        !(p->curve_ratio > 0.0f && p->curve_ratio <= 1e6f) ||
-        !(p->floor >= 0.0f && p->floor <= 1e3f) || !(p->max_side > 0.0f && p->max_side <= 1e3f) ||
-        !(p->apex_slack >= 0.0f && p->apex_slack <= 1e3f) ||
-        !(p->min_side_len >= 0.0f && p->min_side_len <= 1e3f) || !(p->max_range > 0.0f) ||
+    if (!bsf_floats_in_range(p, lc_float_ranges,
+                             sizeof lc_float_ranges / sizeof lc_float_ranges[0]) ||
         p->min_side_points < 2u || p->min_side_points > 64u || p->join_grazing > 2u ||
         p->corner_evidence > 1u) {
         return BSF_ERR_PARAM;
@@ -1293,6 +1310,54 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
     return LC_CORNER;
 }
 
+/* Is a side of count points reaching sqrt(d2) from the apex too short to
+ * give its line a direction? The direction's standard error falls as
+ * 1 / (length sqrt(points)), so a side of more points than the need may be
+ * shorter than min_side_len (len2 squared) by the square root of their
+ * ratio, down to half of it at 4 x need: as well determined as need points
+ * over min_side_len. Only a side that runs to the end of its run can fall
+ * short at all (judge walks the others on): at fine beams, the 10 cm face
+ * of a door jamb or a recess beside a wall's end, whose corner the fit
+ * could otherwise only round off, climbing to its control-point cap. */
+static int side_too_short(float d2, size_t count, float len2, size_t need)
+{
+    const size_t capped = count > 4u * need ? 4u * need : count;
+    /* need points or fewer: min_side_len itself, compared as it always was */
+    return count <= need ? d2 < len2 : d2 * (float)capped < len2 * (float)need;
+}
+
+/* How far, in noise standard deviations, a vertex must lie past its apex
+ * and the apex off the short side's line (short_side_overshoots). */
+#define LC_OVERSHOOT_SIGMAS 3.0f
+
+/* A side of min_side_points - 1 returns, allowed where it runs to the end of
+ * the run, takes its line from two returns: when one is a mixed pixel (a
+ * range blended between two surfaces at a depth jump), that line turns off
+ * its wall, and the two lines meet on the other wall past the apex, short of
+ * the wall's end. The split at apex (the long side's line ll, the short
+ * side's ls, the short side before the apex when short_before) is such a
+ * corner when its vertex x (relative to the apex) lies past the apex's ray,
+ * away from the short side, and the apex lies nearer the long side's line
+ * than the short side's by LC_OVERSHOOT_SIGMAS: a wall's return beyond its
+ * own corner. A real corner past the apex has the apex on the short side's
+ * wall. */
+static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
+                                 const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
+{
+    const float tol = LC_OVERSHOOT_SIGMAS * sqrtf(c->noise2);
+    /* the vertex's cross product with the apex's ray (its distance from the
+     * ray times the range), positive on the side of the later beams when
+     * the angles increase */
+    float past = c->o.x * x.y - c->o.y * x.x;
+    if (!short_before == (c->pts->angle_increment > 0.0f)) {
+        past = -past; /* positive away from the short side */
+    }
+    /* then the apex (the origin) from each line */
+    return past > tol * c->pts->range[c->run[apex]] &&
+           fabsf(ll->dy * ll->mx - ll->dx * ll->my) + tol <
+               fabsf(ls->dy * ls->mx - ls->dx * ls->my);
+}
+
 /* Judge the split at position apex between the pieces that start at lo and
  * end at hi, in a run of m points. Returns LC_CORNER and fills *kp (beam
  * index, intersection, ...) for a corner, else LC_MERGE or LC_BOUNDARY. */
@@ -1350,7 +1415,8 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (dist2_once(rp[a0], ap) < len2 || dist2_once(rp[b1], ap) < len2) {
+    if (side_too_short(dist2_once(rp[a0], ap), apex - a0, len2, need) ||
+        side_too_short(dist2_once(rp[b1], ap), b1 - apex, len2, need)) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
@@ -1384,9 +1450,18 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     if (v != LC_CORNER) {
         v = judge_lines(c, a0, apex, b1, &la, &lb, cross, reach, &x, &score);
     }
-    if (v == LC_CORNER) {
-        corner_keypoint(c, a0, apex, b1, x, &la, &lb, score, kp);
+    if (v != LC_CORNER) {
+        return v;
     }
+    /* A short side at the end of the run (a mixed pixel may have turned it);
+     * where both are short, the one before the apex is tested. */
+    if (apex - a0 < need || b1 - apex < need) {
+        const int before = apex - a0 < need;
+        if (short_side_overshoots(c, apex, before, before ? &la : &lb, before ? &lb : &la, x)) {
+            return LC_MERGE;
+        }
+    }
+    corner_keypoint(c, a0, apex, b1, x, &la, &lb, score, kp);
     return v;
 }
 
@@ -1830,6 +1905,9 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
     size_t m = 0;
     size_t i;
     size_t step;
+#if !BSF_CONFIG_COMPACT
+    float jump_a2;
+#endif
     if (n_out != NULL) {
         *n_out = 0u;
     }
@@ -1856,6 +1934,9 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
     c.noise_points = 0.0f;
     blocks_detach(&c);
     c.start = bsf_points_full_circle(pts) ? ring_start(pts, p, grazing_memo) : 0u;
+#if !BSF_CONFIG_COMPACT
+    jump_a2 = p->jump_a * p->jump_a;
+#endif
     for (step = 0; step <= pts->count; ++step) {
         int close_run = step == pts->count;
         i = close_run
@@ -1865,7 +1946,13 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
             continue;
         }
         if (!close_run && m > 0u) {
+#if BSF_CONFIG_COMPACT
             close_run = !lc_joins(pts, p, grazing_memo, work->run[m - 1u], i);
+#else
+            /* lc_joins' first test here, as most beams pass it: no call */
+            close_run = !(dist2(pts->pt[work->run[m - 1u]], pts->pt[i]) <= jump_a2 ||
+                          lc_joins(pts, p, grazing_memo, work->run[m - 1u], i));
+#endif
             if (close_run) {
                 const size_t j = past_occluder(pts, p, work->run[m - 1u], i);
                 if (j > i && step + (j - i) < pts->count) {

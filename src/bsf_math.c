@@ -141,3 +141,10 @@ float bsf_asinf(float x)
     }
     return bsf_atan2f(x, sqrtf((1.0f - x) * (1.0f + x)));
 }
+
+#if BSF_CONFIG_COMPACT
+int bsf_floats_in_range(const void *params, const bsf_float_range_t *ranges, size_t n)
+{
+    return bsf_floats_in_range_inline(params, ranges, n);
+}
+#endif

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * bsf_math.h - internal: the transcendental functions the library needs,
- * computed with + - * / and sqrtf only.
+ * computed with + - * / and sqrtf only (and, at the end, the range table
+ * the parameter checks share).
  *
  * Why: those five operations are correctly rounded by IEEE 754 on every
  * target, while sinf, cosf, expf, atan2f and asinf differ in the last bits
@@ -17,7 +18,10 @@
 #ifndef BSF_MATH_H
 #define BSF_MATH_H
 
+#include "bsf/bsf_config.h"
+
 #include <float.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -255,5 +259,46 @@ float bsf_atan2f(float y, float x);
 
 /** asin(x) in [-pi/2, pi/2] for |x| <= 1; NaN outside. */
 float bsf_asinf(float x);
+
+/* A float parameter's allowed range, for the parameter checks: the field's
+ * byte offset in its struct, its upper bound, and which bounds are open.
+ * The lower bound is always 0 (every checked float is a length, a count or
+ * a ratio). A table of these is smaller code than written-out comparisons
+ * (the extract + encode firmware's size budget). */
+typedef struct {
+    float hi;
+    uint16_t offset;
+    uint8_t open; /* BSF_RANGE_LO_OPEN | BSF_RANGE_HI_OPEN */
+} bsf_float_range_t;
+
+#define BSF_RANGE_LO_OPEN 1u /* value > 0, else value >= 0 */
+#define BSF_RANGE_HI_OPEN 2u /* value < hi, else value <= hi */
+
+/* 1 when each of the n fields of params that ranges name lies within its
+ * range, else 0. NaN lies within none. */
+static inline int bsf_floats_in_range_inline(const void *params, const bsf_float_range_t *ranges,
+                                             size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        const bsf_float_range_t *r = &ranges[i];
+        float v;
+        memcpy(&v, (const unsigned char *)params + r->offset, sizeof v);
+        /* written so that NaN fails both tests */
+        if (!((r->open & BSF_RANGE_LO_OPEN) != 0u ? v > 0.0f : v >= 0.0f) ||
+            !((r->open & BSF_RANGE_HI_OPEN) != 0u ? v < r->hi : v <= r->hi)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* The compact build calls one copy; the speed build inlines it, where the
+ * constant table folds into the comparisons it stands for. */
+#if BSF_CONFIG_COMPACT
+int bsf_floats_in_range(const void *params, const bsf_float_range_t *ranges, size_t n);
+#else
+#define bsf_floats_in_range bsf_floats_in_range_inline
+#endif
 
 #endif /* BSF_MATH_H */

@@ -2,6 +2,7 @@
 #include "bsf/bsf_segment.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "bsf_grazing.h"
@@ -54,12 +55,19 @@ static int min_points_ok(uint16_t n)
     return n >= 1u && n <= (uint16_t)BSF_MAX_POINTS;
 }
 
+/* a finite and positive, b finite (bsf_floats_in_range) */
+static const bsf_float_range_t sved_float_ranges[] = {
+    {FLT_MAX, (uint16_t)offsetof(bsf_sved_params_t, a), BSF_RANGE_LO_OPEN},
+    {FLT_MAX, (uint16_t)offsetof(bsf_sved_params_t, b), 0u},
+};
+
 bsf_status_t bsf_sved_params_check(const bsf_sved_params_t *p)
 {
     if (p == NULL) {
         return BSF_ERR_ARG;
     }
-    if (!is_finite_f(p->a) || !(p->a > 0.0f) || !is_finite_f(p->b) || !(p->b >= 0.0f) ||
+    if (!bsf_floats_in_range(p, sved_float_ranges,
+                             sizeof sved_float_ranges / sizeof sved_float_ranges[0]) ||
         !min_points_ok(p->min_segment_points) || p->max_gap_beams < 1u ||
         p->max_gap_beams > (uint16_t)BSF_MAX_POINTS || !is_finite_f(p->radius_max) ||
         !(p->radius_max == 0.0f || p->radius_max >= p->a) || p->lookback > BSF_SVED_MAX_LOOKBACK ||

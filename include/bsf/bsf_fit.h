@@ -94,8 +94,13 @@ typedef struct {
      *  (fragment RMS / sqrt(bias_window)), or (2) a point lies more than
      *  3 * target_rms from the curve. Range noise averages out over the
      *  window, a curve that bulges off a curved wall or swings off the last
-     *  points before a corner does not. Points, 0 (off: RMS alone, as the
-     *  paper) or 2..BSF_PDM_MAX_BIAS_WINDOW. Default 16. */
+     *  points before a corner does not. With it and refine on (and max_ctrl above 3),
+     *  a fragment without vertices whose first and last quarters of points
+     *  (each at least 10 cm long) head more than 90 degrees apart starts
+     *  with two spans instead of one: one quadratic span on a pillar's
+     *  silhouette meets the target with its ends centimetres off, where
+     *  the windowed mean does not see it. Points, 0 (off: RMS alone, as
+     *  the paper) or 2..BSF_PDM_MAX_BIAS_WINDOW. Default 16. */
     uint8_t bias_window;
     /** Smallest windowed mean that counts, as a fraction of target_rms, in
      *  (0, 1]. Default 0.2 (6 mm at the default target). Unused when

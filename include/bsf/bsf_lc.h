@@ -21,7 +21,9 @@
  *  2. judge every split point with the two pieces beside it (each cut to
  *     max_side metres from the apex): fit a total-least-squares line to each
  *     side (the apex left out) and keep the split as a corner only when
- *     - each side has min_side_points points and reaches min_side_len,
+ *     - each side has min_side_points points (one fewer where it runs to
+ *       the end of its run) and reaches min_side_len (a side of more points
+ *       may fall short of it by the square root of their ratio, to half),
  *     - the lines turn by at least min_turn,
  *     - their intersection lies near the apex (within twice the local beam
  *       spacing plus apex_slack), and
@@ -67,7 +69,13 @@
  *     as the lines must) at min_turn or more. The circles of one pillar, or
  *     of a wall of varying curvature, touch rather than cross, so these get
  *     no corner. Where a side is round, the two lines' intersection would
- *     lie off the crease even when they pass;
+ *     lie off the crease even when they pass; a side of min_side_points - 1
+ *     points (where it runs to the end of its run) gives no corner when the
+ *     intersection lies past the apex's ray, away from it, by 3 noise
+ *     standard deviations while the apex lies 3 of them nearer the other
+ *     side's line than its own: the far wall's first return beyond its own
+ *     corner, where a mixed pixel among the two points turned their line
+ *     (where both sides are that short, the side before the apex is tested);
  *  3. report each corner at its apex beam, with the intersection of the two
  *     lines (of the crease's pieces) as its position (PDM starts the vertex
  *     there and keeps it there).
@@ -99,7 +107,10 @@ typedef struct {
     float floor;        /**< residual floor per point, metres (0.003) */
     float max_side;     /**< length of each side used for the line fits, metres (1.5) */
     float apex_slack;   /**< extra distance allowed from apex to intersection, metres (0.05) */
-    float min_side_len; /**< length each side must reach from the apex, metres (0.15) */
+    float min_side_len; /**< length each side must reach from the apex, metres (0.15); a
+                             side of more than min_side_points points may fall short of it
+                             by the square root of their ratio, to half at four times as
+                             many (its direction is as well determined) */
     float max_range;    /**< no corner at an apex farther than this, metres (FLT_MAX: no
                              limit; the side tests already need min_side_points points
                              within max_side of the apex, which the beam spacing decides) */

@@ -154,8 +154,7 @@ static void test_oracle_is_exact_without_noise(void)
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&sc, &lid, NULL, clean, hits, BSF_MAX_POINTS));
         scan = bsf_scene_lidar_scan(&lid, clean);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &scan, &res));
-        TEST_ASSERT_EQUAL_INT(
-            0, bsf_truth_add_oracle(&acc, &sc, &lid, clean, hits, clean, NULL, &res));
+        TEST_ASSERT_EQUAL_INT(0, bsf_truth_add_oracle(&acc, &sc, &lid, clean, hits, clean, &res));
     }
     printf("oracle without noise: %lu corners, largest error %.2e m, %lu undefined\n",
            (unsigned long)acc.oracle_err_all.n, acc.oracle_err_all.max,
@@ -178,8 +177,8 @@ static int noisy_corner(const bsf_scene_t *sc, const bsf_lidar_t *lid, bsf_scene
     for (k = 0; k < n; ++k) {
         int n_side[2];
         if (corners[k].visible && corners[k].range <= 6.0 &&
-            bsf_truth_oracle_vertex(&corners[k], lid, clean, hits, ranges, NULL, 0.0, ox, oy,
-                                    n_side, NULL) == 0 &&
+            bsf_truth_oracle_vertex(&corners[k], lid, clean, hits, ranges, 0.0, ox, oy, n_side,
+                                    NULL) == 0 &&
             n_side[0] >= 4 && n_side[1] >= 4) {
             *cn = corners[k];
             return 1;
@@ -194,6 +193,7 @@ static void test_oracle_takes_only_its_walls_returns(void)
 {
     static bsf_scene_t sc;
     static float unmixed[BSF_MAX_POINTS];
+    static int16_t on_shape[BSF_MAX_POINTS];
     bsf_scene_rng_t rng;
     bsf_scene_corner_t cn;
     bsf_lidar_t lid;
@@ -235,31 +235,107 @@ static void test_oracle_takes_only_its_walls_returns(void)
     TEST_ASSERT_TRUE(hits[other_beam] >= 0);
     /* another surface's return does not count */
     ranges[other_beam] += 0.5f;
-    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.0, &qx,
-                                                     &qy, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(
+        0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, 0.0, &qx, &qy, NULL, NULL));
     TEST_ASSERT_TRUE(qx == ox && qy == oy);
     /* the wall's own return does */
     memcpy(unmixed, ranges, sizeof ranges);
     ranges[near_beam] += 0.5f;
-    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.0, &qx,
-                                                     &qy, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(
+        0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, 0.0, &qx, &qy, NULL, NULL));
     TEST_ASSERT_TRUE(hypot(qx - cn.x, qy - cn.y) > o0 + 0.02);
-    /* unless it is marked as a mixed pixel (its range not what the wall gave) */
-    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, unmixed, 0.0,
-                                                     &qx, &qy, NULL, NULL));
+    /* unless it is labelled a mixed pixel (its range not what the wall gave) */
+    TEST_ASSERT_EQUAL_INT(
+        1, (int)bsf_truth_returns_on_shapes(on_shape, hits, clean, ranges, unmixed, 361u, 0.03));
+    TEST_ASSERT_EQUAL_INT(-1, on_shape[near_beam]);
+    TEST_ASSERT_EQUAL_INT(
+        0, bsf_truth_oracle_vertex(&cn, &lid, clean, on_shape, ranges, 0.0, &qx, &qy, NULL, NULL));
     TEST_ASSERT_TRUE(hypot(qx - cn.x, qy - cn.y) < 0.02);
     /* reach: returns within 0.6 m of the corner only */
     memcpy(ranges, unmixed, sizeof ranges);
-    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.0, &qx,
-                                                     &qy, n_whole, len_whole));
-    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, NULL, 0.6, &qx,
-                                                     &qy, n_near, len_near));
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, 0.0, &qx, &qy,
+                                                     n_whole, len_whole));
+    TEST_ASSERT_EQUAL_INT(0, bsf_truth_oracle_vertex(&cn, &lid, clean, hits, ranges, 0.6, &qx, &qy,
+                                                     n_near, len_near));
     for (i = 0; i < 2u; ++i) {
         TEST_ASSERT_TRUE(len_near[i] <= 0.6);
         TEST_ASSERT_TRUE(n_near[i] <= n_whole[i]);
         TEST_ASSERT_TRUE(len_near[i] <= len_whole[i]);
     }
     TEST_ASSERT_TRUE(n_near[0] < n_whole[0] || n_near[1] < n_whole[1]);
+}
+
+/* A blend between two surfaces is no return on a wall: a corner whose wall
+ * keeps a single return after mixing is visible under neither rule, and a
+ * blend inside the wall's run breaks the run of consecutive returns; a
+ * changed range within the tolerance of its own wall is still a return
+ * there. */
+static void test_a_mixed_pixel_is_no_hit_for_visibility(void)
+{
+    static bsf_scene_t sc;
+    static bsf_scene_corner_t corners[256];
+    static int16_t on_shape[BSF_MAX_POINTS];
+    bsf_lidar_t lid;
+    double x, y, th;
+    size_t n = 0;
+    size_t k;
+    size_t i;
+    size_t start = 0;
+    size_t next = 0;
+    size_t on_wall = 0;
+    double dmin = 1e300;
+    const bsf_scene_corner_t *cn = NULL;
+    bsf_scene_demo_office(&sc);
+    bsf_scene_demo_pose(3, 10, &x, &y, &th);
+    lid = bsf_lidar_default(x, y, th, 361u, 1.5 * PI);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&sc, &lid, NULL, clean, hits, BSF_MAX_POINTS));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_corners(&sc, &lid, corners, 256u, &n));
+    for (k = 0; k < n && cn == NULL; ++k) {
+        if (bsf_truth_corner_seen(&corners[k], &lid, clean, hits) &&
+            bsf_truth_corner_seen_sparse(&corners[k], &lid, clean, hits)) {
+            cn = &corners[k];
+        }
+    }
+    TEST_ASSERT_NOT_NULL(cn);
+    /* the wall's return nearest the vertex, and the next one along the wall */
+    for (i = 0; i < 361u; ++i) {
+        const double a = lid.angle_min + (double)i * lid.angle_increment;
+        const double d =
+            hypot((double)clean[i] * cos(a) - cn->x, (double)clean[i] * sin(a) - cn->y);
+        if (hits[i] == cn->shape_a) {
+            ++on_wall;
+            if (d < dmin) {
+                dmin = d;
+                start = i;
+            }
+        }
+    }
+    TEST_ASSERT_TRUE(on_wall >= 4u);
+    next = start > 0u && hits[start - 1u] == cn->shape_a ? start - 1u : start + 1u;
+    TEST_ASSERT_EQUAL_INT(cn->shape_a, hits[next]);
+    /* every return of the wall but the nearest blended with a nearer surface */
+    memcpy(ranges, clean, sizeof ranges);
+    for (i = 0; i < 361u; ++i) {
+        if (hits[i] == cn->shape_a && i != start) {
+            ranges[i] = clean[i] - 0.4f;
+        }
+    }
+    TEST_ASSERT_EQUAL_INT((int)on_wall - 1, (int)bsf_truth_returns_on_shapes(
+                                                on_shape, hits, clean, ranges, clean, 361u, 0.03));
+    TEST_ASSERT_FALSE(bsf_truth_corner_seen(cn, &lid, clean, on_shape));
+    TEST_ASSERT_FALSE(bsf_truth_corner_seen_sparse(cn, &lid, clean, on_shape));
+    /* one blend, next to the nearest return: the run of consecutive returns ends */
+    memcpy(ranges, clean, sizeof ranges);
+    ranges[next] = clean[next] - 0.4f;
+    TEST_ASSERT_EQUAL_INT(
+        1, (int)bsf_truth_returns_on_shapes(on_shape, hits, clean, ranges, clean, 361u, 0.03));
+    TEST_ASSERT_FALSE(bsf_truth_corner_seen_sparse(cn, &lid, clean, on_shape));
+    /* a changed range within the tolerance of its wall is a return on it */
+    ranges[next] = clean[next] - 0.02f;
+    TEST_ASSERT_EQUAL_INT(
+        0, (int)bsf_truth_returns_on_shapes(on_shape, hits, clean, ranges, clean, 361u, 0.03));
+    TEST_ASSERT_TRUE(bsf_truth_corner_seen(cn, &lid, clean, on_shape));
+    TEST_ASSERT_TRUE(bsf_truth_corner_seen_sparse(cn, &lid, clean, on_shape));
 }
 
 int main(void)
@@ -272,5 +348,6 @@ int main(void)
     RUN_TEST(test_office_curves_never_stray_far_from_the_walls);
     RUN_TEST(test_oracle_is_exact_without_noise);
     RUN_TEST(test_oracle_takes_only_its_walls_returns);
+    RUN_TEST(test_a_mixed_pixel_is_no_hit_for_visibility);
     return UNITY_END();
 }

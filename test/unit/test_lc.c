@@ -573,6 +573,44 @@ static void test_the_corners_of_a_recess_are_found_with_beams_denser_than_the_no
     }
 }
 
+/* A door jamb 10 cm deep at the end of a wall, 0.85 m from a sensor of
+ * 0.25-degree beams (the default configuration: grazing joins and the
+ * evidence test): the jamb's face gives 12-18 returns, shorter than
+ * min_side_len but as many as give its direction as well as 3 returns over
+ * min_side_len would. Its corner is found at 1 cm range noise; at 3 cm no
+ * corner is made of the jamb. (Fine beams see such faces everywhere: 10
+ * returns at 2 m at 3200 beams per turn.) */
+static void test_the_corner_of_a_short_jamb_at_a_walls_end_is_found_at_fine_beams(void)
+{
+    static const double wall[6] = {-6.0, 0.8, 0.4, 0.8, 0.4, 0.7};
+    static const double far_wall[4] = {-8.0, 6.0, 8.0, 6.0};
+    int pose;
+    int found = 0;
+    int stray = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, wall, 3u, 0));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_polyline(&scene, far_wall, 2u, 0));
+    join_grazing = 1;
+    corner_evidence = 1;
+    for (pose = 0; pose < 8; ++pose) {
+        const double x = -0.35 + 0.05 * (double)pose;
+        const double heading = 0.5 * PI + 0.1 * (double)(pose - 4);
+        size_t n = detect(x, 0.0, heading, 1081u, 1.5 * PI, 0.01);
+        size_t k;
+        int hit = 0;
+        for (k = 0; k < n; ++k) {
+            hit |= dist_to(k, x, 0.0, heading, 0.4, 0.8) < 0.02;
+        }
+        found += hit;
+        n = detect(x, 0.0, heading, 1081u, 1.5 * PI, 0.03);
+        for (k = 0; k < n; ++k) {
+            stray += dist_to(k, x, 0.0, heading, 0.4, 0.8) < 0.3;
+        }
+    }
+    TEST_ASSERT_GREATER_OR_EQUAL_INT_MESSAGE(7, found,
+                                             "the jamb's corner missed in more than 1 of 8 poses");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, stray, "a corner made of the jamb at 3 cm range noise");
+}
+
 /* The scan's noise that bsf_lc_detect leaves in work.noise2 (the tail
  * rule of the extractor judges short runs against it) follows the range
  * noise of a room at 0.5-degree and 1-degree beams (within 30 %: at 3 cm
@@ -600,6 +638,59 @@ static void test_the_scans_noise_follows_the_range_noise(void)
     TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 3.0, -0.05, 3.0, 0.05) >= 0);
     (void)detect(0.0, 0.0, 0.0, 541u, 1.5 * PI, 0.01);
     TEST_ASSERT_TRUE(work.noise2 == 0.0f);
+}
+
+/* LC with its defaults on the ranges[] of lidar lid as they are (no new
+ * scan); returns the keypoint count. */
+static size_t detect_ranges(const bsf_lidar_t *lid)
+{
+    const bsf_lc_params_t p = bsf_lc_params_default();
+    const bsf_scan_t scan = bsf_scene_lidar_scan(lid, ranges);
+    size_t n_out = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
+    return n_out;
+}
+
+/* A room corner 11.5 m away (the demo office's, 1 deg beams, no noise)
+ * whose first wall is seen at grazing incidence, its returns 0.4-0.5 m
+ * apart, and whose second wall faces the sensor. Mixed pixels on the first
+ * wall: its last return before the corner blended a fifth of the way from
+ * its neighbour's range to its own, and the return two before that half
+ * way, which cuts the run there. The run's first side then has two returns,
+ * its line turns off the wall, and the lines would meet on the second wall
+ * 0.5 m short of the corner: no such vertex. Without the blends the corner
+ * is found. */
+static void test_a_mixed_pixel_in_a_two_return_side_puts_no_vertex_on_the_far_wall(void)
+{
+    const bsf_scene_pose_t pose = {3.196, 3.971, 0.746};
+    bsf_lidar_t lid;
+    double sx;
+    double sy;
+    size_t n;
+    size_t k;
+    size_t last;
+    int found = 0;
+    bsf_scene_demo_office(&scene);
+    lid = bsf_lidar_default(pose.x, pose.y, pose.theta, 181u, PI);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &lid, NULL, ranges, NULL, BSF_MAX_POINTS));
+    bsf_scene_world_to_sensor(&pose, 14.0, 0.0, &sx, &sy);
+    /* the first wall's last return: the beam just before the corner's bearing */
+    last = (size_t)((atan2(sy, sx) - lid.angle_min) / lid.angle_increment);
+    TEST_ASSERT_TRUE(last >= 3u && (double)ranges[last] < hypot(sx, sy));
+    n = detect_ranges(&lid);
+    for (k = 0; k < n; ++k) {
+        found |= hypot((double)kps[k].point.x - sx, (double)kps[k].point.y - sy) < 0.1;
+    }
+    TEST_ASSERT_TRUE_MESSAGE(found, "the corner without mixed pixels");
+    ranges[last] = ranges[last - 1u] + 0.2f * (ranges[last] - ranges[last - 1u]);
+    ranges[last - 2u] = ranges[last - 3u] + 0.5f * (ranges[last - 2u] - ranges[last - 3u]);
+    n = detect_ranges(&lid);
+    for (k = 0; k < n; ++k) {
+        const double d = hypot((double)kps[k].point.x - sx, (double)kps[k].point.y - sy);
+        TEST_ASSERT_TRUE_MESSAGE(d < 0.1 || d > 2.0, "a vertex on the wall short of its corner");
+    }
 }
 
 static void test_refused_calls(void)
@@ -674,7 +765,9 @@ int main(void)
     RUN_TEST(test_corners_between_long_shallow_sides_are_not_lost_to_a_missed_neighbour);
     RUN_TEST(test_a_corner_behind_a_full_circle_sensor_is_found_across_the_seam);
     RUN_TEST(test_the_corners_of_a_recess_are_found_with_beams_denser_than_the_noise);
+    RUN_TEST(test_the_corner_of_a_short_jamb_at_a_walls_end_is_found_at_fine_beams);
     RUN_TEST(test_the_scans_noise_follows_the_range_noise);
+    RUN_TEST(test_a_mixed_pixel_in_a_two_return_side_puts_no_vertex_on_the_far_wall);
     RUN_TEST(test_refused_calls);
     RUN_TEST(test_more_corners_than_room_reports_capacity_and_the_total);
     return UNITY_END();

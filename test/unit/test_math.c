@@ -2,6 +2,7 @@
 /* The library's own sin, cos, exp, atan2 and asin (src/bsf_math.c): close to
  * the C library's, and the special values callers can meet. White-box. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -288,6 +289,43 @@ static void test_asin_agrees_with_libm_and_is_nan_outside_its_domain(void)
     TEST_ASSERT_TRUE(isnan(bsf_asinf(NAN)));
 }
 
+/* The parameter checks' range table: 0 is in a closed lower bound and out
+ * of an open one, hi likewise, NaN in none, and the first field out of its
+ * range fails the whole table. */
+typedef struct {
+    float a;
+    float b;
+} two_floats_t;
+
+static void test_floats_in_range_honours_open_and_closed_bounds_and_rejects_nan(void)
+{
+    static const bsf_float_range_t closed[] = {{2.0f, 0u, 0u}, {2.0f, 4u, 0u}};
+    static const bsf_float_range_t open[] = {{2.0f, 0u, BSF_RANGE_LO_OPEN | BSF_RANGE_HI_OPEN},
+                                             {2.0f, 4u, BSF_RANGE_LO_OPEN | BSF_RANGE_HI_OPEN}};
+    two_floats_t p = {0.0f, 2.0f};
+    TEST_ASSERT_EQUAL_size_t(4u, offsetof(two_floats_t, b));
+    TEST_ASSERT_EQUAL_INT(1, bsf_floats_in_range(&p, closed, 2u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, open, 2u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, open, 1u)); /* a = 0: open at 0 */
+    p.a = 1e-45f;                                                /* the least positive float */
+    TEST_ASSERT_EQUAL_INT(1, bsf_floats_in_range(&p, open, 1u));
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, open, 2u)); /* b = hi: open at hi */
+    p.b = 1.9999999f;
+    TEST_ASSERT_EQUAL_INT(1, bsf_floats_in_range(&p, open, 2u));
+    p.b = 2.0000002f;
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, closed, 2u));
+    p.b = -0.0f; /* -0 >= 0 */
+    TEST_ASSERT_EQUAL_INT(1, bsf_floats_in_range(&p, closed, 2u));
+    p.b = -1e-45f;
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, closed, 2u));
+    p.b = NAN;
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, closed, 2u));
+    TEST_ASSERT_EQUAL_INT(1, bsf_floats_in_range(&p, closed, 1u)); /* only a is looked at */
+    p.a = NAN;
+    TEST_ASSERT_EQUAL_INT(0, bsf_floats_in_range(&p, closed, 1u));
+    TEST_ASSERT_EQUAL_INT(1, bsf_floats_in_range(&p, closed, 0u)); /* an empty table */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -301,5 +339,6 @@ int main(void)
     RUN_TEST(test_atan2_agrees_with_libm_in_every_quadrant);
     RUN_TEST(test_atan2_signed_zeros_infinities_and_nan_follow_c99);
     RUN_TEST(test_asin_agrees_with_libm_and_is_nan_outside_its_domain);
+    RUN_TEST(test_floats_in_range_honours_open_and_closed_bounds_and_rejects_nan);
     return UNITY_END();
 }

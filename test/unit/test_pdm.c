@@ -391,6 +391,50 @@ static void test_systematic_deviation_refines_a_bulge_the_rms_accepts(void)
     TEST_ASSERT_TRUE(off_bias < 0.04f);
 }
 
+/* A round pillar of radius 0.4 m, 3 m ahead, seen by 0.25-degree beams with
+ * 1 cm range noise: its silhouette turns through about 165 degrees. One
+ * quadratic span fits it within the 30 mm target (about 1.5 cm RMS) and the
+ * windowed-mean test hardly sees the misfit, which lies at the ends: the
+ * curve swung 3-5 cm off the pillar past its last returns. A span that
+ * turns back on itself is split from the start. */
+static void test_a_pillar_silhouette_is_not_one_span(void)
+{
+    const float cx = 3.0f;
+    const float radius = 0.4f;
+    const float step = 0.25f * 3.14159265f / 180.0f;
+    const float half = asinf(radius / cx);
+    size_t n = 0;
+    size_t n_ctrl = 0;
+    size_t j;
+    float e = -1.0f;
+    float worst = 0.0f;
+    float a;
+    rng_state = 4242u;
+    for (a = -half + 0.5f * step; a < half && n < N_MAX; a += step) {
+        /* nearest intersection of the ray at angle a with the circle */
+        const float b = cx * cosf(a);
+        const float r = b - sqrtf(b * b - (cx * cx - radius * radius)) + 0.01f * rng_gauss();
+        pts[n].x = r * cosf(a);
+        pts[n].y = r * sinf(a);
+        ++n;
+    }
+    TEST_ASSERT_TRUE(n >= 40u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
+                                              BSF_MAX_CTRL_PER_FEATURE, &n_ctrl, &e, NULL));
+    for (j = 0; j <= 200u; ++j) {
+        bsf_point_t q;
+        float d;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_bspline_eval(ctrl, n_ctrl, (float)j / 200.0f, &q, NULL, NULL));
+        d = fabsf(sqrtf((q.x - cx) * (q.x - cx) + q.y * q.y) - radius);
+        worst = d > worst ? d : worst;
+    }
+    printf("pillar: %u points, %u ctrl, E %.4f m, curve %.4f m off at worst\n", (unsigned)n,
+           (unsigned)n_ctrl, (double)e, (double)worst);
+    TEST_ASSERT_TRUE(n_ctrl >= 4u);
+    TEST_ASSERT_TRUE(worst < 0.025f);
+}
+
 static void test_refinement_stops_at_the_per_fragment_cap(void)
 {
     /* 12 noisy points: cap of 12 / 4 = 3 precision points, target unreachable. */
@@ -539,7 +583,7 @@ static void test_max_passes_bounds_the_climb_near_the_target(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK,
                           bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
                                       BSF_MAX_CTRL_PER_FEATURE, &n_free, &e_free, &free_info));
-    for (cap = 1u; cap <= 3u; ++cap) {
+    for (cap = 1u; cap <= 2u; ++cap) {
         params.max_passes = cap;
         TEST_ASSERT_EQUAL_INT(BSF_OK,
                               bsf_pdm_fit(pts, n, NULL, 0u, &params, &work, ctrl, NULL,
@@ -553,7 +597,7 @@ static void test_max_passes_bounds_the_climb_near_the_target(void)
         TEST_ASSERT_TRUE(e_capped >= e_free && e_capped < 2.0f * params.target_rms);
         assert_all_finite(ctrl, n_capped);
     }
-    TEST_ASSERT_TRUE(free_info.iterations > 3u); /* so the cap had something to cut */
+    TEST_ASSERT_TRUE(free_info.iterations > 2u); /* so the cap had something to cut */
 }
 
 /* The cap never stops a fragment still far from the target: a room fitted
@@ -700,6 +744,7 @@ int main(void)
     RUN_TEST(test_refinement_reaches_target_and_one_point_less_misses_it);
     RUN_TEST(test_refinement_refines_only_the_curved_fragment_of_a_corner);
     RUN_TEST(test_systematic_deviation_refines_a_bulge_the_rms_accepts);
+    RUN_TEST(test_a_pillar_silhouette_is_not_one_span);
     RUN_TEST(test_refinement_stops_at_the_per_fragment_cap);
     RUN_TEST(test_refinement_of_a_whole_room_without_vertices_does_not_get_stuck);
     RUN_TEST(test_dense_noisy_wall_is_not_refined_on_noise);

@@ -400,6 +400,30 @@ int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
     return c->visible && c->range <= BSF_TRUTH_RANGE_MAX && walls_seen(c, lidar, ranges, hit_shape);
 }
 
+int bsf_truth_corner_seen_sparse(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                                 const float *ranges, const int16_t *hit_shape)
+{
+    return c->visible && c->range <= BSF_TRUTH_RANGE_MAX &&
+           walls_seen_sparse(c, lidar, ranges, hit_shape);
+}
+
+size_t bsf_truth_returns_on_shapes(int16_t *on_shape, const int16_t *hit_shape, const float *clean,
+                                   const float *delivered, const float *unmixed, size_t n,
+                                   double tol)
+{
+    size_t relabelled = 0;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        /* A blend lies between two surfaces, on neither, unless it happens
+         * to land within the noise of its own wall. */
+        const int blend = delivered[i] != unmixed[i] &&
+                          fabs((double)delivered[i] - (double)clean[i]) > tol && hit_shape[i] >= 0;
+        on_shape[i] = blend ? (int16_t)-1 : hit_shape[i];
+        relabelled += (size_t)blend;
+    }
+    return relabelled;
+}
+
 int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                   const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
                   size_t bytes, double time_ns)
@@ -689,19 +713,15 @@ static int oracle_line(const oracle_sums_t *s, double *nx, double *ny, double *d
 
 /* Beam b of a wall's run into the oracle's sums. Returns 1 when the beam
  * lies beyond reach (the walk stops: along a straight wall, the beams after
- * it are farther still), else 0. A mixed pixel is skipped. */
+ * it are farther still), else 0. */
 static int oracle_take(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, const float *clean,
-                       const float *measured, const float *unmixed, double reach, size_t b,
-                       oracle_sums_t *s, double *len)
+                       const float *measured, double reach, size_t b, oracle_sums_t *s, double *len)
 {
     const double a = lidar->angle_min + (double)b * lidar->angle_increment;
     const double d = hypot((double)clean[b] * cos(a) - c->x, (double)clean[b] * sin(a) - c->y);
     double px, py;
     if (reach > 0.0 && d > reach) {
         return 1;
-    }
-    if (unmixed != NULL && measured[b] != unmixed[b]) {
-        return 0; /* a mixed pixel: no return of this wall */
     }
     px = (double)measured[b] * cos(a);
     py = (double)measured[b] * sin(a);
@@ -717,8 +737,7 @@ static int oracle_take(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar, co
 
 int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
                             const float *clean, const int16_t *hit_shape, const float *measured,
-                            const float *unmixed, double reach, double *x, double *y, int n_side[2],
-                            double len_side[2])
+                            double reach, double *x, double *y, int n_side[2], double len_side[2])
 {
     const size_t n = lidar->n_beams;
     const int ring = full_ring(lidar);
@@ -734,14 +753,14 @@ int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lida
         if (start == n) {
             return -1;
         }
-        if (oracle_take(c, lidar, clean, measured, unmixed, reach, start, &s, &len) == 0) {
+        if (oracle_take(c, lidar, clean, measured, reach, start, &s, &len) == 0) {
             /* the run either way from the start beam, as the sparse-wall rule walks it */
             for (dir = -1; dir <= 1; dir += 2) {
                 size_t b = start;
                 size_t steps;
                 for (steps = 1; steps < n && step_beam(&b, dir, n, ring); ++steps) {
                     if (hit_shape[b] != wall || b == start ||
-                        oracle_take(c, lidar, clean, measured, unmixed, reach, b, &s, &len) != 0) {
+                        oracle_take(c, lidar, clean, measured, reach, b, &s, &len) != 0) {
                         break;
                     }
                 }
@@ -768,7 +787,7 @@ int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lida
 
 int bsf_truth_add_oracle(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                          const float *clean, const int16_t *hit_shape, const float *measured,
-                         const float *unmixed, const bsf_result_t *res)
+                         const bsf_result_t *res)
 {
     static bsf_scene_corner_t corners[TRUTH_MAX_CORNERS];
     size_t n_corners = 0;
@@ -802,8 +821,8 @@ int bsf_truth_add_oracle(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const b
                 }
             }
         }
-        if (bsf_truth_oracle_vertex(c, lidar, clean, hit_shape, measured, unmixed,
-                                    bsf_truth_oracle_reach, &ox, &oy, n_side, len_side) != 0) {
+        if (bsf_truth_oracle_vertex(c, lidar, clean, hit_shape, measured, bsf_truth_oracle_reach,
+                                    &ox, &oy, n_side, len_side) != 0) {
             acc->oracle_undefined++;
             continue;
         }

@@ -15,6 +15,10 @@
  *    surface: no gap above BSF_TRUTH_MAX_GAP from the vertex to the first or
  *    between them (a wall seen at grazing incidence, one return every half
  *    metre, is not seen as a wall by any segmentation).
+ *  - A "hit" on a wall is a return that lies on it: bsf_truth_returns_on_shapes
+ *    labels each beam with the shape its delivered return lies on, so a
+ *    mixed pixel (a blend between two surfaces at a depth jump) is a hit on
+ *    none and breaks a wall's run of consecutive returns.
  *  - Sparse-wall rule (reported beside the first): a visible corner within
  *    BSF_TRUTH_RANGE_MAX counts when each of its two walls has at least
  *    BSF_TRUTH_MIN_HITS consecutive beams hitting it, starting with the hit
@@ -107,9 +111,24 @@ extern int bsf_truth_verbose;
 void bsf_truth_acc_init(bsf_truth_acc_t *acc);
 
 /**
- * Judge one result. ranges and hit_shape are the scan as simulated (before
- * mixed pixels is fine too); lidar holds the pose. bytes is the frame size.
- * Returns 0, or -1 when the scene has more than 256 corners.
+ * The shape each beam's delivered return lies on, for the visibility rules
+ * and the oracle: on_shape[i] = hit_shape[i], except that a beam whose
+ * delivered range is not the one the scene gave it (delivered[i] !=
+ * unmixed[i]: bsf_scene_mixed_pixels changed it) and lies more than tol
+ * metres from its clean range gets -1, a return on no shape (a blend between
+ * two surfaces). The arrays hold n beams; on_shape may be hit_shape.
+ * Returns the number of beams relabelled.
+ */
+size_t bsf_truth_returns_on_shapes(int16_t *on_shape, const int16_t *hit_shape, const float *clean,
+                                   const float *delivered, const float *unmixed, size_t n,
+                                   double tol);
+
+/**
+ * Judge one result. ranges are the clean ranges of the scan as simulated and
+ * hit_shape the shape each beam's return lies on (bsf_scene_scan's labels,
+ * or with mixed pixels bsf_truth_returns_on_shapes); lidar holds the pose.
+ * bytes is the frame size. Returns 0, or -1 when the scene has more than 256
+ * corners.
  */
 int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                   const float *ranges, const int16_t *hit_shape, const bsf_result_t *res,
@@ -118,10 +137,15 @@ int bsf_truth_add(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lida
 /**
  * Is corner c (from bsf_scene_corners for this lidar) a visible corner in the
  * sense above: visible, within BSF_TRUTH_RANGE_MAX, both walls seen? ranges
- * and hit_shape are the simulated scan. 1 or 0.
+ * and hit_shape as bsf_truth_add. 1 or 0.
  */
 int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
                           const float *ranges, const int16_t *hit_shape);
+
+/** The same under the sparse-wall rule: visible, within BSF_TRUTH_RANGE_MAX,
+ *  each wall's run of consecutive hits long enough. 1 or 0. */
+int bsf_truth_corner_seen_sparse(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
+                                 const float *ranges, const int16_t *hit_shape);
 
 /**
  * The oracle of a corner: the best estimate of its vertex the data allow
@@ -131,10 +155,10 @@ int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
  * the wall (through the seam of a full-circle scan), as the sparse-wall rule
  * walks them, up to `reach` metres from the vertex (their true positions; 0
  * or less: the whole run); the vertex is the lines' intersection.
- * `measured` are the ranges the extractor saw; `unmixed` the same before
- * mixed pixels were added (NULL when none were): a beam whose two differ is
- * no return of the wall and is left out. clean and hit_shape are the scan as
- * simulated. On success *x, *y get the vertex (sensor frame) and, when not
+ * `measured` are the ranges the extractor saw; clean the ranges as simulated
+ * and hit_shape the shape each return lies on, as bsf_truth_add (a mixed
+ * pixel labelled -1 by bsf_truth_returns_on_shapes is no return of the wall
+ * and ends its run). On success *x, *y get the vertex (sensor frame) and, when not
  * NULL, n_side the returns used on each wall (shape_a, shape_b) and
  * len_side how far the farthest reaches from the vertex.
  * @return 0; -1 when a wall has fewer than 2 usable returns or the lines are
@@ -142,8 +166,7 @@ int bsf_truth_corner_seen(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
  */
 int bsf_truth_oracle_vertex(const bsf_scene_corner_t *c, const bsf_lidar_t *lidar,
                             const float *clean, const int16_t *hit_shape, const float *measured,
-                            const float *unmixed, double reach, double *x, double *y, int n_side[2],
-                            double len_side[2]);
+                            double reach, double *x, double *y, int n_side[2], double len_side[2]);
 
 /** How far the oracle's sides reach from the vertex (bsf_truth_oracle_vertex),
  *  metres; 0: the whole run of returns. bench_truth sets LC's max_side. */
@@ -173,7 +196,7 @@ extern size_t bsf_truth_oracle_n_keypoints;
  */
 int bsf_truth_add_oracle(bsf_truth_acc_t *acc, const bsf_scene_t *scene, const bsf_lidar_t *lidar,
                          const float *clean, const int16_t *hit_shape, const float *measured,
-                         const float *unmixed, const bsf_result_t *res);
+                         const bsf_result_t *res);
 
 /** Quantile q in [0,1] of a histogram (upper bin edge), metres; 0 when empty. */
 double bsf_truth_quantile(const bsf_truth_hist_t *h, double q);
