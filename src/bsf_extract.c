@@ -491,6 +491,48 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t run, float nois
            d2 > lc->split_min * lc->split_min && d2 > s * s * (sx * sx + sy * sy);
 }
 
+/* Is the end return p[0] a tail past a vertex two returns in, at p[2 step]:
+ * on another surface than the vertex's side, while the return p[step]
+ * between them lies on that side? LC's vertex then sits one return before
+ * the corner, the fit must bend twice within the last two returns, and no
+ * run beside the end is free of the vertex for tail_end to judge. The line
+ * is the vertex's side, the run p[2 step], ... p[(run + 1) step]; p[step]
+ * is on it when within split_sigmas standard errors of a return one step
+ * past the run (or split_min), and p[0] is a tail by tail_end's bound at
+ * two steps past it. */
+static int vertex_tail(const bsf_point_t *p, ptrdiff_t step, size_t run, float noise2,
+                       const bsf_lc_params_t *lc)
+{
+    bsf_point_t w[TAIL_RUN + 1u];
+    bsf_side_line_t l;
+    float bound2;
+    float d;
+    float sx;
+    float sy;
+    float s;
+    size_t k;
+    w[0] = p[step];
+    for (k = 1; k <= run; ++k) {
+        w[k] = p[(ptrdiff_t)(k + 1u) * step];
+    }
+    l.n = (int)run + 1;
+    bsf_side_fit(w, &l);
+    if (l.var < noise2) {
+        l.var = noise2;
+    }
+    bound2 = lc->split_sigmas * lc->split_sigmas * l.var;
+    if (l.d_near * l.d_near > bound2 * l.reach_nr &&
+        l.d_near * l.d_near > lc->split_min * lc->split_min) {
+        return 0; /* p[step] is off the side too: a second side of two returns */
+    }
+    d = bsf_side_distance(&l, p[0]);
+    sx = p[0].x - p[step].x;
+    sy = p[0].y - p[step].y;
+    s = bsf_sinf(lc->min_turn);
+    return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_i &&
+           d * d > lc->split_min * lc->split_min && d * d > s * s * (sx * sx + sy * sy);
+}
+
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
  * that leaves the other end out) is left off unless LC has a corner within
@@ -507,10 +549,25 @@ static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, siz
     if ((n_vertex == 0u || pos[0] > run + 1u) &&
         tail_end(pts, 1, run, ex->noise2, &ex->params.lc)) {
         *lo = 1u;
+    } else if (n_vertex > 0u && pos[0] == 2u) {
+        /* the vertex's side: up to TAIL_RUN returns, not past the next
+         * vertex (its return included) nor to the other end */
+        size_t side = (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u;
+        side = side < TAIL_RUN ? side : TAIL_RUN;
+        if (side >= TAIL_MIN_RUN && vertex_tail(pts, 1, side, ex->noise2, &ex->params.lc)) {
+            *lo = 1u;
+        }
     }
     if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
         tail_end(&pts[n - 1u], -1, run, ex->noise2, &ex->params.lc)) {
         *hi = n - 2u;
+    } else if (n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n) {
+        size_t side = n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u);
+        side = side < TAIL_RUN ? side : TAIL_RUN;
+        if (side >= TAIL_MIN_RUN &&
+            vertex_tail(&pts[n - 1u], -1, side, ex->noise2, &ex->params.lc)) {
+            *hi = n - 2u;
+        }
     }
 }
 #endif
