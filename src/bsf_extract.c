@@ -447,69 +447,91 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 #define TAIL_MIN_RUN 5u
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
- * nearer the sensor, that the straight run p[step], ... p[run step] beside
- * it (step +1 or -1) does not explain? At a concave corner seen at grazing
- * incidence the next wall often gives a single return before the corner,
- * which no corner test can confirm, and a curve bent to reach it swings
- * through free space (half a metre past a corridor's end wall on the
- * ground-truth scenes). It is one when the run's line (total least squares,
- * SVED's side line) misses p[0] by more than split_sigmas standard errors
- * of a new return one step past the run (the noise variance: the run's
- * scatter per degree of freedom, at least the scan's noise2 from LC, and
- * the line's own error there) and at least split_min, on the sensor's
- * side, with a turn of at least min_turn. Only the sensor's side: a convex
- * surface's last returns (a pillar's silhouette) bend away from the sensor
- * and still lie on it. The scan's noise keeps a short run, whose own
- * scatter over a few degrees of freedom is often far below the noise by
- * chance, from taking real returns for tails. */
-static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t run, float noise2,
+ * nearer the sensor, that the straight run p[(gap + 1) step], ...
+ * p[(gap + run) step] (step +1 or -1) does not explain? At a concave corner
+ * seen at grazing incidence the next wall often gives a single return
+ * before the corner, which no corner test can confirm, and a curve bent to
+ * reach it swings through free space (half a metre past a corridor's end
+ * wall on the ground-truth scenes). It is one when the run's line (total
+ * least squares, SVED's side line) misses p[0] by more than split_sigmas
+ * standard errors of a new return gap + 1 steps past the run (the noise
+ * variance: the run's scatter per degree of freedom, at least the scan's
+ * noise2 from LC, and the line's own error there) and at least split_min,
+ * on the sensor's side, with a turn of at least min_turn. Only the sensor's
+ * side: a convex surface's last returns (a pillar's silhouette) bend away
+ * from the sensor and still lie on it. The scan's noise keeps a short run,
+ * whose own scatter over a few degrees of freedom is often far below the
+ * noise by chance, from taking real returns for tails. With gap 1 the run
+ * is a vertex's side (the vertex two returns from the end) and the return
+ * p[step] between must lie on its line (within the same bound one step past
+ * it, or split_min): LC's vertex then sits one return before the corner and
+ * only p[0] is on the next surface. */
+static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
                     const bsf_lc_params_t *lc)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
-    float d2;
+    float bound2;
+    float d;
     float sx;
     float sy;
     float s;
     size_t k;
     for (k = 0; k <= run; ++k) {
-        w[k] = p[(ptrdiff_t)k * step];
+        w[k] = p[(ptrdiff_t)(k + gap) * step];
     }
     l.n = (int)run + 1;
     bsf_side_fit(w, &l);
     if (l.var < noise2) {
         l.var = noise2;
     }
-    d2 = l.d_near * l.d_near;
+    bound2 = lc->split_sigmas * lc->split_sigmas * l.var;
+    d = l.d_near;
+    if (gap > 0u) {
+        if (d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) {
+            return 0; /* p[step] is off the side too: a second side of two returns */
+        }
+        d = bsf_side_distance(&l, p[0]);
+        l.reach_nr = l.reach_i;
+    }
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
-    return l.d_near * (l.nx * l.cx + l.ny * l.cy) < 0.0f &&
-           d2 > lc->split_sigmas * lc->split_sigmas * l.reach_nr * l.var &&
-           d2 > lc->split_min * lc->split_min && d2 > s * s * (sx * sx + sy * sy);
+    return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_nr &&
+           d * d > lc->split_min * lc->split_min && d * d > s * s * (sx * sx + sy * sy);
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
  * that leaves the other end out) is left off unless LC has a corner within
- * that run, which already bends the curve there. */
+ * that run, which already bends the curve there; with the corner two
+ * returns from the end, the end is judged by the corner's side (up to
+ * TAIL_RUN returns from the vertex, not past the next one nor to the other
+ * end). */
 static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
 {
     const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
+    size_t gap;
+    size_t side;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
         n < TAIL_MIN_RUN + 2u) {
         return;
     }
-    if ((n_vertex == 0u || pos[0] > run + 1u) &&
-        tail_end(pts, 1, run, ex->noise2, &ex->params.lc)) {
+    gap = n_vertex > 0u && pos[0] == 2u;
+    side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : run;
+    if (side >= TAIL_MIN_RUN && (gap || n_vertex == 0u || pos[0] > run + 1u) &&
+        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
         *lo = 1u;
     }
-    if ((n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, run, ex->noise2, &ex->params.lc)) {
+    gap = n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n;
+    side = gap ? n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u) : run;
+    if (side >= TAIL_MIN_RUN &&
+        (gap || n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
+        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
         *hi = n - 2u;
     }
 }

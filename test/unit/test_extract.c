@@ -653,6 +653,62 @@ static void test_a_tail_return_on_a_short_segment_is_left_off_the_feature(void)
     TEST_ASSERT_TRUE(t.wasted_on <= t.wasted_off + 2u * 12u);
 }
 
+/* A cluttered room (10 m x 7 m, toothed shelves, posts, boxes) seen by a
+ * 361-beam 270-degree LIDAR with 1 cm noise from 40 poses on a circle. At
+ * some corners the second wall gives one return at a segment's end and LC
+ * puts its vertex one return early, two returns from the end: the span past
+ * the vertex then holds one return on each wall and the curve swings 16 cm
+ * past the corner. The return on the second wall is left off when the
+ * return between lies on the vertex's side. */
+static void test_a_tail_return_past_an_end_vertex_is_left_off_the_feature(void)
+{
+    static float clean[BSF_MAX_POINTS];
+    static int16_t hits[BSF_MAX_POINTS];
+    const size_t n_beams = 361u;
+    const double fov = (double)(n_beams - 1u) * 0.75 * 3.14159265358979 / 180.0;
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scene_clutter_t c;
+    bsf_scene_rng_t rng;
+    double worst = 0.0;
+    long k;
+    c.half_w = 5.0;
+    c.half_h = 3.5;
+    c.n_teeth = 4;
+    c.tooth_depth = 0.4;
+    c.n_posts = 6;
+    c.n_boxes = 5;
+    c.clear = 1.5;
+    bsf_scene_rng_seed(&rng, 2718u);
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_clutter_room(&scene, &c, &rng));
+    bsf_scene_rng_seed(&rng, 1623u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    for (k = 0; k < 40; ++k) {
+        const double a = 2.0 * 3.14159265358979 * (double)k / 40.0;
+        bsf_lidar_t l = bsf_lidar_default(0.8 * cos(a), 0.8 * sin(a),
+                                          atan2(sin(1.5 * a), cos(1.5 * a)), n_beams, fov);
+        bsf_scan_t s;
+        double rms;
+        double max_d;
+        size_t i;
+        l.noise_sigma = 0.0;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
+        for (i = 0; i < n_beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0) {
+                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
+                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
+            }
+        }
+        s = scan_of(&l);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        curve_to_truth(&l, &rms, &max_d);
+        worst = max_d > worst ? max_d : worst;
+    }
+    TEST_ASSERT_TRUE_MESSAGE(worst < 0.08, "a curve swings past a corner beside an end vertex");
+}
+
 /* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
  * on dense scans whose fits climb near the target, and the curves it leaves
  * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
@@ -714,6 +770,7 @@ int main(void)
     RUN_TEST(test_the_cut_policy_splits_rough_features_and_keeps_every_point);
     RUN_TEST(test_a_tail_return_past_a_concave_corner_is_left_off_the_feature);
     RUN_TEST(test_a_tail_return_on_a_short_segment_is_left_off_the_feature);
+    RUN_TEST(test_a_tail_return_past_an_end_vertex_is_left_off_the_feature);
     RUN_TEST(test_a_mixed_pixel_at_the_end_of_a_corner_side_costs_no_corner);
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
