@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "bench_scenes.h"
 #include "bsf/bsf.h"
 #include "bsf_scene.h"
 #include "unity.h"
@@ -667,26 +668,16 @@ static void test_a_tail_return_past_an_end_vertex_is_left_off_the_feature(void)
     const size_t n_beams = 361u;
     const double fov = (double)(n_beams - 1u) * 0.75 * 3.14159265358979 / 180.0;
     const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
-    bsf_scene_clutter_t c;
     bsf_scene_rng_t rng;
     double worst = 0.0;
     long k;
-    c.half_w = 5.0;
-    c.half_h = 3.5;
-    c.n_teeth = 4;
-    c.tooth_depth = 0.4;
-    c.n_posts = 6;
-    c.n_boxes = 5;
-    c.clear = 1.5;
-    bsf_scene_rng_seed(&rng, 2718u);
-    bsf_scene_init(&scene);
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_clutter_room(&scene, &c, &rng));
+    /* bench_truth's cluttered room and poses */
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bench_truth_clutter(&scene));
     bsf_scene_rng_seed(&rng, 1623u);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
     for (k = 0; k < 40; ++k) {
-        const double a = 2.0 * 3.14159265358979 * (double)k / 40.0;
-        bsf_lidar_t l = bsf_lidar_default(0.8 * cos(a), 0.8 * sin(a),
-                                          atan2(sin(1.5 * a), cos(1.5 * a)), n_beams, fov);
+        const bsf_scene_pose_t pose = bench_truth_clutter_pose(k, 40);
+        bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, n_beams, fov);
         bsf_scan_t s;
         double rms;
         double max_d;
