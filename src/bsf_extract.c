@@ -533,29 +533,35 @@ static void trim_tails(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t
     const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    size_t gap;
-    size_t near;
-    size_t side;
+    int e;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
         n < TAIL_FLOAT_RUN + 2u) {
         return;
     }
-    gap = n_vertex > 0u && pos[0] == 2u;
-    near = !gap && n_vertex > 0u && pos[0] <= run + 1u;
-    side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : (near ? pos[0] - 1u : run);
-    if ((side >= TAIL_MIN_RUN ||
-         (side >= TAIL_FLOAT_RUN && floating_end(&ex->points, s->first, -1))) &&
-        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
-        *lo = 1u;
-    }
-    gap = n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n;
-    near = !gap && n_vertex > 0u && (size_t)pos[n_vertex - 1u] + run + 2u >= n;
-    side = gap ? n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u)
-               : (near ? n - 2u - (size_t)pos[n_vertex - 1u] : run);
-    if ((side >= TAIL_MIN_RUN ||
-         (side >= TAIL_FLOAT_RUN && floating_end(&ex->points, s->last, 1))) &&
-        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
-        *hi = n - 2u;
+    for (e = 0; e < 2; ++e) {
+        /* Distances from this end to its nearest vertex (n: none) and to
+         * the next one (n - 2 when there is no second vertex). */
+        size_t d1 = n;
+        size_t d2 = n - 2u;
+        size_t side;
+        if (n_vertex > 0u) {
+            d1 = e ? n - 1u - pos[n_vertex - 1u] : pos[0];
+        }
+        if (n_vertex > 1u) {
+            d2 = e ? n - 1u - pos[n_vertex - 2u] : pos[1];
+        }
+        side = d1 == 2u ? d2 - 1u : (d1 <= run + 1u ? d1 - 1u : run);
+        if ((side >= TAIL_MIN_RUN ||
+             (side >= TAIL_FLOAT_RUN &&
+              floating_end(&ex->points, e ? s->last : s->first, e ? 1 : -1))) &&
+            tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, d1 == 2u, side < run ? side : run,
+                     ex->noise2, &ex->params.lc)) {
+            if (e) {
+                *hi = n - 2u;
+            } else {
+                *lo = 1u;
+            }
+        }
     }
 }
 #endif
