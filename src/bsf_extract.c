@@ -468,8 +468,12 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * p[step] between must lie on its line (within the same bound one step past
  * it, or split_min): LC's vertex then sits one return before the corner and
  * only p[0] is on the next surface. */
-static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
-                    const bsf_lc_params_t *lc)
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
+#endif
+static int
+tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
+         const bsf_lc_params_t *lc)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
