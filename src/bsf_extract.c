@@ -524,13 +524,14 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
- * that leaves the other end out) is left off unless LC has a corner within
- * that run, which already bends the curve there; with the corner two
- * returns from the end, the end is judged by the corner's side (up to
- * TAIL_RUN returns from the vertex, not past the next one nor to the other
- * end). A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1 returns judges only a
- * floating end (floating_end): a far surface seen over a few returns
- * through a gap, whose end beam blends with the surface in front. */
+ * that leaves the other end out) is left off. With an LC corner within
+ * that run the run is the corner's side: the returns between the end and
+ * the corner, its apex left out; with the corner two returns from the end,
+ * up to TAIL_RUN returns from the vertex, not past the next one nor to the
+ * other end. A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1 returns judges
+ * only a floating end (floating_end): a far surface seen over a few
+ * returns through a gap, whose end beam blends with the surface in
+ * front. */
 static void trim_tails(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, size_t n_vertex,
                        size_t *lo, size_t *hi)
 {
