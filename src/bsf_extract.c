@@ -443,8 +443,10 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 #define TAIL_RUN 8u
 /* The shortest run: a segment of fewer than TAIL_MIN_RUN + 2 returns
  * (the run, the end judged, the other end left out of the run) is not
- * judged. */
+ * judged, unless its end is a floating return (floating_end). */
 #define TAIL_MIN_RUN 5u
+/* The shortest run beside a floating return (floating_end). */
+#define TAIL_FLOAT_RUN 3u
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
  * nearer the sensor, that the straight run p[(gap + 1) step], ...
@@ -466,8 +468,12 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * p[step] between must lie on its line (within the same bound one step past
  * it, or split_min): LC's vertex then sits one return before the corner and
  * only p[0] is on the next surface. */
-static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
-                    const bsf_lc_params_t *lc)
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
+#endif
+static int
+tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
+         const bsf_lc_params_t *lc)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
@@ -503,36 +509,64 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
            d * d > lc->split_min * lc->split_min && d * d > s * s * (sx * sx + sy * sy);
 }
 
+/* Does the beam past segment end b (dir -1 before it, +1 after it) read a
+ * valid range nearer the sensor than b? Then b lies in range between the
+ * surface its segment follows and the nearer surface seen past it: at a
+ * depth jump, where a mixed pixel (a beam that reads a blend of the two
+ * ranges and floats in free space) lies. A real end return of a far
+ * surface, beside the surface that hides the rest, lies on its line, which
+ * tail_end checks. */
+static int floating_end(const bsf_points_t *pts, size_t b, int dir)
+{
+    const size_t o = b + (size_t)(ptrdiff_t)dir;
+    return o < pts->count && pts->valid[o] && pts->range[o] < pts->range[b];
+}
+
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
- * that leaves the other end out) is left off unless LC has a corner within
- * that run, which already bends the curve there; with the corner two
- * returns from the end, the end is judged by the corner's side (up to
- * TAIL_RUN returns from the vertex, not past the next one nor to the other
- * end). */
-static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
+ * that leaves the other end out) is left off. With an LC corner within
+ * that run the run is the corner's side: the returns between the end and
+ * the corner, its apex left out; with the corner two returns from the end,
+ * up to TAIL_RUN returns from the vertex, not past the next one nor to the
+ * other end. A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1 returns judges
+ * only a floating end (floating_end): a far surface seen over a few
+ * returns through a gap, whose end beam blends with the surface in
+ * front. */
+static void trim_tails(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, size_t n_vertex,
+                       size_t *lo, size_t *hi)
 {
     const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    size_t gap;
-    size_t side;
+    int e;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < TAIL_MIN_RUN + 2u) {
+        n < TAIL_FLOAT_RUN + 2u) {
         return;
     }
-    gap = n_vertex > 0u && pos[0] == 2u;
-    side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : run;
-    if (side >= TAIL_MIN_RUN && (gap || n_vertex == 0u || pos[0] > run + 1u) &&
-        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
-        *lo = 1u;
-    }
-    gap = n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n;
-    side = gap ? n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u) : run;
-    if (side >= TAIL_MIN_RUN &&
-        (gap || n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
-        *hi = n - 2u;
+    for (e = 0; e < 2; ++e) {
+        /* Distances from this end to its nearest vertex (n: none) and to
+         * the next one (n - 2 when there is no second vertex). */
+        size_t d1 = n;
+        size_t d2 = n - 2u;
+        size_t side;
+        if (n_vertex > 0u) {
+            d1 = e ? n - 1u - pos[n_vertex - 1u] : pos[0];
+        }
+        if (n_vertex > 1u) {
+            d2 = e ? n - 1u - pos[n_vertex - 2u] : pos[1];
+        }
+        side = d1 == 2u ? d2 - 1u : (d1 <= run + 1u ? d1 - 1u : run);
+        if ((side >= TAIL_MIN_RUN ||
+             (side >= TAIL_FLOAT_RUN &&
+              floating_end(&ex->points, e ? s->last : s->first, e ? 1 : -1))) &&
+            tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, d1 == 2u, side < run ? side : run,
+                     ex->noise2, &ex->params.lc)) {
+            if (e) {
+                *hi = n - 2u;
+            } else {
+                *lo = 1u;
+            }
+        }
     }
 }
 #endif
@@ -773,7 +807,7 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     int may_split = 1;
     size_t depth = 1u;
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    trim_tails(ex, n, n_vertex, &lo0, &hi0);
+    trim_tails(ex, s, n, n_vertex, &lo0, &hi0);
 #endif
     lo[0] = (uint16_t)lo0;
     hi[0] = (uint16_t)hi0;

@@ -81,8 +81,12 @@ typedef struct {
      *  run's own scatter) and lc.split_min, turning by lc.min_turn or more:
      *  a single return on the next wall past a concave corner seen at
      *  grazing incidence, or on an occluder. A curve bent to reach it swings
-     *  through free space. Segments of at least 17 returns, and not where LC
-     *  has a corner within the run. The return counts as wasted in Γ.
+     *  through free space. Segments of at least 7 returns (the run is then
+     *  shorter, down to 5, and the noise at least the scan's); where LC has
+     *  a corner within the run, the returns between the end and the corner.
+     *  An end whose neighbouring beam past it reads nearer the sensor (a
+     *  floating return at a depth jump, likely a mixed pixel) is judged
+     *  from a run of 3 returns. The return counts as wasted in Γ.
      *  0 keeps every return (bsf_params_paper). */
     uint8_t trim_tails;
     /** The three PDM methods: a bound on the fit's work per scan, for
