@@ -445,6 +445,13 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * (the run, the end judged, the other end left out of the run) is not
  * judged. */
 #define TAIL_MIN_RUN 5u
+/* The shortest run that judges a two-return end (a segment of 5 returns). */
+#define TAIL_TWO_RUN 3u
+
+static float sq_dist(bsf_point_t a, bsf_point_t b)
+{
+    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+}
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
  * nearer the sensor, that the straight run p[(gap + 1) step], ...
@@ -465,14 +472,22 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * is a vertex's side (the vertex two returns from the end) and the return
  * p[step] between must lie on its line (within the same bound one step past
  * it, or split_min): LC's vertex then sits one return before the corner and
- * only p[0] is on the next surface. */
+ * only p[0] is on the next surface. With apex (gap 1) it asks instead
+ * whether p[step] and p[0] are a second surface: both off the run's line
+ * (p[step] by the bound above), on either side, their line turning away
+ * from it by min_turn or more and crossing it (the corner, written to apex)
+ * between the beams of p[2 step] and p[step], and the step from p[2 step]
+ * to p[step] at least twice the run's spacing. A smooth surface (a
+ * pillar's silhouette) bends by degrees and keeps its spacing; a second
+ * surface starts where the returns jump. */
 static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
-                    const bsf_lc_params_t *lc)
+                    const bsf_lc_params_t *lc, bsf_point_t *apex)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
     float bound2;
     float d;
+    float d1;
     float sx;
     float sy;
     float s;
@@ -487,9 +502,11 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
     }
     bound2 = lc->split_sigmas * lc->split_sigmas * l.var;
     d = l.d_near;
+    d1 = d;
     if (gap > 0u) {
-        if (d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) {
-            return 0; /* p[step] is off the side too: a second side of two returns */
+        if ((d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) ==
+            (apex == NULL)) {
+            return 0; /* p[step] off the side too (a second side of two returns), or on it */
         }
         d = bsf_side_distance(&l, p[0]);
         l.reach_nr = l.reach_i;
@@ -497,6 +514,19 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
+    if (apex != NULL) {
+        const bsf_point_t q = p[2 * step];
+        d -= d1;
+        if (!(d * d1 > 0.0f && d * d > s * s * (sx * sx + sy * sy) &&
+              sq_dist(q, p[step]) * (float)((run - 1u) * (run - 1u)) >
+                  4.0f * sq_dist(w[1], w[run]))) {
+            return 0;
+        }
+        d1 /= d;
+        apex->x = p[step].x - d1 * sx;
+        apex->y = p[step].y - d1 * sy;
+        return (q.x * apex->y - q.y * apex->x) * (apex->x * p[step].y - apex->y * p[step].x) > 0.0f;
+    }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
     return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_nr &&
@@ -509,29 +539,50 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
  * that run, which already bends the curve there; with the corner two
  * returns from the end, the end is judged by the corner's side (up to
  * TAIL_RUN returns from the vertex, not past the next one nor to the other
- * end). */
-static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
+ * end). A segment too short for that run (fewer than TAIL_MIN_RUN + 2
+ * returns) and without a corner gets one (*nv, a vertex at its third
+ * return from that end, anchored at the crossing) when its last two
+ * returns at one end are a second surface (tail_end with an apex, judged by
+ * the other returns): its one quadratic span cannot turn there and would
+ * swing off both surfaces, and leaving the two returns out would waste a
+ * third of the segment. */
+static void trim_tails(bsf_extractor_t *ex, size_t n, size_t *nv, size_t *lo, size_t *hi)
 {
-    const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
+    uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
+    const size_t n_vertex = *nv;
     size_t gap;
     size_t side;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < TAIL_MIN_RUN + 2u) {
+        n < TAIL_TWO_RUN + 2u) {
+        return;
+    }
+    if (n < TAIL_MIN_RUN + 2u) {
+        if (n_vertex == 0u) {
+            bsf_point_t *apex = ex->scratch.seg.use.fit.vertex_anchor;
+            if (tail_end(pts, 1, 1u, run, ex->noise2, &ex->params.lc, apex)) {
+                pos[0] = 2u;
+                *nv = 1u;
+            } else if (tail_end(&pts[n - 1u], -1, 1u, run, ex->noise2, &ex->params.lc, apex)) {
+                pos[0] = (uint16_t)(n - 3u);
+                *nv = 1u;
+            }
+        }
         return;
     }
     gap = n_vertex > 0u && pos[0] == 2u;
     side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : run;
     if (side >= TAIL_MIN_RUN && (gap || n_vertex == 0u || pos[0] > run + 1u) &&
-        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
+        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc, NULL)) {
         *lo = 1u;
     }
     gap = n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n;
     side = gap ? n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u) : run;
     if (side >= TAIL_MIN_RUN &&
         (gap || n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
+        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc,
+                 NULL)) {
         *hi = n - 2u;
     }
 }
@@ -773,7 +824,7 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     int may_split = 1;
     size_t depth = 1u;
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    trim_tails(ex, n, n_vertex, &lo0, &hi0);
+    trim_tails(ex, n, &n_vertex, &lo0, &hi0);
 #endif
     lo[0] = (uint16_t)lo0;
     hi[0] = (uint16_t)hi0;
