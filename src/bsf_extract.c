@@ -514,23 +514,29 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
+    /* The turn: p[0] off the line by its own return, or off p[step]'s
+     * offset (two returns) by min_turn or more. */
+    d1 = apex != NULL ? d - d1 : d;
+    if (!(d1 * d1 > s * s * (sx * sx + sy * sy))) {
+        return 0;
+    }
     if (apex != NULL) {
-        const bsf_point_t q = p[2 * step];
-        d -= d1;
-        if (!(d * d1 > 0.0f && d * d > s * s * (sx * sx + sy * sy) &&
-              sq_dist(q, p[step]) * (float)((run - 1u) * (run - 1u)) >
-                  4.0f * sq_dist(w[1], w[run]))) {
+        d = d - d1; /* p[step]'s offset */
+        if (!(d * d1 > 0.0f &&
+              sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]))) {
             return 0;
         }
-        d1 /= d;
-        apex->x = p[step].x - d1 * sx;
-        apex->y = p[step].y - d1 * sy;
-        return (q.x * apex->y - q.y * apex->x) * (apex->x * p[step].y - apex->y * p[step].x) > 0.0f;
+        d /= d1;
+        apex->x = p[step].x - d * sx;
+        apex->y = p[step].y - d * sy;
+        return (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
+                   (apex->x * p[step].y - apex->y * p[step].x) >
+               0.0f;
     }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
     return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_nr &&
-           d * d > lc->split_min * lc->split_min && d * d > s * s * (sx * sx + sy * sy);
+           d * d > lc->split_min * lc->split_min;
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
@@ -546,30 +552,27 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
  * the other returns): its one quadratic span cannot turn there and would
  * swing off both surfaces, and leaving the two returns out would waste a
  * third of the segment. */
-static void trim_tails(bsf_extractor_t *ex, size_t n, size_t *nv, size_t *lo, size_t *hi)
+static size_t trim_tails(bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
 {
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    const size_t n_vertex = *nv;
     size_t gap;
     size_t side;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
         n < TAIL_TWO_RUN + 2u) {
-        return;
+        return n_vertex;
     }
     if (n < TAIL_MIN_RUN + 2u) {
-        if (n_vertex == 0u) {
-            bsf_point_t *apex = ex->scratch.seg.use.fit.vertex_anchor;
-            if (tail_end(pts, 1, 1u, run, ex->noise2, &ex->params.lc, apex)) {
-                pos[0] = 2u;
-                *nv = 1u;
-            } else if (tail_end(&pts[n - 1u], -1, 1u, run, ex->noise2, &ex->params.lc, apex)) {
-                pos[0] = (uint16_t)(n - 3u);
-                *nv = 1u;
+        size_t k;
+        for (k = 0; k < 2u && n_vertex == 0u; ++k) {
+            if (tail_end(k ? &pts[n - 1u] : pts, k ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
+                         ex->scratch.seg.use.fit.vertex_anchor)) {
+                pos[0] = (uint16_t)(k ? n - 3u : 2u);
+                n_vertex = 1u;
             }
         }
-        return;
+        return n_vertex;
     }
     gap = n_vertex > 0u && pos[0] == 2u;
     side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : run;
@@ -585,6 +588,7 @@ static void trim_tails(bsf_extractor_t *ex, size_t n, size_t *nv, size_t *lo, si
                  NULL)) {
         *hi = n - 2u;
     }
+    return n_vertex;
 }
 #endif
 
@@ -824,7 +828,7 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     int may_split = 1;
     size_t depth = 1u;
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    trim_tails(ex, n, &n_vertex, &lo0, &hi0);
+    n_vertex = trim_tails(ex, n, n_vertex, &lo0, &hi0);
 #endif
     lo[0] = (uint16_t)lo0;
     hi[0] = (uint16_t)hi0;
