@@ -557,35 +557,35 @@ static size_t trim_tails(bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t 
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
+    /* Too short for the tail rule's run: a two-return end is a corner. */
+    bsf_point_t *apex = n < TAIL_MIN_RUN + 2u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
     size_t gap;
     size_t side;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < TAIL_TWO_RUN + 2u) {
-        return n_vertex;
-    }
-    if (n < TAIL_MIN_RUN + 2u) {
-        size_t k;
-        for (k = 0; k < 2u && n_vertex == 0u; ++k) {
-            if (tail_end(k ? &pts[n - 1u] : pts, k ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
-                         ex->scratch.seg.use.fit.vertex_anchor)) {
-                pos[0] = (uint16_t)(k ? n - 3u : 2u);
-                n_vertex = 1u;
-            }
-        }
+        n < TAIL_TWO_RUN + 2u || (apex != NULL && n_vertex > 0u)) {
         return n_vertex;
     }
     gap = n_vertex > 0u && pos[0] == 2u;
     side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : run;
-    if (side >= TAIL_MIN_RUN && (gap || n_vertex == 0u || pos[0] > run + 1u) &&
-        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc, NULL)) {
+    if ((apex != NULL || (side >= TAIL_MIN_RUN && (gap || n_vertex == 0u || pos[0] > run + 1u))) &&
+        tail_end(pts, 1, gap || apex != NULL, side < run ? side : run, ex->noise2, &ex->params.lc,
+                 apex)) {
+        if (apex != NULL) {
+            pos[0] = 2u;
+            return 1u;
+        }
         *lo = 1u;
     }
     gap = n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n;
     side = gap ? n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u) : run;
-    if (side >= TAIL_MIN_RUN &&
-        (gap || n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc,
-                 NULL)) {
+    if ((apex != NULL || (side >= TAIL_MIN_RUN &&
+                          (gap || n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n))) &&
+        tail_end(&pts[n - 1u], -1, gap || apex != NULL, side < run ? side : run, ex->noise2,
+                 &ex->params.lc, apex)) {
+        if (apex != NULL) {
+            pos[0] = (uint16_t)(n - 3u);
+            return 1u;
+        }
         *hi = n - 2u;
     }
     return n_vertex;
