@@ -546,12 +546,13 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
  * returns from the end, the end is judged by the corner's side (up to
  * TAIL_RUN returns from the vertex, not past the next one nor to the other
  * end). A segment too short for that run (fewer than TAIL_MIN_RUN + 2
- * returns) and without a corner gets one (*nv, a vertex at its third
- * return from that end, anchored at the crossing) when its last two
- * returns at one end are a second surface (tail_end with an apex, judged by
- * the other returns): its one quadratic span cannot turn there and would
- * swing off both surfaces, and leaving the two returns out would waste a
- * third of the segment. */
+ * returns) and without a corner gets one, a vertex at its third return from
+ * that end anchored at the crossing, when its last two returns at one end
+ * are a second surface (tail_end with an apex, judged by the other
+ * returns): its one quadratic span cannot turn there and would swing off
+ * both surfaces, and leaving the two returns out would waste a third of the
+ * segment. Returns the segment's vertex count (vertex_pos and
+ * vertex_anchor, as gather_segment wrote them, or that one vertex). */
 static size_t trim_tails(bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
 {
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
