@@ -445,8 +445,15 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * (the run, the end judged, the other end left out of the run) is not
  * judged, unless its end is a floating return (floating_end). */
 #define TAIL_MIN_RUN 5u
-/* The shortest run beside a floating return (floating_end). */
+/* The shortest run beside a floating return (floating_end), and beside a
+ * two-return end of a segment too short for TAIL_MIN_RUN (a segment of 5
+ * returns). */
 #define TAIL_FLOAT_RUN 3u
+
+static float sq_dist(bsf_point_t a, bsf_point_t b)
+{
+    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+}
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
  * nearer the sensor, that the straight run p[(gap + 1) step], ...
@@ -467,18 +474,26 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * is a vertex's side (the vertex two returns from the end) and the return
  * p[step] between must lie on its line (within the same bound one step past
  * it, or split_min): LC's vertex then sits one return before the corner and
- * only p[0] is on the next surface. */
+ * only p[0] is on the next surface. With apex (gap 1) it asks instead
+ * whether p[step] and p[0] are a second surface: both off the run's line
+ * (p[step] by the bound above), on either side, their line turning away
+ * from it by min_turn or more and crossing it (the corner, written to apex)
+ * between the beams of p[2 step] and p[step], and the step from p[2 step]
+ * to p[step] at least twice the run's spacing. A smooth surface (a
+ * pillar's silhouette) bends by degrees and keeps its spacing; a second
+ * surface starts where the returns jump. */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
 #endif
 static int
 tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
-         const bsf_lc_params_t *lc)
+         const bsf_lc_params_t *lc, bsf_point_t *apex)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
     float bound2;
     float d;
+    float d1;
     float sx;
     float sy;
     float s;
@@ -493,9 +508,11 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     }
     bound2 = lc->split_sigmas * lc->split_sigmas * l.var;
     d = l.d_near;
+    d1 = d;
     if (gap > 0u) {
-        if (d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) {
-            return 0; /* p[step] is off the side too: a second side of two returns */
+        if ((d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) ==
+            (apex == NULL)) {
+            return 0; /* p[step] off the side too (a second side of two returns), or on it */
         }
         d = bsf_side_distance(&l, p[0]);
         l.reach_nr = l.reach_i;
@@ -503,10 +520,29 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
+    /* The turn: p[0] off the line by its own return, or off p[step]'s
+     * offset (two returns) by min_turn or more. */
+    d1 = apex != NULL ? d - d1 : d;
+    if (!(d1 * d1 > s * s * (sx * sx + sy * sy))) {
+        return 0;
+    }
+    if (apex != NULL) {
+        d = d - d1; /* p[step]'s offset */
+        if (!(d * d1 > 0.0f &&
+              sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]))) {
+            return 0;
+        }
+        d /= d1;
+        apex->x = p[step].x - d * sx;
+        apex->y = p[step].y - d * sy;
+        return (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
+                   (apex->x * p[step].y - apex->y * p[step].x) >
+               0.0f;
+    }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
     return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_nr &&
-           d * d > lc->split_min * lc->split_min && d * d > s * s * (sx * sx + sy * sy);
+           d * d > lc->split_min * lc->split_min;
 }
 
 /* Does the beam past segment end b (dir -1 before it, +1 after it) read a
@@ -531,17 +567,34 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
  * other end. A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1 returns judges
  * only a floating end (floating_end): a far surface seen over a few
  * returns through a gap, whose end beam blends with the surface in
- * front. */
-static void trim_tails(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, size_t n_vertex,
-                       size_t *lo, size_t *hi)
+ * front. A segment too short for TAIL_MIN_RUN and without a corner gets
+ * one, a vertex at its third return from that end anchored at the
+ * crossing, when its last two returns at one end are a second surface
+ * (tail_end with an apex, judged by the other returns): its one quadratic
+ * span cannot turn there and would swing off both surfaces, and leaving
+ * the two returns out would waste a third of the segment. Returns the
+ * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
+ * wrote them, or that one vertex). */
+static size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, size_t n_vertex,
+                         size_t *lo, size_t *hi)
 {
-    const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
+    uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
+    /* Too short for the tail rule's run: a two-return end is a corner. */
+    bsf_point_t *apex =
+        n < TAIL_MIN_RUN + 2u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
     int e;
     if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
         n < TAIL_FLOAT_RUN + 2u) {
-        return;
+        return n_vertex;
+    }
+    for (e = 0; apex != NULL && e < 2; ++e) {
+        if (tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
+                     apex)) {
+            pos[0] = (uint16_t)(e ? n - 3u : 2u);
+            return 1u;
+        }
     }
     for (e = 0; e < 2; ++e) {
         /* Distances from this end to its nearest vertex (n: none) and to
@@ -560,7 +613,7 @@ static void trim_tails(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t
              (side >= TAIL_FLOAT_RUN &&
               floating_end(&ex->points, e ? s->last : s->first, e ? 1 : -1))) &&
             tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, d1 == 2u, side < run ? side : run,
-                     ex->noise2, &ex->params.lc)) {
+                     ex->noise2, &ex->params.lc, NULL)) {
             if (e) {
                 *hi = n - 2u;
             } else {
@@ -568,6 +621,7 @@ static void trim_tails(const bsf_extractor_t *ex, const bsf_segment_t *s, size_t
             }
         }
     }
+    return n_vertex;
 }
 #endif
 
@@ -807,7 +861,7 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     int may_split = 1;
     size_t depth = 1u;
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    trim_tails(ex, s, n, n_vertex, &lo0, &hi0);
+    n_vertex = trim_tails(ex, s, n, n_vertex, &lo0, &hi0);
 #endif
     lo[0] = (uint16_t)lo0;
     hi[0] = (uint16_t)hi0;

@@ -87,6 +87,10 @@ typedef struct {
      *  An end whose neighbouring beam past it reads nearer the sensor (a
      *  floating return at a depth jump, likely a mixed pixel) is judged
      *  from a run of 3 returns. The return counts as wasted in Γ.
+     *  A segment of 5 or 6 returns without a corner whose last two returns
+     *  at one end lie off the line of the others, turning by lc.min_turn
+     *  or more and starting with a step at least twice their spacing, gets
+     *  a vertex where the two lines cross instead (no return is left out).
      *  0 keeps every return (bsf_params_paper). */
     uint8_t trim_tails;
     /** The three PDM methods: a bound on the fit's work per scan, for

@@ -764,6 +764,76 @@ static void test_a_floating_return_at_a_depth_jump_is_left_off_a_short_far_wall(
     TEST_ASSERT_TRUE_MESSAGE(worst < 0.03, "a curve reaches out to a floating return");
 }
 
+/* bench_truth's corridor at 1-degree beams (181 over 180 degrees), 1 cm
+ * noise, its 40 poses. Far along it a wall end seen square-on gives 3-4
+ * returns and the wall behind it, receding at grazing incidence, 2 more
+ * half a metre apart: SVED joins them into a segment of 5 or 6 returns,
+ * too short for the tail rule or an LC corner, and its one quadratic span
+ * swings 5-7 cm off both walls to reach them. Such an end gets a vertex
+ * where the two lines cross, and its curve stays within 1.2 cm of them. */
+static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex(void)
+{
+    static float clean[BSF_MAX_POINTS];
+    static int16_t hits[BSF_MAX_POINTS];
+    const size_t n_beams = 181u;
+    const double fov = 3.14159265358979;
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scene_rng_t rng;
+    size_t swinging = 0u;
+    size_t short_features = 0u;
+    size_t short_vertices = 0u;
+    long k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bench_truth_corridor(&scene));
+    bsf_scene_rng_seed(&rng, 1436u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    for (k = 0; k < 40; ++k) {
+        const bsf_scene_pose_t pose = bench_truth_corridor_pose(k, 40);
+        bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, n_beams, fov);
+        bsf_scan_t s;
+        size_t i;
+        size_t fi;
+        l.noise_sigma = 0.0;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
+        for (i = 0; i < n_beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0) {
+                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
+                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
+            }
+        }
+        s = scan_of(&l);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        for (fi = 0; fi < res.n_features; ++fi) {
+            const bsf_feature_t *f = &res.features[fi];
+            int j;
+            double fw = 0.0;
+            if (f->n_points > 6u) {
+                continue;
+            }
+            ++short_features;
+            for (j = 0; j < f->n_ctrl; ++j) {
+                short_vertices += res.ctrl_is_vertex[f->ctrl_first + (size_t)j];
+            }
+            for (j = 0; j <= 200; ++j) {
+                bsf_point_t q;
+                double wx, wy, d;
+                TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(&res.ctrl[f->ctrl_first], f->n_ctrl,
+                                                               (float)j / 200.0f, &q, NULL, NULL));
+                bsf_scene_sensor_to_world(&l.pose, (double)q.x, (double)q.y, &wx, &wy);
+                d = bsf_scene_distance_to_surface(&scene, wx, wy, NULL);
+                fw = d > fw ? d : fw;
+            }
+            swinging += fw > 0.05;
+        }
+    }
+    TEST_ASSERT_TRUE_MESSAGE(short_features >= 15u, "the scene should give short segments");
+    TEST_ASSERT_TRUE_MESSAGE(short_vertices >= 8u, "short segments got no vertex");
+    /* 5 without the rule (6-7 cm off); the one left ends in two returns
+     * 0.5 m apart after three as sparse, no jump where the surfaces change. */
+    TEST_ASSERT_TRUE_MESSAGE(swinging <= 1u, "short segments' curves swing off the walls");
+}
+
 /* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
  * on dense scans whose fits climb near the target, and the curves it leaves
  * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
@@ -827,6 +897,7 @@ int main(void)
     RUN_TEST(test_a_tail_return_on_a_short_segment_is_left_off_the_feature);
     RUN_TEST(test_a_tail_return_past_an_end_vertex_is_left_off_the_feature);
     RUN_TEST(test_a_floating_return_at_a_depth_jump_is_left_off_a_short_far_wall);
+    RUN_TEST(test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex);
     RUN_TEST(test_a_mixed_pixel_at_the_end_of_a_corner_side_costs_no_corner);
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
