@@ -24,6 +24,7 @@
  * to a counter, the buffer or the sink.
  */
 #include "bsf/bsf_stream.h"
+#include "bsf_compact.h"
 
 #include <math.h>
 #include <string.h>
@@ -342,7 +343,7 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 /* A feature's own fields (not its points) within the result and the caps. */
-static int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
+static BSF_COMPACT_INLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
 {
     const size_t n = f->n_ctrl;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
@@ -398,7 +399,7 @@ static bsf_status_t check_stats(const bsf_stats_t *st)
     return BSF_OK;
 }
 
-static int32_t round_to_int(float v)
+static BSF_COMPACT_INLINE int32_t round_to_int(float v)
 {
     return (int32_t)bsf_floorf(v + 0.5f);
 }
@@ -463,8 +464,8 @@ static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t
  * bounds the payload's size: the values' exact bits plus the most the
  * header and feature fields can take.
  */
-static bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table, plan_t *pl,
-                               uint32_t *max_bits)
+static BSF_COMPACT_INLINE bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table,
+                                                  plan_t *pl, uint32_t *max_bits)
 {
     bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     const float step = pl->step;

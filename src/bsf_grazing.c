@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Grazing joins (bsf_grazing.h explains them): one copy for SVED and LC. */
 #include "bsf_grazing.h"
+#include "bsf_compact.h"
 
 #include <stddef.h>
 
@@ -39,7 +40,7 @@ static int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
 }
 
 /* |q - p| <= cap */
-static int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
+static BSF_COMPACT_NOINLINE int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
 {
     const float dx = q.x - p.x;
     const float dy = q.y - p.y;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
+#include "bsf_compact.h"
 #include "bsf_grazing.h"
 #include "bsf_lc_internal.h"
 #include "bsf_math.h"
@@ -255,8 +256,8 @@ typedef struct {
  * distances to the circle) over positions a..b, centre (*cx, *cy) relative
  * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
  * or leaves no sensible circle. */
-static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float *cx,
-                        float *cy, float *r)
+static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0,
+                                           float cy0, float *cx, float *cy, float *r)
 {
     const bsf_point_t *rp = c->rel;
     float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
@@ -1010,7 +1011,7 @@ typedef enum {
  * min_turn and two lines explain them curve_ratio times better than one
  * line: one smooth curve (residual rss_curve) explains them within the
  * noise, or not. */
-static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
+static BSF_COMPACT_INLINE lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
 {
     return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
 }
@@ -1135,7 +1136,7 @@ typedef struct {
 /* The most squared residual a piece of dof degrees of freedom leaves within
  * the noise: dof + LC_EVIDENCE_SIGMAS standard deviations of that
  * chi-square sum, bounded as dof + k sqrt(2 dof) <= 2 dof + k^2 / 4. */
-static float piece_bound(float dof, float noise_var)
+static BSF_COMPACT_NOINLINE float piece_bound(float dof, float noise_var)
 {
     return noise_var * (2.0f * dof + 0.25f * LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS);
 }
@@ -1176,7 +1177,7 @@ static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, 
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
-static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
+static BSF_COMPACT_INLINE float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
 {
     float dx, dy, len;
     if (!s->round) {
@@ -1341,8 +1342,9 @@ static int side_too_short(float d2, size_t count, float len2, size_t need)
  * than the short side's by LC_OVERSHOOT_SIGMAS: a wall's return beyond its
  * own corner. A real corner past the apex has the apex on the short side's
  * wall. */
-static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
-                                 const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
+static BSF_COMPACT_INLINE int short_side_overshoots(const lc_ctx_t *c, size_t apex,
+                                                    int short_before, const lc_line_t *ls,
+                                                    const lc_line_t *ll, bsf_point_t x)
 {
     const float tol = LC_OVERSHOOT_SIGMAS * sqrtf(c->noise2);
     /* the vertex's cross product with the apex's ray (its distance from the
@@ -1605,7 +1607,8 @@ static size_t pass_pos(size_t b, size_t start, size_t count)
 
 /* Two keypoints of one run on one corner: beams closer than the points a
  * side needs, or intersections within apex_slack of each other. */
-static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const lc_ctx_t *c)
+static BSF_COMPACT_INLINE int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b,
+                                        const lc_ctx_t *c)
 {
     const size_t count = c->pts->count;
     return pass_pos(a->index, c->start, count) + c->p->min_side_points >=
@@ -1857,7 +1860,8 @@ static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *
  * 0) that does not continue the run of the valid beam before it on the ring,
  * so that no run is cut at the seam; 0 when every step joins (one closed
  * surface all round: the seam then cuts it, as on a scan that is no ring). */
-static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo)
+static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p,
+                                            uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
     size_t i;
