@@ -252,6 +252,22 @@ typedef struct {
     float cx, cy, r;
 } lc_circle_t;
 
+/* Cramer's rule for the symmetric [a b c; b d e; c e f] x = (g0, g1, g2),
+ * x into x[0..3) and 1, or 0 when the determinant
+ * is 0 or NaN. */
+static BSF_COMPACT_NOINLINE int solve3_sym(float a, float b, float c, float d, float e, float f,
+                                           float g0, float g1, float g2, float *x)
+{
+    const float det = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
+    if (!(fabsf(det) > 0.0f)) {
+        return 0;
+    }
+    x[0] = (g0 * (d * f - e * e) - b * (g1 * f - e * g2) + c * (g1 * e - d * g2)) / det;
+    x[1] = (a * (g1 * f - e * g2) - g0 * (b * f - e * c) + c * (b * g2 - g1 * c)) / det;
+    x[2] = (a * (d * g2 - g1 * e) - b * (b * g2 - g1 * c) + g0 * (b * e - d * c)) / det;
+    return 1;
+}
+
 /* One Gauss-Newton step of the geometric circle fit (the sum of squared
  * distances to the circle) over positions a..b, centre (*cx, *cy) relative
  * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
@@ -262,7 +278,7 @@ static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b
     const bsf_point_t *rp = c->rel;
     float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
     float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
-    float det, du, dv, dr;
+    float du, dv, dr;
     size_t i;
     for (i = a; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - *cx;
@@ -286,15 +302,16 @@ static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b
         gv += v * g;
         g1 += g;
     }
-    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1) by Cramer. */
-    det = juu * (jvv * n - jv * jv) - juv * (juv * n - jv * ju) + ju * (juv * jv - jvv * ju);
-    if (!(fabsf(det) > 0.0f)) {
-        return;
+    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1). */
+    {
+        float x[3];
+        if (!solve3_sym(juu, juv, ju, jvv, jv, n, gu, gv, g1, x)) {
+            return;
+        }
+        du = x[0];
+        dv = x[1];
+        dr = x[2];
     }
-    du = (gu * (jvv * n - jv * jv) - juv * (gv * n - jv * g1) + ju * (gv * jv - jvv * g1)) / det;
-    dv = (juu * (gv * n - jv * g1) - gu * (juv * n - jv * ju) + ju * (juv * g1 - gv * ju)) / det;
-    dr = (juu * (jvv * g1 - gv * jv) - juv * (juv * g1 - gv * ju) + gu * (juv * jv - jvv * ju)) /
-         det;
     if (!(*r + dr > 0.0f) || !(fabsf(du) + fabsf(dv) + fabsf(dr) < *r + 1.0f)) {
         return; /* NaN ends here too */
     }
@@ -316,7 +333,7 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
     float n = 0.0f;
-    float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
+    float d, e, f, cx, cy, r2, r, rss = 0.0f;
     size_t i;
     for (i = a; i <= b; ++i) {
         const float x = rp[i].x - cx0;
@@ -332,17 +349,17 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         sz += z;
         n += 1.0f;
     }
-    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz) by Cramer. */
-    det = sxx * (syy * n - sy * sy) - sxy * (sxy * n - sy * sx) + sx * (sxy * sy - syy * sx);
-    if (!(fabsf(det) > 0.0f)) {
-        return -1.0f;
+    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz): the
+     * solution for (sxz syz sz), negated (exact). */
+    {
+        float x[3];
+        if (!solve3_sym(sxx, sxy, sx, syy, sy, n, sxz, syz, sz, x)) {
+            return -1.0f;
+        }
+        d = -x[0];
+        e = -x[1];
+        f = -x[2];
     }
-    d = (-sxz * (syy * n - sy * sy) + sxy * (syz * n - sy * sz) - sx * (syz * sy - syy * sz)) / det;
-    e = (sxx * (-syz * n + sy * sz) + sxz * (sxy * n - sy * sx) + sx * (-sxy * sz + syz * sx)) /
-        det;
-    f = (sxx * (-syy * sz + syz * sy) - sxy * (-sxy * sz + syz * sx) -
-         sxz * (sxy * sy - syy * sx)) /
-        det;
     cx = -0.5f * d;
     cy = -0.5f * e;
     r2 = cx * cx + cy * cy - f;
