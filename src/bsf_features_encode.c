@@ -421,6 +421,10 @@ ENC_INLINE void field_pose(writer_t *w, bits_t *b, int costing, const bsf_pose_t
 #define HEADER_MAX_BITS 619u
 #define FEATURE_MAX_BITS 211u
 
+#if BSF_WIRE_N_CLASSES * BSF_WIRE_K_CTRL_BITS > 31
+#error "the classes' orders are written as one field of at most 31 bits"
+#endif
+
 /* What the planning run learns for the writing runs. */
 typedef struct {
     uint32_t step_code;
@@ -539,6 +543,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
     orders_t ord;
     uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
+    uint32_t k_fields = 0;             /* the classes' orders, the first highest: one field */
     uint32_t used = 0;
     int32_t prev[2];
     uint32_t i;
@@ -547,12 +552,15 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
         ord.one[i] = (uint32_t)1 << k_ctrl[i];
         ord.adj[i] = 1u - k_ctrl[i];
+        k_fields = (k_fields << BSF_WIRE_K_CTRL_BITS) | k_ctrl[i];
     }
     prev[0] = pl->prev_resume[0];
     prev[1] = pl->prev_resume[1];
-    field_u(w, &b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
-    field_u(w, &b, costing, info->has_pose != 0u ? 1u : 0u, 1u);
-    field_u(w, &b, costing, pl->has_ext ? 1u : 0u, 1u);
+    /* version and type (8 bits), the pose and extension flags: one field */
+    field_u(w, &b, costing,
+            (((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES) << 2) |
+                (info->has_pose != 0u ? 2u : 0u) | (pl->has_ext ? 1u : 0u),
+            10u);
     field_eg64(w, &b, costing, info->seq, BSF_WIRE_K_SEQ);
     field_eg64(w, &b, costing, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
@@ -565,13 +573,14 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
              res->stats.time_ns / 1000u + (res->stats.time_ns % 1000u + 500u) / 1000u,
              BSF_WIRE_K_TIME_US);
     field_eg(w, &b, costing, res->n_features, BSF_WIRE_K_FEATURES);
-    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
-        field_u(w, &b, costing, k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
-    }
+    field_u(w, &b, costing, k_fields, BSF_WIRE_N_CLASSES * BSF_WIRE_K_CTRL_BITS);
     if (pl->has_ext) {
-        field_u(w, &b, costing, pl->has_beams ? 1u : 0u, 1u);
-        field_u(w, &b, costing, info->has_geometry != 0u ? 1u : 0u, 1u);
-        field_u(w, &b, costing, res->stats.cut, BSF_WIRE_CUT_BITS);
+        /* the beams and geometry flags and the cut bits (checked: within
+         * BSF_WIRE_CUT_BITS): one field */
+        field_u(w, &b, costing,
+                (pl->has_beams ? 2u << BSF_WIRE_CUT_BITS : 0u) |
+                    (info->has_geometry != 0u ? 1u << BSF_WIRE_CUT_BITS : 0u) | res->stats.cut,
+                BSF_WIRE_CUT_BITS + 2u);
         if (pl->has_beams) {
             field_eg(w, &b, costing, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
         }
