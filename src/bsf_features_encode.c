@@ -317,7 +317,6 @@ ENC_INLINE void field_kind_m_mask(writer_t *w, bits_t *b, int costing, uint32_t 
                                   int has_mask)
 {
     (void)costing; /* unused in the compact variant (ENC_COSTING) */
-#if !BSF_CONFIG_COMPACT
 #if BSF_WIRE_K_M != 1u
 #error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
 #endif
@@ -325,11 +324,6 @@ ENC_INLINE void field_kind_m_mask(writer_t *w, bits_t *b, int costing, uint32_t 
      * 2 floor(log2 m) bits */
     const unsigned m_len = 2u * log2_nz(m);
     field_u(w, b, costing, (kind << (m_len + 1u)) | (m << 1) | (has_mask ? 1u : 0u), m_len + 2u);
-#else
-    field_u(w, b, costing, kind, 1u);
-    field_eg(w, b, costing, m - 2u, BSF_WIRE_K_M);
-    field_u(w, b, costing, has_mask ? 1u : 0u, 1u);
-#endif
 }
 
 /* Beams minus one of a feature's run: last - first, or through the seam of
