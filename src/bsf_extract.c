@@ -65,7 +65,9 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     p.rpos = bsf_rpos_params_default();
 #endif
     bsf_pdm_params_default(&p.pdm);
-    if (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM) {
+    /* (nothing to set when both are left out: bsf_params_check refuses them) */
+    if (((BSF_CONFIG_METHODS) & (BSF_CONFIG_METHOD_FALKO | BSF_CONFIG_METHOD_BID)) != 0u &&
+        (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM)) {
         /* Keypoint detectors that miss most corners (docs/GROUND_TRUTH.md):
          * PDM's systematic-deviation test would spend control points rounding
          * the corners they miss, so these methods refine on RMS alone, at the
@@ -176,6 +178,14 @@ bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params)
 #else
 #define USES_RPOS(ex) 0
 #endif
+/* Whether the method in use is LC-SVED-PDM: constant 1 when LC is the only
+ * method compiled in (bsf_extractor_init refuses any other), so the other
+ * methods' branches are not compiled. */
+#if (BSF_CONFIG_METHODS) == BSF_CONFIG_METHOD_LC
+#define USES_LC(ex) 1
+#else
+#define USES_LC(ex) ((ex)->params.method == BSF_METHOD_LC_SVED_PDM)
+#endif
 
 /* Tick difference to nanoseconds, saturating at 2^32 - 1 ns. */
 static BSF_COMPACT_NOINLINE uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
@@ -237,7 +247,7 @@ static BSF_COMPACT_NOINLINE bsf_status_t keep_keypoints_that_fit(bsf_status_t st
  * again). They live in ex->segments, unused until segmentation fills it. */
 static uint8_t *mixed_marks(bsf_extractor_t *ex)
 {
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
+    if (!USES_LC(ex) || !ex->params.sved.reject_mixed ||
         sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
         return NULL;
     }
@@ -521,8 +531,7 @@ static BSF_COMPACT_NOINLINE void trim_tails(const bsf_extractor_t *ex, size_t n,
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
     size_t gap;
     size_t side;
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < TAIL_MIN_RUN + 2u) {
+    if (!USES_LC(ex) || !ex->params.trim_tails || n < TAIL_MIN_RUN + 2u) {
         return;
     }
     gap = n_vertex > 0u && pos[0] == 2u;
@@ -690,7 +699,7 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
 {
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
-    const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
+    const int anchored = USES_LC(ex);
     const size_t n = b + 1u - a;
     /* This fit's parameters and outcome live in the scratch, not on the
      * stack of the deepest call chain. */
