@@ -131,15 +131,14 @@ typedef struct {
 #endif
 } lc_ctx_t;
 
-/* Run point pos relative to the origin, also stored for the fits: judge's
- * side walks visit every point of the window a0..b1 this way first. */
-static bsf_point_t rel_store(const lc_ctx_t *c, size_t pos)
+/* Run point pos relative to the origin, stored for the fits: judge's side
+ * walks visit every point of the window a0..b1 this way first. */
+static void rel_store(const lc_ctx_t *c, size_t pos)
 {
     bsf_point_t q = c->pts->pt[c->run[pos]];
     q.x -= c->o.x;
     q.y -= c->o.y;
     c->rel[pos] = q;
-    return q;
 }
 
 static float dist2(bsf_point_t a, bsf_point_t b)
@@ -158,6 +157,13 @@ static float
 dist2_once(bsf_point_t a, bsf_point_t b)
 {
     return dist2(a, b);
+}
+
+/* dist2 of run positions i and j relative to the origin (c->rel): one copy
+ * for the judgement's single uses in the compact build (code size). */
+static BSF_COMPACT_NOINLINE float rel_dist2(const lc_ctx_t *c, size_t i, size_t j)
+{
+    return dist2(c->rel[i], c->rel[j]);
 }
 
 /* Unit eigenvector (*dx, *dy) of the scatter [sxx sxy; sxy syy] for its
@@ -252,11 +258,21 @@ typedef struct {
     float cx, cy, r;
 } lc_circle_t;
 
+/* solve3_sym: one copy in the compact build (two callers); inlined in the
+ * others, where circle_rss keeps the size and the inlining it had. */
+#if BSF_CONFIG_COMPACT
+#define LC_SOLVE3_INLINE BSF_COMPACT_NOINLINE
+#elif defined(__GNUC__) || defined(__clang__)
+#define LC_SOLVE3_INLINE inline __attribute__((always_inline))
+#else
+#define LC_SOLVE3_INLINE inline
+#endif
+
 /* Cramer's rule for the symmetric [a b c; b d e; c e f] x = (g0, g1, g2),
  * x into x[0..3) and 1, or 0 when the determinant
  * is 0 or NaN. */
-static BSF_COMPACT_NOINLINE int solve3_sym(float a, float b, float c, float d, float e, float f,
-                                           float g0, float g1, float g2, float *x)
+static LC_SOLVE3_INLINE int solve3_sym(float a, float b, float c, float d, float e, float f,
+                                       float g0, float g1, float g2, float *x)
 {
     const float det = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
     if (!(fabsf(det) > 0.0f)) {
@@ -413,7 +429,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     if (l->rss * (float)(n - 3u) <= line_dof * floor_rss) {
         return 1;
     }
-    extent = sqrtf(dist2_once(c->rel[a], c->rel[b]));
+    extent = sqrtf(rel_dist2(c, a, b));
     enough.scale = line_dof;
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
@@ -952,8 +968,7 @@ static float side_curve(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = l->rss - cut < cap ? l->rss - cut : cap; /* uncurved from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2_once(c->rel[a], c->rel[b])), &enough,
-                            refine, fit);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(rel_dist2(c, a, b)), &enough, refine, fit);
     /* below the target the sum ran to the end: the whole residual */
     return rss_circle < 0.0f || rss_circle >= enough.target ? -1.0f : rss_circle;
 }
@@ -1003,8 +1018,8 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = bound; /* from there on, the corner stands */
-    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
-                            &enough, LC_CIRCLE_STEPS, NULL);
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(rel_dist2(c, a0, b1)), &enough,
+                            LC_CIRCLE_STEPS, NULL);
     return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
@@ -1058,8 +1073,8 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
     kp->point.y = x.y + c->o.y;
     kp->orientation = bsf_atan2f(la->my + lb->my - 2.0f * x.y, la->mx + lb->mx - 2.0f * x.x);
     {
-        const float ra = sqrtf(dist2_once(rp[a0], rp[apex]));
-        const float rb = sqrtf(dist2_once(rp[b1], rp[apex]));
+        const float ra = sqrtf(rel_dist2(c, a0, apex));
+        const float rb = sqrtf(rel_dist2(c, b1, apex));
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = score;
@@ -1073,7 +1088,6 @@ LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t a
                                           const lc_line_t *la, const lc_line_t *lb, float cross,
                                           float reach, bsf_point_t *xo, float *score)
 {
-    const bsf_point_t *rp = c->rel;
     float t, extent, rss_curve, rss_circle, rss_lines;
     lc_line_t lu;
     lc_corner_test_t test;
@@ -1103,7 +1117,7 @@ LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t a
     if (evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) {
         return LC_MERGE;
     }
-    extent = sqrtf(dist2_once(rp[a0], rp[b1]));
+    extent = sqrtf(rel_dist2(c, a0, b1));
     rss_curve = lu.rss;
     enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
     enough.ratio = 1.0f;
@@ -1190,7 +1204,7 @@ static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, 
     }
     s->rss = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
     s->round = 1;
-    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2_once(c->rel[a], c->rel[b]);
+    return s->rss >= 0.0f && s->k.r * s->k.r >= rel_dist2(c, a, b);
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
@@ -1293,8 +1307,8 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
      * line is its limit; none exists when the points lie on a line, which
      * is no crease of a curved side). The pieces are credited with no
      * better than the noise: their fit to it is chance. */
-    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
-                           &lc_whole, LC_CIRCLE_STEPS, NULL);
+    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(rel_dist2(c, a0, b1)), &lc_whole,
+                           LC_CIRCLE_STEPS, NULL);
     if (rss_pieces < (float)n * noise_var) {
         rss_pieces = (float)n * noise_var;
     }
@@ -1391,11 +1405,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     lc_line_t lb;
     size_t a0 = apex;
     size_t b1 = apex;
-    const bsf_point_t *rp = c->rel;
     float cross, spacing, reach;
     float score = 0.0f;
     lc_verdict_t v;
-    bsf_point_t ap;
     bsf_point_t x = {0.0f, 0.0f};
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
@@ -1403,7 +1415,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     c->o = c->pts->pt[c->run[apex]];
-    ap = rel_store(c, apex);
+    rel_store(c, apex); /* the apex relative to itself: (0, 0) */
     blocks = blocks_use(c, apex, m, side2);
     a0 = walk(c, blocks, apex, lo, -1, side2);
     b1 = walk(c, blocks, apex, hi, 1, side2);
@@ -1411,10 +1423,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2_once(rp[a0], ap) < len2) {
+    if (apex - a0 < need || rel_dist2(c, a0, apex) < len2) {
         a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
-    if (b1 - apex < need || dist2_once(rp[b1], ap) < len2) {
+    if (b1 - apex < need || rel_dist2(c, b1, apex) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A wall seen at grazing incidence has a return every half metre or
@@ -1434,8 +1446,8 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (side_too_short(dist2_once(rp[a0], ap), apex - a0, len2, need) ||
-        side_too_short(dist2_once(rp[b1], ap), b1 - apex, len2, need)) {
+    if (side_too_short(rel_dist2(c, a0, apex), apex - a0, len2, need) ||
+        side_too_short(rel_dist2(c, b1, apex), b1 - apex, len2, need)) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
@@ -1450,9 +1462,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     }
     /* the sides' fits must meet within twice the local beam spacing plus
      * apex_slack of the apex */
-    spacing = dist2_once(rp[apex - 1u], ap);
+    spacing = rel_dist2(c, apex - 1u, apex);
     {
-        const float s2 = dist2_once(rp[apex + 1u], ap);
+        const float s2 = rel_dist2(c, apex + 1u, apex);
         spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
     reach = 2.0f * spacing + p->apex_slack;
