@@ -500,9 +500,8 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
             return 0;
         }
     }
-    if (k >= 2 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
-        (other_wide ||
-         (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
+    if (k >= 2 && bsf_grazing_triple(pts->pt, i, o[0], o[1]) &&
+        (other_wide || (k == 3 && bsf_grazing_triple(pts->pt, o[0], o[1], o[2])))) {
         return 0;
     }
     side_line(pts, i, near_dir, ring, rad, &near);
