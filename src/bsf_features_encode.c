@@ -47,10 +47,10 @@
 #if FEATURES_SSE2
 /* Both coordinates at once with the same IEEE single operations as
  * quantise (divide, add, truncate, compare), so the same q and verdict. */
-ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
+ENC_INLINE int quantise_point(const bsf_point_t *p, float step, int32_t q[2])
 {
     const __m128 r =
-        _mm_add_ps(_mm_div_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)&p)),
+        _mm_add_ps(_mm_div_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)p)),
                               _mm_set1_ps(step)),
                    _mm_set1_ps(0.5f));
     const __m128 in_range = _mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), r),
@@ -82,10 +82,10 @@ ENC_INLINE int quantise(float v, float step, int32_t *q)
     return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
 }
 
-ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
+ENC_INLINE int quantise_point(const bsf_point_t *p, float step, int32_t q[2])
 {
-    const int ok_x = quantise(p.x, step, &q[0]);
-    const int ok_y = quantise(p.y, step, &q[1]);
+    const int ok_x = quantise(p->x, step, &q[0]);
+    const int ok_y = quantise(p->y, step, &q[1]);
     return ok_x && ok_y;
 }
 #endif
@@ -157,7 +157,7 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
         return 1; /* the usual copy: the same bits quantise alike (the test below's answer) */
     }
 #endif
-    return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
+    return quantise_point(&p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
 }
 
 /*
@@ -183,7 +183,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
 
     *mask = 0u;
 
-    if (!quantise_point(p[0], step, q_a)) {
+    if (!quantise_point(&p[0], step, q_a)) {
         return 0u;
     }
     c_a = 1u;
@@ -206,7 +206,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
             ++s_b;
         }
         k = (uint32_t)(s_b - t);
-        if (!quantise_point(p[s_b], step, q_b)) {
+        if (!quantise_point(&p[s_b], step, q_b)) {
             return 0u;
         }
         *mask <<= k + 1u; /* k + 1 <= 63: the k precision points and anchor b */
@@ -223,7 +223,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
         for (i = t; i < s_b; ++i) {
             const uint32_t s = (uint32_t)(i - t) + 1u;
             int32_t q[2];
-            if (!quantise_point(p[i], step, q)) {
+            if (!quantise_point(&p[i], step, q)) {
                 return 0u;
             }
             cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_PREC,
