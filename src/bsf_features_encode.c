@@ -126,8 +126,13 @@ ENC_INLINE uint32_t add_value(uint32_t *out, uint32_t cnt, bsf_wire_eg_tally_t *
 
 /* bsf_wire_predict in 32 bits: quantised coordinates within 2^23 - 1 make
  * |b - a| <= 2^24 - 2, and k <= BSF_MAX_CTRL_PER_FEATURE - 2 <= 62 (bsf_stream.h
- * caps it at 64), so (b - a)(2s - 1) + k stays below 2^24 * 123 + 62 < 2^31. */
+ * caps it at 64), so (b - a)(2s - 1) + k stays below 2^24 * 123 + 62 < 2^31.
+ * Inlined in the compact build too: its two uses are smaller than calls. */
+#if BSF_CONFIG_COMPACT
+static BSF_COMPACT_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
+#else
 ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
+#endif
 {
     const int32_t den = 2 * (int32_t)k;
     const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;

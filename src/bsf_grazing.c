@@ -57,7 +57,7 @@ static BSF_COMPACT_NOINLINE int bsf_grazing_within(const bsf_point_t *pt, size_t
     return dx * dx + dy * dy <= cap * cap;
 }
 
-static int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
+static BSF_COMPACT_INLINE int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
 {
     return i < pts->count && pts->valid[i] != 0u;
 }
