@@ -682,16 +682,9 @@ static bsf_status_t features_job_plan(bsf_enc_job_t *job)
 void bsf_frame_info_init(bsf_frame_info_t *info)
 {
     if (info != NULL) {
-        info->seq = 0u;
-        info->timestamp_ms = 0u;
-        info->has_pose = 0u;
-        info->pose.x = 0.0f;
-        info->pose.y = 0.0f;
-        info->pose.theta = 0.0f;
+        /* every field zero (0.0f is all zero bits) but the step */
+        memset(info, 0, sizeof *info);
         info->quant_step = BSF_QUANT_STEP_DEFAULT;
-        info->has_geometry = 0u;
-        info->angle_min = 0.0f;
-        info->angle_increment = 0.0f;
     }
 }
 
