@@ -614,12 +614,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         }
         field_kind_m_mask(w, &b, costing, f->kind, n_unique, mask != 0u);
         if (mask != 0u) {
-            uint32_t j = n_unique; /* bits left, the highest first */
-            do {
-                const unsigned take = j > 16u ? 16u : j;
-                j -= take;
-                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
-            } while (j > 0u);
+            field_u64(w, &b, costing, mask, n_unique); /* 16 bits at a time, the highest first */
         }
         field_eg2(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
                   BSF_WIRE_K_GAP, span, BSF_WIRE_K_SPAN);

@@ -201,6 +201,7 @@ ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
 #define field_eg(w, b, costing, v, k) field_eg_(w, b, v, k)
 #define field_eg64(w, b, costing, v, k) field_eg64_(w, b, v, k)
 #define field_float(w, b, costing, v) field_float_(w, b, v)
+#define field_u64(w, b, costing, v, n) field_u64_(w, b, v, n)
 #else
 #define ENC_COSTING_PARAM int costing,
 #define ENC_COSTING(b) costing
@@ -208,6 +209,7 @@ ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
 #define field_eg(w, b, costing, v, k) field_eg_(w, b, costing, v, k)
 #define field_eg64(w, b, costing, v, k) field_eg64_(w, b, costing, v, k)
 #define field_float(w, b, costing, v) field_float_(w, b, costing, v)
+#define field_u64(w, b, costing, v, n) field_u64_(w, b, costing, v, n)
 #endif
 
 /* Fields, written or (costing) counted: u(n) with n <= 31. */
@@ -265,6 +267,16 @@ static inline void put_bits_wide(writer_t *w, bits_t *b, uint64_t x, unsigned n)
         const unsigned take = n > 16u ? 16u : n;
         n -= take;
         put_bits(w, b, (uint32_t)(x >> n) & ((1u << take) - 1u), take);
+    }
+}
+
+/* u(n) of v < 2^n for n <= 64: the n low bits of v, 16 at a time. */
+ENC_INLINE void field_u64_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint64_t v, unsigned n)
+{
+    if (ENC_COSTING(b)) {
+        b->bits += n;
+    } else {
+        put_bits_wide(w, b, v, n);
     }
 }
 
