@@ -311,9 +311,8 @@ ENC_INLINE void field_eg64_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint64_t v
 
 ENC_INLINE void field_float_(writer_t *w, bits_t *b, ENC_COSTING_PARAM float v)
 {
-    const uint32_t u = bsf_float_bits(v);
-    field_u(w, b, costing, u >> 16, 16u);
-    field_u(w, b, costing, u & 0xFFFFu, 16u);
+    /* the 32 bits, 16 at a time */
+    field_u64(w, b, costing, bsf_float_bits(v), 32u);
 }
 
 static inline int is_finite_f(float v)
