@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_compact.h"
 #include "bsf_grazing.h"
 #include "bsf_lc_internal.h"
 #include "bsf_math.h"
@@ -64,7 +65,9 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     p.rpos = bsf_rpos_params_default();
 #endif
     bsf_pdm_params_default(&p.pdm);
-    if (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM) {
+    /* (nothing to set when both are left out: bsf_params_check refuses them) */
+    if (((BSF_CONFIG_METHODS) & (BSF_CONFIG_METHOD_FALKO | BSF_CONFIG_METHOD_BID)) != 0u &&
+        (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM)) {
         /* Keypoint detectors that miss most corners (docs/GROUND_TRUTH.md):
          * PDM's systematic-deviation test would spend control points rounding
          * the corners they miss, so these methods refine on RMS alone, at the
@@ -175,9 +178,17 @@ bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params)
 #else
 #define USES_RPOS(ex) 0
 #endif
+/* Whether the method in use is LC-SVED-PDM: constant 1 when LC is the only
+ * method compiled in (bsf_extractor_init refuses any other), so the other
+ * methods' branches are not compiled. */
+#if (BSF_CONFIG_METHODS) == BSF_CONFIG_METHOD_LC
+#define USES_LC(ex) 1
+#else
+#define USES_LC(ex) ((ex)->params.method == BSF_METHOD_LC_SVED_PDM)
+#endif
 
 /* Tick difference to nanoseconds, saturating at 2^32 - 1 ns. */
-static uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
+static BSF_COMPACT_NOINLINE uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
 {
     const float ns = (float)ticks * (1.0e9f / (float)hz);
     if (!(ns < 4294967040.0f)) {
@@ -214,8 +225,9 @@ static void clock_stage(stage_clock_t *c, bsf_stats_t *stats, bsf_stage_t stage)
  * bsf_bid_detect the strongest, bsf_lc_detect the first in beam order) and
  * reports how many it found: keep those and count the rest as cut. Any other
  * error stands. */
-static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex,
-                                            bsf_stats_t *stats)
+static BSF_COMPACT_NOINLINE bsf_status_t keep_keypoints_that_fit(bsf_status_t st,
+                                                                 bsf_extractor_t *ex,
+                                                                 bsf_stats_t *stats)
 {
     if (st == BSF_ERR_CAPACITY && ex->n_keypoints > (size_t)BSF_MAX_KEYPOINTS) {
         stats->cut |= BSF_CUT_KEYPOINTS;
@@ -235,7 +247,7 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
  * again). They live in ex->segments, unused until segmentation fills it. */
 static uint8_t *mixed_marks(bsf_extractor_t *ex)
 {
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
+    if (!USES_LC(ex) || !ex->params.sved.reject_mixed ||
         sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
         return NULL;
     }
@@ -259,7 +271,7 @@ static uint8_t *grazing_memo(bsf_extractor_t *ex)
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
 /* Beams ex->interest[0..n) valid (1) or not (0). */
-static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
+static BSF_COMPACT_NOINLINE void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
 {
     size_t k;
     for (k = 0; k < n; ++k) {
@@ -347,7 +359,8 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 /* Segments of at least min_points points among all[0..n). */
-static size_t count_segments_from(const bsf_segment_t *all, size_t n, uint32_t min_points)
+static BSF_COMPACT_INLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
+                                                     uint32_t min_points)
 {
     size_t c = 0u;
     size_t i;
@@ -360,8 +373,8 @@ static size_t count_segments_from(const bsf_segment_t *all, size_t n, uint32_t m
 /* Copy the kept segments all[0..n) into ex->segments. Over BSF_MAX_SEGMENTS,
  * the segments covering the most points win (ties: earlier in segmentation
  * order), they stay in segmentation order, and the rest are counted as cut. */
-static void keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n,
-                                   bsf_stats_t *stats)
+static BSF_COMPACT_NOINLINE void
+keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, bsf_stats_t *stats)
 {
     const size_t cap = BSF_MAX_SEGMENTS;
     uint32_t lo = 0u; /* at least cap segments have lo points or more */
@@ -575,8 +588,8 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
  * the two returns out would waste a third of the segment. Returns the
  * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
  * wrote them, or that one vertex). */
-static size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, size_t n_vertex,
-                         size_t *lo, size_t *hi)
+static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
+                                              size_t n_vertex, size_t *lo, size_t *hi)
 {
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
@@ -585,8 +598,7 @@ static size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, 
     bsf_point_t *apex =
         n < TAIL_MIN_RUN + 2u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
     int e;
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < TAIL_FLOAT_RUN + 2u) {
+    if (!USES_LC(ex) || !ex->params.trim_tails || n < TAIL_FLOAT_RUN + 2u) {
         return n_vertex;
     }
     for (e = 0; apex != NULL && e < 2; ++e) {
@@ -630,7 +642,8 @@ static size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n, 
  * are not among its first two or last two points (the rule of
  * bsf_segment_classify). Returns the number of points. */
 
-static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
+static BSF_COMPACT_INLINE size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s,
+                                                size_t *n_vertex)
 {
     size_t n = 0u;
     size_t nv = 0u;
@@ -743,8 +756,8 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
  * every control point it may have stands: its worst point is at an end the
  * cap left off, and cutting there only chips the end off. The RMS bounds the
  * largest distance (max^2 <= n rms^2), so most fits need no search. */
-static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t n_ctrl,
-                          float e_curve, const bsf_result_t *res)
+static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b,
+                                             size_t n_ctrl, float e_curve, const bsf_result_t *res)
 {
     const float bound = ex->params.split_dist;
     const size_t n = b + 1u - a;
@@ -773,7 +786,7 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
 {
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
-    const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
+    const int anchored = USES_LC(ex);
     const size_t n = b + 1u - a;
     /* This fit's parameters and outcome live in the scratch, not on the
      * stack of the deepest call chain. */
@@ -847,8 +860,8 @@ static void append_feature(bsf_result_t *res, uint16_t first_beam, uint16_t last
  * that fails undoes the pieces appended before it; the segment is then
  * fitted whole, unsplit, or its status returned when the whole fit fails or
  * the result has no room (BSF_ERR_BUFFER). */
-static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
-                               size_t n_vertex, bsf_result_t *res)
+static BSF_COMPACT_INLINE bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s,
+                                                  size_t n, size_t n_vertex, bsf_result_t *res)
 {
     size_t lo0 = 0u;
     size_t hi0 = n - 1u;
@@ -986,7 +999,7 @@ static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
 
 /* Beam order of features: by first beam, one wrapping through the seam of a
  * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
-static uint32_t beam_order_key(const bsf_feature_t *f)
+static BSF_COMPACT_INLINE uint32_t beam_order_key(const bsf_feature_t *f)
 {
     return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
 }

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
+#include "bsf_compact.h"
 #include "bsf_grazing.h"
 #include "bsf_lc_internal.h"
 #include "bsf_math.h"
@@ -130,15 +131,14 @@ typedef struct {
 #endif
 } lc_ctx_t;
 
-/* Run point pos relative to the origin, also stored for the fits: judge's
- * side walks visit every point of the window a0..b1 this way first. */
-static bsf_point_t rel_store(const lc_ctx_t *c, size_t pos)
+/* Run point pos relative to the origin, stored for the fits: judge's side
+ * walks visit every point of the window a0..b1 this way first. */
+static void rel_store(const lc_ctx_t *c, size_t pos)
 {
     bsf_point_t q = c->pts->pt[c->run[pos]];
     q.x -= c->o.x;
     q.y -= c->o.y;
     c->rel[pos] = q;
-    return q;
 }
 
 static float dist2(bsf_point_t a, bsf_point_t b)
@@ -157,6 +157,13 @@ static float
 dist2_once(bsf_point_t a, bsf_point_t b)
 {
     return dist2(a, b);
+}
+
+/* dist2 of run positions i and j relative to the origin (c->rel): one copy
+ * for the judgement's single uses in the compact build (code size). */
+static BSF_COMPACT_NOINLINE float rel_dist2(const lc_ctx_t *c, size_t i, size_t j)
+{
+    return dist2(c->rel[i], c->rel[j]);
 }
 
 /* Unit eigenvector (*dx, *dy) of the scatter [sxx sxy; sxy syy] for its
@@ -251,17 +258,43 @@ typedef struct {
     float cx, cy, r;
 } lc_circle_t;
 
+/* solve3_sym: one copy in the compact build (two callers); inlined in the
+ * others, where circle_rss keeps the size and the inlining it had. */
+#if BSF_CONFIG_COMPACT
+#define LC_SOLVE3_INLINE BSF_COMPACT_NOINLINE
+#elif defined(__GNUC__) || defined(__clang__)
+#define LC_SOLVE3_INLINE inline __attribute__((always_inline))
+#else
+#define LC_SOLVE3_INLINE inline
+#endif
+
+/* Cramer's rule for the symmetric [a b c; b d e; c e f] x = (g0, g1, g2),
+ * x into x[0..3) and 1, or 0 when the determinant
+ * is 0 or NaN. */
+static LC_SOLVE3_INLINE int solve3_sym(float a, float b, float c, float d, float e, float f,
+                                       float g0, float g1, float g2, float *x)
+{
+    const float det = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
+    if (!(fabsf(det) > 0.0f)) {
+        return 0;
+    }
+    x[0] = (g0 * (d * f - e * e) - b * (g1 * f - e * g2) + c * (g1 * e - d * g2)) / det;
+    x[1] = (a * (g1 * f - e * g2) - g0 * (b * f - e * c) + c * (b * g2 - g1 * c)) / det;
+    x[2] = (a * (d * g2 - g1 * e) - b * (b * g2 - g1 * c) + g0 * (b * e - d * c)) / det;
+    return 1;
+}
+
 /* One Gauss-Newton step of the geometric circle fit (the sum of squared
  * distances to the circle) over positions a..b, centre (*cx, *cy) relative
  * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
  * or leaves no sensible circle. */
-static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float *cx,
-                        float *cy, float *r)
+static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0,
+                                           float cy0, float *cx, float *cy, float *r)
 {
     const bsf_point_t *rp = c->rel;
     float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
     float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
-    float det, du, dv, dr;
+    float du, dv, dr;
     size_t i;
     for (i = a; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - *cx;
@@ -285,15 +318,16 @@ static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         gv += v * g;
         g1 += g;
     }
-    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1) by Cramer. */
-    det = juu * (jvv * n - jv * jv) - juv * (juv * n - jv * ju) + ju * (juv * jv - jvv * ju);
-    if (!(fabsf(det) > 0.0f)) {
-        return;
+    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1). */
+    {
+        float x[3];
+        if (!solve3_sym(juu, juv, ju, jvv, jv, n, gu, gv, g1, x)) {
+            return;
+        }
+        du = x[0];
+        dv = x[1];
+        dr = x[2];
     }
-    du = (gu * (jvv * n - jv * jv) - juv * (gv * n - jv * g1) + ju * (gv * jv - jvv * g1)) / det;
-    dv = (juu * (gv * n - jv * g1) - gu * (juv * n - jv * ju) + ju * (juv * g1 - gv * ju)) / det;
-    dr = (juu * (jvv * g1 - gv * jv) - juv * (juv * g1 - gv * ju) + gu * (juv * jv - jvv * ju)) /
-         det;
     if (!(*r + dr > 0.0f) || !(fabsf(du) + fabsf(dv) + fabsf(dr) < *r + 1.0f)) {
         return; /* NaN ends here too */
     }
@@ -315,7 +349,7 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
     float n = 0.0f;
-    float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
+    float d, e, f, cx, cy, r2, r, rss = 0.0f;
     size_t i;
     for (i = a; i <= b; ++i) {
         const float x = rp[i].x - cx0;
@@ -331,17 +365,17 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         sz += z;
         n += 1.0f;
     }
-    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz) by Cramer. */
-    det = sxx * (syy * n - sy * sy) - sxy * (sxy * n - sy * sx) + sx * (sxy * sy - syy * sx);
-    if (!(fabsf(det) > 0.0f)) {
-        return -1.0f;
+    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz): the
+     * solution for (sxz syz sz), negated (exact). */
+    {
+        float x[3];
+        if (!solve3_sym(sxx, sxy, sx, syy, sy, n, sxz, syz, sz, x)) {
+            return -1.0f;
+        }
+        d = -x[0];
+        e = -x[1];
+        f = -x[2];
     }
-    d = (-sxz * (syy * n - sy * sy) + sxy * (syz * n - sy * sz) - sx * (syz * sy - syy * sz)) / det;
-    e = (sxx * (-syz * n + sy * sz) + sxz * (sxy * n - sy * sx) + sx * (-sxy * sz + syz * sx)) /
-        det;
-    f = (sxx * (-syy * sz + syz * sy) - sxy * (-sxy * sz + syz * sx) -
-         sxz * (sxy * sy - syy * sx)) /
-        det;
     cx = -0.5f * d;
     cy = -0.5f * e;
     r2 = cx * cx + cy * cy - f;
@@ -395,7 +429,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     if (l->rss * (float)(n - 3u) <= line_dof * floor_rss) {
         return 1;
     }
-    extent = sqrtf(dist2_once(c->rel[a], c->rel[b]));
+    extent = sqrtf(rel_dist2(c, a, b));
     enough.scale = line_dof;
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
@@ -934,8 +968,7 @@ static float side_curve(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = l->rss - cut < cap ? l->rss - cut : cap; /* uncurved from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2_once(c->rel[a], c->rel[b])), &enough,
-                            refine, fit);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(rel_dist2(c, a, b)), &enough, refine, fit);
     /* below the target the sum ran to the end: the whole residual */
     return rss_circle < 0.0f || rss_circle >= enough.target ? -1.0f : rss_circle;
 }
@@ -985,8 +1018,8 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = bound; /* from there on, the corner stands */
-    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
-                            &enough, LC_CIRCLE_STEPS, NULL);
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(rel_dist2(c, a0, b1)), &enough,
+                            LC_CIRCLE_STEPS, NULL);
     return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
@@ -1010,7 +1043,7 @@ typedef enum {
  * min_turn and two lines explain them curve_ratio times better than one
  * line: one smooth curve (residual rss_curve) explains them within the
  * noise, or not. */
-static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
+static BSF_COMPACT_INLINE lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
 {
     return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
 }
@@ -1040,8 +1073,8 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
     kp->point.y = x.y + c->o.y;
     kp->orientation = bsf_atan2f(la->my + lb->my - 2.0f * x.y, la->mx + lb->mx - 2.0f * x.x);
     {
-        const float ra = sqrtf(dist2_once(rp[a0], rp[apex]));
-        const float rb = sqrtf(dist2_once(rp[b1], rp[apex]));
+        const float ra = sqrtf(rel_dist2(c, a0, apex));
+        const float rb = sqrtf(rel_dist2(c, b1, apex));
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = score;
@@ -1055,7 +1088,6 @@ LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t a
                                           const lc_line_t *la, const lc_line_t *lb, float cross,
                                           float reach, bsf_point_t *xo, float *score)
 {
-    const bsf_point_t *rp = c->rel;
     float t, extent, rss_curve, rss_circle, rss_lines;
     lc_line_t lu;
     lc_corner_test_t test;
@@ -1085,7 +1117,7 @@ LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t a
     if (evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) {
         return LC_MERGE;
     }
-    extent = sqrtf(dist2_once(rp[a0], rp[b1]));
+    extent = sqrtf(rel_dist2(c, a0, b1));
     rss_curve = lu.rss;
     enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
     enough.ratio = 1.0f;
@@ -1135,7 +1167,7 @@ typedef struct {
 /* The most squared residual a piece of dof degrees of freedom leaves within
  * the noise: dof + LC_EVIDENCE_SIGMAS standard deviations of that
  * chi-square sum, bounded as dof + k sqrt(2 dof) <= 2 dof + k^2 / 4. */
-static float piece_bound(float dof, float noise_var)
+static BSF_COMPACT_NOINLINE float piece_bound(float dof, float noise_var)
 {
     return noise_var * (2.0f * dof + 0.25f * LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS);
 }
@@ -1172,11 +1204,11 @@ static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, 
     }
     s->rss = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
     s->round = 1;
-    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2_once(c->rel[a], c->rel[b]);
+    return s->rss >= 0.0f && s->k.r * s->k.r >= rel_dist2(c, a, b);
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
-static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
+static BSF_COMPACT_INLINE float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
 {
     float dx, dy, len;
     if (!s->round) {
@@ -1275,8 +1307,8 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
      * line is its limit; none exists when the points lie on a line, which
      * is no crease of a curved side). The pieces are credited with no
      * better than the noise: their fit to it is chance. */
-    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
-                           &lc_whole, LC_CIRCLE_STEPS, NULL);
+    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(rel_dist2(c, a0, b1)), &lc_whole,
+                           LC_CIRCLE_STEPS, NULL);
     if (rss_pieces < (float)n * noise_var) {
         rss_pieces = (float)n * noise_var;
     }
@@ -1341,8 +1373,9 @@ static int side_too_short(float d2, size_t count, float len2, size_t need)
  * than the short side's by LC_OVERSHOOT_SIGMAS: a wall's return beyond its
  * own corner. A real corner past the apex has the apex on the short side's
  * wall. */
-static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
-                                 const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
+static BSF_COMPACT_INLINE int short_side_overshoots(const lc_ctx_t *c, size_t apex,
+                                                    int short_before, const lc_line_t *ls,
+                                                    const lc_line_t *ll, bsf_point_t x)
 {
     const float tol = LC_OVERSHOOT_SIGMAS * sqrtf(c->noise2);
     /* the vertex's cross product with the apex's ray (its distance from the
@@ -1372,11 +1405,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     lc_line_t lb;
     size_t a0 = apex;
     size_t b1 = apex;
-    const bsf_point_t *rp = c->rel;
     float cross, spacing, reach;
     float score = 0.0f;
     lc_verdict_t v;
-    bsf_point_t ap;
     bsf_point_t x = {0.0f, 0.0f};
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
@@ -1384,7 +1415,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     c->o = c->pts->pt[c->run[apex]];
-    ap = rel_store(c, apex);
+    rel_store(c, apex); /* the apex relative to itself: (0, 0) */
     blocks = blocks_use(c, apex, m, side2);
     a0 = walk(c, blocks, apex, lo, -1, side2);
     b1 = walk(c, blocks, apex, hi, 1, side2);
@@ -1392,10 +1423,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2_once(rp[a0], ap) < len2) {
+    if (apex - a0 < need || rel_dist2(c, a0, apex) < len2) {
         a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
-    if (b1 - apex < need || dist2_once(rp[b1], ap) < len2) {
+    if (b1 - apex < need || rel_dist2(c, b1, apex) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A wall seen at grazing incidence has a return every half metre or
@@ -1415,8 +1446,8 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (side_too_short(dist2_once(rp[a0], ap), apex - a0, len2, need) ||
-        side_too_short(dist2_once(rp[b1], ap), b1 - apex, len2, need)) {
+    if (side_too_short(rel_dist2(c, a0, apex), apex - a0, len2, need) ||
+        side_too_short(rel_dist2(c, b1, apex), b1 - apex, len2, need)) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
@@ -1431,9 +1462,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     }
     /* the sides' fits must meet within twice the local beam spacing plus
      * apex_slack of the apex */
-    spacing = dist2_once(rp[apex - 1u], ap);
+    spacing = rel_dist2(c, apex - 1u, apex);
     {
-        const float s2 = dist2_once(rp[apex + 1u], ap);
+        const float s2 = rel_dist2(c, apex + 1u, apex);
         spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
     reach = 2.0f * spacing + p->apex_slack;
@@ -1605,7 +1636,8 @@ static size_t pass_pos(size_t b, size_t start, size_t count)
 
 /* Two keypoints of one run on one corner: beams closer than the points a
  * side needs, or intersections within apex_slack of each other. */
-static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const lc_ctx_t *c)
+static BSF_COMPACT_INLINE int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b,
+                                        const lc_ctx_t *c)
 {
     const size_t count = c->pts->count;
     return pass_pos(a->index, c->start, count) + c->p->min_side_points >=
@@ -1857,7 +1889,8 @@ static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *
  * 0) that does not continue the run of the valid beam before it on the ring,
  * so that no run is cut at the seam; 0 when every step joins (one closed
  * surface all round: the seam then cuts it, as on a scan that is no ring). */
-static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo)
+static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p,
+                                            uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
     size_t i;

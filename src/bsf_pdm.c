@@ -3,6 +3,7 @@
  * control points, and error-driven refinement (docs/DESIGN.md, "PDM and
  * refinement"). */
 #include "bsf/bsf_fit.h"
+#include "bsf_compact.h"
 #include "bsf/bsf_bspline.h"
 #include "bsf_fit_internal.h"
 #include "bsf_linalg.h"
@@ -145,10 +146,11 @@ static float dist2_pts(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
-static float dist(bsf_point_t a, bsf_point_t b)
+/* |pts[j] - pts[i]| (indices: fewer instructions to pass than four floats) */
+static float dist(const bsf_point_t *pts, size_t i, size_t j)
 {
-    const float dx = b.x - a.x;
-    const float dy = b.y - a.y;
+    const float dx = pts[j].x - pts[i].x;
+    const float dy = pts[j].y - pts[i].y;
     return sqrtf(dx * dx + dy * dy);
 }
 
@@ -162,7 +164,8 @@ static float dist(bsf_point_t a, bsf_point_t b)
  * footpoints. Both window ends only move forward: linear cost. Returns the
  * fragment's length (<= 0 only for a fragment that folds back on itself,
  * which the caller then spaces by index). */
-static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
+static BSF_COMPACT_NOINLINE float fragment_arc(const bsf_point_t *pts, size_t a, size_t b,
+                                               float *arc)
 {
     const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
     size_t lo = a;
@@ -234,7 +237,7 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
 }
 
 /* Span of t and its local coordinate (t in [0, 1]). */
-static inline size_t span_of(float t, float fs, size_t n_span, float *u)
+static BSF_COMPACT_INLINE size_t span_of(float t, float fs, size_t n_span, float *u)
 {
     /* t is in [0, 1], so x is small and non-negative: a signed conversion
      * is exact and much cheaper than one to size_t on 64-bit targets. */
@@ -630,7 +633,7 @@ static float systematic_error(const pdm_state_t *s, float rms, float window_max,
 /* Points per slot of fragment f's deviation window: 1 up to
  * PDM_BIAS_MAX_WINDOWS windows of bias_window points, then as many as keep
  * the fragment within that many windows. */
-static size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f)
+static BSF_COMPACT_INLINE size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f)
 {
     const size_t count = (size_t)w->frag_last[f] - w->frag_first[f] + 1u;
     const size_t span = PDM_BIAS_MAX_WINDOWS * s->bias_window;
@@ -1039,8 +1042,9 @@ static size_t pick_fragment(const pdm_state_t *s, const bsf_pdm_work_t *w, float
 
 /* Warm start after adding a precision point: every parameter keeps its
  * relative place inside its fragment's knot range. */
-static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const float *old_t0,
-                             const float *old_t1, const float *t0, const float *t1)
+static BSF_COMPACT_INLINE void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w,
+                                                const float *old_t0, const float *old_t1,
+                                                const float *t0, const float *t1)
 {
     float scale[BSF_PDM_MAX_FRAGMENTS];
     size_t f;
@@ -1143,7 +1147,8 @@ static size_t turns_back(const bsf_point_t *pts, size_t a, size_t b)
                : 0u;
 }
 
-static bsf_status_t check_vertices(const uint16_t *vertex_pos, size_t n_vertex, size_t n)
+static BSF_COMPACT_INLINE bsf_status_t check_vertices(const uint16_t *vertex_pos, size_t n_vertex,
+                                                      size_t n)
 {
     size_t k;
     if (n_vertex > 0u && vertex_pos == NULL) {
@@ -1227,7 +1232,7 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
         s.target = p->target_rms;
     }
     for (i = 1; i < n; ++i) {
-        length += dist(pts[i - 1u], pts[i]);
+        length += dist(pts, i - 1u, i);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;
@@ -1260,7 +1265,7 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
                        ? 1u + (p->bias_window > 0u && p->max_ctrl > 3u ? turns_back(pts, a, b) : 0u)
                        : 0u;
         } else {
-            const float chord = dist(pts[a], pts[b]);
+            const float chord = dist(pts, a, b);
             const float want = floorf(chord / p->precision_spacing + 0.5f);
             const size_t cap = precision_cap(work, f);
             prec = want < 1.0f ? 1u : (want >= (float)cap ? cap : (size_t)want);
@@ -1390,7 +1395,7 @@ bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
         return BSF_ERR_DEGENERATE;
     }
     for (i = 1; i < n; ++i) {
-        length += dist(pts[i - 1u], pts[i]);
+        length += dist(pts, i - 1u, i);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;
@@ -1409,7 +1414,7 @@ bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
     build_layout(&s, work, t0, t1);
     for (i = 0; i < n; ++i) {
         if (i > 0u) {
-            acc += dist(pts[i - 1u], pts[i]);
+            acc += dist(pts, i - 1u, i);
         }
         work->t[i] = acc / length;
     }

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_segment.h"
+#include "bsf_compact.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -434,8 +435,8 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
 
 /* Beam i lies off side line l by more than the noise explains (variance
  * var), towards the sensor when toward_sensor, else away from it. */
-static int off_side_line(const bsf_points_t *pts, size_t i, const bsf_side_line_t *l, float var,
-                         int toward_sensor)
+static BSF_COMPACT_INLINE int off_side_line(const bsf_points_t *pts, size_t i,
+                                            const bsf_side_line_t *l, float var, int toward_sensor)
 {
     const float d = bsf_side_distance(l, pts->pt[i]);
     float d_sensor;
@@ -499,9 +500,8 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
             return 0;
         }
     }
-    if (k >= 2 && bsf_grazing_triple(pts->pt[i], pts->pt[o[0]], pts->pt[o[1]]) &&
-        (other_wide ||
-         (k == 3 && bsf_grazing_triple(pts->pt[o[0]], pts->pt[o[1]], pts->pt[o[2]])))) {
+    if (k >= 2 && bsf_grazing_triple(pts->pt, i, o[0], o[1]) &&
+        (other_wide || (k == 3 && bsf_grazing_triple(pts->pt, o[0], o[1], o[2])))) {
         return 0;
     }
     side_line(pts, i, near_dir, ring, rad, &near);
