@@ -650,8 +650,12 @@ static size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f
  * no longer end below give_up_rms (the squared distances only add up) and
  * returns 0, leaving the parameters half updated for the caller to discard;
  * otherwise it returns 1. */
-static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next,
-                          float give_up_rms)
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline)) /* one copy: inlined into try_cold_start, it doubled the stack */
+#endif
+static int
+footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next,
+               float give_up_rms)
 {
     const size_t n_span = s->n_ctrl - 2u;
     const float fs = (float)n_span;
@@ -668,6 +672,11 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     size_t frag_end = w->frag_last[0];
     size_t f = 0;
     size_t i;
+    /* One test per point for three rare events: the end of a fragment (the
+     * last one ends the pass), the first point and the last but one (the end
+     * points take no footpoint step). */
+    size_t next_event = 0;
+    unsigned n_steps = 0u;
     /* Systematic deviation (bias_window > 0): the last bias_window signed
      * residuals of the fragment (a ring), their sum, the fragment's largest
      * |sum| and its largest squared distance. Only ring[0..bias_window) is
@@ -703,11 +712,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     sums_reset(&acc, 0u);
     load_span(w->ctrl, n_span, 0u, &c);
     cn = c;
-    for (i = 0; i < s->n; ++i) {
+    for (i = 0;; ++i) {
         const float qx = s->pts[i].x - ox;
         const float qy = s->pts[i].y - oy;
-        /* Not the end points: i - 1 wraps for i == 0. */
-        const unsigned n_steps = i - 1u < last - 1u ? steps : 0u;
         float t = w->t[i];
         float u;
         size_t span = span_of(t, fs, n_span, &u);
@@ -885,6 +892,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             }
             prev_best = best;
         }
+        if (i != next_event) {
+            continue;
+        }
         if (i == frag_end) {
             const size_t count = frag_end - w->frag_first[f] + 1u;
             const float rms = sqrtf(frag_sum / (float)count);
@@ -919,7 +929,13 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 block_n = 0u;
                 block_sum = 0.0f;
             }
+            if (i == last) {
+                break;
+            }
         }
+        /* The last point (the last fragment's end) takes no step. */
+        n_steps = i + 1u < last ? steps : 0u;
+        next_event = i + 1u < last && frag_end > last - 1u ? last - 1u : frag_end;
     }
     if (assemble_next) {
         sums_flush(w, &acc);
