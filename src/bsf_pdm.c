@@ -479,7 +479,35 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
         /* The vertex point closing fragment f opens fragment f + 1: it is
          * accumulated once, by the fragment it closes. */
-        for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
+        i = f == 0u ? a : a + 1u;
+#if !BSF_CONFIG_COMPACT
+        /* Points before the last of a curved fragment of some length: the
+         * general loop's tests are decided for them (the same float
+         * operations, fewer branches). */
+        if (!straight && len > 0.0f) {
+            for (; i < b; ++i) {
+                float frac = w->arc[i] * inv_len;
+                float u;
+                float t;
+                size_t span;
+                frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
+                t = t0[f] + frac * range;
+                w->t[i] = t;
+                span = span_of(t, fs, n_span, &u);
+                if (span != acc.span) {
+                    SUMS_FLUSH_ACC(w, acc);
+                    sums_reset(&acc, span);
+                    k0 = span == 0u ? 1.0f : 0.5f;
+                    k2 = span + 1u == n_span ? 1.0f : 0.5f;
+                }
+                {
+                    const float v = 1.0f - u;
+                    sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
+                }
+            }
+        }
+#endif
+        for (; i <= b; ++i) {
             float frac;
             float u;
             float t;
