@@ -427,6 +427,9 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
     const float fs = (float)n_span;
     const float ox = s->origin.x;
     const float oy = s->origin.y;
+    /* A local: the flushes' stores could change s->pts as far as the
+     * compiler knows, which then reloads it at every point. */
+    const bsf_point_t *pts = s->pts;
     span_sums_t acc;
     size_t i;
     float k0 = 1.0f; /* basis scales of span acc.span */
@@ -443,7 +446,7 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
             k0 = span == 0u ? 1.0f : 0.5f;
             k2 = span + 1u == n_span ? 1.0f : 0.5f;
         }
-        sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
+        sums_add(&acc, k0 * v * v, k2 * u * u, pts[i].x - ox, pts[i].y - oy);
     }
     SUMS_FLUSH_ACC(w, acc);
 }
@@ -485,6 +488,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
          * general loop's tests are decided for them (the same float
          * operations, fewer branches). */
         if (!straight && len > 0.0f) {
+            const bsf_point_t *pts = s->pts; /* a local: as in assemble */
             for (; i < b; ++i) {
                 float frac = w->arc[i] * inv_len;
                 float u;
@@ -502,7 +506,7 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
                 }
                 {
                     const float v = 1.0f - u;
-                    sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
+                    sums_add(&acc, k0 * v * v, k2 * u * u, pts[i].x - ox, pts[i].y - oy);
                 }
             }
         }
