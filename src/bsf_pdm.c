@@ -717,6 +717,9 @@ footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_n
     float ring[BSF_PDM_MAX_BIAS_WINDOW];
     size_t ring_at = 0;
     size_t ring_wait = bias_window;
+#if !BSF_CONFIG_COMPACT
+    int ring_full = 0; /* block is 1 and ring_wait 0: the ring's fast path */
+#endif
     float ring_sum = 0.0f;
     float window_max = 0.0f;
     float point_max = 0.0f;
@@ -892,28 +895,45 @@ footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_n
             }
             r = ex * nx + ey * ny;
             slot = r;
-            if (block > 1u) {
-                block_sum += r;
-                slot = block_sum;
-                if (++block_n == block) {
-                    block_n = 0u;
-                    block_sum = 0.0f;
-                } else {
-                    slot_open = 1;
-                }
-            }
-            if (!slot_open) {
-                if (ring_wait > 0u) {
-                    ring_sum += slot; /* an empty slot: slot - 0 is slot */
-                    --ring_wait;
-                } else {
-                    ring_sum += slot - ring[ring_at];
-                }
+#if !BSF_CONFIG_COMPACT
+            if (ring_full) {
+                /* the general path below with one point per slot and the
+                 * window full: one test instead of three */
+                ring_sum += slot - ring[ring_at];
                 ring[ring_at] = slot;
                 ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
-                if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
+                if (fabsf(ring_sum) > window_max) {
                     window_max = fabsf(ring_sum);
                 }
+            } else
+#endif
+            {
+                if (block > 1u) {
+                    block_sum += r;
+                    slot = block_sum;
+                    if (++block_n == block) {
+                        block_n = 0u;
+                        block_sum = 0.0f;
+                    } else {
+                        slot_open = 1;
+                    }
+                }
+                if (!slot_open) {
+                    if (ring_wait > 0u) {
+                        ring_sum += slot; /* an empty slot: slot - 0 is slot */
+                        --ring_wait;
+                    } else {
+                        ring_sum += slot - ring[ring_at];
+                    }
+                    ring[ring_at] = slot;
+                    ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
+                    if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
+                        window_max = fabsf(ring_sum);
+                    }
+                }
+#if !BSF_CONFIG_COMPACT
+                ring_full = block == 1u && ring_wait == 0u;
+#endif
             }
             if (best > point_max) {
                 point_max = best;
@@ -961,6 +981,9 @@ footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_n
                 block_n = 0u;
                 block_sum = 0.0f;
             }
+#if !BSF_CONFIG_COMPACT
+            ring_full = block == 1u && ring_wait == 0u;
+#endif
             if (i == last) {
                 break;
             }
