@@ -788,6 +788,9 @@ footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_n
             float ney = ey;
             unsigned halving;
             unsigned n_try;
+#if BSF_CONFIG_COMPACT
+            int closer = 0; /* d < best: the step is taken */
+#endif
             size_t span_new = c.span;
 
             if (!(h >= 0.5f * gn)) {
@@ -846,13 +849,22 @@ footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_n
                 }
                 d = nex * nex + ney * ney;
                 if (d < best) {
+#if BSF_CONFIG_COMPACT
+                    closer = 1;
+#endif
                     break;
                 }
                 delta *= 0.5f;
             }
-            if (!(d < best)) {
+#if BSF_CONFIG_COMPACT
+            if (!closer) { /* the flag, not d < best again: 24 bytes shorter */
                 break;
             }
+#else
+            if (!(d < best)) { /* not the flag: 0.7 % fewer x86 instructions */
+                break;
+            }
+#endif
             best = d;
             t = t_new;
             u = u_new;
