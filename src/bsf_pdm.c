@@ -1132,6 +1132,23 @@ static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const floa
         scale[f] = (t1[f] - t0[f]) / (old_t1[f] - old_t0[f]);
     }
     f = 0;
+#if !BSF_CONFIG_COMPACT
+    /* One fragment (no vertex, most fits): the general loop below with its
+     * fragment searches decided. Locals: the stores into w->t would make
+     * the compiler reload s->n at every point. */
+    if (s->n_frag == 1u) {
+        const size_t n = s->n;
+        float *const tp = w->t;
+        const float base = t0[0];
+        const float old_base = old_t0[0];
+        const float scale0 = scale[0];
+        for (i = 0; i < n; ++i) {
+            const float t = base + (tp[i] - old_base) * scale0;
+            tp[i] = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+        }
+        return;
+    }
+#endif
     for (i = 0; i < s->n; ++i) {
         float t = w->t[i];
         while (f + 1u < s->n_frag && t > old_t1[f]) {
