@@ -488,14 +488,17 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
          * general loop's tests are decided for them (the same float
          * operations, fewer branches). */
         if (!straight && len > 0.0f) {
-            const bsf_point_t *pts = s->pts; /* a local: as in assemble */
+            /* locals: as in assemble (the stores into w->t could change
+             * t0[f] too, as far as the compiler knows) */
+            const bsf_point_t *pts = s->pts;
+            const float t_start = t0[f];
             for (; i < b; ++i) {
                 float frac = w->arc[i] * inv_len;
                 float u;
                 float t;
                 size_t span;
                 frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
-                t = t0[f] + frac * range;
+                t = t_start + frac * range;
                 w->t[i] = t;
                 span = span_of(t, fs, n_span, &u);
                 if (span != acc.span) {
