@@ -645,37 +645,44 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
 static BSF_COMPACT_INLINE size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s,
                                                 size_t *n_vertex)
 {
+    /* Locals: the point stores below could change *s and ex's counts as
+     * far as the compiler knows, which then reloads them at every beam
+     * (the arrays' addresses too, but as locals they cost x86 registers). */
+    const size_t first = s->first;
+    const size_t last = s->last;
+    const size_t count = ex->points.count;
+    const size_t n_keypoints = ex->n_keypoints;
     size_t n = 0u;
     size_t nv = 0u;
     size_t k = 0u;
     size_t b;
     size_t i;
 
-    while (k < ex->n_keypoints && ex->interest[k] < s->first) {
+    while (k < n_keypoints && ex->interest[k] < first) {
         ++k;
     }
     /* The segment's beams are those labelled with its first beam; a
      * wrapping segment (first > last) runs on through beam 0. */
-    for (b = s->first;; b = (b + 1u < ex->points.count) ? b + 1u : 0u) {
-        if (b == 0u && s->first > 0u) {
+    for (b = first;; b = (b + 1u < count) ? b + 1u : 0u) {
+        if (b == 0u && first > 0u) {
             k = 0u; /* wrapped through the seam */
         }
-        if (ex->scratch.seg.label[b] != s->first) {
-            if (b == s->last) {
+        if (ex->scratch.seg.label[b] != first) {
+            if (b == last) {
                 break;
             }
             continue;
         }
-        while (k < ex->n_keypoints && ex->interest[k] < b) {
+        while (k < n_keypoints && ex->interest[k] < b) {
             ++k; /* an interest beam on an invalid reading is no vertex */
         }
-        if (k < ex->n_keypoints && ex->interest[k] == b) {
+        if (k < n_keypoints && ex->interest[k] == b) {
             ex->scratch.seg.use.fit.vertex_anchor[nv] = ex->keypoints[k].point;
             ex->scratch.seg.use.fit.vertex_pos[nv++] = (uint16_t)n;
             ++k;
         }
         ex->scratch.seg.use.fit.seg_points[n++] = ex->points.pt[b];
-        if (b == s->last) {
+        if (b == last) {
             break;
         }
     }

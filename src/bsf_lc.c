@@ -1572,6 +1572,24 @@ static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m, f
     return n > 0u ? sum / ((float)n * LC_NOISE_MEAN_ABS) : 0.0f;
 }
 
+#if !BSF_CONFIG_COMPACT
+/* The parked keypoints out[slot + 1 ..] move down one place (n of them),
+ * field by field where the compact build calls memmove: newlib-nano's is a
+ * byte loop (about 4 Cortex-M4F instructions a byte, 24 bytes a keypoint). */
+static void keypoints_down(bsf_keypoint_t *out, size_t slot, size_t n)
+{
+    size_t k;
+    for (k = slot; k < slot + n; ++k) {
+        out[k].index = out[k + 1u].index;
+        out[k].point.x = out[k + 1u].point.x;
+        out[k].point.y = out[k + 1u].point.y;
+        out[k].orientation = out[k + 1u].orientation;
+        out[k].radius = out[k + 1u].radius;
+        out[k].score = out[k + 1u].score;
+    }
+}
+#endif
+
 /* Douglas-Peucker split of run positions 0..m-1 with an explicit stack;
  * returns the number of splits, ascending in w->brk. */
 
@@ -1736,7 +1754,11 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                 memmove(&w->judged_hi[j], &w->judged_hi[j + 1u], tail * sizeof w->judged_hi[0]);
                 if (slot + 1u < out_cap) {
                     const size_t fit = out_cap - slot - 1u;
+#if BSF_CONFIG_COMPACT
                     memmove(&out[slot], &out[slot + 1u], (tail < fit ? tail : fit) * sizeof out[0]);
+#else
+                    keypoints_down(out, slot, tail < fit ? tail : fit);
+#endif
                 }
                 --nb;
                 changed = 1;

@@ -162,6 +162,26 @@ typedef struct {
     bsf_point_t end;   /* its last point */
 } open_seg_t;
 
+/* open[0..k-1] moved up one slot, to open[1..k]. In the speed builds field
+ * by field: as struct copies, GCC turns the loop into a memmove call, which
+ * newlib-nano runs as a byte loop (about 4 instructions a byte on the
+ * Cortex-M4F, about 1 % of its instructions on the Intel log). */
+static void open_shift_up(open_seg_t *open, size_t k)
+{
+#if BSF_CONFIG_COMPACT
+    memmove(&open[1], &open[0], k * sizeof open[0]);
+#else
+    for (; k > 0u; --k) {
+        open[k].first = open[k - 1u].first;
+        open[k].last = open[k - 1u].last;
+        open[k].last_pos = open[k - 1u].last_pos;
+        open[k].n = open[k - 1u].n;
+        open[k].end.x = open[k - 1u].end.x;
+        open[k].end.y = open[k - 1u].end.y;
+    }
+#endif
+}
+
 /* Radius test d^2 <= r(rho)^2, r = a*exp(b*rho) capped at sqrt(cap2) when
  * cap2 > 0. As in bsf_segment_sved, expf only near the threshold; NaN fails. */
 static int within_radius(float d2, float rho, float a2, float two_b, float cap2)
@@ -861,9 +881,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             s.last_pos = (uint32_t)j;
             s.n++;
             s.end = q;
-            for (k = best; k > 0u; --k) {
-                open[k] = open[k - 1u];
-            }
+            open_shift_up(open, best);
             open[0] = s;
         } else {
             if (n_open == slots) {
@@ -872,9 +890,7 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
                 }
                 --n_open;
             }
-            for (k = n_open; k > 0u; --k) {
-                open[k] = open[k - 1u];
-            }
+            open_shift_up(open, n_open);
             open[0].first = (uint32_t)b;
             open[0].last = (uint32_t)b;
             open[0].last_pos = (uint32_t)j;
