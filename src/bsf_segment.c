@@ -537,6 +537,42 @@ static inline int between_neighbours(const bsf_points_t *pts, size_t i, float *r
     return r[1] > *lo && r[1] < *hi;
 }
 
+/* is_mixed_pixel past its first tests: beam i's range r[2] lies strictly
+ * between its neighbours' r[1] and r[3] (lo and hi, the smaller first), and
+ * have_outer says whether r[0] and r[4] hold the next ones out. */
+static int mixed_kind(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
+                      const float *r, float lo, float hi, int have_outer)
+{
+    const float jump = hi - lo;
+    if (beam_within(rad, jump * jump)) {
+        return 0;
+    }
+    if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
+        r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
+        return MIXED_BETWEEN;
+    }
+    /* Near one surface in range: a mixed pixel only when it lies on neither.
+     * The run nearer in range must go on past beam i's neighbour (steps
+     * within the radius; on_neither_surface asks more of it); the other may
+     * step wider (a wall seen at grazing incidence, whose lines
+     * on_neither_surface keeps). */
+    if (!have_outer) {
+        return 0;
+    }
+    {
+        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
+        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
+        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
+        if (!beam_within(rad, near_step * near_step)) {
+            return 0;
+        }
+        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
+                                  !beam_within(rad, other_step * other_step))
+                   ? MIXED_OFF_A_LINE
+                   : 0;
+    }
+}
+
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
@@ -546,7 +582,6 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     float r[5] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     float lo;
     float hi;
-    float jump;
     int have_outer;
     int k;
     if (i >= 2u && i + 2u < pts->count) {
@@ -581,34 +616,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         have_outer =
             neighbour_range(pts, i, -2, ring, &r[0]) && neighbour_range(pts, i, 2, ring, &r[4]);
     }
-    jump = hi - lo;
-    if (beam_within(rad, jump * jump)) {
-        return 0;
-    }
-    if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
-        r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
-        return MIXED_BETWEEN;
-    }
-    /* Near one surface in range: a mixed pixel only when it lies on neither.
-     * The run nearer in range must go on past beam i's neighbour (steps
-     * within the radius; on_neither_surface asks more of it); the other may
-     * step wider (a wall seen at grazing incidence, whose lines
-     * on_neither_surface keeps). */
-    if (!have_outer) {
-        return 0;
-    }
-    {
-        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
-        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
-        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
-        if (!beam_within(rad, near_step * near_step)) {
-            return 0;
-        }
-        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
-                                  !beam_within(rad, other_step * other_step))
-                   ? MIXED_OFF_A_LINE
-                   : 0;
-    }
+    return mixed_kind(pts, i, ring, rad, r, lo, hi, have_outer);
 }
 
 /* The radius test's constants for beam_within. */
@@ -651,16 +659,24 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
              * the jump, and with either invalid the return is no mixed
              * pixel anyway. */
             const float step = pts->range[b + 1u] - pts->range[b - 1u];
-            float r3[3];
+            float r[5];
             float lo;
             float hi;
-            if (step * step <= rad.a2 || !between_neighbours(pts, b, r3, &lo, &hi)) {
+            if (step * step <= rad.a2 || !between_neighbours(pts, b, &r[1], &lo, &hi)) {
                 continue;
             }
-        }
+            /* and on with its other tests, where is_mixed_pixel goes on */
+            r[0] = pts->range[b - 2u];
+            r[4] = pts->range[b + 2u];
+            beam_radius_start(&rad, r[2]);
+            kind = mixed_kind(pts, b, ring, &rad, r, lo, hi,
+                              (pts->valid[b - 2u] != 0u) & (pts->valid[b + 2u] != 0u));
+        } else
 #endif
-        beam_radius_start(&rad, pts->range[b]);
-        kind = is_mixed_pixel(pts, b, ring, &rad);
+        {
+            beam_radius_start(&rad, pts->range[b]);
+            kind = is_mixed_pixel(pts, b, ring, &rad);
+        }
         if (kind != 0 && marks != NULL) {
             marks[b / 8u] = (uint8_t)(marks[b / 8u] | (1u << (b % 8u)));
         }
@@ -778,22 +794,30 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         start = ring_start(pts, a2, two_b, cap2);
     }
 
-    for (j = 0; j < pts->count; ++j) {
+    /* Locals for the loop's invariants (the calls inside it could change
+     * what pts and p point to as far as the compiler knows). */
+    const size_t count = pts->count;
+    const size_t max_gap = p->max_gap_beams;
+    /* the mixed-pixel marks the loop reads, or NULL: none, or (reject_mixed
+     * without marks) each beam tested here */
+    const uint8_t *mixed = reject_mixed ? marks : NULL;
+    const int mixed_here = reject_mixed && marks == NULL;
+    for (j = 0; j < count; ++j) {
         size_t b = start + j;
         bsf_point_t q;
         float rho;
         float best_d2 = HUGE_VALF;
         size_t best = slots; /* none */
-        if (b >= pts->count) {
-            b -= pts->count;
+        if (b >= count) {
+            b -= count;
         }
         if (!pts->valid[b]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
         rho = pts->range[b];
         beam_radius_start(&rad, rho);
-        if (reject_mixed && (marks != NULL ? (marks[b / 8u] >> (b % 8u)) & 1u
-                                           : (unsigned)is_mixed_pixel(pts, b, ring, &rad))) {
+        if (mixed != NULL ? (mixed[b / 8u] >> (b % 8u)) & 1u
+                          : mixed_here && is_mixed_pixel(pts, b, ring, &rad)) {
             sink.n_wasted++;
             continue;
         }
@@ -802,9 +826,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
          * ones expire once their last point is more than max_gap_beams back.
          * The list is most recently extended first, so last_pos falls along
          * it and the expired ones are a tail, closed first to last. */
-        if (n_open > 1u && j - open[n_open - 1u].last_pos > (size_t)p->max_gap_beams) {
+        if (n_open > 1u && j - open[n_open - 1u].last_pos > max_gap) {
             size_t keep_n = n_open - 1u;
-            while (keep_n > 1u && j - open[keep_n - 1u].last_pos > (size_t)p->max_gap_beams) {
+            while (keep_n > 1u && j - open[keep_n - 1u].last_pos > max_gap) {
                 --keep_n;
             }
             for (k = keep_n; k < n_open; ++k) {
