@@ -356,10 +356,41 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
-    float n = 0.0f;
+    /* the count (a float sum of ones would be the same, below 2^24) */
+    const float n = (float)(b + 1u - a);
     float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
-    size_t i;
-    for (i = a; i <= b; ++i) {
+    size_t i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): every sum takes point i, then i + 1 */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        __m128 s1 = _mm_setzero_ps(); /* sx, sy, sxx, syy */
+        __m128 s2 = _mm_setzero_ps(); /* sxz, syz, sxy, sz */
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_loadu_ps(&rp[i].x), o);
+            const __m128 sq = _mm_mul_ps(v, v);
+            /* z0 z0 z1 z1 */
+            const __m128 z = _mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1)));
+            const __m128 vz = _mm_mul_ps(v, z);
+            /* x0 * y0, ., x1 * y1, . */
+            const __m128 xy = _mm_mul_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+            s1 = _mm_add_ps(s1, _mm_movelh_ps(v, sq));
+            s1 = _mm_add_ps(s1, _mm_shuffle_ps(v, sq, _MM_SHUFFLE(3, 2, 3, 2)));
+            s2 = _mm_add_ps(s2, _mm_movelh_ps(vz, _mm_unpacklo_ps(xy, z)));
+            s2 =
+                _mm_add_ps(s2, _mm_shuffle_ps(vz, _mm_unpackhi_ps(xy, z), _MM_SHUFFLE(1, 0, 3, 2)));
+        }
+        sx = _mm_cvtss_f32(s1);
+        sy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxx = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
+        syy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(3, 3, 3, 3)));
+        sxz = _mm_cvtss_f32(s2);
+        syz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxy = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
+        sz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+    }
+#endif
+    for (; i <= b; ++i) {
         const float x = rp[i].x - cx0;
         const float y = rp[i].y - cy0;
         const float z = x * x + y * y;
@@ -371,7 +402,6 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         sxz += x * z;
         syz += y * z;
         sz += z;
-        n += 1.0f;
     }
     /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz) by Cramer. */
     det = sxx * (syy * n - sy * sy) - sxy * (sxy * n - sy * sx) + sx * (sxy * sy - syy * sx);
