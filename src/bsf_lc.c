@@ -429,7 +429,36 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         fit->cy = cy0 + cy;
         fit->r = r;
     }
-    for (i = a; i <= b; ++i) {
+    i = a;
+#ifdef LC_SSE2
+    {
+        /* both points' squared distances at once, then the sum and its test
+         * point by point as below */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        const __m128 k = _mm_set_ps(cy, cx, cy, cx);
+        const __m128 rr = _mm_set1_ps(r);
+        const float scale = enough->scale;
+        const float ratio = enough->ratio;
+        const float floor_rss = enough->floor_rss;
+        const float target = enough->target;
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(&rp[i].x), o), k);
+            const __m128 sq = _mm_mul_ps(v, v);
+            const __m128 g = _mm_sub_ps(
+                _mm_sqrt_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1)))), rr);
+            const __m128 g2 = _mm_mul_ps(g, g);
+            rss += _mm_cvtss_f32(g2);
+            if (scale * (ratio * rss + floor_rss) >= target) {
+                return rss;
+            }
+            rss += _mm_cvtss_f32(_mm_movehl_ps(g2, g2));
+            if (scale * (ratio * rss + floor_rss) >= target) {
+                return rss;
+            }
+        }
+    }
+#endif
+    for (; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
         const float dy = rp[i].y - cy0 - cy;
         const float g = sqrtf(dx * dx + dy * dy) - r;
