@@ -301,11 +301,54 @@ static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
                         float *cy, float *r)
 {
     const bsf_point_t *rp = c->rel;
-    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
+    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f;
     float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
+    /* the count (a float sum of ones would be the same, below 2^24) */
+    const float n = (float)(b + 1u - a);
     float det, du, dv, dr;
-    size_t i;
-    for (i = a; i <= b; ++i) {
+    size_t i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): every sum takes point i, then i + 1 */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        const __m128 k = _mm_set_ps(*cy, *cx, *cy, *cx);
+        const __m128 rr = _mm_set1_ps(*r);
+        __m128 s1 = _mm_setzero_ps(); /* juu, jvv, juv, . */
+        __m128 s2 = _mm_setzero_ps(); /* ju, jv, gu, gv */
+        __m128 s3 = _mm_setzero_ps(); /* g1 */
+        for (; i < b; i += 2u) {
+            const __m128 d = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(&rp[i].x), o), k);
+            const __m128 sq = _mm_mul_ps(d, d);
+            /* dist0 dist0 dist1 dist1 */
+            const __m128 dist =
+                _mm_sqrt_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))));
+            __m128 uv, uu, cr, g, ug;
+            if ((_mm_movemask_ps(_mm_cmpgt_ps(dist, _mm_setzero_ps())) & 5) != 5) {
+                return;
+            }
+            uv = _mm_div_ps(d, dist); /* u0 v0 u1 v1 */
+            g = _mm_sub_ps(dist, rr); /* g0 g0 g1 g1 */
+            uu = _mm_mul_ps(uv, uv);
+            cr = _mm_mul_ps(uv, _mm_shuffle_ps(uv, uv, _MM_SHUFFLE(2, 3, 0, 1)));
+            ug = _mm_mul_ps(uv, g);
+            s1 = _mm_add_ps(s1, _mm_movelh_ps(uu, cr));
+            s1 = _mm_add_ps(s1, _mm_shuffle_ps(uu, cr, _MM_SHUFFLE(3, 2, 3, 2)));
+            s2 = _mm_add_ps(s2, _mm_movelh_ps(uv, ug));
+            s2 = _mm_add_ps(s2, _mm_shuffle_ps(uv, ug, _MM_SHUFFLE(3, 2, 3, 2)));
+            s3 = _mm_add_ss(s3, g);
+            s3 = _mm_add_ss(s3, _mm_movehl_ps(g, g));
+        }
+        juu = _mm_cvtss_f32(s1);
+        jvv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
+        juv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
+        ju = _mm_cvtss_f32(s2);
+        jv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
+        gu = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
+        gv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+        g1 = _mm_cvtss_f32(s3);
+    }
+#endif
+    for (; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - *cx;
         const float dy = rp[i].y - cy0 - *cy;
         const float dist = sqrtf(dx * dx + dy * dy);
@@ -322,7 +365,6 @@ static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         jvv += v * v;
         ju += u;
         jv += v;
-        n += 1.0f;
         gu += u * g;
         gv += v * g;
         g1 += g;
