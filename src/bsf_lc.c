@@ -1709,7 +1709,37 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        for (i = a + 1u; i < b; ++i) {
+        i = a + 1u;
+#ifdef LC_SSE2
+        if (len > 0.0f) {
+            /* two points per step: both distances at once, then taken in
+             * order as below; lanes (x0, y0, x1, y1) */
+            const __m128 o = _mm_set_ps(pa.y, pa.x, pa.y, pa.x);
+            const __m128 e = _mm_set_ps(ex, ey, ex, ey);
+            const __m128 l = _mm_set1_ps(len);
+            const __m128 no_sign = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+            for (; i + 1u < b; i += 2u) {
+                const __m128 q =
+                    _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), (const __m64 *)&pts->pt[w->run[i]]),
+                                 (const __m64 *)&pts->pt[w->run[i + 1u]]);
+                const __m128 p = _mm_mul_ps(_mm_sub_ps(q, o), e);
+                /* ex * dy - ey * dx in lanes 0 and 2 */
+                const __m128 cr = _mm_sub_ps(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 3, 0, 1)), p);
+                const __m128 d = _mm_div_ps(_mm_and_ps(cr, no_sign), l);
+                const float d0 = _mm_cvtss_f32(d);
+                const float d1 = _mm_cvtss_f32(_mm_movehl_ps(d, d));
+                if (d0 > dmax) {
+                    dmax = d0;
+                    imax = i;
+                }
+                if (d1 > dmax) {
+                    dmax = d1;
+                    imax = i + 1u;
+                }
+            }
+        }
+#endif
+        for (; i < b; ++i) {
             const bsf_point_t q = pts->pt[w->run[i]];
             /* distance from the chord, or from its end when it has no length */
             const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
