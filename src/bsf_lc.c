@@ -562,6 +562,37 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
     bsf_point_t *rel = c->rel;
     const float ox = c->o.x;
     const float oy = c->o.y;
+#ifdef LC_SSE2
+    {
+        /* Two points per step while two are left, then as below. Both are
+         * stored, the second also when the walk stops at the first (as the
+         * point it stops before is: nothing reads it). */
+        const __m128 o = _mm_set_ps(oy, ox, oy, ox);
+        const __m128 s2 = _mm_set1_ps(side2);
+        while (step > 0 ? stop - pos >= 2u : pos - stop >= 2u) {
+            /* lanes (x, y) of the nearer point to pos, then the farther */
+            const size_t lo = step > 0 ? pos + 1u : pos - 2u;
+            const __m128 q =
+                _mm_sub_ps(_mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), (const __m64 *)&pt[run[lo]]),
+                                        (const __m64 *)&pt[run[lo + 1u]]),
+                           o);
+            const __m128 sq = _mm_mul_ps(q, q);
+            const int in = _mm_movemask_ps(
+                _mm_cmple_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))), s2));
+            /* bit 0: the point at lo, bit 2: the one at lo + 1 */
+            const int first = step > 0 ? in & 1 : in & 4;
+            const int second = step > 0 ? in & 4 : in & 1;
+            _mm_storeu_ps(&rel[lo].x, q);
+            if (!first) {
+                return pos;
+            }
+            if (!second) {
+                return step > 0 ? pos + 1u : pos - 1u;
+            }
+            pos = step > 0 ? pos + 2u : pos - 2u;
+        }
+    }
+#endif
     while (pos != stop) {
         const size_t next = step > 0 ? pos + 1u : pos - 1u;
         bsf_point_t q = pt[run[next]];
