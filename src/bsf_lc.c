@@ -2146,6 +2146,37 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
         i = close_run
                 ? 0u
                 : (c.start + step < pts->count ? c.start + step : c.start + step - pts->count);
+#ifdef LC_SSE2
+        /* Speed only, same runs: the next four beams, all valid and each
+         * within jump_a of the one before (the run's last point first),
+         * join the run as below, tested at once. */
+        if (m > 0u && step + 4u <= pts->count && i + 4u <= pts->count &&
+            work->run[m - 1u] + 1u == i) {
+            uint32_t valid4;
+            memcpy(&valid4, &pts->valid[i], sizeof valid4);
+            /* no zero byte */
+            if (((valid4 - 0x01010101u) & ~valid4 & 0x80808080u) == 0u) {
+                const float *q = &pts->pt[i].x;
+                /* pairs (i - 1, i), (i, i + 1) and (i + 1, i + 2), (i + 2, i + 3) */
+                const __m128 d1 = _mm_sub_ps(_mm_loadu_ps(q - 2), _mm_loadu_ps(q));
+                const __m128 d2 = _mm_sub_ps(_mm_loadu_ps(q + 2), _mm_loadu_ps(q + 4));
+                const __m128 s1 = _mm_mul_ps(d1, d1);
+                const __m128 s2 = _mm_mul_ps(d2, d2);
+                const __m128 t1 = _mm_add_ps(s1, _mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 3, 0, 1)));
+                const __m128 t2 = _mm_add_ps(s2, _mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 3, 0, 1)));
+                if (_mm_movemask_ps(_mm_cmple_ps(_mm_shuffle_ps(t1, t2, _MM_SHUFFLE(2, 0, 2, 0)),
+                                                 _mm_set1_ps(jump_a2))) == 15) {
+                    work->run[m] = (uint16_t)i;
+                    work->run[m + 1u] = (uint16_t)(i + 1u);
+                    work->run[m + 2u] = (uint16_t)(i + 2u);
+                    work->run[m + 3u] = (uint16_t)(i + 3u);
+                    m += 4u;
+                    step += 3u;
+                    continue;
+                }
+            }
+        }
+#endif
         if (!close_run && !pts->valid[i]) {
             continue;
         }
