@@ -17,6 +17,18 @@
 #define LC_SSE2 1
 #endif
 
+#ifdef LC_SSE2
+/* Points p and q in lanes (p.x, p.y, q.x, q.y). */
+static inline __m128 lc_pair(const bsf_point_t *p, const bsf_point_t *q)
+{
+    double lo;
+    double hi;
+    memcpy(&lo, p, sizeof lo);
+    memcpy(&hi, q, sizeof hi);
+    return _mm_castpd_ps(_mm_set_pd(hi, lo));
+}
+#endif
+
 /* Split-judge passes per run: each pass after the first only re-judges the
  * neighbours of merged splits, and a run rarely needs more than three. */
 #define LC_MAX_PASSES 8u
@@ -570,12 +582,9 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
         const __m128 o = _mm_set_ps(oy, ox, oy, ox);
         const __m128 s2 = _mm_set1_ps(side2);
         while (step > 0 ? stop - pos >= 2u : pos - stop >= 2u) {
-            /* lanes (x, y) of the nearer point to pos, then the farther */
+            /* the points at lo and lo + 1 */
             const size_t lo = step > 0 ? pos + 1u : pos - 2u;
-            const __m128 q =
-                _mm_sub_ps(_mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), (const __m64 *)&pt[run[lo]]),
-                                        (const __m64 *)&pt[run[lo + 1u]]),
-                           o);
+            const __m128 q = _mm_sub_ps(lc_pair(&pt[run[lo]], &pt[run[lo + 1u]]), o);
             const __m128 sq = _mm_mul_ps(q, q);
             const int in = _mm_movemask_ps(
                 _mm_cmple_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))), s2));
@@ -1750,9 +1759,7 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
             const __m128 l = _mm_set1_ps(len);
             const __m128 no_sign = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
             for (; i + 1u < b; i += 2u) {
-                const __m128 q =
-                    _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), (const __m64 *)&pts->pt[w->run[i]]),
-                                 (const __m64 *)&pts->pt[w->run[i + 1u]]);
+                const __m128 q = lc_pair(&pts->pt[w->run[i]], &pts->pt[w->run[i + 1u]]);
                 const __m128 p = _mm_mul_ps(_mm_sub_ps(q, o), e);
                 /* ex * dy - ey * dx in lanes 0 and 2 */
                 const __m128 cr = _mm_sub_ps(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 3, 0, 1)), p);
