@@ -817,31 +817,24 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         start = ring_start(pts, a2, two_b, cap2);
     }
 
-    /* Locals for the loop's invariants (the calls inside it could change
-     * what pts and p point to as far as the compiler knows). */
-    const size_t count = pts->count;
-    const size_t max_gap = p->max_gap_beams;
-    /* the mixed-pixel marks the loop reads, or NULL: none, or (reject_mixed
-     * without marks) each beam tested here */
-    const uint8_t *mixed = reject_mixed ? marks : NULL;
-    const int mixed_here = reject_mixed && marks == NULL;
-    for (j = 0; j < count; ++j) {
+    for (j = 0; j < pts->count; ++j) {
         size_t b = start + j;
         bsf_point_t q;
         float rho;
         float best_d2 = HUGE_VALF;
         size_t best = slots; /* none */
-        if (b >= count) {
-            b -= count;
+        if (b >= pts->count) {
+            b -= pts->count;
         }
 #ifdef SEG_SSE2
         /* Speed only, same segments: with one open segment, whose last beam
          * is b - 1, the next four beams (valid, not marked mixed) each within
          * the radius's floor of the one before continue it as below, tested
          * at once. */
-        if (n_open == 1u && open[0].last + 1u == b && b + 4u <= count && j + 4u <= count &&
-            !mixed_here && (mixed == NULL || b % 8u <= 4u) &&
-            (mixed == NULL || ((mixed[b / 8u] >> (b % 8u)) & 15u) == 0u)) {
+        if (n_open == 1u && open[0].last + 1u == b && b + 4u <= pts->count &&
+            j + 4u <= pts->count &&
+            (!reject_mixed ||
+             (marks != NULL && b % 8u <= 4u && ((marks[b / 8u] >> (b % 8u)) & 15u) == 0u))) {
             uint32_t valid4;
             memcpy(&valid4, &pts->valid[b], sizeof valid4);
             /* no zero byte */
@@ -875,8 +868,8 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         }
         rho = pts->range[b];
         beam_radius_start(&rad, rho);
-        if (mixed != NULL ? (mixed[b / 8u] >> (b % 8u)) & 1u
-                          : mixed_here && is_mixed_pixel(pts, b, ring, &rad)) {
+        if (reject_mixed && (marks != NULL ? (marks[b / 8u] >> (b % 8u)) & 1u
+                                           : (unsigned)is_mixed_pixel(pts, b, ring, &rad))) {
             sink.n_wasted++;
             continue;
         }
@@ -885,9 +878,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
          * ones expire once their last point is more than max_gap_beams back.
          * The list is most recently extended first, so last_pos falls along
          * it and the expired ones are a tail, closed first to last. */
-        if (n_open > 1u && j - open[n_open - 1u].last_pos > max_gap) {
+        if (n_open > 1u && j - open[n_open - 1u].last_pos > (size_t)p->max_gap_beams) {
             size_t keep_n = n_open - 1u;
-            while (keep_n > 1u && j - open[keep_n - 1u].last_pos > max_gap) {
+            while (keep_n > 1u && j - open[keep_n - 1u].last_pos > (size_t)p->max_gap_beams) {
                 --keep_n;
             }
             for (k = keep_n; k < n_open; ++k) {
