@@ -1799,7 +1799,22 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
             ++top;
         }
     }
-    for (i = 0; i < m; ++i) {
+    i = 0;
+#ifdef LC_SSE2
+    /* sixteen marks per step, most of them all clear */
+    for (; i + 16u <= m; i += 16u) {
+        unsigned set = 0xFFFFu ^ (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(
+                                     _mm_loadu_si128((const __m128i *)(const void *)&w->is_brk[i]),
+                                     _mm_setzero_si128()));
+        size_t k;
+        for (k = i; set != 0u; ++k, set >>= 1) {
+            if (set & 1u) {
+                w->brk[nb++] = (uint16_t)k;
+            }
+        }
+    }
+#endif
+    for (; i < m; ++i) {
         if (w->is_brk[i]) {
             w->brk[nb++] = (uint16_t)i;
         }
