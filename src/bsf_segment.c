@@ -834,7 +834,10 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         if (n_open == 1u && open[0].last + 1u == b && b + 4u <= pts->count &&
             j + 4u <= pts->count &&
             (!reject_mixed ||
-             (marks != NULL && b % 8u <= 4u && ((marks[b / 8u] >> (b % 8u)) & 15u) == 0u))) {
+             (marks != NULL &&
+              /* the marks of beams b..b + 3, in one byte or two (both in the scan) */
+              (((unsigned)marks[b / 8u] | (unsigned)marks[(b + 3u) / 8u] << 8) >> (b % 8u) & 15u) ==
+                  0u))) {
             uint32_t valid4;
             memcpy(&valid4, &pts->valid[b], sizeof valid4);
             /* no zero byte */
