@@ -11,6 +11,25 @@
 #include <stddef.h>
 #include <string.h>
 
+#if BSF_CONFIG_SIMD && defined(__SSE2__)
+#include <emmintrin.h>
+/* Speed only, same sums: the fits' loops on two points per step, each lane
+ * adding the same products in the same order as the scalar loop. */
+#define LC_SSE2 1
+#endif
+
+#ifdef LC_SSE2
+/* Points p and q in lanes (p.x, p.y, q.x, q.y). */
+static inline __m128 lc_pair(const bsf_point_t *p, const bsf_point_t *q)
+{
+    double lo;
+    double hi;
+    memcpy(&lo, p, sizeof lo);
+    memcpy(&hi, q, sizeof hi);
+    return _mm_castpd_ps(_mm_set_pd(hi, lo));
+}
+#endif
+
 /* Split-judge passes per run: each pass after the first only re-judges the
  * neighbours of merged splits, and a run rarely needs more than three. */
 #define LC_MAX_PASSES 8u
@@ -209,7 +228,21 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     if (b < a + 1u) {
         return 0;
     }
-    for (i = from; i <= b; ++i) {
+    i = from;
+#ifdef LC_SSE2
+    {
+        /* (sx, sy) takes point i, then i + 1 */
+        __m128 s = _mm_set_ps(0.0f, 0.0f, sy, sx);
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_loadu_ps(&rp[i].x);
+            s = _mm_add_ps(s, v);
+            s = _mm_add_ps(s, _mm_movehl_ps(v, v));
+        }
+        sx = _mm_cvtss_f32(s);
+        sy = _mm_cvtss_f32(_mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 1, 1, 1)));
+    }
+#endif
+    for (; i <= b; ++i) {
         sx += rp[i].x;
         sy += rp[i].y;
     }
@@ -220,7 +253,28 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     l->n = n;
     l->mx = mx;
     l->my = my;
-    for (i = a; i <= b; ++i) {
+    i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): (sxx, syy) and sxy take point i, then i + 1 */
+        const __m128 m = _mm_set_ps(my, mx, my, mx);
+        __m128 sq = _mm_setzero_ps();
+        __m128 cr = _mm_setzero_ps();
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_loadu_ps(&rp[i].x), m);
+            const __m128 p = _mm_mul_ps(v, v);
+            const __m128 q = _mm_mul_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+            sq = _mm_add_ps(sq, p);
+            sq = _mm_add_ps(sq, _mm_movehl_ps(p, p));
+            cr = _mm_add_ss(cr, q);
+            cr = _mm_add_ss(cr, _mm_movehl_ps(q, q));
+        }
+        sxx = _mm_cvtss_f32(sq);
+        syy = _mm_cvtss_f32(_mm_shuffle_ps(sq, sq, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxy = _mm_cvtss_f32(cr);
+    }
+#endif
+    for (; i <= b; ++i) {
         const float x = rp[i].x - mx;
         const float y = rp[i].y - my;
         sxx += x * x;
@@ -292,11 +346,54 @@ static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b
                                            float cy0, float *cx, float *cy, float *r)
 {
     const bsf_point_t *rp = c->rel;
-    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
+    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f;
     float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
+    /* the count (a float sum of ones would be the same, below 2^24) */
+    const float n = (float)(b + 1u - a);
     float du, dv, dr;
-    size_t i;
-    for (i = a; i <= b; ++i) {
+    size_t i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): every sum takes point i, then i + 1 */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        const __m128 k = _mm_set_ps(*cy, *cx, *cy, *cx);
+        const __m128 rr = _mm_set1_ps(*r);
+        __m128 s1 = _mm_setzero_ps(); /* juu, jvv, juv, . */
+        __m128 s2 = _mm_setzero_ps(); /* ju, jv, gu, gv */
+        __m128 s3 = _mm_setzero_ps(); /* g1 */
+        for (; i < b; i += 2u) {
+            const __m128 d = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(&rp[i].x), o), k);
+            const __m128 sq = _mm_mul_ps(d, d);
+            /* dist0 dist0 dist1 dist1 */
+            const __m128 dist =
+                _mm_sqrt_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))));
+            __m128 uv, uu, cr, g, ug;
+            if ((_mm_movemask_ps(_mm_cmpgt_ps(dist, _mm_setzero_ps())) & 5) != 5) {
+                return;
+            }
+            uv = _mm_div_ps(d, dist); /* u0 v0 u1 v1 */
+            g = _mm_sub_ps(dist, rr); /* g0 g0 g1 g1 */
+            uu = _mm_mul_ps(uv, uv);
+            cr = _mm_mul_ps(uv, _mm_shuffle_ps(uv, uv, _MM_SHUFFLE(2, 3, 0, 1)));
+            ug = _mm_mul_ps(uv, g);
+            s1 = _mm_add_ps(s1, _mm_movelh_ps(uu, cr));
+            s1 = _mm_add_ps(s1, _mm_shuffle_ps(uu, cr, _MM_SHUFFLE(3, 2, 3, 2)));
+            s2 = _mm_add_ps(s2, _mm_movelh_ps(uv, ug));
+            s2 = _mm_add_ps(s2, _mm_shuffle_ps(uv, ug, _MM_SHUFFLE(3, 2, 3, 2)));
+            s3 = _mm_add_ss(s3, g);
+            s3 = _mm_add_ss(s3, _mm_movehl_ps(g, g));
+        }
+        juu = _mm_cvtss_f32(s1);
+        jvv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
+        juv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
+        ju = _mm_cvtss_f32(s2);
+        jv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
+        gu = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
+        gv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+        g1 = _mm_cvtss_f32(s3);
+    }
+#endif
+    for (; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - *cx;
         const float dy = rp[i].y - cy0 - *cy;
         const float dist = sqrtf(dx * dx + dy * dy);
@@ -313,7 +410,6 @@ static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b
         jvv += v * v;
         ju += u;
         jv += v;
-        n += 1.0f;
         gu += u * g;
         gv += v * g;
         g1 += g;
@@ -348,10 +444,41 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
-    float n = 0.0f;
+    /* the count (a float sum of ones would be the same, below 2^24) */
+    const float n = (float)(b + 1u - a);
     float d, e, f, cx, cy, r2, r, rss = 0.0f;
-    size_t i;
-    for (i = a; i <= b; ++i) {
+    size_t i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): every sum takes point i, then i + 1 */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        __m128 s1 = _mm_setzero_ps(); /* sx, sy, sxx, syy */
+        __m128 s2 = _mm_setzero_ps(); /* sxz, syz, sxy, sz */
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_loadu_ps(&rp[i].x), o);
+            const __m128 sq = _mm_mul_ps(v, v);
+            /* z0 z0 z1 z1 */
+            const __m128 z = _mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1)));
+            const __m128 vz = _mm_mul_ps(v, z);
+            /* x0 * y0, ., x1 * y1, . */
+            const __m128 xy = _mm_mul_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+            s1 = _mm_add_ps(s1, _mm_movelh_ps(v, sq));
+            s1 = _mm_add_ps(s1, _mm_shuffle_ps(v, sq, _MM_SHUFFLE(3, 2, 3, 2)));
+            s2 = _mm_add_ps(s2, _mm_movelh_ps(vz, _mm_unpacklo_ps(xy, z)));
+            s2 =
+                _mm_add_ps(s2, _mm_shuffle_ps(vz, _mm_unpackhi_ps(xy, z), _MM_SHUFFLE(1, 0, 3, 2)));
+        }
+        sx = _mm_cvtss_f32(s1);
+        sy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxx = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
+        syy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(3, 3, 3, 3)));
+        sxz = _mm_cvtss_f32(s2);
+        syz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxy = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
+        sz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+    }
+#endif
+    for (; i <= b; ++i) {
         const float x = rp[i].x - cx0;
         const float y = rp[i].y - cy0;
         const float z = x * x + y * y;
@@ -363,7 +490,6 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         sxz += x * z;
         syz += y * z;
         sz += z;
-        n += 1.0f;
     }
     /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz): the
      * solution for (sxz syz sz), negated (exact). */
@@ -391,7 +517,36 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         fit->cy = cy0 + cy;
         fit->r = r;
     }
-    for (i = a; i <= b; ++i) {
+    i = a;
+#ifdef LC_SSE2
+    {
+        /* both points' squared distances at once, then the sum and its test
+         * point by point as below */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        const __m128 k = _mm_set_ps(cy, cx, cy, cx);
+        const __m128 rr = _mm_set1_ps(r);
+        const float scale = enough->scale;
+        const float ratio = enough->ratio;
+        const float floor_rss = enough->floor_rss;
+        const float target = enough->target;
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(&rp[i].x), o), k);
+            const __m128 sq = _mm_mul_ps(v, v);
+            const __m128 g = _mm_sub_ps(
+                _mm_sqrt_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1)))), rr);
+            const __m128 g2 = _mm_mul_ps(g, g);
+            rss += _mm_cvtss_f32(g2);
+            if (scale * (ratio * rss + floor_rss) >= target) {
+                return rss;
+            }
+            rss += _mm_cvtss_f32(_mm_movehl_ps(g2, g2));
+            if (scale * (ratio * rss + floor_rss) >= target) {
+                return rss;
+            }
+        }
+    }
+#endif
+    for (; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
         const float dy = rp[i].y - cy0 - cy;
         const float g = sqrtf(dx * dx + dy * dy) - r;
@@ -453,6 +608,34 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
     bsf_point_t *rel = c->rel;
     const float ox = c->o.x;
     const float oy = c->o.y;
+#ifdef LC_SSE2
+    {
+        /* Two points per step while two are left, then as below. Both are
+         * stored, the second also when the walk stops at the first (as the
+         * point it stops before is: nothing reads it). */
+        const __m128 o = _mm_set_ps(oy, ox, oy, ox);
+        const __m128 s2 = _mm_set1_ps(side2);
+        while (step > 0 ? stop - pos >= 2u : pos - stop >= 2u) {
+            /* the points at lo and lo + 1 */
+            const size_t lo = step > 0 ? pos + 1u : pos - 2u;
+            const __m128 q = _mm_sub_ps(lc_pair(&pt[run[lo]], &pt[run[lo + 1u]]), o);
+            const __m128 sq = _mm_mul_ps(q, q);
+            const int in = _mm_movemask_ps(
+                _mm_cmple_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))), s2));
+            /* bit 0: the point at lo, bit 2: the one at lo + 1 */
+            const int first = step > 0 ? in & 1 : in & 4;
+            const int second = step > 0 ? in & 4 : in & 1;
+            _mm_storeu_ps(&rel[lo].x, q);
+            if (!first) {
+                return pos;
+            }
+            if (!second) {
+                return step > 0 ? pos + 1u : pos - 1u;
+            }
+            pos = step > 0 ? pos + 2u : pos - 2u;
+        }
+    }
+#endif
     while (pos != stop) {
         const size_t next = step > 0 ? pos + 1u : pos - 1u;
         bsf_point_t q = pt[run[next]];
@@ -1615,7 +1798,35 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        for (i = a + 1u; i < b; ++i) {
+        i = a + 1u;
+#ifdef LC_SSE2
+        if (len > 0.0f) {
+            /* two points per step: both distances at once, then taken in
+             * order as below; lanes (x0, y0, x1, y1) */
+            const __m128 o = _mm_set_ps(pa.y, pa.x, pa.y, pa.x);
+            const __m128 e = _mm_set_ps(ex, ey, ex, ey);
+            const __m128 l = _mm_set1_ps(len);
+            const __m128 no_sign = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+            for (; i + 1u < b; i += 2u) {
+                const __m128 q = lc_pair(&pts->pt[w->run[i]], &pts->pt[w->run[i + 1u]]);
+                const __m128 p = _mm_mul_ps(_mm_sub_ps(q, o), e);
+                /* ex * dy - ey * dx in lanes 0 and 2 */
+                const __m128 cr = _mm_sub_ps(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 3, 0, 1)), p);
+                const __m128 d = _mm_div_ps(_mm_and_ps(cr, no_sign), l);
+                const float d0 = _mm_cvtss_f32(d);
+                const float d1 = _mm_cvtss_f32(_mm_movehl_ps(d, d));
+                if (d0 > dmax) {
+                    dmax = d0;
+                    imax = i;
+                }
+                if (d1 > dmax) {
+                    dmax = d1;
+                    imax = i + 1u;
+                }
+            }
+        }
+#endif
+        for (; i < b; ++i) {
             const bsf_point_t q = pts->pt[w->run[i]];
             /* distance from the chord, or from its end when it has no length */
             const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
@@ -1637,7 +1848,22 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
             ++top;
         }
     }
-    for (i = 0; i < m; ++i) {
+    i = 0;
+#ifdef LC_SSE2
+    /* sixteen marks per step, most of them all clear */
+    for (; i + 16u <= m; i += 16u) {
+        unsigned set = 0xFFFFu ^ (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(
+                                     _mm_loadu_si128((const __m128i *)(const void *)&w->is_brk[i]),
+                                     _mm_setzero_si128()));
+        size_t k;
+        for (k = i; set != 0u; ++k, set >>= 1) {
+            if (set & 1u) {
+                w->brk[nb++] = (uint16_t)k;
+            }
+        }
+    }
+#endif
+    for (; i < m; ++i) {
         if (w->is_brk[i]) {
             w->brk[nb++] = (uint16_t)i;
         }
@@ -1997,6 +2223,37 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
         i = close_run
                 ? 0u
                 : (c.start + step < pts->count ? c.start + step : c.start + step - pts->count);
+#ifdef LC_SSE2
+        /* Speed only, same runs: the next four beams, all valid and each
+         * within jump_a of the one before (the run's last point first),
+         * join the run as below, tested at once. */
+        if (m > 0u && step + 4u <= pts->count && i + 4u <= pts->count &&
+            work->run[m - 1u] + 1u == i) {
+            uint32_t valid4;
+            memcpy(&valid4, &pts->valid[i], sizeof valid4);
+            /* no zero byte */
+            if (((valid4 - 0x01010101u) & ~valid4 & 0x80808080u) == 0u) {
+                const float *q = &pts->pt[i].x;
+                /* pairs (i - 1, i), (i, i + 1) and (i + 1, i + 2), (i + 2, i + 3) */
+                const __m128 d1 = _mm_sub_ps(_mm_loadu_ps(q - 2), _mm_loadu_ps(q));
+                const __m128 d2 = _mm_sub_ps(_mm_loadu_ps(q + 2), _mm_loadu_ps(q + 4));
+                const __m128 s1 = _mm_mul_ps(d1, d1);
+                const __m128 s2 = _mm_mul_ps(d2, d2);
+                const __m128 t1 = _mm_add_ps(s1, _mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 3, 0, 1)));
+                const __m128 t2 = _mm_add_ps(s2, _mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 3, 0, 1)));
+                if (_mm_movemask_ps(_mm_cmple_ps(_mm_shuffle_ps(t1, t2, _MM_SHUFFLE(2, 0, 2, 0)),
+                                                 _mm_set1_ps(jump_a2))) == 15) {
+                    work->run[m] = (uint16_t)i;
+                    work->run[m + 1u] = (uint16_t)(i + 1u);
+                    work->run[m + 2u] = (uint16_t)(i + 2u);
+                    work->run[m + 3u] = (uint16_t)(i + 3u);
+                    m += 4u;
+                    step += 3u;
+                    continue;
+                }
+            }
+        }
+#endif
         if (!close_run && !pts->valid[i]) {
             continue;
         }

@@ -10,6 +10,13 @@
 #include "bsf_math.h"
 #include "bsf_segment_internal.h"
 
+#if BSF_CONFIG_SIMD && defined(__SSE2__)
+#include <emmintrin.h>
+/* Speed only, same marks: the mixed-pixel scan's first test on four beams
+ * at once. */
+#define SEG_SSE2 1
+#endif
+
 #define BSF_SEG_PI_F 3.14159265f
 
 static int is_finite_f(float v)
@@ -557,6 +564,42 @@ static inline int between_neighbours(const bsf_points_t *pts, size_t i, float *r
     return r[1] > *lo && r[1] < *hi;
 }
 
+/* is_mixed_pixel past its first tests: beam i's range r[2] lies strictly
+ * between its neighbours' r[1] and r[3] (lo and hi, the smaller first), and
+ * have_outer says whether r[0] and r[4] hold the next ones out. */
+static int mixed_kind(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
+                      const float *r, float lo, float hi, int have_outer)
+{
+    const float jump = hi - lo;
+    if (beam_within(rad, jump * jump)) {
+        return 0;
+    }
+    if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
+        r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
+        return MIXED_BETWEEN;
+    }
+    /* Near one surface in range: a mixed pixel only when it lies on neither.
+     * The run nearer in range must go on past beam i's neighbour (steps
+     * within the radius; on_neither_surface asks more of it); the other may
+     * step wider (a wall seen at grazing incidence, whose lines
+     * on_neither_surface keeps). */
+    if (!have_outer) {
+        return 0;
+    }
+    {
+        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
+        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
+        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
+        if (!beam_within(rad, near_step * near_step)) {
+            return 0;
+        }
+        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
+                                  !beam_within(rad, other_step * other_step))
+                   ? MIXED_OFF_A_LINE
+                   : 0;
+    }
+}
+
 /* The mixed-pixel rule documented on bsf_segment_sved_labelled; rad holds
  * beam i's range. */
 static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad)
@@ -566,7 +609,6 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     float r[5] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     float lo;
     float hi;
-    float jump;
     int have_outer;
     int k;
     if (i >= 2u && i + 2u < pts->count) {
@@ -601,34 +643,7 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
         have_outer =
             neighbour_range(pts, i, -2, ring, &r[0]) && neighbour_range(pts, i, 2, ring, &r[4]);
     }
-    jump = hi - lo;
-    if (beam_within(rad, jump * jump)) {
-        return 0;
-    }
-    if (have_outer && fabsf(r[1] - r[0]) < 0.25f * jump && fabsf(r[4] - r[3]) < 0.25f * jump &&
-        r[2] - lo > 0.125f * jump && hi - r[2] > 0.125f * jump) {
-        return MIXED_BETWEEN;
-    }
-    /* Near one surface in range: a mixed pixel only when it lies on neither.
-     * The run nearer in range must go on past beam i's neighbour (steps
-     * within the radius; on_neither_surface asks more of it); the other may
-     * step wider (a wall seen at grazing incidence, whose lines
-     * on_neither_surface keeps). */
-    if (!have_outer) {
-        return 0;
-    }
-    {
-        const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
-        const float near_step = near_before ? r[1] - r[0] : r[4] - r[3];
-        const float other_step = near_before ? r[4] - r[3] : r[1] - r[0];
-        if (!beam_within(rad, near_step * near_step)) {
-            return 0;
-        }
-        return on_neither_surface(pts, i, ring, rad, near_before, r[1] > r[2],
-                                  !beam_within(rad, other_step * other_step))
-                   ? MIXED_OFF_A_LINE
-                   : 0;
-    }
+    return mixed_kind(pts, i, ring, rad, r, lo, hi, have_outer);
 }
 
 /* The radius test's constants for beam_within. */
@@ -658,6 +673,22 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
     }
     for (b = 0; b < pts->count; ++b) {
         int kind;
+#ifdef SEG_SSE2
+        /* Beams b..b + 3 whose neighbours' ranges differ by the radius's
+         * floor or less (the first test below, valid or not) are passed
+         * over together: 1 + how many lead[mask] beams of a run of them. */
+        static const uint8_t lead[16] = {0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 4};
+        if (b >= 2u && b + 6u <= pts->count) {
+            const __m128 step =
+                _mm_sub_ps(_mm_loadu_ps(&pts->range[b + 1u]), _mm_loadu_ps(&pts->range[b - 1u]));
+            const size_t skip =
+                lead[_mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(step, step), _mm_set1_ps(rad.a2)))];
+            if (skip > 0u) {
+                b += skip - 1u;
+                continue;
+            }
+        }
+#endif
         if (!pts->valid[b]) {
             continue;
         }
@@ -671,16 +702,24 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
              * the jump, and with either invalid the return is no mixed
              * pixel anyway. */
             const float step = pts->range[b + 1u] - pts->range[b - 1u];
-            float r3[3];
+            float r[5];
             float lo;
             float hi;
-            if (step * step <= rad.a2 || !between_neighbours(pts, b, r3, &lo, &hi)) {
+            if (step * step <= rad.a2 || !between_neighbours(pts, b, &r[1], &lo, &hi)) {
                 continue;
             }
-        }
+            /* and on with its other tests, where is_mixed_pixel goes on */
+            r[0] = pts->range[b - 2u];
+            r[4] = pts->range[b + 2u];
+            beam_radius_start(&rad, r[2]);
+            kind = mixed_kind(pts, b, ring, &rad, r, lo, hi,
+                              (pts->valid[b - 2u] != 0u) & (pts->valid[b + 2u] != 0u));
+        } else
 #endif
-        beam_radius_start(&rad, pts->range[b]);
-        kind = is_mixed_pixel(pts, b, ring, &rad);
+        {
+            beam_radius_start(&rad, pts->range[b]);
+            kind = is_mixed_pixel(pts, b, ring, &rad);
+        }
         if (kind != 0 && marks != NULL) {
             marks[b / 8u] = (uint8_t)(marks[b / 8u] | (1u << (b % 8u)));
         }
@@ -807,6 +846,46 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         if (b >= pts->count) {
             b -= pts->count;
         }
+#ifdef SEG_SSE2
+        /* Speed only, same segments: with one open segment, whose last beam
+         * is b - 1, the next four beams (valid, not marked mixed) each within
+         * the radius's floor of the one before continue it as below, tested
+         * at once. */
+        if (n_open == 1u && open[0].last + 1u == b && b + 4u <= pts->count &&
+            j + 4u <= pts->count &&
+            (!reject_mixed ||
+             (marks != NULL &&
+              /* the marks of beams b..b + 3, in one byte or two (both in the scan) */
+              (((unsigned)marks[b / 8u] | (unsigned)marks[(b + 3u) / 8u] << 8) >> (b % 8u) & 15u) ==
+                  0u))) {
+            uint32_t valid4;
+            memcpy(&valid4, &pts->valid[b], sizeof valid4);
+            /* no zero byte */
+            if (((valid4 - 0x01010101u) & ~valid4 & 0x80808080u) == 0u) {
+                const float *v = &pts->pt[b].x;
+                /* pairs (b - 1, b), (b, b + 1) and (b + 1, b + 2), (b + 2, b + 3) */
+                const __m128 d1 = _mm_sub_ps(_mm_loadu_ps(v), _mm_loadu_ps(v - 2));
+                const __m128 d2 = _mm_sub_ps(_mm_loadu_ps(v + 4), _mm_loadu_ps(v + 2));
+                const __m128 s1 = _mm_mul_ps(d1, d1);
+                const __m128 s2 = _mm_mul_ps(d2, d2);
+                const __m128 t1 = _mm_add_ps(s1, _mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 3, 0, 1)));
+                const __m128 t2 = _mm_add_ps(s2, _mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 3, 0, 1)));
+                if (_mm_movemask_ps(_mm_cmple_ps(_mm_shuffle_ps(t1, t2, _MM_SHUFFLE(2, 0, 2, 0)),
+                                                 _mm_set1_ps(a2))) == 15) {
+                    open[0].last = (uint32_t)(b + 3u);
+                    open[0].last_pos = (uint32_t)(j + 3u);
+                    open[0].n += 4u;
+                    open[0].end = pts->pt[b + 3u];
+                    if (label != NULL) {
+                        label[b] = label[b + 1u] = label[b + 2u] = label[b + 3u] =
+                            (uint16_t)open[0].first;
+                    }
+                    j += 3u;
+                    continue;
+                }
+            }
+        }
+#endif
         if (!pts->valid[b]) {
             continue; /* an invalid beam never breaks a segment by itself */
         }
