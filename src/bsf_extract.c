@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "bsf/bsf_extract.h"
+#include "bsf_compact.h"
 #include "bsf_grazing.h"
 #include "bsf_lc_internal.h"
 #include "bsf_math.h"
@@ -64,7 +65,9 @@ bsf_params_t bsf_params_default(bsf_method_t method)
     p.rpos = bsf_rpos_params_default();
 #endif
     bsf_pdm_params_default(&p.pdm);
-    if (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM) {
+    /* (nothing to set when both are left out: bsf_params_check refuses them) */
+    if (((BSF_CONFIG_METHODS) & (BSF_CONFIG_METHOD_FALKO | BSF_CONFIG_METHOD_BID)) != 0u &&
+        (method == BSF_METHOD_FALKO_SVED_PDM || method == BSF_METHOD_BID_SVED_PDM)) {
         /* Keypoint detectors that miss most corners (docs/GROUND_TRUTH.md):
          * PDM's systematic-deviation test would spend control points rounding
          * the corners they miss, so these methods refine on RMS alone, at the
@@ -175,9 +178,17 @@ bsf_status_t bsf_extractor_init(bsf_extractor_t *ex, const bsf_params_t *params)
 #else
 #define USES_RPOS(ex) 0
 #endif
+/* Whether the method in use is LC-SVED-PDM: constant 1 when LC is the only
+ * method compiled in (bsf_extractor_init refuses any other), so the other
+ * methods' branches are not compiled. */
+#if (BSF_CONFIG_METHODS) == BSF_CONFIG_METHOD_LC
+#define USES_LC(ex) 1
+#else
+#define USES_LC(ex) ((ex)->params.method == BSF_METHOD_LC_SVED_PDM)
+#endif
 
 /* Tick difference to nanoseconds, saturating at 2^32 - 1 ns. */
-static uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
+static BSF_COMPACT_NOINLINE uint32_t ticks_to_ns(uint32_t ticks, uint32_t hz)
 {
     const float ns = (float)ticks * (1.0e9f / (float)hz);
     if (!(ns < 4294967040.0f)) {
@@ -214,8 +225,9 @@ static void clock_stage(stage_clock_t *c, bsf_stats_t *stats, bsf_stage_t stage)
  * bsf_bid_detect the strongest, bsf_lc_detect the first in beam order) and
  * reports how many it found: keep those and count the rest as cut. Any other
  * error stands. */
-static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex,
-                                            bsf_stats_t *stats)
+static BSF_COMPACT_NOINLINE bsf_status_t keep_keypoints_that_fit(bsf_status_t st,
+                                                                 bsf_extractor_t *ex,
+                                                                 bsf_stats_t *stats)
 {
     if (st == BSF_ERR_CAPACITY && ex->n_keypoints > (size_t)BSF_MAX_KEYPOINTS) {
         stats->cut |= BSF_CUT_KEYPOINTS;
@@ -235,7 +247,7 @@ static bsf_status_t keep_keypoints_that_fit(bsf_status_t st, bsf_extractor_t *ex
  * again). They live in ex->segments, unused until segmentation fills it. */
 static uint8_t *mixed_marks(bsf_extractor_t *ex)
 {
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.sved.reject_mixed ||
+    if (!USES_LC(ex) || !ex->params.sved.reject_mixed ||
         sizeof ex->segments * 8u < (size_t)BSF_MAX_POINTS) {
         return NULL;
     }
@@ -259,7 +271,7 @@ static uint8_t *grazing_memo(bsf_extractor_t *ex)
 
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
 /* Beams ex->interest[0..n) valid (1) or not (0). */
-static void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
+static BSF_COMPACT_NOINLINE void set_valid(bsf_extractor_t *ex, size_t n, uint8_t valid)
 {
     size_t k;
     for (k = 0; k < n; ++k) {
@@ -347,7 +359,8 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 /* Segments of at least min_points points among all[0..n). */
-static size_t count_segments_from(const bsf_segment_t *all, size_t n, uint32_t min_points)
+static BSF_COMPACT_INLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
+                                                     uint32_t min_points)
 {
     size_t c = 0u;
     size_t i;
@@ -360,8 +373,8 @@ static size_t count_segments_from(const bsf_segment_t *all, size_t n, uint32_t m
 /* Copy the kept segments all[0..n) into ex->segments. Over BSF_MAX_SEGMENTS,
  * the segments covering the most points win (ties: earlier in segmentation
  * order), they stay in segmentation order, and the rest are counted as cut. */
-static void keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n,
-                                   bsf_stats_t *stats)
+static BSF_COMPACT_NOINLINE void
+keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, bsf_stats_t *stats)
 {
     const size_t cap = BSF_MAX_SEGMENTS;
     uint32_t lo = 0u; /* at least cap segments have lo points or more */
@@ -443,8 +456,17 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 #define TAIL_RUN 8u
 /* The shortest run: a segment of fewer than TAIL_MIN_RUN + 2 returns
  * (the run, the end judged, the other end left out of the run) is not
- * judged. */
+ * judged, unless its end is a floating return (floating_end). */
 #define TAIL_MIN_RUN 5u
+/* The shortest run beside a floating return (floating_end), and beside a
+ * two-return end of a segment too short for TAIL_MIN_RUN (a segment of 5
+ * returns). */
+#define TAIL_FLOAT_RUN 3u
+
+static float sq_dist(bsf_point_t a, bsf_point_t b)
+{
+    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+}
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
  * nearer the sensor, that the straight run p[(gap + 1) step], ...
@@ -465,14 +487,26 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * is a vertex's side (the vertex two returns from the end) and the return
  * p[step] between must lie on its line (within the same bound one step past
  * it, or split_min): LC's vertex then sits one return before the corner and
- * only p[0] is on the next surface. */
-static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
-                    const bsf_lc_params_t *lc)
+ * only p[0] is on the next surface. With apex (gap 1) it asks instead
+ * whether p[step] and p[0] are a second surface: both off the run's line
+ * (p[step] by the bound above), on either side, their line turning away
+ * from it by min_turn or more and crossing it (the corner, written to apex)
+ * between the beams of p[2 step] and p[step], and the step from p[2 step]
+ * to p[step] at least twice the run's spacing. A smooth surface (a
+ * pillar's silhouette) bends by degrees and keeps its spacing; a second
+ * surface starts where the returns jump. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
+#endif
+static int
+tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noise2,
+         const bsf_lc_params_t *lc, bsf_point_t *apex)
 {
     bsf_point_t w[TAIL_RUN + 1u];
     bsf_side_line_t l;
     float bound2;
     float d;
+    float d1;
     float sx;
     float sy;
     float s;
@@ -487,9 +521,11 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
     }
     bound2 = lc->split_sigmas * lc->split_sigmas * l.var;
     d = l.d_near;
+    d1 = d;
     if (gap > 0u) {
-        if (d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) {
-            return 0; /* p[step] is off the side too: a second side of two returns */
+        if ((d * d > bound2 * l.reach_nr && d * d > lc->split_min * lc->split_min) ==
+            (apex == NULL)) {
+            return 0; /* p[step] off the side too (a second side of two returns), or on it */
         }
         d = bsf_side_distance(&l, p[0]);
         l.reach_nr = l.reach_i;
@@ -497,43 +533,107 @@ static int tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run
     sx = p[0].x - p[step].x;
     sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
+    /* The turn: p[0] off the line by its own return, or off p[step]'s
+     * offset (two returns) by min_turn or more. */
+    d1 = apex != NULL ? d - d1 : d;
+    if (!(d1 * d1 > s * s * (sx * sx + sy * sy))) {
+        return 0;
+    }
+    if (apex != NULL) {
+        d = d - d1; /* p[step]'s offset */
+        if (!(d * d1 > 0.0f &&
+              sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]))) {
+            return 0;
+        }
+        d /= d1;
+        apex->x = p[step].x - d * sx;
+        apex->y = p[step].y - d * sy;
+        return (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
+                   (apex->x * p[step].y - apex->y * p[step].x) >
+               0.0f;
+    }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
     return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_nr &&
-           d * d > lc->split_min * lc->split_min && d * d > s * s * (sx * sx + sy * sy);
+           d * d > lc->split_min * lc->split_min;
+}
+
+/* Does the beam past segment end b (dir -1 before it, +1 after it) read a
+ * valid range nearer the sensor than b? Then b lies in range between the
+ * surface its segment follows and the nearer surface seen past it: at a
+ * depth jump, where a mixed pixel (a beam that reads a blend of the two
+ * ranges and floats in free space) lies. A real end return of a far
+ * surface, beside the surface that hides the rest, lies on its line, which
+ * tail_end checks. */
+static int floating_end(const bsf_points_t *pts, size_t b, int dir)
+{
+    const size_t o = b + (size_t)(ptrdiff_t)dir;
+    return o < pts->count && pts->valid[o] && pts->range[o] < pts->range[b];
 }
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
- * that leaves the other end out) is left off unless LC has a corner within
- * that run, which already bends the curve there; with the corner two
- * returns from the end, the end is judged by the corner's side (up to
- * TAIL_RUN returns from the vertex, not past the next one nor to the other
- * end). */
-static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, size_t *lo, size_t *hi)
+ * that leaves the other end out) is left off. With an LC corner within
+ * that run the run is the corner's side: the returns between the end and
+ * the corner, its apex left out; with the corner two returns from the end,
+ * up to TAIL_RUN returns from the vertex, not past the next one nor to the
+ * other end. A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1 returns judges
+ * only a floating end (floating_end): a far surface seen over a few
+ * returns through a gap, whose end beam blends with the surface in
+ * front. A segment too short for TAIL_MIN_RUN and without a corner gets
+ * one, a vertex at its third return from that end anchored at the
+ * crossing, when its last two returns at one end are a second surface
+ * (tail_end with an apex, judged by the other returns): its one quadratic
+ * span cannot turn there and would swing off both surfaces, and leaving
+ * the two returns out would waste a third of the segment. Returns the
+ * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
+ * wrote them, or that one vertex). */
+static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
+                                              size_t n_vertex, size_t *lo, size_t *hi)
 {
-    const uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
+    uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    size_t gap;
-    size_t side;
-    if (ex->params.method != BSF_METHOD_LC_SVED_PDM || !ex->params.trim_tails ||
-        n < TAIL_MIN_RUN + 2u) {
-        return;
+    /* Too short for the tail rule's run: a two-return end is a corner. */
+    bsf_point_t *apex =
+        n < TAIL_MIN_RUN + 2u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+    int e;
+    if (!USES_LC(ex) || !ex->params.trim_tails || n < TAIL_FLOAT_RUN + 2u) {
+        return n_vertex;
     }
-    gap = n_vertex > 0u && pos[0] == 2u;
-    side = gap ? (n_vertex > 1u ? (size_t)pos[1] : n - 2u) - 1u : run;
-    if (side >= TAIL_MIN_RUN && (gap || n_vertex == 0u || pos[0] > run + 1u) &&
-        tail_end(pts, 1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
-        *lo = 1u;
+    for (e = 0; apex != NULL && e < 2; ++e) {
+        if (tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
+                     apex)) {
+            pos[0] = (uint16_t)(e ? n - 3u : 2u);
+            return 1u;
+        }
     }
-    gap = n_vertex > 0u && (size_t)pos[n_vertex - 1u] + 3u == n;
-    side = gap ? n - 2u - (n_vertex > 1u ? (size_t)pos[n_vertex - 2u] : 1u) : run;
-    if (side >= TAIL_MIN_RUN &&
-        (gap || n_vertex == 0u || (size_t)pos[n_vertex - 1u] + run + 2u < n) &&
-        tail_end(&pts[n - 1u], -1, gap, side < run ? side : run, ex->noise2, &ex->params.lc)) {
-        *hi = n - 2u;
+    for (e = 0; e < 2; ++e) {
+        /* Distances from this end to its nearest vertex (n: none) and to
+         * the next one (n - 2 when there is no second vertex). */
+        size_t d1 = n;
+        size_t d2 = n - 2u;
+        size_t side;
+        if (n_vertex > 0u) {
+            d1 = e ? n - 1u - pos[n_vertex - 1u] : pos[0];
+        }
+        if (n_vertex > 1u) {
+            d2 = e ? n - 1u - pos[n_vertex - 2u] : pos[1];
+        }
+        side = d1 == 2u ? d2 - 1u : (d1 <= run + 1u ? d1 - 1u : run);
+        if ((side >= TAIL_MIN_RUN ||
+             (side >= TAIL_FLOAT_RUN &&
+              floating_end(&ex->points, e ? s->last : s->first, e ? 1 : -1))) &&
+            tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, d1 == 2u, side < run ? side : run,
+                     ex->noise2, &ex->params.lc, NULL)) {
+            if (e) {
+                *hi = n - 2u;
+            } else {
+                *lo = 1u;
+            }
+        }
     }
+    return n_vertex;
 }
 #endif
 
@@ -542,39 +642,47 @@ static void trim_tails(const bsf_extractor_t *ex, size_t n, size_t n_vertex, siz
  * are not among its first two or last two points (the rule of
  * bsf_segment_classify). Returns the number of points. */
 
-static size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s, size_t *n_vertex)
+static BSF_COMPACT_INLINE size_t gather_segment(bsf_extractor_t *ex, const bsf_segment_t *s,
+                                                size_t *n_vertex)
 {
+    /* Locals: the point stores below could change *s and ex's counts as
+     * far as the compiler knows, which then reloads them at every beam
+     * (the arrays' addresses too, but as locals they cost x86 registers). */
+    const size_t first = s->first;
+    const size_t last = s->last;
+    const size_t count = ex->points.count;
+    const size_t n_keypoints = ex->n_keypoints;
     size_t n = 0u;
     size_t nv = 0u;
     size_t k = 0u;
     size_t b;
     size_t i;
 
-    while (k < ex->n_keypoints && ex->interest[k] < s->first) {
+    while (k < n_keypoints && ex->interest[k] < first) {
         ++k;
     }
     /* The segment's beams are those labelled with its first beam; a
      * wrapping segment (first > last) runs on through beam 0. */
-    for (b = s->first;; b = (b + 1u < ex->points.count) ? b + 1u : 0u) {
-        if (b == 0u && s->first > 0u) {
+    for (b = first;; b = (b + 1u < count) ? b + 1u : 0u) {
+        if (b == 0u && first > 0u) {
             k = 0u; /* wrapped through the seam */
         }
-        if (ex->scratch.seg.label[b] != s->first) {
-            if (b == s->last) {
+        if (ex->scratch.seg.label[b] != first) {
+            if (b == last) {
                 break;
             }
             continue;
         }
-        while (k < ex->n_keypoints && ex->interest[k] < b) {
+        while (k < n_keypoints && ex->interest[k] < b) {
             ++k; /* an interest beam on an invalid reading is no vertex */
         }
-        if (k < ex->n_keypoints && ex->interest[k] == b) {
+        if (k < n_keypoints && ex->interest[k] == b) {
             ex->scratch.seg.use.fit.vertex_anchor[nv] = ex->keypoints[k].point;
             ex->scratch.seg.use.fit.vertex_pos[nv++] = (uint16_t)n;
             ++k;
         }
         ex->scratch.seg.use.fit.seg_points[n++] = ex->points.pt[b];
-        if (b == s->last) {
+        if (b == last) {
             break;
         }
     }
@@ -655,8 +763,8 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
  * every control point it may have stands: its worst point is at an end the
  * cap left off, and cutting there only chips the end off. The RMS bounds the
  * largest distance (max^2 <= n rms^2), so most fits need no search. */
-static size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b, size_t n_ctrl,
-                          float e_curve, const bsf_result_t *res)
+static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a, size_t b,
+                                             size_t n_ctrl, float e_curve, const bsf_result_t *res)
 {
     const float bound = ex->params.split_dist;
     const size_t n = b + 1u - a;
@@ -685,7 +793,7 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
 {
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
-    const int anchored = ex->params.method == BSF_METHOD_LC_SVED_PDM;
+    const int anchored = USES_LC(ex);
     const size_t n = b + 1u - a;
     /* This fit's parameters and outcome live in the scratch, not on the
      * stack of the deepest call chain. */
@@ -759,8 +867,8 @@ static void append_feature(bsf_result_t *res, uint16_t first_beam, uint16_t last
  * that fails undoes the pieces appended before it; the segment is then
  * fitted whole, unsplit, or its status returned when the whole fit fails or
  * the result has no room (BSF_ERR_BUFFER). */
-static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
-                               size_t n_vertex, bsf_result_t *res)
+static BSF_COMPACT_INLINE bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s,
+                                                  size_t n, size_t n_vertex, bsf_result_t *res)
 {
     size_t lo0 = 0u;
     size_t hi0 = n - 1u;
@@ -773,7 +881,7 @@ static bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf_segment_t *s, size
     int may_split = 1;
     size_t depth = 1u;
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    trim_tails(ex, n, n_vertex, &lo0, &hi0);
+    n_vertex = trim_tails(ex, s, n, n_vertex, &lo0, &hi0);
 #endif
     lo[0] = (uint16_t)lo0;
     hi[0] = (uint16_t)hi0;
@@ -898,7 +1006,7 @@ static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
 
 /* Beam order of features: by first beam, one wrapping through the seam of a
  * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
-static uint32_t beam_order_key(const bsf_feature_t *f)
+static BSF_COMPACT_INLINE uint32_t beam_order_key(const bsf_feature_t *f)
 {
     return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
 }

@@ -24,6 +24,7 @@
  * to a counter, the buffer or the sink.
  */
 #include "bsf/bsf_stream.h"
+#include "bsf_compact.h"
 
 #include <math.h>
 #include <string.h>
@@ -46,10 +47,10 @@
 #if FEATURES_SSE2
 /* Both coordinates at once with the same IEEE single operations as
  * quantise (divide, add, truncate, compare), so the same q and verdict. */
-ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
+ENC_INLINE int quantise_point(const bsf_point_t *p, float step, int32_t q[2])
 {
     const __m128 r =
-        _mm_add_ps(_mm_div_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)&p)),
+        _mm_add_ps(_mm_div_ps(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)p)),
                               _mm_set1_ps(step)),
                    _mm_set1_ps(0.5f));
     const __m128 in_range = _mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), r),
@@ -81,10 +82,10 @@ ENC_INLINE int quantise(float v, float step, int32_t *q)
     return *q >= -BSF_QUANT_MAX_STEPS; /* -2^23 < r < -(2^23 - 1) floors to -2^23 */
 }
 
-ENC_INLINE int quantise_point(bsf_point_t p, float step, int32_t q[2])
+ENC_INLINE int quantise_point(const bsf_point_t *p, float step, int32_t q[2])
 {
-    const int ok_x = quantise(p.x, step, &q[0]);
-    const int ok_y = quantise(p.y, step, &q[1]);
+    const int ok_x = quantise(p->x, step, &q[0]);
+    const int ok_y = quantise(p->y, step, &q[1]);
     return ok_x && ok_y;
 }
 #endif
@@ -125,8 +126,13 @@ ENC_INLINE uint32_t add_value(uint32_t *out, uint32_t cnt, bsf_wire_eg_tally_t *
 
 /* bsf_wire_predict in 32 bits: quantised coordinates within 2^23 - 1 make
  * |b - a| <= 2^24 - 2, and k <= BSF_MAX_CTRL_PER_FEATURE - 2 <= 62 (bsf_stream.h
- * caps it at 64), so (b - a)(2s - 1) + k stays below 2^24 * 123 + 62 < 2^31. */
+ * caps it at 64), so (b - a)(2s - 1) + k stays below 2^24 * 123 + 62 < 2^31.
+ * Inlined in the compact build too: its two uses are smaller than calls. */
+#if BSF_CONFIG_COMPACT
+static BSF_COMPACT_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
+#else
 ENC_INLINE int32_t predict32(int32_t a, int32_t b, uint32_t s, uint32_t k)
+#endif
 {
     const int32_t den = 2 * (int32_t)k;
     const int32_t num = (b - a) * (2 * (int32_t)s - 1) + (int32_t)k;
@@ -156,7 +162,7 @@ static int vertex_partner_ok(const bsf_point_t *p, const uint8_t *vtx, size_t s,
         return 1; /* the usual copy: the same bits quantise alike (the test below's answer) */
     }
 #endif
-    return quantise_point(p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
+    return quantise_point(&p[s + 1u], step, q2) && q2[0] == q[0] && q2[1] == q[1];
 }
 
 /*
@@ -182,7 +188,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
 
     *mask = 0u;
 
-    if (!quantise_point(p[0], step, q_a)) {
+    if (!quantise_point(&p[0], step, q_a)) {
         return 0u;
     }
     c_a = 1u;
@@ -205,7 +211,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
             ++s_b;
         }
         k = (uint32_t)(s_b - t);
-        if (!quantise_point(p[s_b], step, q_b)) {
+        if (!quantise_point(&p[s_b], step, q_b)) {
             return 0u;
         }
         *mask <<= k + 1u; /* k + 1 <= 63: the k precision points and anchor b */
@@ -222,7 +228,7 @@ ENC_INLINE uint32_t feature_values(const bsf_point_t *p, const uint8_t *vtx, siz
         for (i = t; i < s_b; ++i) {
             const uint32_t s = (uint32_t)(i - t) + 1u;
             int32_t q[2];
-            if (!quantise_point(p[i], step, q)) {
+            if (!quantise_point(&p[i], step, q)) {
                 return 0u;
             }
             cnt = add_value(out, cnt, tally, BSF_WIRE_CLASS_PREC,
@@ -316,7 +322,6 @@ ENC_INLINE void field_kind_m_mask(writer_t *w, bits_t *b, int costing, uint32_t 
                                   int has_mask)
 {
     (void)costing; /* unused in the compact variant (ENC_COSTING) */
-#if !BSF_CONFIG_COMPACT
 #if BSF_WIRE_K_M != 1u
 #error "the fused kind / m / mask-flag field below assumes m - 2 in EG1"
 #endif
@@ -324,11 +329,6 @@ ENC_INLINE void field_kind_m_mask(writer_t *w, bits_t *b, int costing, uint32_t 
      * 2 floor(log2 m) bits */
     const unsigned m_len = 2u * log2_nz(m);
     field_u(w, b, costing, (kind << (m_len + 1u)) | (m << 1) | (has_mask ? 1u : 0u), m_len + 2u);
-#else
-    field_u(w, b, costing, kind, 1u);
-    field_eg(w, b, costing, m - 2u, BSF_WIRE_K_M);
-    field_u(w, b, costing, has_mask ? 1u : 0u, 1u);
-#endif
 }
 
 /* Beams minus one of a feature's run: last - first, or through the seam of
@@ -342,7 +342,7 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 /* A feature's own fields (not its points) within the result and the caps. */
-static int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
+static BSF_COMPACT_INLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
 {
     const size_t n = f->n_ctrl;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
@@ -398,7 +398,7 @@ static bsf_status_t check_stats(const bsf_stats_t *st)
     return BSF_OK;
 }
 
-static int32_t round_to_int(float v)
+static BSF_COMPACT_INLINE int32_t round_to_int(float v)
 {
     return (int32_t)bsf_floorf(v + 0.5f);
 }
@@ -419,6 +419,10 @@ ENC_INLINE void field_pose(writer_t *w, bits_t *b, int costing, const bsf_pose_t
  * point values (FORMAT.md section 7). */
 #define HEADER_MAX_BITS 619u
 #define FEATURE_MAX_BITS 211u
+
+#if BSF_WIRE_N_CLASSES * BSF_WIRE_K_CTRL_BITS > 31
+#error "the classes' orders are written as one field of at most 31 bits"
+#endif
 
 /* What the planning run learns for the writing runs. */
 typedef struct {
@@ -463,8 +467,8 @@ static bsf_status_t check_frame(const bsf_frame_info_t *info, const bsf_result_t
  * bounds the payload's size: the values' exact bits plus the most the
  * header and feature fields can take.
  */
-static bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table, plan_t *pl,
-                               uint32_t *max_bits)
+static BSF_COMPACT_INLINE bsf_status_t plan_frame(const bsf_result_t *res, uint32_t *table,
+                                                  plan_t *pl, uint32_t *max_bits)
 {
     bsf_wire_eg_tally_t tally[BSF_WIRE_N_CLASSES];
     const float step = pl->step;
@@ -538,6 +542,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     uint8_t k_ctrl[BSF_WIRE_N_CLASSES];
     orders_t ord;
     uint32_t prev_last_beam_plus1 = 0; /* the "previous last_beam" of the first feature is -1 */
+    uint32_t k_fields = 0;             /* the classes' orders, the first highest: one field */
     uint32_t used = 0;
     int32_t prev[2];
     uint32_t i;
@@ -546,12 +551,15 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
         ord.one[i] = (uint32_t)1 << k_ctrl[i];
         ord.adj[i] = 1u - k_ctrl[i];
+        k_fields = (k_fields << BSF_WIRE_K_CTRL_BITS) | k_ctrl[i];
     }
     prev[0] = pl->prev_resume[0];
     prev[1] = pl->prev_resume[1];
-    field_u(w, &b, costing, (BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES, 8u);
-    field_u(w, &b, costing, info->has_pose != 0u ? 1u : 0u, 1u);
-    field_u(w, &b, costing, pl->has_ext ? 1u : 0u, 1u);
+    /* version and type (8 bits), the pose and extension flags: one field */
+    field_u(w, &b, costing,
+            (((BSF_FORMAT_VERSION << 4) | BSF_FRAME_TYPE_FEATURES) << 2) |
+                (info->has_pose != 0u ? 2u : 0u) | (pl->has_ext ? 1u : 0u),
+            10u);
     field_eg64(w, &b, costing, info->seq, BSF_WIRE_K_SEQ);
     field_eg64(w, &b, costing, info->timestamp_ms, BSF_WIRE_K_TIMESTAMP);
     if (info->has_pose != 0u) {
@@ -564,13 +572,14 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
              res->stats.time_ns / 1000u + (res->stats.time_ns % 1000u + 500u) / 1000u,
              BSF_WIRE_K_TIME_US);
     field_eg(w, &b, costing, res->n_features, BSF_WIRE_K_FEATURES);
-    for (i = 0; i < BSF_WIRE_N_CLASSES; ++i) {
-        field_u(w, &b, costing, k_ctrl[i], BSF_WIRE_K_CTRL_BITS);
-    }
+    field_u(w, &b, costing, k_fields, BSF_WIRE_N_CLASSES * BSF_WIRE_K_CTRL_BITS);
     if (pl->has_ext) {
-        field_u(w, &b, costing, pl->has_beams ? 1u : 0u, 1u);
-        field_u(w, &b, costing, info->has_geometry != 0u ? 1u : 0u, 1u);
-        field_u(w, &b, costing, res->stats.cut, BSF_WIRE_CUT_BITS);
+        /* the beams and geometry flags and the cut bits (checked: within
+         * BSF_WIRE_CUT_BITS): one field */
+        field_u(w, &b, costing,
+                (pl->has_beams ? 2u << BSF_WIRE_CUT_BITS : 0u) |
+                    (info->has_geometry != 0u ? 1u << BSF_WIRE_CUT_BITS : 0u) | res->stats.cut,
+                BSF_WIRE_CUT_BITS + 2u);
         if (pl->has_beams) {
             field_eg(w, &b, costing, res->stats.n_beams, BSF_WIRE_K_N_BEAMS);
         }
@@ -605,12 +614,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
         }
         field_kind_m_mask(w, &b, costing, f->kind, n_unique, mask != 0u);
         if (mask != 0u) {
-            uint32_t j = n_unique; /* bits left, the highest first */
-            do {
-                const unsigned take = j > 16u ? 16u : j;
-                j -= take;
-                field_u(w, &b, costing, (uint32_t)(mask >> j) & ((1u << take) - 1u), take);
-            } while (j > 0u);
+            field_u64(w, &b, costing, mask, n_unique); /* 16 bits at a time, the highest first */
         }
         field_eg2(w, &b, costing, zigzag32((int32_t)f->first_beam - (int32_t)prev_last_beam_plus1),
                   BSF_WIRE_K_GAP, span, BSF_WIRE_K_SPAN);
@@ -673,16 +677,9 @@ static bsf_status_t features_job_plan(bsf_enc_job_t *job)
 void bsf_frame_info_init(bsf_frame_info_t *info)
 {
     if (info != NULL) {
-        info->seq = 0u;
-        info->timestamp_ms = 0u;
-        info->has_pose = 0u;
-        info->pose.x = 0.0f;
-        info->pose.y = 0.0f;
-        info->pose.theta = 0.0f;
+        /* every field zero (0.0f is all zero bits) but the step */
+        memset(info, 0, sizeof *info);
         info->quant_step = BSF_QUANT_STEP_DEFAULT;
-        info->has_geometry = 0u;
-        info->angle_min = 0.0f;
-        info->angle_increment = 0.0f;
     }
 }
 

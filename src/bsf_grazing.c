@@ -1,11 +1,15 @@
 /* SPDX-License-Identifier: MIT */
 /* Grazing joins (bsf_grazing.h explains them): one copy for SVED and LC. */
 #include "bsf_grazing.h"
+#include "bsf_compact.h"
 
 #include <stddef.h>
 
-int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
+int bsf_grazing_triple(const bsf_point_t *pt, size_t i0, size_t i1, size_t i2)
 {
+    const bsf_point_t p0 = pt[i0];
+    const bsf_point_t p1 = pt[i1];
+    const bsf_point_t p2 = pt[i2];
     const float ax = p1.x - p0.x;
     const float ay = p1.y - p0.y;
     const float bx = p2.x - p1.x;
@@ -24,10 +28,14 @@ int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
     return cross * cross <= BSF_GRAZING_LINE_TOL * BSF_GRAZING_LINE_TOL * (cx * cx + cy * cy);
 }
 
-/* Point e lies just before the line that goes from p through q: behind p
- * by at most 1.5 steps |q - p| along it, off it by at most half a step. */
-static int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
+/* Point e = pt[ie] lies just before the line that goes from p = pt[ip]
+ * through q = pt[iq]: behind p by at most 1.5 steps |q - p| along it, off it
+ * by at most half a step. */
+static int bsf_grazing_entry(const bsf_point_t *pt, size_t ie, size_t ip, size_t iq)
 {
+    const bsf_point_t e = pt[ie];
+    const bsf_point_t p = pt[ip];
+    const bsf_point_t q = pt[iq];
     const float ux = q.x - p.x;
     const float uy = q.y - p.y;
     const float s2 = ux * ux + uy * uy;
@@ -38,15 +46,18 @@ static int bsf_grazing_entry(bsf_point_t e, bsf_point_t p, bsf_point_t q)
     return s2 > 0.0f && along > 0.0f && along <= 1.5f * s2 && off * off <= 0.25f * s2 * s2;
 }
 
-/* |q - p| <= cap */
-static int bsf_grazing_within(bsf_point_t p, bsf_point_t q, float cap)
+/* |pt[iq] - pt[ip]| <= cap */
+static BSF_COMPACT_NOINLINE int bsf_grazing_within(const bsf_point_t *pt, size_t ip, size_t iq,
+                                                   float cap)
 {
+    const bsf_point_t p = pt[ip];
+    const bsf_point_t q = pt[iq];
     const float dx = q.x - p.x;
     const float dy = q.y - p.y;
     return dx * dx + dy * dy <= cap * cap;
 }
 
-static int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
+static BSF_COMPACT_INLINE int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
 {
     return i < pts->count && pts->valid[i] != 0u;
 }
@@ -56,8 +67,8 @@ static int bsf_grazing_run4(const bsf_points_t *pts, size_t i)
 {
     const bsf_point_t *p = pts->pt;
     return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
-           bsf_grazing_ok(pts, i + 3u) && bsf_grazing_triple(p[i], p[i + 1u], p[i + 2u]) &&
-           bsf_grazing_triple(p[i + 1u], p[i + 2u], p[i + 3u]);
+           bsf_grazing_ok(pts, i + 3u) && bsf_grazing_triple(p, i, i + 1u, i + 2u) &&
+           bsf_grazing_triple(p, i + 1u, i + 2u, i + 3u);
 }
 
 /* The middle return p1 lies where its ray crosses the chord p0-p2, to
@@ -80,7 +91,7 @@ static int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
 {
     const bsf_point_t *p = pts->pt;
     return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
-           bsf_grazing_triple(p[i], p[i + 1u], p[i + 2u]) &&
+           bsf_grazing_triple(p, i, i + 1u, i + 2u) &&
            bsf_grazing_on_ray(p[i], p[i + 1u], p[i + 2u]);
 }
 
@@ -95,8 +106,8 @@ static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir)
     const bsf_point_t *p = pts->pt;
     const ptrdiff_t d = dir;
     const size_t c = (size_t)((ptrdiff_t)s - d); /* the corner's return */
-    return bsf_grazing_entry(p[c], p[s], p[(ptrdiff_t)s + d]) &&
-           !bsf_grazing_triple(p[(ptrdiff_t)c - d], p[c], p[s]) &&
+    return bsf_grazing_entry(p, c, s, (size_t)((ptrdiff_t)s + d)) &&
+           !bsf_grazing_triple(p, (size_t)((ptrdiff_t)c - d), c, s) &&
            bsf_grazing_line3(pts, d > 0 ? c - 2u : c) &&
            bsf_grazing_line3(pts, d > 0 ? s : s - 2u) &&
            bsf_grazing_line3(pts, d > 0 ? s + 1u : s - 3u);
@@ -109,7 +120,7 @@ static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir)
 static int bsf_grazing_run_room(const bsf_points_t *pts, size_t s, float cap)
 {
     return s >= 3u && s + 3u < pts->count && pts->valid[s - 1u] && pts->valid[s] &&
-           pts->valid[s + 1u] && bsf_grazing_within(pts->pt[s - 1u], pts->pt[s + 1u], cap);
+           pts->valid[s + 1u] && bsf_grazing_within(pts->pt, s - 1u, s + 1u, cap);
 }
 
 /* The step between beams a and a + 1 is the step onto such a corner run or
@@ -158,12 +169,12 @@ static int grazing_join_verdict(const bsf_points_t *pts, size_t a, float cap, in
     }
     /* a corner turning onto the wall that starts at b, or off the one that
      * ends at a */
-    if (bsf_grazing_run4(pts, b) && bsf_grazing_entry(p[a], p[b], p[b + 1u]) &&
-        bsf_grazing_within(p[a], p[b + 2u], cap)) {
+    if (bsf_grazing_run4(pts, b) && bsf_grazing_entry(p, a, b, b + 1u) &&
+        bsf_grazing_within(p, a, b + 2u, cap)) {
         return 1;
     }
-    return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p[b], p[a], p[a - 1u]) &&
-           bsf_grazing_within(p[b], p[a - 2u], cap);
+    return a >= 3u && bsf_grazing_run4(pts, a - 3u) && bsf_grazing_entry(p, b, a, a - 1u) &&
+           bsf_grazing_within(p, b, a - 2u, cap);
 }
 
 int bsf_grazing_join(const bsf_points_t *pts, size_t a, float cap, int at_corners, uint8_t *memo)

@@ -36,9 +36,11 @@
  * two returns that still line up, and the feature would close it. */
 #define BSF_GRAZING_MIN_SIN 0.17f
 
-/* Points p0, p1, p2 in that order on a line: p1 between the two, within
- * BSF_GRAZING_LINE_TOL of their chord, the two steps within the ratio. */
-int bsf_grazing_triple(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2);
+/* Points pt[i0], pt[i1], pt[i2] in that order on a line: the middle one
+ * between the two, within BSF_GRAZING_LINE_TOL of their chord, the two steps
+ * within the ratio. (Indices, not points: every caller's points are in one
+ * array, and three indices are fewer instructions to pass than six floats.) */
+int bsf_grazing_triple(const bsf_point_t *pt, size_t i0, size_t i1, size_t i2);
 
 /* The last valid beam, the one before beam 0 on the ring of a full-circle
  * scan (where SVED's and LC's passes look for their start), or pts->count

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* LC, the line-corner detector (include/bsf/bsf_lc.h explains the method). */
 #include "bsf/bsf_lc.h"
+#include "bsf_compact.h"
 #include "bsf_grazing.h"
 #include "bsf_lc_internal.h"
 #include "bsf_math.h"
@@ -9,6 +10,25 @@
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
+
+#if BSF_CONFIG_SIMD && defined(__SSE2__)
+#include <emmintrin.h>
+/* Speed only, same sums: the fits' loops on two points per step, each lane
+ * adding the same products in the same order as the scalar loop. */
+#define LC_SSE2 1
+#endif
+
+#ifdef LC_SSE2
+/* Points p and q in lanes (p.x, p.y, q.x, q.y). */
+static inline __m128 lc_pair(const bsf_point_t *p, const bsf_point_t *q)
+{
+    double lo;
+    double hi;
+    memcpy(&lo, p, sizeof lo);
+    memcpy(&hi, q, sizeof hi);
+    return _mm_castpd_ps(_mm_set_pd(hi, lo));
+}
+#endif
 
 /* Split-judge passes per run: each pass after the first only re-judges the
  * neighbours of merged splits, and a run rarely needs more than three. */
@@ -130,15 +150,14 @@ typedef struct {
 #endif
 } lc_ctx_t;
 
-/* Run point pos relative to the origin, also stored for the fits: judge's
- * side walks visit every point of the window a0..b1 this way first. */
-static bsf_point_t rel_store(const lc_ctx_t *c, size_t pos)
+/* Run point pos relative to the origin, stored for the fits: judge's side
+ * walks visit every point of the window a0..b1 this way first. */
+static void rel_store(const lc_ctx_t *c, size_t pos)
 {
     bsf_point_t q = c->pts->pt[c->run[pos]];
     q.x -= c->o.x;
     q.y -= c->o.y;
     c->rel[pos] = q;
-    return q;
 }
 
 static float dist2(bsf_point_t a, bsf_point_t b)
@@ -157,6 +176,13 @@ static float
 dist2_once(bsf_point_t a, bsf_point_t b)
 {
     return dist2(a, b);
+}
+
+/* dist2 of run positions i and j relative to the origin (c->rel): one copy
+ * for the judgement's single uses in the compact build (code size). */
+static BSF_COMPACT_NOINLINE float rel_dist2(const lc_ctx_t *c, size_t i, size_t j)
+{
+    return dist2(c->rel[i], c->rel[j]);
 }
 
 /* Unit eigenvector (*dx, *dy) of the scatter [sxx sxy; sxy syy] for its
@@ -202,7 +228,21 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     if (b < a + 1u) {
         return 0;
     }
-    for (i = from; i <= b; ++i) {
+    i = from;
+#ifdef LC_SSE2
+    {
+        /* (sx, sy) takes point i, then i + 1 */
+        __m128 s = _mm_set_ps(0.0f, 0.0f, sy, sx);
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_loadu_ps(&rp[i].x);
+            s = _mm_add_ps(s, v);
+            s = _mm_add_ps(s, _mm_movehl_ps(v, v));
+        }
+        sx = _mm_cvtss_f32(s);
+        sy = _mm_cvtss_f32(_mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 1, 1, 1)));
+    }
+#endif
+    for (; i <= b; ++i) {
         sx += rp[i].x;
         sy += rp[i].y;
     }
@@ -213,7 +253,28 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     l->n = n;
     l->mx = mx;
     l->my = my;
-    for (i = a; i <= b; ++i) {
+    i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): (sxx, syy) and sxy take point i, then i + 1 */
+        const __m128 m = _mm_set_ps(my, mx, my, mx);
+        __m128 sq = _mm_setzero_ps();
+        __m128 cr = _mm_setzero_ps();
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_loadu_ps(&rp[i].x), m);
+            const __m128 p = _mm_mul_ps(v, v);
+            const __m128 q = _mm_mul_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+            sq = _mm_add_ps(sq, p);
+            sq = _mm_add_ps(sq, _mm_movehl_ps(p, p));
+            cr = _mm_add_ss(cr, q);
+            cr = _mm_add_ss(cr, _mm_movehl_ps(q, q));
+        }
+        sxx = _mm_cvtss_f32(sq);
+        syy = _mm_cvtss_f32(_mm_shuffle_ps(sq, sq, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxy = _mm_cvtss_f32(cr);
+    }
+#endif
+    for (; i <= b; ++i) {
         const float x = rp[i].x - mx;
         const float y = rp[i].y - my;
         sxx += x * x;
@@ -251,19 +312,88 @@ typedef struct {
     float cx, cy, r;
 } lc_circle_t;
 
+/* solve3_sym: one copy in the compact build (two callers); inlined in the
+ * others, where circle_rss keeps the size and the inlining it had. */
+#if BSF_CONFIG_COMPACT
+#define LC_SOLVE3_INLINE BSF_COMPACT_NOINLINE
+#elif defined(__GNUC__) || defined(__clang__)
+#define LC_SOLVE3_INLINE inline __attribute__((always_inline))
+#else
+#define LC_SOLVE3_INLINE inline
+#endif
+
+/* Cramer's rule for the symmetric [a b c; b d e; c e f] x = (g0, g1, g2),
+ * x into x[0..3) and 1, or 0 when the determinant
+ * is 0 or NaN. */
+static LC_SOLVE3_INLINE int solve3_sym(float a, float b, float c, float d, float e, float f,
+                                       float g0, float g1, float g2, float *x)
+{
+    const float det = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
+    if (!(fabsf(det) > 0.0f)) {
+        return 0;
+    }
+    x[0] = (g0 * (d * f - e * e) - b * (g1 * f - e * g2) + c * (g1 * e - d * g2)) / det;
+    x[1] = (a * (g1 * f - e * g2) - g0 * (b * f - e * c) + c * (b * g2 - g1 * c)) / det;
+    x[2] = (a * (d * g2 - g1 * e) - b * (b * g2 - g1 * c) + g0 * (b * e - d * c)) / det;
+    return 1;
+}
+
 /* One Gauss-Newton step of the geometric circle fit (the sum of squared
  * distances to the circle) over positions a..b, centre (*cx, *cy) relative
  * to (cx0, cy0) and radius *r; left unchanged when the step is degenerate
  * or leaves no sensible circle. */
-static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float cy0, float *cx,
-                        float *cy, float *r)
+static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0,
+                                           float cy0, float *cx, float *cy, float *r)
 {
     const bsf_point_t *rp = c->rel;
-    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f, n = 0.0f;
+    float juu = 0.0f, juv = 0.0f, jvv = 0.0f, ju = 0.0f, jv = 0.0f;
     float gu = 0.0f, gv = 0.0f, g1 = 0.0f;
-    float det, du, dv, dr;
-    size_t i;
-    for (i = a; i <= b; ++i) {
+    /* the count (a float sum of ones would be the same, below 2^24) */
+    const float n = (float)(b + 1u - a);
+    float du, dv, dr;
+    size_t i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): every sum takes point i, then i + 1 */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        const __m128 k = _mm_set_ps(*cy, *cx, *cy, *cx);
+        const __m128 rr = _mm_set1_ps(*r);
+        __m128 s1 = _mm_setzero_ps(); /* juu, jvv, juv, . */
+        __m128 s2 = _mm_setzero_ps(); /* ju, jv, gu, gv */
+        __m128 s3 = _mm_setzero_ps(); /* g1 */
+        for (; i < b; i += 2u) {
+            const __m128 d = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(&rp[i].x), o), k);
+            const __m128 sq = _mm_mul_ps(d, d);
+            /* dist0 dist0 dist1 dist1 */
+            const __m128 dist =
+                _mm_sqrt_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))));
+            __m128 uv, uu, cr, g, ug;
+            if ((_mm_movemask_ps(_mm_cmpgt_ps(dist, _mm_setzero_ps())) & 5) != 5) {
+                return;
+            }
+            uv = _mm_div_ps(d, dist); /* u0 v0 u1 v1 */
+            g = _mm_sub_ps(dist, rr); /* g0 g0 g1 g1 */
+            uu = _mm_mul_ps(uv, uv);
+            cr = _mm_mul_ps(uv, _mm_shuffle_ps(uv, uv, _MM_SHUFFLE(2, 3, 0, 1)));
+            ug = _mm_mul_ps(uv, g);
+            s1 = _mm_add_ps(s1, _mm_movelh_ps(uu, cr));
+            s1 = _mm_add_ps(s1, _mm_shuffle_ps(uu, cr, _MM_SHUFFLE(3, 2, 3, 2)));
+            s2 = _mm_add_ps(s2, _mm_movelh_ps(uv, ug));
+            s2 = _mm_add_ps(s2, _mm_shuffle_ps(uv, ug, _MM_SHUFFLE(3, 2, 3, 2)));
+            s3 = _mm_add_ss(s3, g);
+            s3 = _mm_add_ss(s3, _mm_movehl_ps(g, g));
+        }
+        juu = _mm_cvtss_f32(s1);
+        jvv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
+        juv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
+        ju = _mm_cvtss_f32(s2);
+        jv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
+        gu = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
+        gv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+        g1 = _mm_cvtss_f32(s3);
+    }
+#endif
+    for (; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - *cx;
         const float dy = rp[i].y - cy0 - *cy;
         const float dist = sqrtf(dx * dx + dy * dy);
@@ -280,20 +410,20 @@ static void circle_step(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         jvv += v * v;
         ju += u;
         jv += v;
-        n += 1.0f;
         gu += u * g;
         gv += v * g;
         g1 += g;
     }
-    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1) by Cramer. */
-    det = juu * (jvv * n - jv * jv) - juv * (juv * n - jv * ju) + ju * (juv * jv - jvv * ju);
-    if (!(fabsf(det) > 0.0f)) {
-        return;
+    /* Solve [juu juv ju; juv jvv jv; ju jv n] (du dv dr) = (gu gv g1). */
+    {
+        float x[3];
+        if (!solve3_sym(juu, juv, ju, jvv, jv, n, gu, gv, g1, x)) {
+            return;
+        }
+        du = x[0];
+        dv = x[1];
+        dr = x[2];
     }
-    du = (gu * (jvv * n - jv * jv) - juv * (gv * n - jv * g1) + ju * (gv * jv - jvv * g1)) / det;
-    dv = (juu * (gv * n - jv * g1) - gu * (juv * n - jv * ju) + ju * (juv * g1 - gv * ju)) / det;
-    dr = (juu * (jvv * g1 - gv * jv) - juv * (juv * g1 - gv * ju) + gu * (juv * jv - jvv * ju)) /
-         det;
     if (!(*r + dr > 0.0f) || !(fabsf(du) + fabsf(dv) + fabsf(dr) < *r + 1.0f)) {
         return; /* NaN ends here too */
     }
@@ -314,10 +444,41 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
     const bsf_point_t *rp = c->rel;
     float sxx = 0.0f, sxy = 0.0f, syy = 0.0f, sx = 0.0f, sy = 0.0f;
     float sxz = 0.0f, syz = 0.0f, sz = 0.0f;
-    float n = 0.0f;
-    float det, d, e, f, cx, cy, r2, r, rss = 0.0f;
-    size_t i;
-    for (i = a; i <= b; ++i) {
+    /* the count (a float sum of ones would be the same, below 2^24) */
+    const float n = (float)(b + 1u - a);
+    float d, e, f, cx, cy, r2, r, rss = 0.0f;
+    size_t i = a;
+#ifdef LC_SSE2
+    {
+        /* lanes (x0, y0, x1, y1): every sum takes point i, then i + 1 */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        __m128 s1 = _mm_setzero_ps(); /* sx, sy, sxx, syy */
+        __m128 s2 = _mm_setzero_ps(); /* sxz, syz, sxy, sz */
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_loadu_ps(&rp[i].x), o);
+            const __m128 sq = _mm_mul_ps(v, v);
+            /* z0 z0 z1 z1 */
+            const __m128 z = _mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1)));
+            const __m128 vz = _mm_mul_ps(v, z);
+            /* x0 * y0, ., x1 * y1, . */
+            const __m128 xy = _mm_mul_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+            s1 = _mm_add_ps(s1, _mm_movelh_ps(v, sq));
+            s1 = _mm_add_ps(s1, _mm_shuffle_ps(v, sq, _MM_SHUFFLE(3, 2, 3, 2)));
+            s2 = _mm_add_ps(s2, _mm_movelh_ps(vz, _mm_unpacklo_ps(xy, z)));
+            s2 =
+                _mm_add_ps(s2, _mm_shuffle_ps(vz, _mm_unpackhi_ps(xy, z), _MM_SHUFFLE(1, 0, 3, 2)));
+        }
+        sx = _mm_cvtss_f32(s1);
+        sy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxx = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
+        syy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(3, 3, 3, 3)));
+        sxz = _mm_cvtss_f32(s2);
+        syz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
+        sxy = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
+        sz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+    }
+#endif
+    for (; i <= b; ++i) {
         const float x = rp[i].x - cx0;
         const float y = rp[i].y - cy0;
         const float z = x * x + y * y;
@@ -329,19 +490,18 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         sxz += x * z;
         syz += y * z;
         sz += z;
-        n += 1.0f;
     }
-    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz) by Cramer. */
-    det = sxx * (syy * n - sy * sy) - sxy * (sxy * n - sy * sx) + sx * (sxy * sy - syy * sx);
-    if (!(fabsf(det) > 0.0f)) {
-        return -1.0f;
+    /* Solve [sxx sxy sx; sxy syy sy; sx sy n] (d e f) = -(sxz syz sz): the
+     * solution for (sxz syz sz), negated (exact). */
+    {
+        float x[3];
+        if (!solve3_sym(sxx, sxy, sx, syy, sy, n, sxz, syz, sz, x)) {
+            return -1.0f;
+        }
+        d = -x[0];
+        e = -x[1];
+        f = -x[2];
     }
-    d = (-sxz * (syy * n - sy * sy) + sxy * (syz * n - sy * sz) - sx * (syz * sy - syy * sz)) / det;
-    e = (sxx * (-syz * n + sy * sz) + sxz * (sxy * n - sy * sx) + sx * (-sxy * sz + syz * sx)) /
-        det;
-    f = (sxx * (-syy * sz + syz * sy) - sxy * (-sxy * sz + syz * sx) -
-         sxz * (sxy * sy - syy * sx)) /
-        det;
     cx = -0.5f * d;
     cy = -0.5f * e;
     r2 = cx * cx + cy * cy - f;
@@ -357,7 +517,36 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
         fit->cy = cy0 + cy;
         fit->r = r;
     }
-    for (i = a; i <= b; ++i) {
+    i = a;
+#ifdef LC_SSE2
+    {
+        /* both points' squared distances at once, then the sum and its test
+         * point by point as below */
+        const __m128 o = _mm_set_ps(cy0, cx0, cy0, cx0);
+        const __m128 k = _mm_set_ps(cy, cx, cy, cx);
+        const __m128 rr = _mm_set1_ps(r);
+        const float scale = enough->scale;
+        const float ratio = enough->ratio;
+        const float floor_rss = enough->floor_rss;
+        const float target = enough->target;
+        for (; i < b; i += 2u) {
+            const __m128 v = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(&rp[i].x), o), k);
+            const __m128 sq = _mm_mul_ps(v, v);
+            const __m128 g = _mm_sub_ps(
+                _mm_sqrt_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1)))), rr);
+            const __m128 g2 = _mm_mul_ps(g, g);
+            rss += _mm_cvtss_f32(g2);
+            if (scale * (ratio * rss + floor_rss) >= target) {
+                return rss;
+            }
+            rss += _mm_cvtss_f32(_mm_movehl_ps(g2, g2));
+            if (scale * (ratio * rss + floor_rss) >= target) {
+                return rss;
+            }
+        }
+    }
+#endif
+    for (; i <= b; ++i) {
         const float dx = rp[i].x - cx0 - cx;
         const float dy = rp[i].y - cy0 - cy;
         const float g = sqrtf(dx * dx + dy * dy) - r;
@@ -395,7 +584,7 @@ static int side_straight(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t 
     if (l->rss * (float)(n - 3u) <= line_dof * floor_rss) {
         return 1;
     }
-    extent = sqrtf(dist2_once(c->rel[a], c->rel[b]));
+    extent = sqrtf(rel_dist2(c, a, b));
     enough.scale = line_dof;
     enough.ratio = c->p->curve_ratio;
     enough.floor_rss = floor_rss;
@@ -419,6 +608,34 @@ static inline size_t walk_side(const lc_ctx_t *c, size_t pos, size_t stop, int s
     bsf_point_t *rel = c->rel;
     const float ox = c->o.x;
     const float oy = c->o.y;
+#ifdef LC_SSE2
+    {
+        /* Two points per step while two are left, then as below. Both are
+         * stored, the second also when the walk stops at the first (as the
+         * point it stops before is: nothing reads it). */
+        const __m128 o = _mm_set_ps(oy, ox, oy, ox);
+        const __m128 s2 = _mm_set1_ps(side2);
+        while (step > 0 ? stop - pos >= 2u : pos - stop >= 2u) {
+            /* the points at lo and lo + 1 */
+            const size_t lo = step > 0 ? pos + 1u : pos - 2u;
+            const __m128 q = _mm_sub_ps(lc_pair(&pt[run[lo]], &pt[run[lo + 1u]]), o);
+            const __m128 sq = _mm_mul_ps(q, q);
+            const int in = _mm_movemask_ps(
+                _mm_cmple_ps(_mm_add_ps(sq, _mm_shuffle_ps(sq, sq, _MM_SHUFFLE(2, 3, 0, 1))), s2));
+            /* bit 0: the point at lo, bit 2: the one at lo + 1 */
+            const int first = step > 0 ? in & 1 : in & 4;
+            const int second = step > 0 ? in & 4 : in & 1;
+            _mm_storeu_ps(&rel[lo].x, q);
+            if (!first) {
+                return pos;
+            }
+            if (!second) {
+                return step > 0 ? pos + 1u : pos - 1u;
+            }
+            pos = step > 0 ? pos + 2u : pos - 2u;
+        }
+    }
+#endif
     while (pos != stop) {
         const size_t next = step > 0 ? pos + 1u : pos - 1u;
         bsf_point_t q = pt[run[next]];
@@ -934,8 +1151,7 @@ static float side_curve(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = l->rss - cut < cap ? l->rss - cut : cap; /* uncurved from there on */
-    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(dist2_once(c->rel[a], c->rel[b])), &enough,
-                            refine, fit);
+    rss_circle = circle_rss(c, a, b, l->mx, l->my, sqrtf(rel_dist2(c, a, b)), &enough, refine, fit);
     /* below the target the sum ran to the end: the whole residual */
     return rss_circle < 0.0f || rss_circle >= enough.target ? -1.0f : rss_circle;
 }
@@ -985,8 +1201,8 @@ static int evidence_holds(const lc_ctx_t *c, const lc_corner_test_t *t, size_t a
     enough.ratio = 1.0f;
     enough.floor_rss = 0.0f;
     enough.target = bound; /* from there on, the corner stands */
-    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
-                            &enough, LC_CIRCLE_STEPS, NULL);
+    rss_circle = circle_rss(c, a0, b1, lu->mx, lu->my, sqrtf(rel_dist2(c, a0, b1)), &enough,
+                            LC_CIRCLE_STEPS, NULL);
     return !(rss_circle >= 0.0f && !(rss_circle > bound));
 }
 
@@ -1010,7 +1226,7 @@ typedef enum {
  * min_turn and two lines explain them curve_ratio times better than one
  * line: one smooth curve (residual rss_curve) explains them within the
  * noise, or not. */
-static lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
+static BSF_COMPACT_INLINE lc_verdict_t no_corner(const lc_corner_test_t *t, float rss_curve)
 {
     return curve_misses_points(t, rss_curve) ? LC_BOUNDARY : LC_MERGE;
 }
@@ -1040,8 +1256,8 @@ static void corner_keypoint(const lc_ctx_t *c, size_t a0, size_t apex, size_t b1
     kp->point.y = x.y + c->o.y;
     kp->orientation = bsf_atan2f(la->my + lb->my - 2.0f * x.y, la->mx + lb->mx - 2.0f * x.x);
     {
-        const float ra = sqrtf(dist2_once(rp[a0], rp[apex]));
-        const float rb = sqrtf(dist2_once(rp[b1], rp[apex]));
+        const float ra = sqrtf(rel_dist2(c, a0, apex));
+        const float rb = sqrtf(rel_dist2(c, b1, apex));
         kp->radius = ra > rb ? ra : rb;
     }
     kp->score = score;
@@ -1055,7 +1271,6 @@ LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t a
                                           const lc_line_t *la, const lc_line_t *lb, float cross,
                                           float reach, bsf_point_t *xo, float *score)
 {
-    const bsf_point_t *rp = c->rel;
     float t, extent, rss_curve, rss_circle, rss_lines;
     lc_line_t lu;
     lc_corner_test_t test;
@@ -1085,7 +1300,7 @@ LC_ALWAYS_INLINE lc_verdict_t judge_lines(const lc_ctx_t *c, size_t a0, size_t a
     if (evidence_checked && !evidence_possible(c, &test, a0, b1, la, lb, &lu)) {
         return LC_MERGE;
     }
-    extent = sqrtf(dist2_once(rp[a0], rp[b1]));
+    extent = sqrtf(rel_dist2(c, a0, b1));
     rss_curve = lu.rss;
     enough.scale = 1.0f; /* 1 * x is x: the plain comparison */
     enough.ratio = 1.0f;
@@ -1135,7 +1350,7 @@ typedef struct {
 /* The most squared residual a piece of dof degrees of freedom leaves within
  * the noise: dof + LC_EVIDENCE_SIGMAS standard deviations of that
  * chi-square sum, bounded as dof + k sqrt(2 dof) <= 2 dof + k^2 / 4. */
-static float piece_bound(float dof, float noise_var)
+static BSF_COMPACT_NOINLINE float piece_bound(float dof, float noise_var)
 {
     return noise_var * (2.0f * dof + 0.25f * LC_EVIDENCE_SIGMAS * LC_EVIDENCE_SIGMAS);
 }
@@ -1172,11 +1387,11 @@ static int fit_piece(const lc_ctx_t *c, size_t a, size_t b, const lc_line_t *l, 
     }
     s->rss = side_curve(c, a, b, l, noise_var, cap, LC_CREASE_CIRCLE_STEPS, &s->k);
     s->round = 1;
-    return s->rss >= 0.0f && s->k.r * s->k.r >= dist2_once(c->rel[a], c->rel[b]);
+    return s->rss >= 0.0f && s->k.r * s->k.r >= rel_dist2(c, a, b);
 }
 
 /* Signed distance of point q from piece s, and its unit gradient there. */
-static float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
+static BSF_COMPACT_INLINE float piece_at(const lc_piece_t *s, bsf_point_t q, float *gx, float *gy)
 {
     float dx, dy, len;
     if (!s->round) {
@@ -1275,8 +1490,8 @@ LC_ALWAYS_INLINE lc_verdict_t judge_crease(const lc_ctx_t *c, size_t a0, size_t 
      * line is its limit; none exists when the points lie on a line, which
      * is no crease of a curved side). The pieces are credited with no
      * better than the noise: their fit to it is chance. */
-    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(dist2_once(c->rel[a0], c->rel[b1])),
-                           &lc_whole, LC_CIRCLE_STEPS, NULL);
+    rss_curve = circle_rss(c, a0, b1, 0.0f, 0.0f, sqrtf(rel_dist2(c, a0, b1)), &lc_whole,
+                           LC_CIRCLE_STEPS, NULL);
     if (rss_pieces < (float)n * noise_var) {
         rss_pieces = (float)n * noise_var;
     }
@@ -1341,8 +1556,9 @@ static int side_too_short(float d2, size_t count, float len2, size_t need)
  * than the short side's by LC_OVERSHOOT_SIGMAS: a wall's return beyond its
  * own corner. A real corner past the apex has the apex on the short side's
  * wall. */
-static int short_side_overshoots(const lc_ctx_t *c, size_t apex, int short_before,
-                                 const lc_line_t *ls, const lc_line_t *ll, bsf_point_t x)
+static BSF_COMPACT_INLINE int short_side_overshoots(const lc_ctx_t *c, size_t apex,
+                                                    int short_before, const lc_line_t *ls,
+                                                    const lc_line_t *ll, bsf_point_t x)
 {
     const float tol = LC_OVERSHOOT_SIGMAS * sqrtf(c->noise2);
     /* the vertex's cross product with the apex's ray (its distance from the
@@ -1372,11 +1588,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     lc_line_t lb;
     size_t a0 = apex;
     size_t b1 = apex;
-    const bsf_point_t *rp = c->rel;
     float cross, spacing, reach;
     float score = 0.0f;
     lc_verdict_t v;
-    bsf_point_t ap;
     bsf_point_t x = {0.0f, 0.0f};
     int blocks = 0; /* walks by blocks and the turn bound (speed builds) */
 
@@ -1384,7 +1598,7 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     c->o = c->pts->pt[c->run[apex]];
-    ap = rel_store(c, apex);
+    rel_store(c, apex); /* the apex relative to itself: (0, 0) */
     blocks = blocks_use(c, apex, m, side2);
     a0 = walk(c, blocks, apex, lo, -1, side2);
     b1 = walk(c, blocks, apex, hi, 1, side2);
@@ -1392,10 +1606,10 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
      * splits a corner several times within a few points, and the true apex
      * must not lose to its own echoes (a side that then crosses another
      * corner fails the straightness test). */
-    if (apex - a0 < need || dist2_once(rp[a0], ap) < len2) {
+    if (apex - a0 < need || rel_dist2(c, a0, apex) < len2) {
         a0 = walk(c, blocks, a0, 0u, -1, side2);
     }
-    if (b1 - apex < need || dist2_once(rp[b1], ap) < len2) {
+    if (b1 - apex < need || rel_dist2(c, b1, apex) < len2) {
         b1 = walk(c, blocks, b1, m - 1u, 1, side2);
     }
     /* A wall seen at grazing incidence has a return every half metre or
@@ -1415,8 +1629,8 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
         return LC_MERGE;
     }
     /* Each side must also be long enough to give its line a direction. */
-    if (side_too_short(dist2_once(rp[a0], ap), apex - a0, len2, need) ||
-        side_too_short(dist2_once(rp[b1], ap), b1 - apex, len2, need)) {
+    if (side_too_short(rel_dist2(c, a0, apex), apex - a0, len2, need) ||
+        side_too_short(rel_dist2(c, b1, apex), b1 - apex, len2, need)) {
         return LC_MERGE;
     }
     if (blocks_rule_out(c, blocks, a0, apex, b1)) {
@@ -1431,9 +1645,9 @@ static lc_verdict_t judge(lc_ctx_t *c, size_t lo, size_t apex, size_t hi, size_t
     }
     /* the sides' fits must meet within twice the local beam spacing plus
      * apex_slack of the apex */
-    spacing = dist2_once(rp[apex - 1u], ap);
+    spacing = rel_dist2(c, apex - 1u, apex);
     {
-        const float s2 = dist2_once(rp[apex + 1u], ap);
+        const float s2 = rel_dist2(c, apex + 1u, apex);
         spacing = sqrtf(s2 > spacing ? s2 : spacing);
     }
     reach = 2.0f * spacing + p->apex_slack;
@@ -1541,6 +1755,24 @@ static float run_noise(const bsf_points_t *pts, const uint16_t *run, size_t m, f
     return n > 0u ? sum / ((float)n * LC_NOISE_MEAN_ABS) : 0.0f;
 }
 
+#if !BSF_CONFIG_COMPACT
+/* The parked keypoints out[slot + 1 ..] move down one place (n of them),
+ * field by field where the compact build calls memmove: newlib-nano's is a
+ * byte loop (about 4 Cortex-M4F instructions a byte, 24 bytes a keypoint). */
+static void keypoints_down(bsf_keypoint_t *out, size_t slot, size_t n)
+{
+    size_t k;
+    for (k = slot; k < slot + n; ++k) {
+        out[k].index = out[k + 1u].index;
+        out[k].point.x = out[k + 1u].point.x;
+        out[k].point.y = out[k + 1u].point.y;
+        out[k].orientation = out[k + 1u].orientation;
+        out[k].radius = out[k + 1u].radius;
+        out[k].score = out[k + 1u].score;
+    }
+}
+#endif
+
 /* Douglas-Peucker split of run positions 0..m-1 with an explicit stack;
  * returns the number of splits, ascending in w->brk. */
 
@@ -1566,7 +1798,35 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
         if (b < a + 2u) {
             continue;
         }
-        for (i = a + 1u; i < b; ++i) {
+        i = a + 1u;
+#ifdef LC_SSE2
+        if (len > 0.0f) {
+            /* two points per step: both distances at once, then taken in
+             * order as below; lanes (x0, y0, x1, y1) */
+            const __m128 o = _mm_set_ps(pa.y, pa.x, pa.y, pa.x);
+            const __m128 e = _mm_set_ps(ex, ey, ex, ey);
+            const __m128 l = _mm_set1_ps(len);
+            const __m128 no_sign = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+            for (; i + 1u < b; i += 2u) {
+                const __m128 q = lc_pair(&pts->pt[w->run[i]], &pts->pt[w->run[i + 1u]]);
+                const __m128 p = _mm_mul_ps(_mm_sub_ps(q, o), e);
+                /* ex * dy - ey * dx in lanes 0 and 2 */
+                const __m128 cr = _mm_sub_ps(_mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 3, 0, 1)), p);
+                const __m128 d = _mm_div_ps(_mm_and_ps(cr, no_sign), l);
+                const float d0 = _mm_cvtss_f32(d);
+                const float d1 = _mm_cvtss_f32(_mm_movehl_ps(d, d));
+                if (d0 > dmax) {
+                    dmax = d0;
+                    imax = i;
+                }
+                if (d1 > dmax) {
+                    dmax = d1;
+                    imax = i + 1u;
+                }
+            }
+        }
+#endif
+        for (; i < b; ++i) {
             const bsf_point_t q = pts->pt[w->run[i]];
             /* distance from the chord, or from its end when it has no length */
             const float d = len > 0.0f ? fabsf(ex * (q.y - pa.y) - ey * (q.x - pa.x)) / len
@@ -1588,7 +1848,22 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
             ++top;
         }
     }
-    for (i = 0; i < m; ++i) {
+    i = 0;
+#ifdef LC_SSE2
+    /* sixteen marks per step, most of them all clear */
+    for (; i + 16u <= m; i += 16u) {
+        unsigned set = 0xFFFFu ^ (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(
+                                     _mm_loadu_si128((const __m128i *)(const void *)&w->is_brk[i]),
+                                     _mm_setzero_si128()));
+        size_t k;
+        for (k = i; set != 0u; ++k, set >>= 1) {
+            if (set & 1u) {
+                w->brk[nb++] = (uint16_t)k;
+            }
+        }
+    }
+#endif
+    for (; i < m; ++i) {
         if (w->is_brk[i]) {
             w->brk[nb++] = (uint16_t)i;
         }
@@ -1605,7 +1880,8 @@ static size_t pass_pos(size_t b, size_t start, size_t count)
 
 /* Two keypoints of one run on one corner: beams closer than the points a
  * side needs, or intersections within apex_slack of each other. */
-static int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b, const lc_ctx_t *c)
+static BSF_COMPACT_INLINE int too_close(const bsf_keypoint_t *a, const bsf_keypoint_t *b,
+                                        const lc_ctx_t *c)
 {
     const size_t count = c->pts->count;
     return pass_pos(a->index, c->start, count) + c->p->min_side_points >=
@@ -1704,7 +1980,11 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
                 memmove(&w->judged_hi[j], &w->judged_hi[j + 1u], tail * sizeof w->judged_hi[0]);
                 if (slot + 1u < out_cap) {
                     const size_t fit = out_cap - slot - 1u;
+#if BSF_CONFIG_COMPACT
                     memmove(&out[slot], &out[slot + 1u], (tail < fit ? tail : fit) * sizeof out[0]);
+#else
+                    keypoints_down(out, slot, tail < fit ? tail : fit);
+#endif
                 }
                 --nb;
                 changed = 1;
@@ -1857,7 +2137,8 @@ static int lc_joins(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *
  * 0) that does not continue the run of the valid beam before it on the ring,
  * so that no run is cut at the seam; 0 when every step joins (one closed
  * surface all round: the seam then cuts it, as on a scan that is no ring). */
-static size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p, uint8_t *grazing_memo)
+static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_lc_params_t *p,
+                                            uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
     size_t i;
@@ -1942,6 +2223,37 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
         i = close_run
                 ? 0u
                 : (c.start + step < pts->count ? c.start + step : c.start + step - pts->count);
+#ifdef LC_SSE2
+        /* Speed only, same runs: the next four beams, all valid and each
+         * within jump_a of the one before (the run's last point first),
+         * join the run as below, tested at once. */
+        if (m > 0u && step + 4u <= pts->count && i + 4u <= pts->count &&
+            work->run[m - 1u] + 1u == i) {
+            uint32_t valid4;
+            memcpy(&valid4, &pts->valid[i], sizeof valid4);
+            /* no zero byte */
+            if (((valid4 - 0x01010101u) & ~valid4 & 0x80808080u) == 0u) {
+                const float *q = &pts->pt[i].x;
+                /* pairs (i - 1, i), (i, i + 1) and (i + 1, i + 2), (i + 2, i + 3) */
+                const __m128 d1 = _mm_sub_ps(_mm_loadu_ps(q - 2), _mm_loadu_ps(q));
+                const __m128 d2 = _mm_sub_ps(_mm_loadu_ps(q + 2), _mm_loadu_ps(q + 4));
+                const __m128 s1 = _mm_mul_ps(d1, d1);
+                const __m128 s2 = _mm_mul_ps(d2, d2);
+                const __m128 t1 = _mm_add_ps(s1, _mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 3, 0, 1)));
+                const __m128 t2 = _mm_add_ps(s2, _mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 3, 0, 1)));
+                if (_mm_movemask_ps(_mm_cmple_ps(_mm_shuffle_ps(t1, t2, _MM_SHUFFLE(2, 0, 2, 0)),
+                                                 _mm_set1_ps(jump_a2))) == 15) {
+                    work->run[m] = (uint16_t)i;
+                    work->run[m + 1u] = (uint16_t)(i + 1u);
+                    work->run[m + 2u] = (uint16_t)(i + 2u);
+                    work->run[m + 3u] = (uint16_t)(i + 3u);
+                    m += 4u;
+                    step += 3u;
+                    continue;
+                }
+            }
+        }
+#endif
         if (!close_run && !pts->valid[i]) {
             continue;
         }

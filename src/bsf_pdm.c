@@ -3,6 +3,7 @@
  * control points, and error-driven refinement (docs/DESIGN.md, "PDM and
  * refinement"). */
 #include "bsf/bsf_fit.h"
+#include "bsf_compact.h"
 #include "bsf/bsf_bspline.h"
 #include "bsf_fit_internal.h"
 #include "bsf_linalg.h"
@@ -145,10 +146,11 @@ static float dist2_pts(bsf_point_t a, bsf_point_t b)
     return dx * dx + dy * dy;
 }
 
-static float dist(bsf_point_t a, bsf_point_t b)
+/* |pts[j] - pts[i]| (indices: fewer instructions to pass than four floats) */
+static float dist(const bsf_point_t *pts, size_t i, size_t j)
 {
-    const float dx = b.x - a.x;
-    const float dy = b.y - a.y;
+    const float dx = pts[j].x - pts[i].x;
+    const float dy = pts[j].y - pts[i].y;
     return sqrtf(dx * dx + dy * dy);
 }
 
@@ -162,7 +164,8 @@ static float dist(bsf_point_t a, bsf_point_t b)
  * footpoints. Both window ends only move forward: linear cost. Returns the
  * fragment's length (<= 0 only for a fragment that folds back on itself,
  * which the caller then spaces by index). */
-static float fragment_arc(const bsf_point_t *pts, size_t a, size_t b, float *arc)
+static BSF_COMPACT_NOINLINE float fragment_arc(const bsf_point_t *pts, size_t a, size_t b,
+                                               float *arc)
 {
     const float base2 = PDM_ARC_BASE * PDM_ARC_BASE;
     size_t lo = a;
@@ -234,7 +237,7 @@ static void build_layout(pdm_state_t *s, bsf_pdm_work_t *w, float *t0, float *t1
 }
 
 /* Span of t and its local coordinate (t in [0, 1]). */
-static inline size_t span_of(float t, float fs, size_t n_span, float *u)
+static BSF_COMPACT_INLINE size_t span_of(float t, float fs, size_t n_span, float *u)
 {
     /* t is in [0, 1], so x is small and non-negative: a signed conversion
      * is exact and much cheaper than one to size_t on 64-bit targets. */
@@ -427,6 +430,9 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
     const float fs = (float)n_span;
     const float ox = s->origin.x;
     const float oy = s->origin.y;
+    /* A local: the flushes' stores could change s->pts as far as the
+     * compiler knows, which then reloads it at every point. */
+    const bsf_point_t *pts = s->pts;
     span_sums_t acc;
     size_t i;
     float k0 = 1.0f; /* basis scales of span acc.span */
@@ -443,7 +449,7 @@ static void assemble(const pdm_state_t *s, bsf_pdm_work_t *w)
             k0 = span == 0u ? 1.0f : 0.5f;
             k2 = span + 1u == n_span ? 1.0f : 0.5f;
         }
-        sums_add(&acc, k0 * v * v, k2 * u * u, s->pts[i].x - ox, s->pts[i].y - oy);
+        sums_add(&acc, k0 * v * v, k2 * u * u, pts[i].x - ox, pts[i].y - oy);
     }
     SUMS_FLUSH_ACC(w, acc);
 }
@@ -479,7 +485,39 @@ static void start_from_arc_length(const pdm_state_t *s, bsf_pdm_work_t *w, const
         const unsigned shape = f == 0u ? 0u : (f + 1u == s->n_frag ? 1u : 2u);
         /* The vertex point closing fragment f opens fragment f + 1: it is
          * accumulated once, by the fragment it closes. */
-        for (i = f == 0u ? a : a + 1u; i <= b; ++i) {
+        i = f == 0u ? a : a + 1u;
+#if !BSF_CONFIG_COMPACT
+        /* Points before the last of a curved fragment of some length: the
+         * general loop's tests are decided for them (the same float
+         * operations, fewer branches). */
+        if (!straight && len > 0.0f) {
+            /* locals: as in assemble (the stores into w->t could change
+             * t0[f] too, as far as the compiler knows) */
+            const bsf_point_t *pts = s->pts;
+            const float t_start = t0[f];
+            for (; i < b; ++i) {
+                float frac = w->arc[i] * inv_len;
+                float u;
+                float t;
+                size_t span;
+                frac = frac > 1.0f ? 1.0f : (frac < 0.0f ? 0.0f : frac);
+                t = t_start + frac * range;
+                w->t[i] = t;
+                span = span_of(t, fs, n_span, &u);
+                if (span != acc.span) {
+                    SUMS_FLUSH_ACC(w, acc);
+                    sums_reset(&acc, span);
+                    k0 = span == 0u ? 1.0f : 0.5f;
+                    k2 = span + 1u == n_span ? 1.0f : 0.5f;
+                }
+                {
+                    const float v = 1.0f - u;
+                    sums_add(&acc, k0 * v * v, k2 * u * u, pts[i].x - ox, pts[i].y - oy);
+                }
+            }
+        }
+#endif
+        for (; i <= b; ++i) {
             float frac;
             float u;
             float t;
@@ -630,7 +668,7 @@ static float systematic_error(const pdm_state_t *s, float rms, float window_max,
 /* Points per slot of fragment f's deviation window: 1 up to
  * PDM_BIAS_MAX_WINDOWS windows of bias_window points, then as many as keep
  * the fragment within that many windows. */
-static size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f)
+static BSF_COMPACT_INLINE size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f)
 {
     const size_t count = (size_t)w->frag_last[f] - w->frag_first[f] + 1u;
     const size_t span = PDM_BIAS_MAX_WINDOWS * s->bias_window;
@@ -650,8 +688,12 @@ static size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f
  * no longer end below give_up_rms (the squared distances only add up) and
  * returns 0, leaving the parameters half updated for the caller to discard;
  * otherwise it returns 1. */
-static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next,
-                          float give_up_rms)
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline)) /* one copy: inlined into try_cold_start, it doubled the stack */
+#endif
+static int
+footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int assemble_next,
+               float give_up_rms)
 {
     const size_t n_span = s->n_ctrl - 2u;
     const float fs = (float)n_span;
@@ -668,6 +710,11 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     size_t frag_end = w->frag_last[0];
     size_t f = 0;
     size_t i;
+    /* One test per point for three rare events: the end of a fragment (the
+     * last one ends the pass), the first point and the last but one (the end
+     * points take no footpoint step). */
+    size_t next_event = 0;
+    unsigned n_steps = 0u;
     /* Systematic deviation (bias_window > 0): the last bias_window signed
      * residuals of the fragment (a ring), their sum, the fragment's largest
      * |sum| and its largest squared distance. Only ring[0..bias_window) is
@@ -676,6 +723,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     float ring[BSF_PDM_MAX_BIAS_WINDOW];
     size_t ring_at = 0;
     size_t ring_wait = bias_window;
+#if !BSF_CONFIG_COMPACT
+    int ring_full = 0; /* block is 1 and ring_wait 0: the ring's fast path */
+#endif
     float ring_sum = 0.0f;
     float window_max = 0.0f;
     float point_max = 0.0f;
@@ -703,11 +753,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
     sums_reset(&acc, 0u);
     load_span(w->ctrl, n_span, 0u, &c);
     cn = c;
-    for (i = 0; i < s->n; ++i) {
+    for (i = 0;; ++i) {
         const float qx = s->pts[i].x - ox;
         const float qy = s->pts[i].y - oy;
-        /* Not the end points: i - 1 wraps for i == 0. */
-        const unsigned n_steps = i - 1u < last - 1u ? steps : 0u;
         float t = w->t[i];
         float u;
         size_t span = span_of(t, fs, n_span, &u);
@@ -746,6 +794,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             float ney = ey;
             unsigned halving;
             unsigned n_try;
+#if BSF_CONFIG_COMPACT
+            int closer = 0; /* d < best: the step is taken */
+#endif
             size_t span_new = c.span;
 
             if (!(h >= 0.5f * gn)) {
@@ -804,13 +855,22 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 }
                 d = nex * nex + ney * ney;
                 if (d < best) {
+#if BSF_CONFIG_COMPACT
+                    closer = 1;
+#endif
                     break;
                 }
                 delta *= 0.5f;
             }
-            if (!(d < best)) {
+#if BSF_CONFIG_COMPACT
+            if (!closer) { /* the flag, not d < best again: 24 bytes shorter */
                 break;
             }
+#else
+            if (!(d < best)) { /* not the flag: 0.7 % fewer x86 instructions */
+                break;
+            }
+#endif
             best = d;
             t = t_new;
             u = u_new;
@@ -853,28 +913,45 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
             }
             r = ex * nx + ey * ny;
             slot = r;
-            if (block > 1u) {
-                block_sum += r;
-                slot = block_sum;
-                if (++block_n == block) {
-                    block_n = 0u;
-                    block_sum = 0.0f;
-                } else {
-                    slot_open = 1;
-                }
-            }
-            if (!slot_open) {
-                if (ring_wait > 0u) {
-                    ring_sum += slot; /* an empty slot: slot - 0 is slot */
-                    --ring_wait;
-                } else {
-                    ring_sum += slot - ring[ring_at];
-                }
+#if !BSF_CONFIG_COMPACT
+            if (ring_full) {
+                /* the general path below with one point per slot and the
+                 * window full: one test instead of three */
+                ring_sum += slot - ring[ring_at];
                 ring[ring_at] = slot;
                 ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
-                if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
+                if (fabsf(ring_sum) > window_max) {
                     window_max = fabsf(ring_sum);
                 }
+            } else
+#endif
+            {
+                if (block > 1u) {
+                    block_sum += r;
+                    slot = block_sum;
+                    if (++block_n == block) {
+                        block_n = 0u;
+                        block_sum = 0.0f;
+                    } else {
+                        slot_open = 1;
+                    }
+                }
+                if (!slot_open) {
+                    if (ring_wait > 0u) {
+                        ring_sum += slot; /* an empty slot: slot - 0 is slot */
+                        --ring_wait;
+                    } else {
+                        ring_sum += slot - ring[ring_at];
+                    }
+                    ring[ring_at] = slot;
+                    ring_at = ring_at + 1u == bias_window ? 0u : ring_at + 1u;
+                    if (ring_wait == 0u && fabsf(ring_sum) > window_max) {
+                        window_max = fabsf(ring_sum);
+                    }
+                }
+#if !BSF_CONFIG_COMPACT
+                ring_full = block == 1u && ring_wait == 0u;
+#endif
             }
             if (best > point_max) {
                 point_max = best;
@@ -884,6 +961,9 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 far_near = best;
             }
             prev_best = best;
+        }
+        if (i != next_event) {
+            continue;
         }
         if (i == frag_end) {
             const size_t count = frag_end - w->frag_first[f] + 1u;
@@ -919,7 +999,16 @@ static int footpoint_pass(pdm_state_t *s, bsf_pdm_work_t *w, unsigned steps, int
                 block_n = 0u;
                 block_sum = 0.0f;
             }
+#if !BSF_CONFIG_COMPACT
+            ring_full = block == 1u && ring_wait == 0u;
+#endif
+            if (i == last) {
+                break;
+            }
         }
+        /* The last point (the last fragment's end) takes no step. */
+        n_steps = i + 1u < last ? steps : 0u;
+        next_event = i + 1u < last && frag_end > last - 1u ? last - 1u : frag_end;
     }
     if (assemble_next) {
         sums_flush(w, &acc);
@@ -1039,8 +1128,9 @@ static size_t pick_fragment(const pdm_state_t *s, const bsf_pdm_work_t *w, float
 
 /* Warm start after adding a precision point: every parameter keeps its
  * relative place inside its fragment's knot range. */
-static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const float *old_t0,
-                             const float *old_t1, const float *t0, const float *t1)
+static BSF_COMPACT_INLINE void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w,
+                                                const float *old_t0, const float *old_t1,
+                                                const float *t0, const float *t1)
 {
     float scale[BSF_PDM_MAX_FRAGMENTS];
     size_t f;
@@ -1049,6 +1139,23 @@ static void remap_parameters(const pdm_state_t *s, bsf_pdm_work_t *w, const floa
         scale[f] = (t1[f] - t0[f]) / (old_t1[f] - old_t0[f]);
     }
     f = 0;
+#if !BSF_CONFIG_COMPACT
+    /* One fragment (no vertex, most fits): the general loop below with its
+     * fragment searches decided. Locals: the stores into w->t would make
+     * the compiler reload s->n at every point. */
+    if (s->n_frag == 1u) {
+        const size_t n = s->n;
+        float *const tp = w->t;
+        const float base = t0[0];
+        const float old_base = old_t0[0];
+        const float scale0 = scale[0];
+        for (i = 0; i < n; ++i) {
+            const float t = base + (tp[i] - old_base) * scale0;
+            tp[i] = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+        }
+        return;
+    }
+#endif
     for (i = 0; i < s->n; ++i) {
         float t = w->t[i];
         while (f + 1u < s->n_frag && t > old_t1[f]) {
@@ -1143,7 +1250,8 @@ static size_t turns_back(const bsf_point_t *pts, size_t a, size_t b)
                : 0u;
 }
 
-static bsf_status_t check_vertices(const uint16_t *vertex_pos, size_t n_vertex, size_t n)
+static BSF_COMPACT_INLINE bsf_status_t check_vertices(const uint16_t *vertex_pos, size_t n_vertex,
+                                                      size_t n)
 {
     size_t k;
     if (n_vertex > 0u && vertex_pos == NULL) {
@@ -1227,7 +1335,7 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
         s.target = p->target_rms;
     }
     for (i = 1; i < n; ++i) {
-        length += dist(pts[i - 1u], pts[i]);
+        length += dist(pts, i - 1u, i);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;
@@ -1260,7 +1368,7 @@ bsf_status_t bsf_pdm_fit_anchored(const bsf_point_t *pts, size_t n, const uint16
                        ? 1u + (p->bias_window > 0u && p->max_ctrl > 3u ? turns_back(pts, a, b) : 0u)
                        : 0u;
         } else {
-            const float chord = dist(pts[a], pts[b]);
+            const float chord = dist(pts, a, b);
             const float want = floorf(chord / p->precision_spacing + 0.5f);
             const size_t cap = precision_cap(work, f);
             prec = want < 1.0f ? 1u : (want >= (float)cap ? cap : (size_t)want);
@@ -1390,7 +1498,7 @@ bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
         return BSF_ERR_DEGENERATE;
     }
     for (i = 1; i < n; ++i) {
-        length += dist(pts[i - 1u], pts[i]);
+        length += dist(pts, i - 1u, i);
     }
     if (!(length > 0.0f)) {
         return BSF_ERR_DEGENERATE;
@@ -1409,7 +1517,7 @@ bsf_status_t bsf_pdm_fit_chord(const bsf_point_t *pts, size_t n, size_t n_ctrl,
     build_layout(&s, work, t0, t1);
     for (i = 0; i < n; ++i) {
         if (i > 0u) {
-            acc += dist(pts[i - 1u], pts[i]);
+            acc += dist(pts, i - 1u, i);
         }
         work->t[i] = acc / length;
     }

@@ -8,6 +8,7 @@
  * and bsf_metadata_encode.c.
  */
 #include "bsf_stream_writer.h"
+#include "bsf_compact.h"
 
 /* ---- Streaming output: COBS blocks to a counter, a buffer or a sink ---- */
 
@@ -35,7 +36,7 @@ static void emit(stream_t *s, const uint8_t *data, size_t len)
     }
 }
 
-static void block_start(stream_t *s)
+static BSF_COMPACT_INLINE void block_start(stream_t *s)
 {
     s->code = 1u;
     if (s->sink == NULL) {

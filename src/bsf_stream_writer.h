@@ -201,6 +201,7 @@ ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
 #define field_eg(w, b, costing, v, k) field_eg_(w, b, v, k)
 #define field_eg64(w, b, costing, v, k) field_eg64_(w, b, v, k)
 #define field_float(w, b, costing, v) field_float_(w, b, v)
+#define field_u64(w, b, costing, v, n) field_u64_(w, b, v, n)
 #else
 #define ENC_COSTING_PARAM int costing,
 #define ENC_COSTING(b) costing
@@ -208,6 +209,7 @@ ENC_INLINE unsigned eg_len(uint32_t v, unsigned k)
 #define field_eg(w, b, costing, v, k) field_eg_(w, b, costing, v, k)
 #define field_eg64(w, b, costing, v, k) field_eg64_(w, b, costing, v, k)
 #define field_float(w, b, costing, v) field_float_(w, b, costing, v)
+#define field_u64(w, b, costing, v, n) field_u64_(w, b, costing, v, n)
 #endif
 
 /* Fields, written or (costing) counted: u(n) with n <= 31. */
@@ -258,31 +260,39 @@ ENC_INLINE void field_eg2(writer_t *w, bits_t *b, int costing, uint32_t v0, unsi
     } while (0)
 #endif
 
-/* EGk of any v with v >> k < 2^63 (k <= 63), 16 bits at a time: the rare
- * wide fields. State in and out by value, so that the caller's stays in
- * registers. */
+/* The n low bits of x (n <= 64), 16 at a time, the highest first. */
+static inline void put_bits_wide(writer_t *w, bits_t *b, uint64_t x, unsigned n)
+{
+    while (n > 0u) {
+        const unsigned take = n > 16u ? 16u : n;
+        n -= take;
+        put_bits(w, b, (uint32_t)(x >> n) & ((1u << take) - 1u), take);
+    }
+}
+
+/* u(n) of v < 2^n for n <= 64: the n low bits of v, 16 at a time. */
+ENC_INLINE void field_u64_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint64_t v, unsigned n)
+{
+    if (ENC_COSTING(b)) {
+        b->bits += n;
+    } else {
+        put_bits_wide(w, b, v, n);
+    }
+}
+
+/* EGk of any v with v >> k < 2^63 (k <= 63): the rare wide fields. State
+ * in and out by value, so that the caller's stays in registers. */
 static inline bits_t put_eg_wide(writer_t *w, bits_t b, ENC_COSTING_PARAM uint64_t v, unsigned k)
 {
     const uint64_t u = (v >> k) + 1u;
     const unsigned n = bsf_wire_bitlen(u);
-    unsigned i;
     if (ENC_COSTING(&b)) {
         b.bits += 2u * n - 1u + k;
         return b;
     }
-    for (i = 1u; i < n; ++i) {
-        put_bits(w, &b, 0u, 1u); /* the n - 1 zeros */
-    }
-    for (i = n; i > 0u;) { /* u, then the k low bits of v: 16 bits at a time */
-        const unsigned take = i > 16u ? 16u : i;
-        i -= take;
-        put_bits(w, &b, (uint32_t)(u >> i) & ((1u << take) - 1u), take);
-    }
-    for (i = k; i > 0u;) {
-        const unsigned take = i > 16u ? 16u : i;
-        i -= take;
-        put_bits(w, &b, (uint32_t)(v >> i) & ((1u << take) - 1u), take);
-    }
+    put_bits_wide(w, &b, 0u, n - 1u); /* the n - 1 zeros */
+    put_bits_wide(w, &b, u, n);       /* u, then the k low bits of v */
+    put_bits_wide(w, &b, v, k);
     return b;
 }
 
@@ -301,9 +311,8 @@ ENC_INLINE void field_eg64_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint64_t v
 
 ENC_INLINE void field_float_(writer_t *w, bits_t *b, ENC_COSTING_PARAM float v)
 {
-    const uint32_t u = bsf_float_bits(v);
-    field_u(w, b, costing, u >> 16, 16u);
-    field_u(w, b, costing, u & 0xFFFFu, 16u);
+    /* the 32 bits, 16 at a time */
+    field_u64(w, b, costing, bsf_float_bits(v), 32u);
 }
 
 static inline int is_finite_f(float v)

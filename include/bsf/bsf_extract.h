@@ -81,8 +81,16 @@ typedef struct {
      *  run's own scatter) and lc.split_min, turning by lc.min_turn or more:
      *  a single return on the next wall past a concave corner seen at
      *  grazing incidence, or on an occluder. A curve bent to reach it swings
-     *  through free space. Segments of at least 17 returns, and not where LC
-     *  has a corner within the run. The return counts as wasted in Γ.
+     *  through free space. Segments of at least 7 returns (the run is then
+     *  shorter, down to 5, and the noise at least the scan's); where LC has
+     *  a corner within the run, the returns between the end and the corner.
+     *  An end whose neighbouring beam past it reads nearer the sensor (a
+     *  floating return at a depth jump, likely a mixed pixel) is judged
+     *  from a run of 3 returns. The return counts as wasted in Γ.
+     *  A segment of 5 or 6 returns without a corner whose last two returns
+     *  at one end lie off the line of the others, turning by lc.min_turn
+     *  or more and starting with a step at least twice their spacing, gets
+     *  a vertex where the two lines cross instead (no return is left out).
      *  0 keeps every return (bsf_params_paper). */
     uint8_t trim_tails;
     /** The three PDM methods: a bound on the fit's work per scan, for

@@ -700,6 +700,140 @@ static void test_a_tail_return_past_an_end_vertex_is_left_off_the_feature(void)
     TEST_ASSERT_TRUE_MESSAGE(worst < 0.08, "a curve swings past a corner beside an end vertex");
 }
 
+/* A far wall 10 m away seen through a 0.5 m gap between two near walls 6 m
+ * away: 1-degree beams, 1 cm noise, 4 to 6 returns on the far wall. The far
+ * wall's end beam beside the gap's edge reads a blend of the two ranges,
+ * 0.25 m in front of the far wall (a mixed pixel): it floats in free space,
+ * between the far wall and the near wall seen past it, too near the far
+ * wall for SVED's halfway test and beside a run too short for its line
+ * test. Joined to the far wall's few returns, the curve bent to reach it
+ * lies up to 24 cm off the wall; left off (the beam past it reads nearer, and
+ * the 3-4 returns beside it put it far off their line), every curve stays
+ * within 3 cm of the walls. */
+static void test_a_floating_return_at_a_depth_jump_is_left_off_a_short_far_wall(void)
+{
+    static float clean[BSF_MAX_POINTS];
+    static int16_t hits[BSF_MAX_POINTS];
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    double worst = 0.0;
+    int blended = 0;
+    int pose;
+    int far_wall;
+    bsf_scene_init(&scene);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 6.0, -3.0, 6.0, -0.25) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 6.0, 0.25, 6.0, 3.0) >= 0);
+    far_wall = bsf_scene_add_segment(&scene, 10.0, -4.0, 10.0, 4.0);
+    TEST_ASSERT_TRUE(far_wall >= 0);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    for (pose = 0; pose < 16; ++pose) {
+        bsf_lidar_t l = bsf_lidar_default(0.0, -0.1 + 0.0125 * (double)pose, 0.0, 181u, 3.14159265);
+        bsf_scene_rng_t rng;
+        bsf_scan_t s;
+        double rms;
+        double max_d;
+        int n_far = 0;
+        size_t i;
+        size_t first_far = 0;
+        l.angle_increment = 3.14159265 / 180.0;
+        l.noise_sigma = 0.0;
+        bsf_scene_rng_seed(&rng, 90u + (uint64_t)pose);
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
+        for (i = 0; i < l.n_beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0) {
+                ranges[i] = (float)((double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng));
+            }
+            if (hits[i] == far_wall && n_far++ == 0) {
+                first_far = i;
+            }
+        }
+        TEST_ASSERT_TRUE(n_far >= 4 && n_far <= 6);
+        TEST_ASSERT_TRUE(first_far > 0u && hits[first_far - 1u] >= 0 &&
+                         hits[first_far - 1u] != far_wall);
+        /* the blend: a quarter of a metre in front of the far wall */
+        ranges[first_far] = clean[first_far] - 0.25f;
+        ++blended;
+        s = scan_of(&l);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        curve_to_truth(&l, &rms, &max_d);
+        worst = max_d > worst ? max_d : worst;
+    }
+    printf("floating: worst %.3f m\n", worst);
+    TEST_ASSERT_EQUAL_INT(16, blended);
+    TEST_ASSERT_TRUE_MESSAGE(worst < 0.03, "a curve reaches out to a floating return");
+}
+
+/* bench_truth's corridor at 1-degree beams (181 over 180 degrees), 1 cm
+ * noise, its 40 poses. Far along it a wall end seen square-on gives 3-4
+ * returns and the wall behind it, receding at grazing incidence, 2 more
+ * half a metre apart: SVED joins them into a segment of 5 or 6 returns,
+ * too short for the tail rule or an LC corner, and its one quadratic span
+ * swings 5-7 cm off both walls to reach them. Such an end gets a vertex
+ * where the two lines cross, and its curve stays within 1.2 cm of them. */
+static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex(void)
+{
+    static float clean[BSF_MAX_POINTS];
+    static int16_t hits[BSF_MAX_POINTS];
+    const size_t n_beams = 181u;
+    const double fov = 3.14159265358979;
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scene_rng_t rng;
+    size_t swinging = 0u;
+    size_t short_features = 0u;
+    size_t short_vertices = 0u;
+    long k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bench_truth_corridor(&scene));
+    bsf_scene_rng_seed(&rng, 1436u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    for (k = 0; k < 40; ++k) {
+        const bsf_scene_pose_t pose = bench_truth_corridor_pose(k, 40);
+        bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, n_beams, fov);
+        bsf_scan_t s;
+        size_t i;
+        size_t fi;
+        l.noise_sigma = 0.0;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
+        for (i = 0; i < n_beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0) {
+                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
+                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
+            }
+        }
+        s = scan_of(&l);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        for (fi = 0; fi < res.n_features; ++fi) {
+            const bsf_feature_t *f = &res.features[fi];
+            int j;
+            double fw = 0.0;
+            if (f->n_points > 6u) {
+                continue;
+            }
+            ++short_features;
+            for (j = 0; j < f->n_ctrl; ++j) {
+                short_vertices += res.ctrl_is_vertex[f->ctrl_first + (size_t)j];
+            }
+            for (j = 0; j <= 200; ++j) {
+                bsf_point_t q;
+                double wx, wy, d;
+                TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(&res.ctrl[f->ctrl_first], f->n_ctrl,
+                                                               (float)j / 200.0f, &q, NULL, NULL));
+                bsf_scene_sensor_to_world(&l.pose, (double)q.x, (double)q.y, &wx, &wy);
+                d = bsf_scene_distance_to_surface(&scene, wx, wy, NULL);
+                fw = d > fw ? d : fw;
+            }
+            swinging += fw > 0.05;
+        }
+    }
+    TEST_ASSERT_TRUE_MESSAGE(short_features >= 15u, "the scene should give short segments");
+    TEST_ASSERT_TRUE_MESSAGE(short_vertices >= 8u, "short segments got no vertex");
+    /* 5 without the rule (6-7 cm off); the one left ends in two returns
+     * 0.5 m apart after three as sparse, no jump where the surfaces change. */
+    TEST_ASSERT_TRUE_MESSAGE(swinging <= 1u, "short segments' curves swing off the walls");
+}
+
 /* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
  * on dense scans whose fits climb near the target, and the curves it leaves
  * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
@@ -762,6 +896,8 @@ int main(void)
     RUN_TEST(test_a_tail_return_past_a_concave_corner_is_left_off_the_feature);
     RUN_TEST(test_a_tail_return_on_a_short_segment_is_left_off_the_feature);
     RUN_TEST(test_a_tail_return_past_an_end_vertex_is_left_off_the_feature);
+    RUN_TEST(test_a_floating_return_at_a_depth_jump_is_left_off_a_short_far_wall);
+    RUN_TEST(test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex);
     RUN_TEST(test_a_mixed_pixel_at_the_end_of_a_corner_side_costs_no_corner);
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
