@@ -548,9 +548,14 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
         d /= d1;
         apex->x = p[step].x - d * sx;
         apex->y = p[step].y - d * sy;
+        /* Between the two beams, on the sensor's side (not in the
+         * opposite wedge behind it), and near: lines that barely turn
+         * (a small min_turn) cross far away, or not at all (NaN). */
         return (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
-                   (apex->x * p[step].y - apex->y * p[step].x) >
-               0.0f;
+                       (apex->x * p[step].y - apex->y * p[step].x) >
+                   0.0f &&
+               apex->x * p[step].x + apex->y * p[step].y > 0.0f &&
+               sq_dist(*apex, p[step]) <= 4.0f * sq_dist(p[2 * step], p[step]);
     }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
@@ -920,16 +925,16 @@ static BSF_COMPACT_INLINE bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf
             lo[depth] = (uint16_t)a;
             hi[depth++] = (uint16_t)(cut - 1u);
         } else {
-            /* The whole segment (less its tails) keeps its kind; a piece is
-             * auxiliary when it holds a vertex. The segment's last beam is
-             * known: no walk through it (the first is beam_of_point's first
-             * step anyway). */
+            /* A feature (the whole segment less its tails, or a piece) is
+             * auxiliary when its fit holds a vertex: a tail left off can
+             * take the segment's vertex with it, and a two-return end of a
+             * short segment can give it one (trim_tails). The segment's
+             * last beam is known: no walk through it (the first is
+             * beam_of_point's first step anyway). */
             append_feature(res, beam_of_point(ex, s, a),
                            b + 1u == n ? s->last : beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
-                           a == lo0 && b == hi0
-                               ? s->kind
-                               : (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK),
-                           n_ctrl, e_curve);
+                           (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl,
+                           e_curve);
         }
     }
     return BSF_OK;
