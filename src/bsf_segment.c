@@ -540,6 +540,85 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
 
+/* Returns on each side of a thin occluder that beside_thin_occluder fits a
+ * line to: a surface seen on both sides of it is judged across it. */
+#define SEG_THIN_SIDE 3
+
+/* Up to SEG_THIN_SIDE returns from beam `from` on in direction dir,
+ * consecutive ones within the radius of each other, appended to w at *n. */
+static int thin_side(const bsf_points_t *pts, size_t from, int dir, int ring, beam_radius_t *rad,
+                     bsf_point_t *w, int *n)
+{
+    size_t j = from;
+    int k;
+    for (k = 0; k < SEG_THIN_SIDE; ++k) {
+        if (k > 0) {
+            size_t next;
+            float dx;
+            float dy;
+            if (!neighbour_beam(pts, j, (long)dir, ring, &next)) {
+                break;
+            }
+            dx = pts->pt[next].x - pts->pt[j].x;
+            dy = pts->pt[next].y - pts->pt[j].y;
+            if (!beam_within(rad, dx * dx + dy * dy)) {
+                break;
+            }
+            j = next;
+        }
+        w[(*n)++] = pts->pt[j];
+    }
+    return k;
+}
+
+/* Beam i, strictly between its neighbours in range, beside a thin occluder:
+ * one or two returns nearer the sensor (a leg, a post) with the surface
+ * behind seen again past them. Beam i lies off the line through that
+ * surface's returns on both sides of the occluder, towards the sensor,
+ * by more than the noise explains: a blend of the occluder's range and the
+ * surface's. A real return of the surface lies on that line; a surface that
+ * turns behind the occluder leaves a residual that widens the bound. */
+static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
+                                int occluder_dir)
+{
+    bsf_point_t w[2 * SEG_THIN_SIDE + 1];
+    bsf_side_line_t l;
+    size_t o[3];
+    int len;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        if (!neighbour_beam(pts, i, (long)occluder_dir * (long)(k + 1), ring, &o[k])) {
+            return 0;
+        }
+    }
+    for (len = 1; len <= 2; ++len) {
+        const size_t far = o[len];
+        const float dx = pts->pt[far].x - pts->pt[o[len - 1]].x;
+        const float dy = pts->pt[far].y - pts->pt[o[len - 1]].y;
+        size_t own;
+        int n_own;
+        int n_far;
+        l.n = 1;
+        if (pts->range[o[len - 1]] >= pts->range[i] || pts->range[far] <= pts->range[i] ||
+            beam_within(rad, dx * dx + dy * dy) ||
+            !neighbour_beam(pts, i, -(long)occluder_dir, ring, &own)) {
+            continue;
+        }
+        w[0] = pts->pt[i];
+        n_own = thin_side(pts, own, -occluder_dir, ring, rad, w, &l.n);
+        n_far = thin_side(pts, far, occluder_dir, ring, rad, w, &l.n);
+        if (n_own >= 2 && n_far >= 2) {
+            float var;
+            bsf_side_fit(w, &l);
+            var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
+            if (off_side_line(pts, i, &l, var, 1)) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
 /* What is_mixed_pixel found: a return halfway between two flat surfaces,
  * or one off the line of a long run beside it (on_neither_surface). */
 #define MIXED_BETWEEN 1
@@ -585,6 +664,9 @@ static int mixed_kind(const bsf_points_t *pts, size_t i, int ring, beam_radius_t
      * on_neither_surface keeps). */
     if (!have_outer) {
         return 0;
+    }
+    if (beside_thin_occluder(pts, i, ring, rad, r[1] == lo ? -1 : 1)) {
+        return MIXED_OFF_A_LINE;
     }
     {
         const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;
