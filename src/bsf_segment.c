@@ -544,6 +544,12 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
  * line to: a surface seen on both sides of it is judged across it. */
 #define SEG_THIN_SIDE 3
 
+/* A blend floats: it lies off the surface's line towards the occluder by
+ * more than 1 / SEG_THIN_FLOAT of the occluder's own offset, as in
+ * mixed_kind's halfway test. A return closer to the surface than that
+ * bends its curve little, and may be a real one. */
+#define SEG_THIN_FLOAT 8.0f
+
 /* Up to SEG_THIN_SIDE returns from beam `from` on in direction dir,
  * consecutive ones within the radius of each other, appended to w at *n. */
 static int thin_side(const bsf_points_t *pts, size_t from, int dir, int ring, beam_radius_t *rad,
@@ -584,6 +590,7 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
     bsf_point_t w[2 * SEG_THIN_SIDE + 1];
     bsf_side_line_t l;
     size_t o[3];
+    size_t own;
     int len;
     int k;
     for (k = 0; k < 3; ++k) {
@@ -591,27 +598,35 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
             return 0;
         }
     }
+    {
+        /* beam i is no return of the occluder itself */
+        const float dx = pts->pt[o[0]].x - pts->pt[i].x;
+        const float dy = pts->pt[o[0]].y - pts->pt[i].y;
+        if (beam_within(rad, dx * dx + dy * dy) ||
+            !neighbour_beam(pts, i, -(long)occluder_dir, ring, &own)) {
+            return 0;
+        }
+    }
     for (len = 1; len <= 2; ++len) {
+        /* the occluder: o[0..len) nearer than beam i; the surface behind
+         * from o[len] on, farther, beyond the radius of the occluder */
         const size_t far = o[len];
         const float dx = pts->pt[far].x - pts->pt[o[len - 1]].x;
         const float dy = pts->pt[far].y - pts->pt[o[len - 1]].y;
-        size_t own;
-        int n_own;
-        int n_far;
-        l.n = 1;
         if (pts->range[o[len - 1]] >= pts->range[i] || pts->range[far] <= pts->range[i] ||
-            beam_within(rad, dx * dx + dy * dy) ||
-            !neighbour_beam(pts, i, -(long)occluder_dir, ring, &own)) {
+            beam_within(rad, dx * dx + dy * dy)) {
             continue;
         }
         w[0] = pts->pt[i];
-        n_own = thin_side(pts, own, -occluder_dir, ring, rad, w, &l.n);
-        n_far = thin_side(pts, far, occluder_dir, ring, rad, w, &l.n);
-        if (n_own >= 2 && n_far >= 2) {
+        l.n = 1;
+        if (thin_side(pts, own, -occluder_dir, ring, rad, w, &l.n) >= 2 &&
+            thin_side(pts, far, occluder_dir, ring, rad, w, &l.n) >= 2) {
             float var;
             bsf_side_fit(w, &l);
             var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
-            if (off_side_line(pts, i, &l, var, 1)) {
+            if (off_side_line(pts, i, &l, var, 1) &&
+                SEG_THIN_FLOAT * fabsf(bsf_side_distance(&l, pts->pt[i])) >
+                    fabsf(bsf_side_distance(&l, pts->pt[o[0]]))) {
                 return 1;
             }
         }
