@@ -550,6 +550,11 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
  * bends its curve little, and may be a real one. */
 #define SEG_THIN_FLOAT 8.0f
 
+/* Squared standard deviations beam i must lie off that line by: 5, not
+ * SEG_MIXED_SIGMAS2's 4, as the line's scatter comes from as few as four
+ * returns (two degrees of freedom) and may underestimate the noise. */
+#define SEG_THIN_SIGMAS2 25.0f
+
 /* Up to SEG_THIN_SIDE returns from beam `from` on in direction dir,
  * consecutive ones within the radius of each other, appended to w at *n. */
 static int thin_side(const bsf_points_t *pts, size_t from, int dir, int ring, beam_radius_t *rad,
@@ -624,7 +629,7 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
             float var;
             bsf_side_fit(w, &l);
             var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
-            if (off_side_line(pts, i, &l, var, 1) &&
+            if (off_side_line(pts, i, &l, var * (SEG_THIN_SIGMAS2 / SEG_MIXED_SIGMAS2), 1) &&
                 SEG_THIN_FLOAT * fabsf(bsf_side_distance(&l, pts->pt[i])) >
                     fabsf(bsf_side_distance(&l, pts->pt[o[0]]))) {
                 return 1;
@@ -680,6 +685,8 @@ static int mixed_kind(const bsf_points_t *pts, size_t i, int ring, beam_radius_t
     if (!have_outer) {
         return 0;
     }
+    /* Either side may be nearer in range: the surface behind a thin
+     * occluder is judged across it. */
     if (beside_thin_occluder(pts, i, ring, rad, r[1] == lo ? -1 : 1)) {
         return MIXED_OFF_A_LINE;
     }
