@@ -555,37 +555,37 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
  * returns (two degrees of freedom) and may underestimate the noise. */
 #define SEG_THIN_SIGMAS2 25.0f
 
+/* Beams a and b lie within beam i's radius (rad) of each other. */
+static int points_within(beam_radius_t *rad, const bsf_points_t *pts, size_t a, size_t b)
+{
+    const float dx = pts->pt[a].x - pts->pt[b].x;
+    const float dy = pts->pt[a].y - pts->pt[b].y;
+    return beam_within(rad, dx * dx + dy * dy);
+}
+
 /* Up to SEG_THIN_SIDE returns from beam `from` on in direction dir,
- * consecutive ones within the radius of each other, appended to w at *n. */
+ * consecutive ones within the radius of each other, appended to w at *n;
+ * how many. */
 static int thin_side(const bsf_points_t *pts, size_t from, int dir, int ring, beam_radius_t *rad,
                      bsf_point_t *w, int *n)
 {
     size_t j = from;
-    int k;
-    for (k = 0; k < SEG_THIN_SIDE; ++k) {
-        if (k > 0) {
-            size_t next;
-            float dx;
-            float dy;
-            if (!neighbour_beam(pts, j, (long)dir, ring, &next)) {
-                break;
-            }
-            dx = pts->pt[next].x - pts->pt[j].x;
-            dy = pts->pt[next].y - pts->pt[j].y;
-            if (!beam_within(rad, dx * dx + dy * dy)) {
-                break;
-            }
-            j = next;
-        }
+    size_t next;
+    int k = 0;
+    for (;;) {
         w[(*n)++] = pts->pt[j];
+        if (++k == SEG_THIN_SIDE || !neighbour_beam(pts, j, (long)dir, ring, &next) ||
+            !points_within(rad, pts, j, next)) {
+            return k;
+        }
+        j = next;
     }
-    return k;
 }
 
 /* Beam i, strictly between its neighbours in range, beside a thin occluder:
  * one or two returns nearer the sensor (a leg, a post) with the surface
  * behind seen again past them. Beam i lies off the line through that
- * surface's returns on both sides of the occluder, towards the sensor,
+ * surface's returns on both sides of the occluder, on the occluder's side,
  * by more than the noise explains: a blend of the occluder's range and the
  * surface's. A real return of the surface lies on that line; a surface that
  * turns behind the occluder leaves a residual that widens the bound. */
@@ -597,41 +597,35 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
     size_t o[3];
     size_t own;
     int len;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        if (!neighbour_beam(pts, i, (long)occluder_dir * (long)(k + 1), ring, &o[k])) {
+    for (len = 0; len < 3; ++len) {
+        if (!neighbour_beam(pts, i, (long)occluder_dir * (long)(len + 1), ring, &o[len])) {
             return 0;
         }
     }
-    {
-        /* beam i is no return of the occluder itself */
-        const float dx = pts->pt[o[0]].x - pts->pt[i].x;
-        const float dy = pts->pt[o[0]].y - pts->pt[i].y;
-        if (beam_within(rad, dx * dx + dy * dy) ||
-            !neighbour_beam(pts, i, -(long)occluder_dir, ring, &own)) {
-            return 0;
-        }
+    /* beam i is no return of the occluder itself */
+    if (points_within(rad, pts, i, o[0]) ||
+        !neighbour_beam(pts, i, -(long)occluder_dir, ring, &own)) {
+        return 0;
     }
     for (len = 1; len <= 2; ++len) {
         /* the occluder: o[0..len) nearer than beam i; the surface behind
          * from o[len] on, farther, beyond the radius of the occluder */
-        const size_t far = o[len];
-        const float dx = pts->pt[far].x - pts->pt[o[len - 1]].x;
-        const float dy = pts->pt[far].y - pts->pt[o[len - 1]].y;
-        if (pts->range[o[len - 1]] >= pts->range[i] || pts->range[far] <= pts->range[i] ||
-            beam_within(rad, dx * dx + dy * dy)) {
+        if (pts->range[o[len - 1]] >= pts->range[i] || pts->range[o[len]] <= pts->range[i] ||
+            points_within(rad, pts, o[len - 1], o[len])) {
             continue;
         }
         w[0] = pts->pt[i];
         l.n = 1;
         if (thin_side(pts, own, -occluder_dir, ring, rad, w, &l.n) >= 2 &&
-            thin_side(pts, far, occluder_dir, ring, rad, w, &l.n) >= 2) {
+            thin_side(pts, o[len], occluder_dir, ring, rad, w, &l.n) >= 2) {
             float var;
+            float d_occluder;
             bsf_side_fit(w, &l);
             var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
-            if (off_side_line(pts, i, &l, var * (SEG_THIN_SIGMAS2 / SEG_MIXED_SIGMAS2), 1) &&
-                SEG_THIN_FLOAT * fabsf(bsf_side_distance(&l, pts->pt[i])) >
-                    fabsf(bsf_side_distance(&l, pts->pt[o[0]]))) {
+            d_occluder = bsf_side_distance(&l, pts->pt[o[0]]);
+            if (l.d_near * d_occluder > 0.0f &&
+                l.d_near * l.d_near > SEG_THIN_SIGMAS2 * l.reach_i * var &&
+                SEG_THIN_FLOAT * fabsf(l.d_near) > fabsf(d_occluder)) {
                 return 1;
             }
         }
