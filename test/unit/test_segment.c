@@ -960,8 +960,8 @@ static void wall_behind_a_post(double blend, double sigma, bsf_scene_rng_t *rng)
  * behind seen on both sides: it lies off the line through the wall's
  * returns across the post, towards the post, and joins no segment; the
  * wall's real return there stays with the wall. Without noise, and over
- * 200 scans at 1 cm noise (the blend went in all but a few with this seed;
- * the real return stayed in all). The wall's segment may span the post, so
+ * 200 scans at 1 cm noise (the blend went in all of them with this seed;
+ * the bound leaves room for a chance miss elsewhere). The wall's segment may span the post, so
  * its beams are not all in it (no check_partition). */
 static void test_sved_rejects_a_mixed_pixel_beside_a_thin_occluder(void)
 {
