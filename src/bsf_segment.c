@@ -563,23 +563,22 @@ static int points_within(beam_radius_t *rad, const bsf_points_t *pts, size_t a, 
     return beam_within(rad, dx * dx + dy * dy);
 }
 
-/* Up to SEG_THIN_SIDE returns from beam `from` on in direction dir,
- * consecutive ones within the radius of each other, appended to w at *n;
- * how many. */
+/* Up to SEG_THIN_SIDE returns past beam `from` in direction dir, the first
+ * wherever it lies, the others each within the radius of the one before,
+ * appended to w at *n; how many. */
 static int thin_side(const bsf_points_t *pts, size_t from, int dir, int ring, beam_radius_t *rad,
                      bsf_point_t *w, int *n)
 {
     size_t j = from;
     size_t next;
     int k = 0;
-    for (;;) {
-        w[(*n)++] = pts->pt[j];
-        if (++k == SEG_THIN_SIDE || !neighbour_beam(pts, j, (long)dir, ring, &next) ||
-            !points_within(rad, pts, j, next)) {
-            return k;
-        }
+    while (k < SEG_THIN_SIDE && neighbour_beam(pts, j, (long)dir, ring, &next) &&
+           (k == 0 || points_within(rad, pts, j, next))) {
         j = next;
+        w[(*n)++] = pts->pt[j];
+        ++k;
     }
+    return k;
 }
 
 /* Beam i, strictly between its neighbours in range, beside a thin occluder:
@@ -595,7 +594,6 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
     bsf_point_t w[2 * SEG_THIN_SIDE + 1];
     bsf_side_line_t l;
     size_t o[3];
-    size_t own;
     int len;
     for (len = 0; len < 3; ++len) {
         if (!neighbour_beam(pts, i, (long)occluder_dir * (long)(len + 1), ring, &o[len])) {
@@ -603,8 +601,7 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
         }
     }
     /* beam i is no return of the occluder itself */
-    if (points_within(rad, pts, i, o[0]) ||
-        !neighbour_beam(pts, i, -(long)occluder_dir, ring, &own)) {
+    if (points_within(rad, pts, i, o[0])) {
         return 0;
     }
     for (len = 1; len <= 2; ++len) {
@@ -616,8 +613,8 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
         }
         w[0] = pts->pt[i];
         l.n = 1;
-        if (thin_side(pts, own, -occluder_dir, ring, rad, w, &l.n) >= 2 &&
-            thin_side(pts, o[len], occluder_dir, ring, rad, w, &l.n) >= 2) {
+        if (thin_side(pts, i, -occluder_dir, ring, rad, w, &l.n) >= 2 &&
+            thin_side(pts, o[len - 1], occluder_dir, ring, rad, w, &l.n) >= 2) {
             float var;
             float d_occluder;
             bsf_side_fit(w, &l);
