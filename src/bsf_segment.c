@@ -593,41 +593,45 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
 {
     bsf_point_t w[2 * SEG_THIN_SIDE + 1];
     bsf_side_line_t l;
-    size_t o[3];
-    int len;
-    for (len = 0; len < 3; ++len) {
-        if (!neighbour_beam(pts, i, (long)occluder_dir * (long)(len + 1), ring, &o[len])) {
-            return 0;
-        }
-    }
+    size_t first; /* the occluder's return next to beam i */
+    size_t last;  /* its last */
+    size_t far;   /* the surface behind, past the occluder */
+    int k;
+    float var;
+    float d_occluder;
     /* beam i is no return of the occluder itself */
-    if (points_within(rad, pts, i, o[0])) {
+    if (!neighbour_beam(pts, i, (long)occluder_dir, ring, &first) ||
+        points_within(rad, pts, i, first)) {
         return 0;
     }
-    for (len = 1; len <= 2; ++len) {
-        /* the occluder: o[0..len) nearer than beam i; the surface behind
-         * from o[len] on, farther, beyond the radius of the occluder */
-        if (pts->range[o[len - 1]] >= pts->range[i] || pts->range[o[len]] <= pts->range[i] ||
-            points_within(rad, pts, o[len - 1], o[len])) {
-            continue;
+    last = first;
+    /* the occluder: one or two returns nearer than beam i; then the
+     * surface behind, farther, beyond the radius of the occluder */
+    for (k = 0;; ++k) {
+        if (!neighbour_beam(pts, last, (long)occluder_dir, ring, &far)) {
+            return 0;
         }
-        w[0] = pts->pt[i];
-        l.n = 1;
-        if (thin_side(pts, i, -occluder_dir, ring, rad, w, &l.n) >= 2 &&
-            thin_side(pts, o[len - 1], occluder_dir, ring, rad, w, &l.n) >= 2) {
-            float var;
-            float d_occluder;
-            bsf_side_fit(w, &l);
-            var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
-            d_occluder = bsf_side_distance(&l, pts->pt[o[0]]);
-            if (l.d_near * d_occluder > 0.0f &&
-                l.d_near * l.d_near > SEG_THIN_SIGMAS2 * l.reach_i * var &&
-                SEG_THIN_FLOAT * fabsf(l.d_near) > fabsf(d_occluder)) {
-                return 1;
-            }
+        if (pts->range[far] > pts->range[i]) {
+            break;
         }
+        if (k == 1 || pts->range[far] == pts->range[i]) {
+            return 0;
+        }
+        last = far;
     }
-    return 0;
+    w[0] = pts->pt[i];
+    l.n = 1;
+    if (points_within(rad, pts, last, far) ||
+        thin_side(pts, i, -occluder_dir, ring, rad, w, &l.n) < 2 ||
+        thin_side(pts, last, occluder_dir, ring, rad, w, &l.n) < 2) {
+        return 0;
+    }
+    bsf_side_fit(w, &l);
+    var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
+    d_occluder = bsf_side_distance(&l, pts->pt[first]);
+    return l.d_near * d_occluder > 0.0f &&
+           l.d_near * l.d_near > SEG_THIN_SIGMAS2 * l.reach_i * var &&
+           SEG_THIN_FLOAT * fabsf(l.d_near) > fabsf(d_occluder);
 }
 
 /* What is_mixed_pixel found: a return halfway between two flat surfaces,
