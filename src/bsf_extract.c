@@ -558,6 +558,94 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
            d * d > lc->split_min * lc->split_min;
 }
 
+/* The longest segment split_corner judges. */
+#define SPLIT_MAX_N 8u
+
+/* Is a segment of 6 to SPLIT_MAX_N returns without a vertex a corner LC
+ * could not confirm: two lines of at least 3 returns each (p[0..k) and
+ * p[k..n)) that explain it within the noise where one line does not
+ * (curve_ratio), turning by min_turn or more, each long enough for that
+ * turn to stand out of its direction's noise, crossing between the beams
+ * of p[k - 1] and p[k] and no farther from them than they lie apart, the
+ * returns of one line spaced evenly (within 2 times from step to step) and
+ * at least 3 times as far apart as those of the other? Far along a corridor
+ * a wall seen at grazing incidence gives 3-4 returns half a metre apart and
+ * the next wall, seen square-on, 3-4 more a tenth of that apart; one
+ * quadratic span cannot turn there and swings off both walls. A pillar's
+ * or a round wall's returns bend by degrees and their spacing changes by
+ * degrees too. Writes the vertex (at whichever of p[k - 1] and p[k] lies
+ * nearer the crossing) and its anchor (the crossing) and returns 1, or
+ * returns 0. */
+static BSF_COMPACT_NOINLINE int split_corner(const bsf_point_t *p, size_t n, float noise2,
+                                             const bsf_lc_params_t *lc, uint16_t *pos,
+                                             bsf_point_t *anchor)
+{
+    bsf_point_t w[SPLIT_MAX_N + 1u];
+    bsf_side_line_t a;
+    bsf_side_line_t b;
+    float rss_one;
+    float best = -1.0f;
+    const float s = bsf_sinf(lc->min_turn);
+    /* A line through m returns spanning L turns by sigma / L * sqrt(12 / m) at one
+     * standard error; the turn must exceed split_sigmas of them on each side. */
+    const float tol2 = 12.0f * lc->split_sigmas * lc->split_sigmas * noise2;
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        w[k + 1u] = p[k];
+    }
+    w[0] = p[0];
+    a.n = (int)n + 1;
+    bsf_side_fit(w, &a);
+    rss_one = a.var * (float)(n - 2u);
+    for (k = 3u; k + 3u <= n; ++k) {
+        const float ma = (float)(k - 1u);
+        const float mb = (float)(n - 1u - k);
+        const float la2 = sq_dist(p[0], p[k - 1u]);
+        const float lb2 = sq_dist(p[k], p[n - 1u]);
+        /* the sparse line: its first return and its steps */
+        const size_t q0 = la2 * mb * mb > lb2 * ma * ma ? 0u : k;
+        const size_t q1 = q0 > 0u ? n : k;
+        float lo = 1e30f;
+        float hi = 0.0f;
+        float rss;
+        float det;
+        float da;
+        float db;
+        bsf_point_t x;
+        size_t q;
+        w[0] = p[k];
+        a.n = (int)k + 1;
+        bsf_side_fit(w, &a);
+        b.n = (int)(n - k) + 1;
+        bsf_side_fit(&p[k - 1u], &b);
+        rss = a.var * (ma - 1.0f) + b.var * (mb - 1.0f);
+        det = a.nx * b.ny - a.ny * b.nx;
+        for (q = q0 + 1u; q < q1; ++q) {
+            const float st = sq_dist(p[q - 1u], p[q]);
+            lo = st < lo ? st : lo;
+            hi = st > hi ? st : hi;
+        }
+        if (!(det * det >= s * s && rss <= lc->split_sigmas * noise2 * (float)(n - 4u) &&
+              rss_one > lc->curve_ratio * (rss + noise2) && det * det * (ma + 1.0f) * la2 >= tol2 &&
+              det * det * (mb + 1.0f) * lb2 >= tol2 && hi <= 4.0f * lo &&
+              (la2 * mb * mb > 9.0f * lb2 * ma * ma || lb2 * ma * ma > 9.0f * la2 * mb * mb))) {
+            continue;
+        }
+        da = a.nx * a.cx + a.ny * a.cy;
+        db = b.nx * b.cx + b.ny * b.cy;
+        x.x = (da * b.ny - db * a.ny) / det;
+        x.y = (a.nx * db - b.nx * da) / det;
+        if ((p[k - 1u].x * x.y - p[k - 1u].y * x.x) * (x.x * p[k].y - x.y * p[k].x) > 0.0f &&
+            sq_dist(x, p[k - 1u]) + sq_dist(x, p[k]) <= 2.0f * sq_dist(p[k - 1u], p[k]) &&
+            (best < 0.0f || rss < best)) {
+            best = rss;
+            pos[0] = (uint16_t)(sq_dist(x, p[k - 1u]) <= sq_dist(x, p[k]) ? k - 1u : k);
+            *anchor = x;
+        }
+    }
+    return best >= 0.0f;
+}
+
 /* Does the beam past segment end b (dir -1 before it, +1 after it) read a
  * valid range nearer the sensor than b? Then b lies in range between the
  * surface its segment follows and the nearer surface seen past it: at a
@@ -607,6 +695,11 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
             pos[0] = (uint16_t)(e ? n - 3u : 2u);
             return 1u;
         }
+    }
+    if (n_vertex == 0u && n >= 6u && n <= SPLIT_MAX_N &&
+        split_corner(pts, n, ex->noise2, &ex->params.lc, pos,
+                     ex->scratch.seg.use.fit.vertex_anchor)) {
+        return 1u;
     }
     for (e = 0; e < 2; ++e) {
         /* Distances from this end to its nearest vertex (n: none) and to
