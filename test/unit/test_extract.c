@@ -834,6 +834,75 @@ static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex
     TEST_ASSERT_TRUE_MESSAGE(swinging <= 1u, "short segments' curves swing off the walls");
 }
 
+/* bench_truth's corridor by a full-circle LIDAR of 360 beams, 1 cm noise, its
+ * 40 poses. Far along it a wall seen at grazing incidence gives 3-4 returns
+ * half a metre apart and the wall across its end, seen square-on, 3-4 more
+ * a tenth of that apart; SVED joins them into a segment of 6-8 returns with
+ * 3 or more on each wall, which LC leaves without a corner. One quadratic
+ * span through them swings up to 11 cm off both walls; a vertex where the
+ * two walls' lines cross keeps the curves within 5 cm of them. */
+static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(void)
+{
+    static float clean[BSF_MAX_POINTS];
+    static int16_t hits[BSF_MAX_POINTS];
+    const size_t n_beams = 360u;
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scene_rng_t rng;
+    size_t short_features = 0u;
+    size_t swinging = 0u;
+    double worst = 0.0;
+    long k;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bench_truth_corridor(&scene));
+    bsf_scene_rng_seed(&rng, 2718u);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    for (k = 0; k < 40; ++k) {
+        const bsf_scene_pose_t pose = bench_truth_corridor_pose(k, 40);
+        bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, n_beams, 6.283185307);
+        bsf_scan_t s;
+        size_t i;
+        size_t fi;
+        l.angle_min = -3.14159265358979;
+        l.angle_increment = 6.28318530717959 / (double)n_beams;
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
+        for (i = 0; i < n_beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0) {
+                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
+                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
+            }
+        }
+        s = scan_of(&l);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        for (fi = 0; fi < res.n_features; ++fi) {
+            const bsf_feature_t *f = &res.features[fi];
+            int j;
+            double fw = 0.0;
+            if (f->n_points < 6u || f->n_points > 8u) {
+                continue;
+            }
+            ++short_features;
+            for (j = 0; j <= 200; ++j) {
+                bsf_point_t q;
+                double wx, wy, d;
+                TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_bspline_eval(&res.ctrl[f->ctrl_first], f->n_ctrl,
+                                                               (float)j / 200.0f, &q, NULL, NULL));
+                bsf_scene_sensor_to_world(&l.pose, (double)q.x, (double)q.y, &wx, &wy);
+                d = bsf_scene_distance_to_surface(&scene, wx, wy, NULL);
+                fw = d > fw ? d : fw;
+            }
+            swinging += fw > 0.05;
+            worst = fw > worst ? fw : worst;
+        }
+    }
+    printf("short segments on two walls: %u features of 6-8 returns, %u more than 5 cm off, "
+           "worst %.3f m\n",
+           (unsigned)short_features, (unsigned)swinging, worst);
+    TEST_ASSERT_TRUE_MESSAGE(short_features >= 10u, "the scene should give short segments");
+    /* 2 without the vertex, 7.8 cm off */
+    TEST_ASSERT_EQUAL_MESSAGE(0u, swinging, "a short segment's curve swings off two walls");
+}
+
 /* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
  * on dense scans whose fits climb near the target, and the curves it leaves
  * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
@@ -898,6 +967,7 @@ int main(void)
     RUN_TEST(test_a_tail_return_past_an_end_vertex_is_left_off_the_feature);
     RUN_TEST(test_a_floating_return_at_a_depth_jump_is_left_off_a_short_far_wall);
     RUN_TEST(test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex);
+    RUN_TEST(test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing);
     RUN_TEST(test_a_mixed_pixel_at_the_end_of_a_corner_side_costs_no_corner);
     RUN_TEST(test_bad_parameters_and_arguments_are_refused);
     RUN_TEST(test_empty_and_single_beam_scans_give_no_features);
