@@ -492,9 +492,11 @@ static float sq_dist(bsf_point_t a, bsf_point_t b)
  * (p[step] by the bound above), on either side, their line turning away
  * from it by min_turn or more and crossing it (the corner, written to apex)
  * between the beams of p[2 step] and p[step], and the step from p[2 step]
- * to p[step] at least twice the run's spacing. A smooth surface (a
- * pillar's silhouette) bends by degrees and keeps its spacing; a second
- * surface starts where the returns jump. */
+ * to p[step] at least twice the run's spacing, or the step from p[step] to
+ * p[0] at most half of it (a run at grazing incidence, the second surface
+ * seen square-on). A smooth surface (a pillar's silhouette) bends by
+ * degrees and keeps its spacing; a second surface starts where the returns
+ * jump or their spacing changes at once. */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
 #endif
@@ -542,7 +544,8 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     if (apex != NULL) {
         d = d - d1; /* p[step]'s offset */
         if (!(d * d1 > 0.0f &&
-              sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]))) {
+              (sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]) ||
+               4.0f * sq_dist(p[step], p[0]) < sq_dist(p[2 * step], p[3 * step])))) {
             return 0;
         }
         d /= d1;
@@ -556,94 +559,6 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
      * -(nx cx + ny cy) is positive. */
     return d * (l.nx * l.cx + l.ny * l.cy) < 0.0f && d * d > bound2 * l.reach_nr &&
            d * d > lc->split_min * lc->split_min;
-}
-
-/* The longest segment split_corner judges. */
-#define SPLIT_MAX_N 8u
-
-/* Is a segment of 6 to SPLIT_MAX_N returns without a vertex a corner LC
- * could not confirm: two lines of at least 3 returns each (p[0..k) and
- * p[k..n)) that explain it within the noise where one line does not
- * (curve_ratio), turning by min_turn or more, each long enough for that
- * turn to stand out of its direction's noise, crossing between the beams
- * of p[k - 1] and p[k] and no farther from them than they lie apart, the
- * returns of one line spaced evenly (within 2 times from step to step) and
- * at least 3 times as far apart as those of the other? Far along a corridor
- * a wall seen at grazing incidence gives 3-4 returns half a metre apart and
- * the next wall, seen square-on, 3-4 more a tenth of that apart; one
- * quadratic span cannot turn there and swings off both walls. A pillar's
- * or a round wall's returns bend by degrees and their spacing changes by
- * degrees too. Writes the vertex (at whichever of p[k - 1] and p[k] lies
- * nearer the crossing) and its anchor (the crossing) and returns 1, or
- * returns 0. */
-static BSF_COMPACT_NOINLINE int split_corner(const bsf_point_t *p, size_t n, float noise2,
-                                             const bsf_lc_params_t *lc, uint16_t *pos,
-                                             bsf_point_t *anchor)
-{
-    bsf_point_t w[SPLIT_MAX_N + 1u];
-    bsf_side_line_t a;
-    bsf_side_line_t b;
-    float rss_one;
-    float best = -1.0f;
-    const float s = bsf_sinf(lc->min_turn);
-    /* A line through m returns spanning L turns by sigma / L * sqrt(12 / m) at one
-     * standard error; the turn must exceed split_sigmas of them on each side. */
-    const float tol2 = 12.0f * lc->split_sigmas * lc->split_sigmas * noise2;
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        w[k + 1u] = p[k];
-    }
-    w[0] = p[0];
-    a.n = (int)n + 1;
-    bsf_side_fit(w, &a);
-    rss_one = a.var * (float)(n - 2u);
-    for (k = 3u; k + 3u <= n; ++k) {
-        const float ma = (float)(k - 1u);
-        const float mb = (float)(n - 1u - k);
-        const float la2 = sq_dist(p[0], p[k - 1u]);
-        const float lb2 = sq_dist(p[k], p[n - 1u]);
-        /* the sparse line: its first return and its steps */
-        const size_t q0 = la2 * mb * mb > lb2 * ma * ma ? 0u : k;
-        const size_t q1 = q0 > 0u ? n : k;
-        float lo = 1e30f;
-        float hi = 0.0f;
-        float rss;
-        float det;
-        float da;
-        float db;
-        bsf_point_t x;
-        size_t q;
-        w[0] = p[k];
-        a.n = (int)k + 1;
-        bsf_side_fit(w, &a);
-        b.n = (int)(n - k) + 1;
-        bsf_side_fit(&p[k - 1u], &b);
-        rss = a.var * (ma - 1.0f) + b.var * (mb - 1.0f);
-        det = a.nx * b.ny - a.ny * b.nx;
-        for (q = q0 + 1u; q < q1; ++q) {
-            const float st = sq_dist(p[q - 1u], p[q]);
-            lo = st < lo ? st : lo;
-            hi = st > hi ? st : hi;
-        }
-        if (!(det * det >= s * s && rss <= lc->split_sigmas * noise2 * (float)(n - 4u) &&
-              rss_one > lc->curve_ratio * (rss + noise2) && det * det * (ma + 1.0f) * la2 >= tol2 &&
-              det * det * (mb + 1.0f) * lb2 >= tol2 && hi <= 4.0f * lo &&
-              (la2 * mb * mb > 9.0f * lb2 * ma * ma || lb2 * ma * ma > 9.0f * la2 * mb * mb))) {
-            continue;
-        }
-        da = a.nx * a.cx + a.ny * a.cy;
-        db = b.nx * b.cx + b.ny * b.cy;
-        x.x = (da * b.ny - db * a.ny) / det;
-        x.y = (a.nx * db - b.nx * da) / det;
-        if ((p[k - 1u].x * x.y - p[k - 1u].y * x.x) * (x.x * p[k].y - x.y * p[k].x) > 0.0f &&
-            sq_dist(x, p[k - 1u]) + sq_dist(x, p[k]) <= 2.0f * sq_dist(p[k - 1u], p[k]) &&
-            (best < 0.0f || rss < best)) {
-            best = rss;
-            pos[0] = (uint16_t)(sq_dist(x, p[k - 1u]) <= sq_dist(x, p[k]) ? k - 1u : k);
-            *anchor = x;
-        }
-    }
-    return best >= 0.0f;
 }
 
 /* Does the beam past segment end b (dir -1 before it, +1 after it) read a
@@ -673,7 +588,14 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
  * crossing, when its last two returns at one end are a second surface
  * (tail_end with an apex, judged by the other returns): its one quadratic
  * span cannot turn there and would swing off both surfaces, and leaving
- * the two returns out would waste a third of the segment. Returns the
+ * the two returns out would waste a third of the segment. A segment of 6
+ * to 8 returns without a corner is judged the same way through views of 5
+ * or 6 returns that leave 1 to 3 returns out at one end (shortest view
+ * first): a corner between a wall seen at grazing incidence (3-4 returns
+ * half a metre apart) and the next wall (3-4 returns a tenth of that
+ * apart), the two returns of one wall nearest the corner judged against
+ * the other wall's line; the shortest run that passes puts the vertex
+ * between the last sparse and the first dense return. Returns the
  * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
  * wrote them, or that one vertex). */
 static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
@@ -682,24 +604,23 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    /* Too short for the tail rule's run: a two-return end is a corner. */
+    /* Too short for the tail rule's run (in a view of 5 or 6 returns, leaving
+     * t returns out): a two-return end is a corner. */
     bsf_point_t *apex =
-        n < TAIL_MIN_RUN + 2u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+        n < TAIL_MIN_RUN + 4u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+    size_t t = n - TAIL_MIN_RUN;
     int e;
     if (!USES_LC(ex) || !ex->params.trim_tails || n < TAIL_FLOAT_RUN + 2u) {
         return n_vertex;
     }
-    for (e = 0; apex != NULL && e < 2; ++e) {
-        if (tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
-                     apex)) {
-            pos[0] = (uint16_t)(e ? n - 3u : 2u);
-            return 1u;
+    for (; apex != NULL && t + TAIL_MIN_RUN + 1u >= n && t < n; --t) {
+        for (e = 0; e < 2; ++e) {
+            if (tail_end(e ? &pts[n - 1u - t] : &pts[t], e ? -1 : 1, 1u, n - t - 2u, ex->noise2,
+                         &ex->params.lc, apex)) {
+                pos[0] = (uint16_t)(e ? n - 3u - t : t + 2u);
+                return 1u;
+            }
         }
-    }
-    if (n_vertex == 0u && n >= 6u && n <= SPLIT_MAX_N &&
-        split_corner(pts, n, ex->noise2, &ex->params.lc, pos,
-                     ex->scratch.seg.use.fit.vertex_anchor)) {
-        return 1u;
     }
     for (e = 0; e < 2; ++e) {
         /* Distances from this end to its nearest vertex (n: none) and to
