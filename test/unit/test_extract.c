@@ -839,8 +839,9 @@ static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex
  * half a metre apart and the wall across its end, seen square-on, 3-4 more
  * a tenth of that apart; SVED joins them into a segment of 6-8 returns with
  * 3 or more on each wall, which LC leaves without a corner. One quadratic
- * span through them swings up to 11 cm off both walls; a vertex where the
- * two walls' lines cross keeps the curves within 5 cm of them. */
+ * span through them swings off both walls (7.8 cm here, 11 cm on
+ * bench_truth's draws); a vertex where the two walls' lines cross keeps
+ * the curve on them. */
 static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(void)
 {
     static float clean[BSF_MAX_POINTS];
