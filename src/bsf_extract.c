@@ -492,9 +492,11 @@ static float sq_dist(bsf_point_t a, bsf_point_t b)
  * (p[step] by the bound above), on either side, their line turning away
  * from it by min_turn or more and crossing it (the corner, written to apex)
  * between the beams of p[2 step] and p[step], and the step from p[2 step]
- * to p[step] at least twice the run's spacing. A smooth surface (a
- * pillar's silhouette) bends by degrees and keeps its spacing; a second
- * surface starts where the returns jump. */
+ * to p[step] at least twice the run's spacing, or the step from p[step] to
+ * p[0] at most half of it (a run at grazing incidence, the second surface
+ * seen square-on). A smooth surface (a pillar's silhouette) bends by
+ * degrees and keeps its spacing; a second surface starts where the returns
+ * jump or their spacing changes at once. */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
 #endif
@@ -542,7 +544,8 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     if (apex != NULL) {
         d = d - d1; /* p[step]'s offset */
         if (!(d * d1 > 0.0f &&
-              sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]))) {
+              (sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]) ||
+               4.0f * sq_dist(p[step], p[0]) < sq_dist(p[2 * step], p[3 * step])))) {
             return 0;
         }
         d /= d1;
@@ -590,7 +593,14 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
  * crossing, when its last two returns at one end are a second surface
  * (tail_end with an apex, judged by the other returns): its one quadratic
  * span cannot turn there and would swing off both surfaces, and leaving
- * the two returns out would waste a third of the segment. Returns the
+ * the two returns out would waste a third of the segment. A segment of 6
+ * to 8 returns without a corner is judged the same way through views of 5
+ * or 6 returns that leave 1 to 3 returns out at one end (shortest view
+ * first): a corner between a wall seen at grazing incidence (3-4 returns
+ * half a metre apart) and the next wall (3-4 returns a tenth of that
+ * apart), the two returns of one wall nearest the corner judged against
+ * the other wall's line; the shortest run that passes puts the vertex
+ * between the last sparse and the first dense return. Returns the
  * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
  * wrote them, or that one vertex). */
 static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
@@ -599,18 +609,22 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    /* Too short for the tail rule's run: a two-return end is a corner. */
+    /* Too short for the tail rule's run (in a view of 5 or 6 returns, leaving
+     * t returns out): a two-return end is a corner. */
     bsf_point_t *apex =
-        n < TAIL_MIN_RUN + 2u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+        n < TAIL_MIN_RUN + 4u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+    size_t t = n - TAIL_MIN_RUN;
     int e;
     if (!USES_LC(ex) || !ex->params.trim_tails || n < TAIL_FLOAT_RUN + 2u) {
         return n_vertex;
     }
-    for (e = 0; apex != NULL && e < 2; ++e) {
-        if (tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
-                     apex)) {
-            pos[0] = (uint16_t)(e ? n - 3u : 2u);
-            return 1u;
+    for (; apex != NULL && t + TAIL_MIN_RUN + 1u >= n && t < n; --t) {
+        for (e = 0; e < 2; ++e) {
+            if (tail_end(e ? &pts[n - 1u - t] : &pts[t], e ? -1 : 1, 1u, n - t - 2u, ex->noise2,
+                         &ex->params.lc, apex)) {
+                pos[0] = (uint16_t)(e ? n - 3u - t : t + 2u);
+                return 1u;
+            }
         }
     }
     for (e = 0; e < 2; ++e) {
