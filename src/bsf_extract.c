@@ -455,8 +455,9 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * freedom. */
 #define TAIL_RUN 8u
 /* The shortest run: a segment of fewer than TAIL_MIN_RUN + 2 returns
- * (the run, the end judged, the other end left out of the run) is not
- * judged, unless its end is a floating return (floating_end). */
+ * (the run, the end judged, the other end left out of the run) is judged
+ * only at a floating end (floating_end) or for a two-return corner (the
+ * apex mode of tail_end). */
 #define TAIL_MIN_RUN 5u
 /* The shortest run beside a floating return (floating_end), and beside a
  * two-return end of a segment too short for TAIL_MIN_RUN (a segment of 5
@@ -572,7 +573,8 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
  * depth jump, where a mixed pixel (a beam that reads a blend of the two
  * ranges and floats in free space) lies. A real end return of a far
  * surface, beside the surface that hides the rest, lies on its line, which
- * tail_end checks. */
+ * tail_end checks. It does not look across the seam of a full-circle scan
+ * (measured: no segment ends there at a depth jump). */
 static int floating_end(const bsf_points_t *pts, size_t b, int dir)
 {
     const size_t o = b + (size_t)(ptrdiff_t)dir;
