@@ -455,8 +455,9 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * freedom. */
 #define TAIL_RUN 8u
 /* The shortest run: a segment of fewer than TAIL_MIN_RUN + 2 returns
- * (the run, the end judged, the other end left out of the run) is not
- * judged, unless its end is a floating return (floating_end). */
+ * (the run, the end judged, the other end left out of the run) is judged
+ * only at a floating end (floating_end) or for a two-return corner (the
+ * apex mode of tail_end). */
 #define TAIL_MIN_RUN 5u
 /* The shortest run beside a floating return (floating_end), and beside a
  * two-return end of a segment too short for TAIL_MIN_RUN (a segment of 5
@@ -492,9 +493,11 @@ static float sq_dist(bsf_point_t a, bsf_point_t b)
  * (p[step] by the bound above), on either side, their line turning away
  * from it by min_turn or more and crossing it (the corner, written to apex)
  * between the beams of p[2 step] and p[step], and the step from p[2 step]
- * to p[step] at least twice the run's spacing. A smooth surface (a
- * pillar's silhouette) bends by degrees and keeps its spacing; a second
- * surface starts where the returns jump. */
+ * to p[step] at least twice the run's spacing, or the step from p[step] to
+ * p[0] at most half of it (a run at grazing incidence, the second surface
+ * seen square-on). A smooth surface (a pillar's silhouette) bends by
+ * degrees and keeps its spacing; a second surface starts where the returns
+ * jump or their spacing changes at once. */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
 #endif
@@ -542,15 +545,21 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     if (apex != NULL) {
         d = d - d1; /* p[step]'s offset */
         if (!(d * d1 > 0.0f &&
-              sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]))) {
+              (sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]) ||
+               4.0f * sq_dist(p[step], p[0]) < sq_dist(p[2 * step], p[3 * step])))) {
             return 0;
         }
         d /= d1;
         apex->x = p[step].x - d * sx;
         apex->y = p[step].y - d * sy;
+        /* Between the two beams, on the sensor's side (not in the
+         * opposite wedge behind it), and near: lines that barely turn
+         * (a small min_turn) cross far away, or not at all (NaN). */
         return (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
-                   (apex->x * p[step].y - apex->y * p[step].x) >
-               0.0f;
+                       (apex->x * p[step].y - apex->y * p[step].x) >
+                   0.0f &&
+               apex->x * p[step].x + apex->y * p[step].y > 0.0f &&
+               sq_dist(*apex, p[step]) <= 4.0f * sq_dist(p[2 * step], p[step]);
     }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
@@ -564,7 +573,8 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
  * depth jump, where a mixed pixel (a beam that reads a blend of the two
  * ranges and floats in free space) lies. A real end return of a far
  * surface, beside the surface that hides the rest, lies on its line, which
- * tail_end checks. */
+ * tail_end checks. It does not look across the seam of a full-circle scan
+ * (measured: no segment ends there at a depth jump). */
 static int floating_end(const bsf_points_t *pts, size_t b, int dir)
 {
     const size_t o = b + (size_t)(ptrdiff_t)dir;
@@ -585,7 +595,14 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
  * crossing, when its last two returns at one end are a second surface
  * (tail_end with an apex, judged by the other returns): its one quadratic
  * span cannot turn there and would swing off both surfaces, and leaving
- * the two returns out would waste a third of the segment. Returns the
+ * the two returns out would waste a third of the segment. A segment of 6
+ * to 8 returns without a corner is judged the same way through views of 5
+ * or 6 returns that leave 1 to 3 returns out at one end (shortest view
+ * first): a corner between a wall seen at grazing incidence (3-4 returns
+ * half a metre apart) and the next wall (3-4 returns a tenth of that
+ * apart), the two returns of one wall nearest the corner judged against
+ * the other wall's line; the shortest run that passes puts the vertex
+ * between the last sparse and the first dense return. Returns the
  * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
  * wrote them, or that one vertex). */
 static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
@@ -594,18 +611,22 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     const bsf_point_t *pts = ex->scratch.seg.use.fit.seg_points;
     const size_t run = n - 2u < TAIL_RUN ? n - 2u : TAIL_RUN;
-    /* Too short for the tail rule's run: a two-return end is a corner. */
+    /* Too short for the tail rule's run (in a view of 5 or 6 returns, leaving
+     * t returns out): a two-return end is a corner. */
     bsf_point_t *apex =
-        n < TAIL_MIN_RUN + 2u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+        n < TAIL_MIN_RUN + 4u && n_vertex == 0u ? ex->scratch.seg.use.fit.vertex_anchor : NULL;
+    size_t t = n - TAIL_MIN_RUN;
     int e;
     if (!USES_LC(ex) || !ex->params.trim_tails || n < TAIL_FLOAT_RUN + 2u) {
         return n_vertex;
     }
-    for (e = 0; apex != NULL && e < 2; ++e) {
-        if (tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, 1u, run, ex->noise2, &ex->params.lc,
-                     apex)) {
-            pos[0] = (uint16_t)(e ? n - 3u : 2u);
-            return 1u;
+    for (; apex != NULL && t + TAIL_MIN_RUN + 1u >= n && t < n; --t) {
+        for (e = 0; e < 2; ++e) {
+            if (tail_end(e ? &pts[n - 1u - t] : &pts[t], e ? -1 : 1, 1u, n - t - 2u, ex->noise2,
+                         &ex->params.lc, apex)) {
+                pos[0] = (uint16_t)(e ? n - 3u - t : t + 2u);
+                return 1u;
+            }
         }
     }
     for (e = 0; e < 2; ++e) {
@@ -920,16 +941,16 @@ static BSF_COMPACT_INLINE bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf
             lo[depth] = (uint16_t)a;
             hi[depth++] = (uint16_t)(cut - 1u);
         } else {
-            /* The whole segment (less its tails) keeps its kind; a piece is
-             * auxiliary when it holds a vertex. The segment's last beam is
-             * known: no walk through it (the first is beam_of_point's first
-             * step anyway). */
+            /* A feature (the whole segment less its tails, or a piece) is
+             * auxiliary when its fit holds a vertex: a tail left off can
+             * take the segment's vertex with it, and a two-return end of a
+             * short segment can give it one (trim_tails). The segment's
+             * last beam is known: no walk through it (the first is
+             * beam_of_point's first step anyway). */
             append_feature(res, beam_of_point(ex, s, a),
                            b + 1u == n ? s->last : beam_of_point(ex, s, b), (uint16_t)(b + 1u - a),
-                           a == lo0 && b == hi0
-                               ? s->kind
-                               : (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK),
-                           n_ctrl, e_curve);
+                           (uint8_t)(nv > 0u ? BSF_FEATURE_AUXILIARY : BSF_FEATURE_BLEAK), n_ctrl,
+                           e_curve);
         }
     }
     return BSF_OK;

@@ -2186,7 +2186,7 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
     size_t m = 0;
     size_t i;
     size_t step;
-#if !BSF_CONFIG_COMPACT
+#if !BSF_CONFIG_COMPACT || defined(LC_SSE2)
     float jump_a2;
 #endif
     if (n_out != NULL) {
@@ -2215,7 +2215,7 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
     c.noise_points = 0.0f;
     blocks_detach(&c);
     c.start = bsf_points_full_circle(pts) ? ring_start(pts, p, grazing_memo) : 0u;
-#if !BSF_CONFIG_COMPACT
+#if !BSF_CONFIG_COMPACT || defined(LC_SSE2)
     jump_a2 = p->jump_a * p->jump_a;
 #endif
     for (step = 0; step <= pts->count; ++step) {

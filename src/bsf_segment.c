@@ -540,6 +540,100 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
 
+/* Returns on each side of a thin occluder that beside_thin_occluder fits a
+ * line to: a surface seen on both sides of it is judged across it. */
+#define SEG_THIN_SIDE 3
+
+/* A blend floats: it lies off the surface's line towards the occluder by
+ * more than 1 / SEG_THIN_FLOAT of the occluder's own offset, as in
+ * mixed_kind's halfway test. A return closer to the surface than that
+ * bends its curve little, and may be a real one. */
+#define SEG_THIN_FLOAT 8.0f
+
+/* Squared standard deviations beam i must lie off that line by: 5, not
+ * SEG_MIXED_SIGMAS2's 4, as the line's scatter comes from as few as four
+ * returns (two degrees of freedom) and may underestimate the noise. */
+#define SEG_THIN_SIGMAS2 25.0f
+
+/* Beams a and b lie within beam i's radius (rad) of each other. */
+static int points_within(beam_radius_t *rad, const bsf_points_t *pts, size_t a, size_t b)
+{
+    const float dx = pts->pt[a].x - pts->pt[b].x;
+    const float dy = pts->pt[a].y - pts->pt[b].y;
+    return beam_within(rad, dx * dx + dy * dy);
+}
+
+/* Up to SEG_THIN_SIDE returns past beam `from` in direction dir, the first
+ * wherever it lies, the others each within the radius of the one before,
+ * appended to w at *n; how many. */
+static int thin_side(const bsf_points_t *pts, size_t from, int dir, int ring, beam_radius_t *rad,
+                     bsf_point_t *w, int *n)
+{
+    size_t j = from;
+    size_t next;
+    int k = 0;
+    while (k < SEG_THIN_SIDE && neighbour_beam(pts, j, (long)dir, ring, &next) &&
+           (k == 0 || points_within(rad, pts, j, next))) {
+        j = next;
+        w[(*n)++] = pts->pt[j];
+        ++k;
+    }
+    return k;
+}
+
+/* Beam i, strictly between its neighbours in range, beside a thin occluder:
+ * one or two returns nearer the sensor (a leg, a post) with the surface
+ * behind seen again past them. Beam i lies off the line through that
+ * surface's returns on both sides of the occluder, on the occluder's side,
+ * by more than the noise explains: a blend of the occluder's range and the
+ * surface's. A real return of the surface lies on that line; a surface that
+ * turns behind the occluder leaves a residual that widens the bound. */
+static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, beam_radius_t *rad,
+                                int occluder_dir)
+{
+    bsf_point_t w[2 * SEG_THIN_SIDE + 1];
+    bsf_side_line_t l;
+    size_t first; /* the occluder's return next to beam i */
+    size_t last;  /* its last */
+    size_t far;   /* the surface behind, past the occluder */
+    int k;
+    float var;
+    float d_occluder;
+    /* beam i is no return of the occluder itself */
+    if (!neighbour_beam(pts, i, (long)occluder_dir, ring, &first) ||
+        points_within(rad, pts, i, first)) {
+        return 0;
+    }
+    last = first;
+    /* the occluder: one or two returns nearer than beam i; then the
+     * surface behind, farther, beyond the radius of the occluder */
+    for (k = 0;; ++k) {
+        if (!neighbour_beam(pts, last, (long)occluder_dir, ring, &far)) {
+            return 0;
+        }
+        if (pts->range[far] > pts->range[i]) {
+            break;
+        }
+        if (k == 1 || pts->range[far] == pts->range[i]) {
+            return 0;
+        }
+        last = far;
+    }
+    w[0] = pts->pt[i];
+    l.n = 1;
+    if (points_within(rad, pts, last, far) ||
+        thin_side(pts, i, -occluder_dir, ring, rad, w, &l.n) < 2 ||
+        thin_side(pts, last, occluder_dir, ring, rad, w, &l.n) < 2) {
+        return 0;
+    }
+    bsf_side_fit(w, &l);
+    var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
+    d_occluder = bsf_side_distance(&l, pts->pt[first]);
+    return l.d_near * d_occluder > 0.0f &&
+           l.d_near * l.d_near > SEG_THIN_SIGMAS2 * l.reach_i * var &&
+           SEG_THIN_FLOAT * fabsf(l.d_near) > fabsf(d_occluder);
+}
+
 /* What is_mixed_pixel found: a return halfway between two flat surfaces,
  * or one off the line of a long run beside it (on_neither_surface). */
 #define MIXED_BETWEEN 1
@@ -585,6 +679,11 @@ static int mixed_kind(const bsf_points_t *pts, size_t i, int ring, beam_radius_t
      * on_neither_surface keeps). */
     if (!have_outer) {
         return 0;
+    }
+    /* Either side may be nearer in range: the surface behind a thin
+     * occluder is judged across it. */
+    if (beside_thin_occluder(pts, i, ring, rad, r[1] == lo ? -1 : 1)) {
+        return MIXED_OFF_A_LINE;
     }
     {
         const int near_before = r[2] - lo < hi - r[2] ? r[1] == lo : r[1] == hi;

@@ -83,14 +83,18 @@ typedef struct {
      *  grazing incidence, or on an occluder. A curve bent to reach it swings
      *  through free space. Segments of at least 7 returns (the run is then
      *  shorter, down to 5, and the noise at least the scan's); where LC has
-     *  a corner within the run, the returns between the end and the corner.
-     *  An end whose neighbouring beam past it reads nearer the sensor (a
-     *  floating return at a depth jump, likely a mixed pixel) is judged
-     *  from a run of 3 returns. The return counts as wasted in Γ.
-     *  A segment of 5 or 6 returns without a corner whose last two returns
-     *  at one end lie off the line of the others, turning by lc.min_turn
-     *  or more and starting with a step at least twice their spacing, gets
-     *  a vertex where the two lines cross instead (no return is left out).
+     *  a corner within the run, the returns between the end and the corner
+     *  (a corner 6-9 returns in; 4-5 for a floating end). An end whose
+     *  neighbouring beam past it reads nearer the sensor (a floating return
+     *  at a depth jump, likely a mixed pixel) is judged from a run of 3 or
+     *  4 returns. The return counts as wasted in Γ.
+     *  A segment of 5 to 8 returns without a corner (one of 7 or 8 through
+     *  its views of 5 or 6 returns that leave 1-3 out at one end) whose last
+     *  two returns at one end lie off the line of the others, on diverging
+     *  lines turning by lc.min_turn or more, after a step more than twice
+     *  the step before it or with their own step under half of it, gets a
+     *  vertex where the two lines cross between the two beams, near the
+     *  returns (no return is left out).
      *  0 keeps every return (bsf_params_paper). */
     uint8_t trim_tails;
     /** The three PDM methods: a bound on the fit's work per scan, for

@@ -180,10 +180,21 @@ BSF_NODISCARD bsf_status_t bsf_segment_sved(const bsf_points_t *pts,
  *    run too short or bent to judge (a small object, a corner next to beam
  *    i), and the first return of a grazing wall. A single return of a third
  *    surface beyond a corner, between the two in range and off both, looks
- *    the same as a mixed pixel and goes too.
- *    bsf_extract's LC (the default method) does not see the returns this
- *    second route rejects either (the first route has no noise scale: at
- *    3 cm noise it takes real returns at small depth steps too).
+ *    the same as a mixed pixel and goes too; or
+ *  - it lies beside a thin occluder: its nearer neighbour (beyond the
+ *    radius of beam i) and at most one more return beyond it (a leg, a
+ *    post) are nearer than beam i, the next return past them is farther and
+ *    beyond the radius of the occluder's last, and the surface behind is
+ *    seen on both sides (2 or 3 consecutive returns within the radius on
+ *    beam i's side and past the occluder). Beam i lies off the total
+ *    least-squares line of those returns, on the occluder's side, by more
+ *    than 5 standard deviations of its distance (the noise from the line's
+ *    residual, at least 3 mm) and by more than 1/8 of the occluder's own
+ *    distance from that line. The surface's own return beside the occluder
+ *    lies on the line and stays.
+ *    bsf_extract's LC (the default method) does not see the returns the
+ *    second and third routes reject either (the first route has no noise
+ *    scale: at 3 cm noise it takes real returns at small depth steps too).
  *
  * Full-circle scans (bsf_points_full_circle): the pass starts after the
  * widest step between cyclically consecutive valid points, so a surface
