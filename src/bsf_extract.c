@@ -530,7 +530,7 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
             (apex == NULL)) {
             return 0; /* p[step] off the side too (a second side of two returns), or on it */
         }
-        d = bsf_side_distance(&l, p[0]);
+        d = bsf_side_distance(&l, &p[0]);
         l.reach_nr = l.reach_i;
     }
     sx = p[0].x - p[step].x;
