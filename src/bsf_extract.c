@@ -464,9 +464,9 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
  * returns). */
 #define TAIL_FLOAT_RUN 3u
 
-static float sq_dist(bsf_point_t a, bsf_point_t b)
+static float sq_dist(const bsf_point_t *a, const bsf_point_t *b)
 {
-    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+    return (a->x - b->x) * (a->x - b->x) + (a->y - b->y) * (a->y - b->y);
 }
 
 /* Is the end return p[0] of a segment a tail: a return on another surface,
@@ -530,7 +530,7 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
             (apex == NULL)) {
             return 0; /* p[step] off the side too (a second side of two returns), or on it */
         }
-        d = bsf_side_distance(&l, p[0]);
+        d = bsf_side_distance(&l, &p[0]);
         l.reach_nr = l.reach_i;
     }
     sx = p[0].x - p[step].x;
@@ -545,8 +545,8 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     if (apex != NULL) {
         d = d - d1; /* p[step]'s offset */
         if (!(d * d1 > 0.0f &&
-              (sq_dist(p[2 * step], p[step]) > 4.0f * sq_dist(p[2 * step], p[3 * step]) ||
-               4.0f * sq_dist(p[step], p[0]) < sq_dist(p[2 * step], p[3 * step])))) {
+              (sq_dist(&p[2 * step], &p[step]) > 4.0f * sq_dist(&p[2 * step], &p[3 * step]) ||
+               4.0f * sq_dist(&p[step], &p[0]) < sq_dist(&p[2 * step], &p[3 * step])))) {
             return 0;
         }
         d /= d1;
@@ -559,7 +559,7 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
                        (apex->x * p[step].y - apex->y * p[step].x) >
                    0.0f &&
                apex->x * p[step].x + apex->y * p[step].y > 0.0f &&
-               sq_dist(*apex, p[step]) <= 4.0f * sq_dist(p[2 * step], p[step]);
+               sq_dist(apex, &p[step]) <= 4.0f * sq_dist(&p[2 * step], &p[step]);
     }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */

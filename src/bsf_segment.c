@@ -403,7 +403,7 @@ void bsf_side_fit(const bsf_point_t *w, bsf_side_line_t *l)
         l->reach_i = 1.0f + 1.0f / m + t_i * t_i / spread;
         l->reach_nr = 1.0f + 1.0f / m + t_nr * t_nr / spread;
     }
-    l->d_near = bsf_side_distance(l, w[0]);
+    l->d_near = bsf_side_distance(l, &w[0]);
 }
 
 /* The total least-squares line through the returns on side dir (-1: the
@@ -465,7 +465,7 @@ static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam
 static BSF_COMPACT_INLINE int off_side_line(const bsf_points_t *pts, size_t i,
                                             const bsf_side_line_t *l, float var, int toward_sensor)
 {
-    const float d = bsf_side_distance(l, pts->pt[i]);
+    const float d = bsf_side_distance(l, &pts->pt[i]);
     float d_sensor;
     if (!(d * d > SEG_MIXED_SIGMAS2 * l->reach_i * var)) {
         return 0;
@@ -536,7 +536,7 @@ static int on_neither_surface(const bsf_points_t *pts, size_t i, int ring, beam_
     if (!side_judged(&near, var) || !off_side_line(pts, i, &near, var, near_is_farther)) {
         return 0;
     }
-    d = bsf_side_distance(&near, pts->pt[i]);
+    d = bsf_side_distance(&near, &pts->pt[i]);
     return !((near.d_near > 0.0f) == (d > 0.0f) && SEG_MIXED_TURN * fabsf(near.d_near) > fabsf(d));
 }
 
@@ -628,7 +628,7 @@ static int beside_thin_occluder(const bsf_points_t *pts, size_t i, int ring, bea
     }
     bsf_side_fit(w, &l);
     var = l.var > SEG_MIXED_FLOOR2 ? l.var : SEG_MIXED_FLOOR2;
-    d_occluder = bsf_side_distance(&l, pts->pt[first]);
+    d_occluder = bsf_side_distance(&l, &pts->pt[first]);
     return l.d_near * d_occluder > 0.0f &&
            l.d_near * l.d_near > SEG_THIN_SIGMAS2 * l.reach_i * var &&
            SEG_THIN_FLOAT * fabsf(l.d_near) > fabsf(d_occluder);

@@ -44,9 +44,9 @@ typedef struct {
 void bsf_side_fit(const bsf_point_t *w, bsf_side_line_t *l);
 
 /* Signed distance of p from line l. */
-static inline float bsf_side_distance(const bsf_side_line_t *l, bsf_point_t p)
+static inline float bsf_side_distance(const bsf_side_line_t *l, const bsf_point_t *p)
 {
-    return l->nx * (p.x - l->cx) + l->ny * (p.y - l->cy);
+    return l->nx * (p->x - l->cx) + l->ny * (p->y - l->cy);
 }
 
 #endif /* BSF_SEGMENT_INTERNAL_H */
