@@ -22,11 +22,10 @@
 /* Points p and q in lanes (p.x, p.y, q.x, q.y). */
 static inline __m128 lc_pair(const bsf_point_t *p, const bsf_point_t *q)
 {
-    double lo;
-    double hi;
-    memcpy(&lo, p, sizeof lo);
-    memcpy(&hi, q, sizeof hi);
-    return _mm_castpd_ps(_mm_set_pd(hi, lo));
+    float v[4];
+    memcpy(&v[0], p, 2u * sizeof v[0]);
+    memcpy(&v[2], q, 2u * sizeof v[0]);
+    return _mm_loadu_ps(v);
 }
 #endif
 
@@ -383,14 +382,20 @@ static BSF_COMPACT_INLINE void circle_step(const lc_ctx_t *c, size_t a, size_t b
             s3 = _mm_add_ss(s3, g);
             s3 = _mm_add_ss(s3, _mm_movehl_ps(g, g));
         }
-        juu = _mm_cvtss_f32(s1);
-        jvv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
-        juv = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
-        ju = _mm_cvtss_f32(s2);
-        jv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
-        gu = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
-        gv = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
-        g1 = _mm_cvtss_f32(s3);
+        {
+            float l1[4];
+            float l2[4];
+            _mm_storeu_ps(l1, s1);
+            _mm_storeu_ps(l2, s2);
+            juu = l1[0];
+            jvv = l1[1];
+            juv = l1[2];
+            ju = l2[0];
+            jv = l2[1];
+            gu = l2[2];
+            gv = l2[3];
+            g1 = _mm_cvtss_f32(s3);
+        }
     }
 #endif
     for (; i <= b; ++i) {
@@ -468,14 +473,20 @@ static float circle_rss(const lc_ctx_t *c, size_t a, size_t b, float cx0, float 
             s2 =
                 _mm_add_ps(s2, _mm_shuffle_ps(vz, _mm_unpackhi_ps(xy, z), _MM_SHUFFLE(1, 0, 3, 2)));
         }
-        sx = _mm_cvtss_f32(s1);
-        sy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(1, 1, 1, 1)));
-        sxx = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 2, 2, 2)));
-        syy = _mm_cvtss_f32(_mm_shuffle_ps(s1, s1, _MM_SHUFFLE(3, 3, 3, 3)));
-        sxz = _mm_cvtss_f32(s2);
-        syz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(1, 1, 1, 1)));
-        sxy = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 2, 2, 2)));
-        sz = _mm_cvtss_f32(_mm_shuffle_ps(s2, s2, _MM_SHUFFLE(3, 3, 3, 3)));
+        {
+            float l1[4];
+            float l2[4];
+            _mm_storeu_ps(l1, s1);
+            _mm_storeu_ps(l2, s2);
+            sx = l1[0];
+            sy = l1[1];
+            sxx = l1[2];
+            syy = l1[3];
+            sxz = l2[0];
+            syz = l2[1];
+            sxy = l2[2];
+            sz = l2[3];
+        }
     }
 #endif
     for (; i <= b; ++i) {
@@ -2229,28 +2240,14 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
          * join the run as below, tested at once. */
         if (m > 0u && step + 4u <= pts->count && i + 4u <= pts->count &&
             work->run[m - 1u] + 1u == i) {
-            uint32_t valid4;
-            memcpy(&valid4, &pts->valid[i], sizeof valid4);
-            /* no zero byte */
-            if (((valid4 - 0x01010101u) & ~valid4 & 0x80808080u) == 0u) {
-                const float *q = &pts->pt[i].x;
-                /* pairs (i - 1, i), (i, i + 1) and (i + 1, i + 2), (i + 2, i + 3) */
-                const __m128 d1 = _mm_sub_ps(_mm_loadu_ps(q - 2), _mm_loadu_ps(q));
-                const __m128 d2 = _mm_sub_ps(_mm_loadu_ps(q + 2), _mm_loadu_ps(q + 4));
-                const __m128 s1 = _mm_mul_ps(d1, d1);
-                const __m128 s2 = _mm_mul_ps(d2, d2);
-                const __m128 t1 = _mm_add_ps(s1, _mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 3, 0, 1)));
-                const __m128 t2 = _mm_add_ps(s2, _mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 3, 0, 1)));
-                if (_mm_movemask_ps(_mm_cmple_ps(_mm_shuffle_ps(t1, t2, _MM_SHUFFLE(2, 0, 2, 0)),
-                                                 _mm_set1_ps(jump_a2))) == 15) {
-                    work->run[m] = (uint16_t)i;
-                    work->run[m + 1u] = (uint16_t)(i + 1u);
-                    work->run[m + 2u] = (uint16_t)(i + 2u);
-                    work->run[m + 3u] = (uint16_t)(i + 3u);
-                    m += 4u;
-                    step += 3u;
-                    continue;
-                }
+            if (bsf_four_steps_within(pts, i, jump_a2)) {
+                work->run[m] = (uint16_t)i;
+                work->run[m + 1u] = (uint16_t)(i + 1u);
+                work->run[m + 2u] = (uint16_t)(i + 2u);
+                work->run[m + 3u] = (uint16_t)(i + 3u);
+                m += 4u;
+                step += 3u;
+                continue;
             }
         }
 #endif

@@ -957,31 +957,17 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
               /* the marks of beams b..b + 3, in one byte or two (both in the scan) */
               (((unsigned)marks[b / 8u] | (unsigned)marks[(b + 3u) / 8u] << 8) >> (b % 8u) & 15u) ==
                   0u))) {
-            uint32_t valid4;
-            memcpy(&valid4, &pts->valid[b], sizeof valid4);
-            /* no zero byte */
-            if (((valid4 - 0x01010101u) & ~valid4 & 0x80808080u) == 0u) {
-                const float *v = &pts->pt[b].x;
-                /* pairs (b - 1, b), (b, b + 1) and (b + 1, b + 2), (b + 2, b + 3) */
-                const __m128 d1 = _mm_sub_ps(_mm_loadu_ps(v), _mm_loadu_ps(v - 2));
-                const __m128 d2 = _mm_sub_ps(_mm_loadu_ps(v + 4), _mm_loadu_ps(v + 2));
-                const __m128 s1 = _mm_mul_ps(d1, d1);
-                const __m128 s2 = _mm_mul_ps(d2, d2);
-                const __m128 t1 = _mm_add_ps(s1, _mm_shuffle_ps(s1, s1, _MM_SHUFFLE(2, 3, 0, 1)));
-                const __m128 t2 = _mm_add_ps(s2, _mm_shuffle_ps(s2, s2, _MM_SHUFFLE(2, 3, 0, 1)));
-                if (_mm_movemask_ps(_mm_cmple_ps(_mm_shuffle_ps(t1, t2, _MM_SHUFFLE(2, 0, 2, 0)),
-                                                 _mm_set1_ps(a2))) == 15) {
-                    open[0].last = (uint32_t)(b + 3u);
-                    open[0].last_pos = (uint32_t)(j + 3u);
-                    open[0].n += 4u;
-                    open[0].end = pts->pt[b + 3u];
-                    if (label != NULL) {
-                        label[b] = label[b + 1u] = label[b + 2u] = label[b + 3u] =
-                            (uint16_t)open[0].first;
-                    }
-                    j += 3u;
-                    continue;
+            if (bsf_four_steps_within(pts, b, a2)) {
+                open[0].last = (uint32_t)(b + 3u);
+                open[0].last_pos = (uint32_t)(j + 3u);
+                open[0].n += 4u;
+                open[0].end = pts->pt[b + 3u];
+                if (label != NULL) {
+                    label[b] = label[b + 1u] = label[b + 2u] = label[b + 3u] =
+                        (uint16_t)open[0].first;
                 }
+                j += 3u;
+                continue;
             }
         }
 #endif

@@ -654,6 +654,25 @@ static void test_a_tail_return_on_a_short_segment_is_left_off_the_feature(void)
     TEST_ASSERT_TRUE(t.wasted_on <= t.wasted_off + 2u * 12u);
 }
 
+/* bench_truth's noise on a scene scan: 1 cm Gaussian on every return,
+ * clamped at 0, drawn in beam order from rng; truth_hits says which shape
+ * each beam hit. The scan goes into ranges. */
+static float truth_clean[BSF_MAX_POINTS];
+static int16_t truth_hits[BSF_MAX_POINTS];
+static void scan_scene_1cm(const bsf_lidar_t *l, bsf_scene_rng_t *rng)
+{
+    size_t i;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_scan(&scene, l, NULL, truth_clean, truth_hits, BSF_MAX_POINTS));
+    for (i = 0; i < l->n_beams; ++i) {
+        ranges[i] = truth_clean[i];
+        if (truth_hits[i] >= 0) {
+            const double r = (double)truth_clean[i] + 0.01 * bsf_scene_rng_gauss(rng);
+            ranges[i] = (float)(r < 0.0 ? 0.0 : r);
+        }
+    }
+}
+
 /* A cluttered room (10 m x 7 m, toothed shelves, posts, boxes) seen by a
  * 361-beam 270-degree LIDAR with 1 cm noise from 40 poses on a circle. At
  * some corners the second wall gives one return at a segment's end and LC
@@ -663,8 +682,6 @@ static void test_a_tail_return_on_a_short_segment_is_left_off_the_feature(void)
  * return between lies on the vertex's side. */
 static void test_a_tail_return_past_an_end_vertex_is_left_off_the_feature(void)
 {
-    static float clean[BSF_MAX_POINTS];
-    static int16_t hits[BSF_MAX_POINTS];
     const size_t n_beams = 361u;
     const double fov = (double)(n_beams - 1u) * 0.75 * 3.14159265358979 / 180.0;
     const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
@@ -681,17 +698,8 @@ static void test_a_tail_return_past_an_end_vertex_is_left_off_the_feature(void)
         bsf_scan_t s;
         double rms;
         double max_d;
-        size_t i;
         l.noise_sigma = 0.0;
-        TEST_ASSERT_EQUAL_INT(BSF_OK,
-                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
-        for (i = 0; i < n_beams; ++i) {
-            ranges[i] = clean[i];
-            if (hits[i] >= 0) {
-                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
-                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
-            }
-        }
+        scan_scene_1cm(&l, &rng);
         s = scan_of(&l);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
         curve_to_truth(&l, &rms, &max_d);
@@ -773,8 +781,6 @@ static void test_a_floating_return_at_a_depth_jump_is_left_off_a_short_far_wall(
  * where the two lines cross, and its curve stays within 1.2 cm of them. */
 static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex(void)
 {
-    static float clean[BSF_MAX_POINTS];
-    static int16_t hits[BSF_MAX_POINTS];
     const size_t n_beams = 181u;
     const double fov = 3.14159265358979;
     const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
@@ -790,18 +796,9 @@ static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex
         const bsf_scene_pose_t pose = bench_truth_corridor_pose(k, 40);
         bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, n_beams, fov);
         bsf_scan_t s;
-        size_t i;
         size_t fi;
         l.noise_sigma = 0.0;
-        TEST_ASSERT_EQUAL_INT(BSF_OK,
-                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
-        for (i = 0; i < n_beams; ++i) {
-            ranges[i] = clean[i];
-            if (hits[i] >= 0) {
-                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
-                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
-            }
-        }
+        scan_scene_1cm(&l, &rng);
         s = scan_of(&l);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
         for (fi = 0; fi < res.n_features; ++fi) {
@@ -850,8 +847,6 @@ static void test_two_returns_on_a_second_surface_end_a_short_segment_at_a_vertex
  * the curve on them. */
 static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(void)
 {
-    static float clean[BSF_MAX_POINTS];
-    static int16_t hits[BSF_MAX_POINTS];
     const size_t n_beams = 360u;
     const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
     bsf_scene_rng_t rng;
@@ -866,19 +861,10 @@ static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(vo
         const bsf_scene_pose_t pose = bench_truth_corridor_pose(k, 40);
         bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, n_beams, 6.283185307);
         bsf_scan_t s;
-        size_t i;
         size_t fi;
         l.angle_min = -3.14159265358979;
         l.angle_increment = 6.28318530717959 / (double)n_beams;
-        TEST_ASSERT_EQUAL_INT(BSF_OK,
-                              bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
-        for (i = 0; i < n_beams; ++i) {
-            ranges[i] = clean[i];
-            if (hits[i] >= 0) {
-                const double r = (double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng);
-                ranges[i] = (float)(r < 0.0 ? 0.0 : r);
-            }
-        }
+        scan_scene_1cm(&l, &rng);
         s = scan_of(&l);
         TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
         for (fi = 0; fi < res.n_features; ++fi) {
@@ -893,12 +879,12 @@ static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(vo
             }
             /* its returns: 3 or more on each of two walls, none elsewhere */
             for (;;) {
-                const int w = hits[b] == wall[0] || wall[0] < 0 ? 0 : 1;
-                if (wall[w] >= 0 && hits[b] != wall[w]) {
+                const int w = truth_hits[b] == wall[0] || wall[0] < 0 ? 0 : 1;
+                if (wall[w] >= 0 && truth_hits[b] != wall[w]) {
                     on_wall[0] = 0u; /* a third surface */
                     break;
                 }
-                wall[w] = hits[b];
+                wall[w] = truth_hits[b];
                 ++on_wall[w];
                 if (b == f->last_beam) {
                     break;
