@@ -987,12 +987,6 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size
                                                        : (uint32_t)n);
         pdm->max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
     }
-#ifdef FIT_BIN_SCALE_WINDOW
-    if (nb < n && pdm->bias_window != 0u) {
-        const size_t w = (pdm->bias_window * nb + n / 2u) / n;
-        pdm->bias_window = (uint8_t)(w > 2u ? w : 2u);
-    }
-#endif
     info->iterations = 0u;
     st = bsf_pdm_fit_anchored(pts, nb, nb < n ? ex->scratch.seg.use.fit.bin_pos : &pos[v0],
                               anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
