@@ -906,6 +906,36 @@ static BSF_COMPACT_NOINLINE size_t bin_walk(bsf_extractor_t *ex, bsf_point_t *pt
     }
 }
 
+/* After a fit of points a..a+n-1 of segment s on bin means: the points
+ * gathered again (as gather_segment does), and when the fit succeeded (ctrl,
+ * m control points) their E_curve, returned; the farthest one is left for
+ * split_point (bin_walk). */
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline)) /* inlined, it slowed fit_segment's gather loop by 40 % */
+#endif
+static float
+fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t n,
+                  const uint16_t *pos, size_t nv, const bsf_point_t *ctrl, size_t m)
+{
+    bsf_point_t *pts = &ex->scratch.seg.use.fit.seg_points[a];
+    size_t beam;
+    size_t k = 0u;
+    float sum;
+    for (beam = s->first; k < a + n; beam = beam + 1u < ex->points.count ? beam + 1u : 0u) {
+        if (ex->scratch.seg.label[beam] == s->first) {
+            if (k >= a) {
+                pts[k - a] = ex->points.pt[beam];
+            }
+            ++k;
+        }
+    }
+    if (ctrl == NULL) {
+        return 0.0f;
+    }
+    (void)bin_walk(ex, pts, n, pos, nv, ctrl, m, &sum);
+    return sqrtf(sum / (float)n);
+}
+
 /* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
  * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
  * point lies more than split_dist from the curve, just after that point,
@@ -972,7 +1002,7 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size
         pos[i] = (uint16_t)(pos[i] - a);
     }
     nb = n;
-    if (ex->params.fit_bin_length > 0.0f) {
+    if (ex->params.fit_bin_length > 0.0f && n >= 2u * FIT_BIN_MIN_BINS) {
         float sum;
         nb = bin_walk(ex, pts, n, &pos[v0], v1 - v0, NULL, 0u, &sum);
     }
@@ -1001,22 +1031,10 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size
         res->stats.n_fit_visits += spent;
     }
     if (nb < n) {
-        /* The points again (gathered as gather_segment does), then E_curve
-         * and the farthest point over them. */
-        size_t beam;
-        size_t k = 0u;
-        for (beam = s->first; k <= b; beam = beam + 1u < ex->points.count ? beam + 1u : 0u) {
-            if (ex->scratch.seg.label[beam] == s->first) {
-                if (k >= a) {
-                    pts[k - a] = ex->points.pt[beam];
-                }
-                ++k;
-            }
-        }
+        const float e = fit_returns_again(ex, s, a, n, &pos[v0], v1 - v0,
+                                          st == BSF_OK ? &res->ctrl[res->n_ctrl] : NULL, *n_ctrl);
         if (st == BSF_OK) {
-            float sum;
-            (void)bin_walk(ex, pts, n, &pos[v0], v1 - v0, &res->ctrl[res->n_ctrl], *n_ctrl, &sum);
-            *e_curve = sqrtf(sum / (float)n);
+            *e_curve = e;
         }
     }
     for (i = v0; i < v1; ++i) {
