@@ -130,8 +130,9 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
         p->trim_tails > 1u) {
         return BSF_ERR_PARAM;
     }
-    if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
-        ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) {
+    if (((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
+         ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) ||
+        (!(BSF_CONFIG_FIT_BINS) && p->fit_bin_length != 0.0f)) {
         return BSF_ERR_UNSUPPORTED; /* left out of this build (bsf_config.h) */
     }
     switch (p->method) {
@@ -784,6 +785,7 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
     return worst;
 }
 
+#if BSF_CONFIG_FIT_BINS
 /* Fewest bins of a run between two pinned points: refinement may add one
  * precision point per 4 points, so bins of a short run (or of one seen from
  * close by) must not take the curve's room to bend (measured: with a floor of
@@ -936,6 +938,8 @@ fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t 
     return sqrtf(sum / (float)n);
 }
 
+#endif /* BSF_CONFIG_FIT_BINS */
+
 /* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
  * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
  * point lies more than split_dist from the curve, just after that point,
@@ -953,6 +957,7 @@ static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a
         e_curve * e_curve * (float)n <= bound * bound) {
         return 0u;
     }
+#if BSF_CONFIG_FIT_BINS
     at = ex->scratch.seg.use.fit.bin_worst_at;
     if ((at != 0xFFFFu ? ex->scratch.seg.use.fit.bin_worst
                        : farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n,
@@ -960,6 +965,12 @@ static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a
                                         n_ctrl, &at)) <= bound * bound) {
         return 0u;
     }
+#else
+    if (farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n, ex->scratch.seg.use.fit.pdm.t,
+                       &res->ctrl[res->n_ctrl], n_ctrl, &at) <= bound * bound) {
+        return 0u;
+    }
+#endif
     at = at < SPLIT_MIN_POINTS - 1u ? SPLIT_MIN_POINTS - 1u : at;
     at = at > n - SPLIT_MIN_POINTS - 1u ? n - SPLIT_MIN_POINTS - 1u : at;
     return a + at + 1u;
@@ -1002,11 +1013,13 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size
         pos[i] = (uint16_t)(pos[i] - a);
     }
     nb = n;
+#if BSF_CONFIG_FIT_BINS
     if (ex->params.fit_bin_length > 0.0f && n >= 2u * FIT_BIN_MIN_BINS) {
         float sum;
         nb = bin_walk(ex, pts, n, &pos[v0], v1 - v0, NULL, 0u, &sum);
     }
     ex->scratch.seg.use.fit.bin_worst_at = 0xFFFFu; /* split_point: farthest_point's */
+#endif
     *pdm = ex->params.pdm;
     if (ex->params.fit_passes != 0u) {
         /* The passes left per point left (fit_passes), at least one: the
@@ -1030,6 +1043,7 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size
         *left = spent < *left ? *left - spent : 0u;
         res->stats.n_fit_visits += spent;
     }
+#if BSF_CONFIG_FIT_BINS
     if (nb < n) {
         const float e = fit_returns_again(ex, s, a, n, &pos[v0], v1 - v0,
                                           st == BSF_OK ? &res->ctrl[res->n_ctrl] : NULL, *n_ctrl);
@@ -1037,6 +1051,9 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size
             *e_curve = e;
         }
     }
+#else
+    (void)s;
+#endif
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] + a);
     }

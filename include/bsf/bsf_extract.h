@@ -124,7 +124,9 @@ typedef struct {
      *  (measured: 3 cm bins make the 3200-beam office's fit 7x cheaper, with
      *  curve p99 worse by 0.02 to 0.9 cm on most of the ground-truth
      *  benchmark's 1081- and 3200-beam rows). Metres, 0..1; 0 (the default
-     *  for every method): every return is fitted. */
+     *  for every method): every return is fitted. A build with
+     *  BSF_CONFIG_FIT_BINS 0 (bsf_config.h) refuses a non-zero value with
+     *  BSF_ERR_UNSUPPORTED. */
     float fit_bin_length;
     bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
     void *clock_user;   /**< passed to clock */
@@ -157,7 +159,8 @@ bsf_params_t bsf_params_paper(bsf_method_t method);
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
  *  NULL, BSF_ERR_PARAM for an unknown method or a value out of range,
  *  BSF_ERR_UNSUPPORTED for a method left out of this build
- *  (BSF_CONFIG_METHODS, bsf_config.h). */
+ *  (BSF_CONFIG_METHODS, bsf_config.h) or a non-zero fit_bin_length in a
+ *  build without the fit on bin means (BSF_CONFIG_FIT_BINS). */
 BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
 
 /**

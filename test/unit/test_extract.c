@@ -988,6 +988,15 @@ static void test_fit_bins_cut_the_fit_work_on_dense_scans_and_keep_curves_on_the
     int k;
     build_l_room();
     TEST_ASSERT_EQUAL_FLOAT(0.0f, bsf_params_default(BSF_METHOD_DEFAULT).fit_bin_length);
+#if !BSF_CONFIG_FIT_BINS
+    {
+        /* Left out of this build: the setting is refused, not ignored. */
+        bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
+        p.fit_bin_length = 0.03f;
+        TEST_ASSERT_EQUAL_INT(BSF_ERR_UNSUPPORTED, bsf_extractor_init(&ex, &p));
+        TEST_IGNORE_MESSAGE("BSF_CONFIG_FIT_BINS is 0 in this build");
+    }
+#endif
     for (k = 0; k < 3; ++k) {
         bsf_lidar_t l = bsf_lidar_default(pose[k][0], pose[k][1], pose[k][2], 1081u, 1.57079633);
         uint32_t in_features[2];
