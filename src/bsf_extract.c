@@ -7,10 +7,14 @@
 #include "bsf_segment_internal.h"
 
 #include <float.h>
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
+#ifndef BSF_FIT_BIN_LENGTH_DEFAULT
+#define BSF_FIT_BIN_LENGTH_DEFAULT 0.0f
+#endif
 #ifndef BSF_SPLIT_DIST_DEFAULT
 #define BSF_SPLIT_DIST_DEFAULT 0.25f
 #endif
@@ -80,6 +84,7 @@ bsf_params_t bsf_params_default(bsf_method_t method)
          * its segments may take that wall's first returns (bsf_grazing.h);
          * a detector that leaves no vertex there would round it off. */
         p.sved.join_grazing = 2u;
+        p.fit_bin_length = BSF_FIT_BIN_LENGTH_DEFAULT;
     }
     p.no_return = bsf_no_return_params_default();
     p.split_dist = BSF_SPLIT_DIST_DEFAULT;
@@ -97,6 +102,7 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     p.no_return.min_run = 0u;
     p.split_dist = 0.0f;
     p.trim_tails = 0u;
+    p.fit_bin_length = 0.0f;
     /* The first release's refinement target, so the paper-faithful rows of
      * bsf table1 are the numbers that release printed. */
     p.pdm.target_rms = 0.015f;
@@ -109,6 +115,7 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
 static const bsf_float_range_t extract_float_ranges[] = {
     {FLT_MAX, (uint16_t)offsetof(bsf_params_t, no_return.code), 0u},
     {BSF_FIT_MAX_COORD, (uint16_t)offsetof(bsf_params_t, split_dist), 0u},
+    {1.0f, (uint16_t)offsetof(bsf_params_t, fit_bin_length), 0u},
 };
 
 bsf_status_t bsf_params_check(const bsf_params_t *p)
@@ -123,8 +130,9 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
         p->trim_tails > 1u) {
         return BSF_ERR_PARAM;
     }
-    if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
-        ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) {
+    if (((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
+         ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) ||
+        (!(BSF_CONFIG_FIT_BINS) && p->fit_bin_length != 0.0f)) {
         return BSF_ERR_UNSUPPORTED; /* left out of this build (bsf_config.h) */
     }
     switch (p->method) {
@@ -777,6 +785,161 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
     return worst;
 }
 
+#if BSF_CONFIG_FIT_BINS
+/* Fewest bins of a run between two pinned points: refinement may add one
+ * precision point per 4 points, so bins of a short run (or of one seen from
+ * close by) must not take the curve's room to bend (measured: with a floor of
+ * 64 bins, a 361-return segment wrapping the sensor kept 4 control points). */
+#define FIT_BIN_MIN_BINS 128u
+/* Walk the bins of points pts[0..n) of a fit (bsf_params_t.fit_bin_length):
+ * the first and last point and each vertex pos[0..nv) alone, each run
+ * between two of them cut into equal bins of about `len` (by the run's chord,
+ * so noise only makes bins smaller). With ctrl NULL, bin means are written
+ * over pts[0..) (bin j starts at or after point j, so in place) and the
+ * vertices' bin indices to bin_pos; otherwise pts holds the points again and
+ * each point's squared distance from the curve ctrl[0..m) is measured at its
+ * bin's footpoint (t, one per bin): along the curve's normal for a bin of
+ * several points, whole for a single point (as PDM measures it). Returns the
+ * number of bins, or the sum of squared distances in *sum. */
+static BSF_COMPACT_NOINLINE size_t bin_walk(bsf_extractor_t *ex, bsf_point_t *pts, size_t n,
+                                            const uint16_t *pos, size_t nv, const bsf_point_t *ctrl,
+                                            size_t m, float *sum)
+{
+    const float len = ex->params.fit_bin_length;
+    const float *t = ex->scratch.seg.use.fit.pdm.t;
+    size_t j = 0u;
+    size_t v = 0u;
+    size_t prev = 0u;
+    size_t lo = 0u;
+    size_t hi = 1u;
+    size_t q = 0u;
+    size_t runs = 0u; /* bins of the current run still to walk, after this one */
+    size_t run_m = 0u;
+    size_t worst_at = 0u;
+    float worst = -1.0f;
+    float total = 0.0f;
+    for (;;) {
+        float mx = 0.0f;
+        float my = 0.0f;
+        size_t i;
+        if (ctrl == NULL) {
+            for (i = lo; i < hi; ++i) {
+                mx += pts[i].x;
+                my += pts[i].y;
+            }
+            pts[j].x = mx / (float)(hi - lo);
+            pts[j].y = my / (float)(hi - lo);
+        } else {
+            /* The span's basis and its derivative in u (farthest_point). */
+            const size_t last = m - 3u;
+            const float x = t[j] * (float)(m - 2u);
+            size_t s = x > 0.0f ? (size_t)x : 0u;
+            float u, k0, k2, b0, b2, ax, ay, bx, by, cx, cy, tx, ty, inv;
+            s = s > last ? last : s;
+            u = x - (float)s;
+            k0 = s == 0u ? 1.0f : 0.5f;
+            k2 = s == last ? 1.0f : 0.5f;
+            b0 = k0 * (1.0f - u) * (1.0f - u);
+            b2 = k2 * u * u;
+            ax = ctrl[s].x - ctrl[s + 1u].x;
+            ay = ctrl[s].y - ctrl[s + 1u].y;
+            bx = ctrl[s + 2u].x - ctrl[s + 1u].x;
+            by = ctrl[s + 2u].y - ctrl[s + 1u].y;
+            cx = ctrl[s + 1u].x + b0 * ax + b2 * bx;
+            cy = ctrl[s + 1u].y + b0 * ay + b2 * by;
+            tx = k2 * u * bx - k0 * (1.0f - u) * ax;
+            ty = k2 * u * by - k0 * (1.0f - u) * ay;
+            inv = tx * tx + ty * ty;
+            inv = hi - lo > 1u && inv > 0.0f ? 1.0f / inv : 0.0f;
+            for (i = lo; i < hi; ++i) {
+                const float dx = pts[i].x - cx;
+                const float dy = pts[i].y - cy;
+                const float along = tx * dx + ty * dy;
+                float d2 = dx * dx + dy * dy - along * along * inv;
+                d2 = d2 > 0.0f ? d2 : 0.0f;
+                total += d2;
+                if (d2 > worst) {
+                    worst = d2;
+                    worst_at = i;
+                }
+            }
+        }
+        ++j;
+        if (hi == n) {
+            ex->scratch.seg.use.fit.bin_worst = worst;
+            ex->scratch.seg.use.fit.bin_worst_at = (uint16_t)worst_at;
+            *sum = total;
+            return j;
+        }
+        if (runs == 0u && lo == prev) {
+            /* Past a pinned point: cut the run up to the next one. */
+            const size_t next = v < nv ? pos[v] : n - 1u;
+            size_t k = 1u;
+            run_m = next - prev - 1u;
+            if (run_m >= 2u) {
+                const float dx = pts[next - 1u].x - pts[prev + 1u].x;
+                const float dy = pts[next - 1u].y - pts[prev + 1u].y;
+                const float chord = sqrtf(dx * dx + dy * dy);
+                const float most = len * (float)(run_m - 1u);
+                k = most >= chord * (float)run_m ? run_m : (size_t)(most / chord);
+                k = k < run_m / FIT_BIN_MIN_BINS ? k : run_m / FIT_BIN_MIN_BINS;
+                k = k > 1u ? k : 1u;
+            }
+            runs = run_m > 0u ? (run_m + k - 1u) / k : 0u;
+            q = 0u;
+        }
+        if (runs > 0u) {
+            /* The run's next bin: points prev+1 .. next-1 in `runs` near-equal parts. */
+            const size_t of = q + runs;
+            lo = prev + 1u + run_m * q / of;
+            hi = prev + 1u + run_m * (q + 1u) / of;
+            ++q;
+            --runs;
+            continue;
+        }
+        /* The next pinned point. */
+        prev = v < nv ? pos[v] : n - 1u;
+        if (ctrl == NULL && v < nv) {
+            ex->scratch.seg.use.fit.bin_pos[v] = (uint16_t)j;
+        }
+        ++v;
+        lo = prev;
+        hi = prev + 1u;
+    }
+}
+
+/* After a fit of points a..a+n-1 of segment s on bin means: the points
+ * gathered again (as gather_segment does), and when the fit succeeded (ctrl,
+ * m control points) their E_curve, returned; the farthest one is left for
+ * split_point (bin_walk). */
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline)) /* inlined, it slowed fit_segment's gather loop by 40 % */
+#endif
+static float
+fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t n,
+                  const uint16_t *pos, size_t nv, const bsf_point_t *ctrl, size_t m)
+{
+    bsf_point_t *pts = &ex->scratch.seg.use.fit.seg_points[a];
+    size_t beam;
+    size_t k = 0u;
+    float sum;
+    for (beam = s->first; k < a + n; beam = beam + 1u < ex->points.count ? beam + 1u : 0u) {
+        if (ex->scratch.seg.label[beam] == s->first) {
+            if (k >= a) {
+                pts[k - a] = ex->points.pt[beam];
+            }
+            ++k;
+        }
+    }
+    if (ctrl == NULL) {
+        return 0.0f;
+    }
+    (void)bin_walk(ex, pts, n, pos, nv, ctrl, m, &sum);
+    return sqrtf(sum / (float)n);
+}
+
+#endif /* BSF_CONFIG_FIT_BINS */
+
 /* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
  * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
  * point lies more than split_dist from the curve, just after that point,
@@ -794,10 +957,20 @@ static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a
         e_curve * e_curve * (float)n <= bound * bound) {
         return 0u;
     }
+#if BSF_CONFIG_FIT_BINS
+    at = ex->scratch.seg.use.fit.bin_worst_at;
+    if ((at != 0xFFFFu ? ex->scratch.seg.use.fit.bin_worst
+                       : farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n,
+                                        ex->scratch.seg.use.fit.pdm.t, &res->ctrl[res->n_ctrl],
+                                        n_ctrl, &at)) <= bound * bound) {
+        return 0u;
+    }
+#else
     if (farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n, ex->scratch.seg.use.fit.pdm.t,
                        &res->ctrl[res->n_ctrl], n_ctrl, &at) <= bound * bound) {
         return 0u;
     }
+#endif
     at = at < SPLIT_MIN_POINTS - 1u ? SPLIT_MIN_POINTS - 1u : at;
     at = at > n - SPLIT_MIN_POINTS - 1u ? n - SPLIT_MIN_POINTS - 1u : at;
     return a + at + 1u;
@@ -808,10 +981,12 @@ static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a
  * res->ctrl[res->n_ctrl..] without appending a feature. The vertex
  * positions, ascending, are shifted to the piece in place and back, so no
  * copy is made. *n_vertex_out receives the vertices used. */
-static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n_vertex,
-                               bsf_result_t *res, size_t *n_ctrl, float *e_curve,
+static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t b,
+                               size_t n_vertex, bsf_result_t *res, size_t *n_ctrl, float *e_curve,
                                size_t *n_vertex_out)
 {
+    bsf_point_t *pts = &ex->scratch.seg.use.fit.seg_points[a];
+    size_t nb;
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
     const int anchored = USES_LC(ex);
@@ -837,6 +1012,14 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] - a);
     }
+    nb = n;
+#if BSF_CONFIG_FIT_BINS
+    if (ex->params.fit_bin_length > 0.0f && n >= 2u * FIT_BIN_MIN_BINS) {
+        float sum;
+        nb = bin_walk(ex, pts, n, &pos[v0], v1 - v0, NULL, 0u, &sum);
+    }
+    ex->scratch.seg.use.fit.bin_worst_at = 0xFFFFu; /* split_point: farthest_point's */
+#endif
     *pdm = ex->params.pdm;
     if (ex->params.fit_passes != 0u) {
         /* The passes left per point left (fit_passes), at least one: the
@@ -848,18 +1031,29 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
         pdm->max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
     }
     info->iterations = 0u;
-    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], n, &pos[v0],
+    st = bsf_pdm_fit_anchored(pts, nb, nb < n ? ex->scratch.seg.use.fit.bin_pos : &pos[v0],
                               anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
                               pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
                               &res->ctrl_is_vertex[res->n_ctrl],
                               (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, info);
     {
         /* What this fit spent, failed or not, counts against the scan. */
-        const uint32_t spent = info->iterations * (uint32_t)n;
+        const uint32_t spent = info->iterations * (uint32_t)nb;
         uint32_t *left = &ex->scratch.seg.use.fit.passes_left;
         *left = spent < *left ? *left - spent : 0u;
         res->stats.n_fit_visits += spent;
     }
+#if BSF_CONFIG_FIT_BINS
+    if (nb < n) {
+        const float e = fit_returns_again(ex, s, a, n, &pos[v0], v1 - v0,
+                                          st == BSF_OK ? &res->ctrl[res->n_ctrl] : NULL, *n_ctrl);
+        if (st == BSF_OK) {
+            *e_curve = e;
+        }
+    }
+#else
+    (void)s;
+#endif
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] + a);
     }
@@ -916,7 +1110,7 @@ static BSF_COMPACT_INLINE bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf
         bsf_status_t st = BSF_ERR_BUFFER;
         --depth;
         if (res->n_features < BSF_MAX_SEGMENTS && (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl >= 3u) {
-            st = fit_points(ex, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
+            st = fit_points(ex, s, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
         }
         if (st != BSF_OK) {
             res->n_features = features0;
