@@ -359,8 +359,8 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 /* Segments of at least min_points points among all[0..n). */
-static BSF_COMPACT_INLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
-                                                     uint32_t min_points)
+static BSF_COMPACT_NOINLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
+                                                       uint32_t min_points)
 {
     size_t c = 0u;
     size_t i;

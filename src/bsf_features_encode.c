@@ -342,7 +342,7 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 /* A feature's own fields (not its points) within the result and the caps. */
-static BSF_COMPACT_INLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
+static BSF_COMPACT_NOINLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
 {
     const size_t n = f->n_ctrl;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;

@@ -117,7 +117,7 @@ static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir)
  * in the scan, s - 1..s + 1 valid, s - 1 within cap of s + 1. The cheap
  * tests on the corner's return come first: most wide steps are depth
  * jumps, whose far return lies nowhere near the line. */
-static int bsf_grazing_run_room(const bsf_points_t *pts, size_t s, float cap)
+static BSF_COMPACT_INLINE int bsf_grazing_run_room(const bsf_points_t *pts, size_t s, float cap)
 {
     return s >= 3u && s + 3u < pts->count && pts->valid[s - 1u] && pts->valid[s] &&
            pts->valid[s + 1u] && bsf_grazing_within(pts->pt, s - 1u, s + 1u, cap);

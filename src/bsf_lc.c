@@ -289,7 +289,7 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     return major_axis(sxx, sxy, syy, lmax, &l->dx, &l->dy);
 }
 
-static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
+static BSF_COMPACT_NOINLINE int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
 {
     return fit_line_from(c, a, b, a, 0.0f, 0.0f, l);
 }

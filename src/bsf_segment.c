@@ -107,7 +107,8 @@ typedef struct {
 } seg_sink_t;
 
 /* Returns 0 when the segment is kept but does not fit (capacity exceeded). */
-static int sink_close(seg_sink_t *sink, size_t first, size_t last, size_t n_points)
+static BSF_COMPACT_INLINE int sink_close(seg_sink_t *sink, size_t first, size_t last,
+                                         size_t n_points)
 {
     bsf_segment_t *s;
     if (n_points < (size_t)sink->min_points) {
@@ -127,8 +128,9 @@ static int sink_close(seg_sink_t *sink, size_t first, size_t last, size_t n_poin
 }
 
 /* Common argument checks of both segmenters; on success fills the sink. */
-static bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out, size_t cap, size_t *n_out,
-                          size_t *n_wasted_points, seg_sink_t *sink)
+static BSF_COMPACT_INLINE bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out,
+                                             size_t cap, size_t *n_out, size_t *n_wasted_points,
+                                             seg_sink_t *sink)
 {
     if (n_out != NULL) {
         *n_out = 0;
