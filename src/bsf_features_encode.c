@@ -359,11 +359,8 @@ static BSF_COMPACT_NOINLINE int feature_ok(const bsf_feature_t *f, uint32_t n_be
  * calls it); the same value for every float (test_math). */
 static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code)
 {
-    float code;
-    if (!is_finite_f(info->quant_step)) {
-        return BSF_ERR_ARG;
-    }
-    code = floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    /* a step that is NaN or infinite fails the code's range test */
+    const float code = floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
     if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
         return BSF_ERR_ARG;
     }
