@@ -1908,13 +1908,10 @@ static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, b
                  const bsf_keypoint_t *kp, const lc_ctx_t *c)
 {
     if (*n > first && too_close(last, kp, c)) {
-        if (kp->score > last->score) {
-            *last = *kp;
-            if (*n - 1u < out_cap) {
-                out[*n - 1u] = *kp;
-            }
+        if (!(kp->score > last->score)) {
+            return;
         }
-        return;
+        --*n; /* kp takes the previous keypoint's place */
     }
     if (*n < out_cap) {
         out[*n] = *kp;
