@@ -1027,7 +1027,7 @@ static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
 
 /* Beam order of features: by first beam, one wrapping through the seam of a
  * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
-static BSF_COMPACT_INLINE uint32_t beam_order_key(const bsf_feature_t *f)
+static BSF_COMPACT_NOINLINE uint32_t beam_order_key(const bsf_feature_t *f)
 {
     return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
 }
