@@ -399,7 +399,7 @@ static bsf_status_t check_stats(const bsf_stats_t *st)
     return BSF_OK;
 }
 
-static BSF_COMPACT_INLINE int32_t round_to_int(float v)
+static BSF_COMPACT_NOINLINE int32_t round_to_int(float v)
 {
     return (int32_t)floorf(v + 0.5f);
 }
