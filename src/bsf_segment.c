@@ -409,22 +409,16 @@ void bsf_side_fit(const bsf_point_t *w, bsf_side_line_t *l)
 }
 
 /* The total least-squares line through the returns on side dir (-1: the
- * beams before i, +1: after) of beam i, all but the nearest; only l->n is
- * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
+ * beams before i, +1: after) of beam i, all but the nearest; only l->n and
+ * l->var (0) are set when there are fewer than SEG_MIXED_MIN_SIDE returns
+ * (side_judged looks at n first). */
 static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
                       bsf_side_line_t *l)
 {
     bsf_point_t w[SEG_MIXED_WINDOW];
     int k;
     l->n = 0;
-    l->cx = 0.0f;
-    l->cy = 0.0f;
-    l->nx = 0.0f;
-    l->ny = 1.0f;
     l->var = 0.0f;
-    l->reach_i = 1.0f;
-    l->reach_nr = 1.0f;
-    l->d_near = 0.0f;
 #if !BSF_CONFIG_COMPACT
     const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
 #endif
