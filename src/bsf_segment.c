@@ -741,18 +741,13 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     return mixed_kind(pts, i, ring, rad, r, lo, hi, have_outer);
 }
 
-/* The radius test's constants for beam_within. */
+/* The radius test's constants for beam_within (the rest is each beam's,
+ * from beam_radius_start on). */
 static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float cap2)
 {
     rad->a2 = a2;
     rad->two_b = two_b;
     rad->cap2 = cap2;
-    rad->rho = 0.0f;
-    rad->lower = 0.0f;
-    rad->upper = 0.0f;
-    rad->limit = 0.0f;
-    rad->have_bounds = 0;
-    rad->have_limit = 0;
 }
 
 size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
