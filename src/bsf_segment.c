@@ -1025,20 +1025,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u, grazing_memo)) {
             best = 0u;
         }
-        if (best == 0u) {
-            open[0].last = (uint32_t)b; /* the current segment goes on (most beams) */
-            open[0].last_pos = (uint32_t)j;
-            open[0].n++;
-            open[0].end = q;
-        } else if (best < slots) {
-            open_seg_t s = open[best];
-            s.last = (uint32_t)b;
-            s.last_pos = (uint32_t)j;
-            s.n++;
-            s.end = q;
-            open_shift_up(open, best);
-            open[0] = s;
-        } else {
+        /* The segment beam b joins goes first (best == 0: the current one,
+         * most beams), or a new one starts there; then b extends it. */
+        if (best == slots) {
             if (n_open == slots) {
                 if (!close_open(&sink, &open[n_open - 1u], label, pts->count)) {
                     return BSF_ERR_CAPACITY;
@@ -1047,12 +1036,17 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             }
             open_shift_up(open, n_open);
             open[0].first = (uint32_t)b;
-            open[0].last = (uint32_t)b;
-            open[0].last_pos = (uint32_t)j;
-            open[0].n = 1u;
-            open[0].end = q;
+            open[0].n = 0u;
             ++n_open;
+        } else if (best > 0u) {
+            const open_seg_t s = open[best];
+            open_shift_up(open, best);
+            open[0] = s;
         }
+        open[0].last = (uint32_t)b;
+        open[0].last_pos = (uint32_t)j;
+        open[0].n++;
+        open[0].end = q;
         if (label != NULL) {
             label[b] = (uint16_t)open[0].first;
         }
