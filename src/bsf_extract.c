@@ -367,8 +367,8 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 /* Segments of at least min_points points among all[0..n). */
-static BSF_COMPACT_INLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
-                                                     uint32_t min_points)
+static BSF_COMPACT_NOINLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
+                                                       uint32_t min_points)
 {
     size_t c = 0u;
     size_t i;
@@ -1221,7 +1221,7 @@ static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
 
 /* Beam order of features: by first beam, one wrapping through the seam of a
  * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
-static BSF_COMPACT_INLINE uint32_t beam_order_key(const bsf_feature_t *f)
+static BSF_COMPACT_NOINLINE uint32_t beam_order_key(const bsf_feature_t *f)
 {
     return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
 }
