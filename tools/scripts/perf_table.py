@@ -391,7 +391,7 @@ def table(rows):
                           "QEMU icount"))
             for name, d in sorted(m4.get(tag, {}).items()):
                 if name.startswith("lc-sved-pdm/f"):
-                    t.append((f"M4F adversarial {tag[4:]}, median / max (default method, `fit_passes` {name[13:]})",
+                    t.append((f"M4F adversarial {tag[4:]}, median / max (default method, {knobs(name[12:])})",
                               f"{fmt(d['median'])} / {fmt(d['max'])}", "(bounds the worst case)", "-", "-", "-",
                               "QEMU icount"))
     if "size_default" in rows:
