@@ -409,6 +409,119 @@ keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, 
     stats->cut |= BSF_CUT_SEGMENTS;
 }
 
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Returns of a segment's end that judge a short run past it
+ * (join_occluded_run): a line with a noise estimate of its own. */
+#define JOIN_END_RUN 8u
+/* Fewest of them: a noise estimate with two degrees of freedom at least. */
+#define JOIN_MIN_END_RUN 5u
+
+static float sq_dist(const bsf_point_t *a, const bsf_point_t *b);
+
+/* A wall seen past an occluder: segment s goes on along the line of its
+ * last 5 to JOIN_END_RUN returns at end e (0: its first beam, 1: its last), that
+ * run straight within the scan's noise (noise2 from LC; a corner or a curve
+ * is not); past its end lie one or more returns in front of that line (a
+ * chair leg, a post, a person), then 2 to min_segment_points - 1 returns
+ * SVED wasted (no segment, no mixed-pixel mark) that all lie on the line,
+ * within split_sigmas standard errors of a return one step past the run,
+ * the first within radius_max of s's end, and nothing else on the line
+ * after them. SVED's radius, which bounds a step from the last return
+ * only, cannot join them across the occluder's width; their line can. A
+ * gap with no return in front (a doorway, an opening, a wall seen nearly
+ * edge-on) is left as it is. They join s: labels, first or last, count. */
+static void join_occluded_run(bsf_extractor_t *ex, bsf_segment_t *s, int e, const uint8_t *marks)
+{
+    const bsf_points_t *pts = &ex->points;
+    uint16_t *label = ex->scratch.seg.label;
+    const ptrdiff_t dir = e ? 1 : -1;
+    const size_t end = e ? s->last : s->first;
+    bsf_point_t w[JOIN_END_RUN + 1u];
+    bsf_side_line_t l;
+    float bound2;
+    float toward;
+    size_t b = end;
+    size_t j = end;
+    size_t k;
+    size_t run = 0u;
+    size_t run_first = 0u;
+    size_t occluded = 0u;
+    /* First, cheaply: a wasted, unmarked return after at least one other
+     * past the end, all valid (most segment ends have none). */
+    for (k = 1u;; ++k) {
+        j = (size_t)((ptrdiff_t)j + dir);
+        if (k > (size_t)ex->params.sved.max_gap_beams || j >= pts->count || !pts->valid[j]) {
+            return;
+        }
+        if (k > 1u && label[j] == (uint16_t)BSF_SEG_NONE && !((marks[j / 8u] >> (j % 8u)) & 1u)) {
+            break;
+        }
+    }
+    j = end;
+    l.n = 1;
+    while (l.n <= (int)JOIN_END_RUN) {
+        if (label[b] == s->first) {
+            w[l.n++] = pts->pt[b];
+        }
+        if (b == (e ? s->first : s->last)) {
+            break;
+        }
+        b = (size_t)((ptrdiff_t)b - dir);
+    }
+    w[0] = pts->pt[end];
+    bsf_side_fit(w, &l);
+    if (l.n <= (int)JOIN_MIN_END_RUN || !(l.var <= 4.0f * ex->noise2)) {
+        return; /* too short to judge, or not straight within the noise */
+    }
+    if (l.var < ex->noise2) {
+        l.var = ex->noise2;
+    }
+    bound2 = ex->params.lc.split_sigmas * ex->params.lc.split_sigmas * l.var * l.reach_i;
+    toward = -(l.nx * l.cx + l.ny * l.cy); /* the sensor's side of the line */
+    for (k = 0u; k < (size_t)ex->params.sved.max_gap_beams; ++k) {
+        float d;
+        j = (size_t)((ptrdiff_t)j + dir);
+        if (j >= pts->count || !pts->valid[j]) {
+            break;
+        }
+        d = bsf_side_distance(&l, &pts->pt[j]);
+        if (label[j] == (uint16_t)BSF_SEG_NONE && !((marks[j / 8u] >> (j % 8u)) & 1u) &&
+            d * d <= bound2) {
+            run_first = run == 0u ? j : run_first;
+            ++run;
+            continue;
+        }
+        if (run > 0u || !(d * toward > 0.0f && d * d > bound2)) {
+            /* the run's end (wasted returns off the line after it spoil
+             * it), or a return behind the line or on another surface */
+            run = label[j] == (uint16_t)BSF_SEG_NONE ? 0u : run;
+            break;
+        }
+        ++occluded;
+    }
+    if (occluded == 0u || run < 2u || run >= (size_t)ex->params.sved.min_segment_points ||
+        !(sq_dist(&pts->pt[run_first], &pts->pt[end]) <=
+          ex->params.sved.radius_max * ex->params.sved.radius_max)) {
+        return;
+    }
+    /* the run's last beam: j stopped one past it, or at max_gap_beams */
+    j = (size_t)((ptrdiff_t)run_first + dir * (ptrdiff_t)(run - 1u));
+    if (e) {
+        s->last = (uint16_t)j;
+    } else {
+        /* a segment's label is its first beam: relabel it */
+        for (b = end; b <= s->last; ++b) {
+            label[b] = label[b] == s->first ? (uint16_t)j : label[b];
+        }
+        s->first = (uint16_t)j;
+    }
+    for (k = 0u; k < run; ++k) {
+        label[(size_t)((ptrdiff_t)run_first + dir * (ptrdiff_t)k)] = (uint16_t)(e ? s->first : j);
+    }
+    s->n_points = (uint16_t)(s->n_points + run);
+}
+#endif
+
 static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     /* Every kept segment fits the scratch (one per valid point at most), so
@@ -441,6 +554,17 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
     if (st != BSF_OK) {
         return st;
     }
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+    if (mixed_marks(ex) != NULL) {
+        size_t k;
+        for (k = 0; k < 2u * n_all; ++k) {
+            /* not through the seam of a full-circle scan */
+            if (all[k / 2u].first <= all[k / 2u].last) {
+                join_occluded_run(ex, &all[k / 2u], (int)(k % 2u), mixed_marks(ex));
+            }
+        }
+    }
+#endif
     keep_segments_that_fit(ex, all, n_all, stats);
     if (USES_RPOS(ex)) {
         return BSF_OK;
