@@ -419,54 +419,38 @@ keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, 
 static float sq_dist(const bsf_point_t *a, const bsf_point_t *b);
 
 /* A wall seen past an occluder: segment s goes on along the line of its
- * last 5 to JOIN_END_RUN returns at end e (0: its first beam, 1: its last), that
- * run straight within the scan's noise (noise2 from LC; a corner or a curve
- * is not); past its end lie one or more returns in front of that line (a
- * chair leg, a post, a person), then 2 to min_segment_points - 1 returns
- * SVED wasted (no segment, no mixed-pixel mark) that all lie on the line,
- * within split_sigmas standard errors of a return one step past the run,
- * the first within radius_max of s's end, and nothing else on the line
- * after them. SVED's radius, which bounds a step from the last return
- * only, cannot join them across the occluder's width; their line can. A
- * gap with no return in front (a doorway, an opening, a wall seen nearly
- * edge-on) is left as it is. They join s: labels, first or last, count. */
-static void join_occluded_run(bsf_extractor_t *ex, bsf_segment_t *s, int e, const uint8_t *marks)
+ * last 5 to JOIN_END_RUN returns at end `end` (dir -1: its first beam, +1:
+ * its last), that run straight within the scan's noise (noise2 from LC; a
+ * corner or a curve is not); past that end lie one or more returns in
+ * front of that line (a chair leg, a post, a person), then 2 to
+ * min_segment_points - 1 returns SVED wasted (no segment, no mixed-pixel
+ * mark) that all lie on the line, within split_sigmas standard errors of a
+ * return one step past the run, the first within radius_max of s's end,
+ * and nothing else on the line after them. SVED's radius, which bounds a
+ * step from the last return only, cannot join them across the occluder's
+ * width; their line can. A gap with no return in front (a doorway, an
+ * opening, a wall seen nearly edge-on) is left as it is. They join s:
+ * labels, first or last, count. */
+static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segment_t *s,
+                                                   ptrdiff_t dir, const uint8_t *marks)
 {
     const bsf_points_t *pts = &ex->points;
     uint16_t *label = ex->scratch.seg.label;
-    const ptrdiff_t dir = e ? 1 : -1;
-    const size_t end = e ? s->last : s->first;
+    const size_t first = s->first;
+    const size_t end = dir > 0 ? s->last : first;
     bsf_point_t w[JOIN_END_RUN + 1u];
     bsf_side_line_t l;
     float bound2;
-    float toward;
     size_t b = end;
-    size_t j = end;
+    size_t j;
     size_t k;
-    size_t run = 0u;
-    size_t run_first = 0u;
-    size_t occluded = 0u;
-    /* First, cheaply: a wasted, unmarked return after at least one other
-     * past the end, all valid (most segment ends have none). */
-    for (k = 1u;; ++k) {
-        j = (size_t)((ptrdiff_t)j + dir);
-        if (k > (size_t)ex->params.sved.max_gap_beams || j >= pts->count || !pts->valid[j]) {
-            return;
-        }
-        if (k > 1u && label[j] == (uint16_t)BSF_SEG_NONE && !((marks[j / 8u] >> (j % 8u)) & 1u)) {
-            break;
-        }
-    }
-    j = end;
-    l.n = 1;
-    while (l.n <= (int)JOIN_END_RUN) {
-        if (label[b] == s->first) {
+    size_t at = 0u; /* the run's first position past the end, 0: none yet */
+    /* s's returns from that end inwards (beams first .. last) */
+    for (l.n = 1; l.n <= (int)JOIN_END_RUN && b - first <= (size_t)s->last - first;
+         b = (size_t)((ptrdiff_t)b - dir)) {
+        if (label[b] == first) {
             w[l.n++] = pts->pt[b];
         }
-        if (b == (e ? s->first : s->last)) {
-            break;
-        }
-        b = (size_t)((ptrdiff_t)b - dir);
     }
     w[0] = pts->pt[end];
     bsf_side_fit(w, &l);
@@ -477,48 +461,63 @@ static void join_occluded_run(bsf_extractor_t *ex, bsf_segment_t *s, int e, cons
         l.var = ex->noise2;
     }
     bound2 = ex->params.lc.split_sigmas * ex->params.lc.split_sigmas * l.var * l.reach_i;
-    toward = -(l.nx * l.cx + l.ny * l.cy); /* the sensor's side of the line */
-    for (k = 0u; k < (size_t)ex->params.sved.max_gap_beams; ++k) {
+    /* Returns in front of the line (positions 1 .. at - 1 past the end),
+     * then the run (at .. k - 1) up to a return of a segment, an invalid
+     * one or max_gap_beams (wasted returns off the line after it spoil
+     * it). */
+    for (k = 1u; k <= (size_t)ex->params.sved.max_gap_beams; ++k) {
         float d;
-        j = (size_t)((ptrdiff_t)j + dir);
+        int none;
+        j = (size_t)((ptrdiff_t)end + dir * (ptrdiff_t)k);
         if (j >= pts->count || !pts->valid[j]) {
             break;
         }
         d = bsf_side_distance(&l, &pts->pt[j]);
-        if (label[j] == (uint16_t)BSF_SEG_NONE && !((marks[j / 8u] >> (j % 8u)) & 1u) &&
-            d * d <= bound2) {
-            run_first = run == 0u ? j : run_first;
-            ++run;
+        none = label[j] == (uint16_t)BSF_SEG_NONE;
+        if (none && !((marks[j / 8u] >> (j % 8u)) & 1u) && d * d <= bound2) {
+            at = at > 0u ? at : k;
             continue;
         }
-        if (run > 0u || !(d * toward > 0.0f && d * d > bound2)) {
-            /* the run's end (wasted returns off the line after it spoil
-             * it), or a return behind the line or on another surface */
-            run = label[j] == (uint16_t)BSF_SEG_NONE ? 0u : run;
+        /* the sensor's side of the line: -(nx cx + ny cy) > 0 */
+        if (at > 0u || !(d * -(l.nx * l.cx + l.ny * l.cy) > 0.0f && d * d > bound2)) {
+            at = none ? 0u : at; /* or behind the line, or on another surface */
             break;
         }
-        ++occluded;
     }
-    if (occluded == 0u || run < 2u || run >= (size_t)ex->params.sved.min_segment_points ||
-        !(sq_dist(&pts->pt[run_first], &pts->pt[end]) <=
+    /* k - at returns in the run */
+    if (at < 2u || k < at + 2u || k - at >= (size_t)ex->params.sved.min_segment_points ||
+        !(sq_dist(&pts->pt[(size_t)((ptrdiff_t)end + dir * (ptrdiff_t)at)], &pts->pt[end]) <=
           ex->params.sved.radius_max * ex->params.sved.radius_max)) {
         return;
     }
-    /* the run's last beam: j stopped one past it, or at max_gap_beams */
-    j = (size_t)((ptrdiff_t)run_first + dir * (ptrdiff_t)(run - 1u));
-    if (e) {
-        s->last = (uint16_t)j;
-    } else {
-        /* a segment's label is its first beam: relabel it */
-        for (b = end; b <= s->last; ++b) {
-            label[b] = label[b] == s->first ? (uint16_t)j : label[b];
-        }
+    /* The run's beams lo .. lo + k - at - 1 join s, whose label is its
+     * first beam (the run's lowest, when it joins before s). */
+    j = dir > 0 ? end + at : end + 1u - k;
+    if (j < first) {
         s->first = (uint16_t)j;
+    } else {
+        s->last = (uint16_t)(j + (k - at) - 1u);
     }
-    for (k = 0u; k < run; ++k) {
-        label[(size_t)((ptrdiff_t)run_first + dir * (ptrdiff_t)k)] = (uint16_t)(e ? s->first : j);
+    s->n_points = (uint16_t)(s->n_points + (k - at));
+    for (b = s->first; b <= s->last; ++b) {
+        if (b - j < k - at || label[b] == first) {
+            label[b] = s->first;
+        }
     }
-    s->n_points = (uint16_t)(s->n_points + run);
+}
+
+/* join_occluded_run at each segment's first end, then its last, in the
+ * order of all[0..n); not through the seam of a full-circle scan. */
+static BSF_COMPACT_NOINLINE void join_occluded_runs(bsf_extractor_t *ex, bsf_segment_t *all,
+                                                    size_t n)
+{
+    const uint8_t *marks = mixed_marks(ex);
+    size_t i;
+    for (i = 0u; marks != NULL && i < 2u * n; ++i) {
+        if (all[i / 2u].first <= all[i / 2u].last) {
+            join_occluded_run(ex, &all[i / 2u], (ptrdiff_t)(i % 2u) * 2 - 1, marks);
+        }
+    }
 }
 #endif
 
@@ -555,15 +554,7 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
         return st;
     }
 #if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
-    if (mixed_marks(ex) != NULL) {
-        size_t k;
-        for (k = 0; k < 2u * n_all; ++k) {
-            /* not through the seam of a full-circle scan */
-            if (all[k / 2u].first <= all[k / 2u].last) {
-                join_occluded_run(ex, &all[k / 2u], (int)(k % 2u), mixed_marks(ex));
-            }
-        }
-    }
+    join_occluded_runs(ex, all, n_all);
 #endif
     keep_segments_that_fit(ex, all, n_all, stats);
     if (USES_RPOS(ex)) {
