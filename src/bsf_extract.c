@@ -418,6 +418,26 @@ keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, 
 
 static float sq_dist(const bsf_point_t *a, const bsf_point_t *b);
 
+#if !BSF_CONFIG_COMPACT
+/* A run of 2 to min_segment_points - 1 of the `wasted` returns just
+ * before position k past beam end (direction dir), at position 2 or
+ * later, starts within radius_max of beam end (join_occluded_run's first
+ * test). */
+static int run_within_radius(const bsf_extractor_t *ex, size_t end, ptrdiff_t dir, size_t k,
+                             size_t wasted)
+{
+    size_t q;
+    for (q = k - 2u; q + wasted >= k && q + ex->params.sved.min_segment_points > k && q > 1u; --q) {
+        if (sq_dist(&ex->points.pt[(size_t)((ptrdiff_t)end + dir * (ptrdiff_t)q)],
+                    &ex->points.pt[end]) <=
+            ex->params.sved.radius_max * ex->params.sved.radius_max) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
 /* A wall seen past an occluder: segment s goes on along the line of its
  * last 5 to JOIN_END_RUN returns at end `end` (dir -1: its first beam, +1:
  * its last), that run straight within the scan's noise (noise2 from LC; a
@@ -445,6 +465,49 @@ static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segm
     size_t j;
     size_t k;
     size_t at = 0u; /* the run's first position past the end, 0: none yet */
+#if !BSF_CONFIG_COMPACT
+    /* Speed only, first, cheaply (most ends have none; the compact build
+     * goes on to the line at every end): a candidate run past the end,
+     * 2 to min_segment_points - 1 wasted, unmarked returns (positions q ..
+     * k - 1, q > 1: one other return at least before them) before a
+     * return of a segment, an invalid one or max_gap_beams, all valid (an
+     * invalid beam has no segment), the first within radius_max of the end.
+     * at counts the wasted, unmarked returns before position k. */
+    j = dir > 0 ? pts->count - 1u - end : end;
+    j = j < (size_t)ex->params.sved.max_gap_beams ? j : (size_t)ex->params.sved.max_gap_beams;
+    b = end;
+    for (k = 1u;; ++k) {
+        int stop;
+        /* Speed only: the next four beams all in segments (no label
+         * BSF_SEG_NONE among them) reset the count, as one by one below;
+         * most ends have a long segment beside them. */
+        while (at < 2u && k + 3u <= j) {
+            uint64_t v;
+            memcpy(&v, &label[dir > 0 ? b + 1u : b - 4u], sizeof v);
+            v = ~v; /* a zero lane: a beam in no segment */
+            if (((v - 0x0001000100010001u) & ~v & 0x8000800080008000u) != 0u) {
+                break;
+            }
+            k += 4u;
+            b = (size_t)((ptrdiff_t)b + 4 * dir);
+            at = 0u;
+        }
+        stop = k > j || (b = (size_t)((ptrdiff_t)b + dir), !pts->valid[b]);
+        if (!stop && label[b] == (uint16_t)BSF_SEG_NONE) {
+            at = (marks[b / 8u] >> (b % 8u)) & 1u ? 0u : at + 1u;
+            continue;
+        }
+        if (at >= 2u && run_within_radius(ex, end, dir, k, at)) {
+            break;
+        }
+        if (stop) {
+            return;
+        }
+        at = 0u;
+    }
+    at = 0u;
+    b = end;
+#endif
     /* s's returns from that end inwards (beams first .. last) */
     for (l.n = 1; l.n <= (int)JOIN_END_RUN && b - first <= (size_t)s->last - first;
          b = (size_t)((ptrdiff_t)b - dir)) {
