@@ -419,18 +419,21 @@ keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, 
 static float sq_dist(const bsf_point_t *a, const bsf_point_t *b);
 
 #if !BSF_CONFIG_COMPACT
-/* A run of 2 to min_segment_points - 1 of the `wasted` returns just
- * before position k past beam end (direction dir), at position 2 or
- * later, starts within radius_max of beam end (join_occluded_run's first
- * test). */
-static int run_within_radius(const bsf_extractor_t *ex, size_t end, ptrdiff_t dir, size_t k,
-                             size_t wasted)
+/* Of the `block` returns in no segment just before position k past beam
+ * end (direction dir), valid, a run of 2 to min_segment_points - 1 not
+ * marked mixed (marks) ends there, at position 2 or later, and starts
+ * within radius_max of beam end (join_occluded_run's first test). */
+static int run_within_radius(const bsf_extractor_t *ex, const uint8_t *marks, size_t end,
+                             ptrdiff_t dir, size_t k, size_t block)
 {
     size_t q;
-    for (q = k - 2u; q + wasted >= k && q + ex->params.sved.min_segment_points > k && q > 1u; --q) {
-        if (sq_dist(&ex->points.pt[(size_t)((ptrdiff_t)end + dir * (ptrdiff_t)q)],
-                    &ex->points.pt[end]) <=
-            ex->params.sved.radius_max * ex->params.sved.radius_max) {
+    for (q = k - 1u; q + block >= k && q > 1u && q + ex->params.sved.min_segment_points > k; --q) {
+        const size_t b = (size_t)((ptrdiff_t)end + dir * (ptrdiff_t)q);
+        if ((marks[b / 8u] >> (b % 8u)) & 1u) {
+            return 0;
+        }
+        if (q + 2u <= k && sq_dist(&ex->points.pt[b], &ex->points.pt[end]) <=
+                               ex->params.sved.radius_max * ex->params.sved.radius_max) {
             return 1;
         }
     }
@@ -472,15 +475,14 @@ static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segm
      * k - 1, q > 1: one other return at least before them) before a
      * return of a segment, an invalid one or max_gap_beams, all valid (an
      * invalid beam has no segment), the first within radius_max of the end.
-     * at counts the wasted, unmarked returns before position k. */
+     * at counts the valid returns in no segment before position k. */
     j = dir > 0 ? pts->count - 1u - end : end;
     j = j < (size_t)ex->params.sved.max_gap_beams ? j : (size_t)ex->params.sved.max_gap_beams;
     b = end;
     for (k = 1u;; ++k) {
-        int stop;
-        /* Speed only: the next four beams all in segments (no label
-         * BSF_SEG_NONE among them) reset the count, as one by one below;
-         * most ends have a long segment beside them. */
+        /* the next four beams all in segments (no label BSF_SEG_NONE among
+         * them) reset the count, as one by one below; most ends have a
+         * long segment beside them */
         while (at < 2u && k + 3u <= j) {
             uint64_t v;
             memcpy(&v, &label[dir > 0 ? b + 1u : b - 4u], sizeof v);
@@ -492,16 +494,18 @@ static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segm
             b = (size_t)((ptrdiff_t)b + 4 * dir);
             at = 0u;
         }
-        stop = k > j || (b = (size_t)((ptrdiff_t)b + dir), !pts->valid[b]);
-        if (!stop && label[b] == (uint16_t)BSF_SEG_NONE) {
-            at = (marks[b / 8u] >> (b % 8u)) & 1u ? 0u : at + 1u;
-            continue;
+        if (k <= j) {
+            b = (size_t)((ptrdiff_t)b + dir);
+            if (label[b] == (uint16_t)BSF_SEG_NONE && pts->valid[b]) {
+                ++at;
+                continue;
+            }
         }
-        if (at >= 2u && run_within_radius(ex, end, dir, k, at)) {
+        if (at >= 2u && run_within_radius(ex, marks, end, dir, k, at)) {
             break;
         }
-        if (stop) {
-            return;
+        if (k > j || label[b] == (uint16_t)BSF_SEG_NONE) {
+            return; /* the window's end, or an invalid beam */
         }
         at = 0u;
     }
