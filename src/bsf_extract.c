@@ -557,7 +557,7 @@ static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segm
           ex->params.sved.radius_max * ex->params.sved.radius_max)) {
         return;
     }
-    /* The run's beams lo .. lo + k - at - 1 join s, whose label is its
+    /* The run's beams j .. j + k - at - 1 join s, whose label is its
      * first beam (the run's lowest, when it joins before s). */
     j = dir > 0 ? end + at : end + 1u - k;
     if (j < first) {
