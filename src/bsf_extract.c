@@ -575,8 +575,11 @@ static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segm
 
 /* join_occluded_run at each segment's first end, then its last, in the
  * order of all[0..n); not through the seam of a full-circle scan. */
-static BSF_COMPACT_NOINLINE void join_occluded_runs(bsf_extractor_t *ex, bsf_segment_t *all,
-                                                    size_t n)
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline)) /* its frame (a line's points) stays off the fit's deepest call chain */
+#endif
+static void
+join_occluded_runs(bsf_extractor_t *ex, bsf_segment_t *all, size_t n)
 {
     const uint8_t *marks = mixed_marks(ex);
     size_t i;
