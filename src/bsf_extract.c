@@ -417,6 +417,188 @@ keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, 
     stats->cut |= BSF_CUT_SEGMENTS;
 }
 
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Returns of a segment's end that judge a short run past it
+ * (join_occluded_run): a line with a noise estimate of its own. */
+#define JOIN_END_RUN 8u
+/* Fewest of them: a noise estimate with two degrees of freedom at least. */
+#define JOIN_MIN_END_RUN 5u
+
+static float sq_dist(const bsf_point_t *a, const bsf_point_t *b);
+
+#if !BSF_CONFIG_COMPACT
+/* Of the `block` returns in no segment just before position k past beam
+ * end (direction dir), valid, a run of 2 to min_segment_points - 1 not
+ * marked mixed (marks) ends there, at position 2 or later, and starts
+ * within radius_max of beam end (join_occluded_run's first test). */
+static int run_within_radius(const bsf_extractor_t *ex, const uint8_t *marks, size_t end,
+                             ptrdiff_t dir, size_t k, size_t block)
+{
+    size_t q;
+    for (q = k - 1u; q + block >= k && q > 1u && q + ex->params.sved.min_segment_points > k; --q) {
+        const size_t b = (size_t)((ptrdiff_t)end + dir * (ptrdiff_t)q);
+        if ((marks[b / 8u] >> (b % 8u)) & 1u) {
+            return 0;
+        }
+        if (q + 2u <= k && sq_dist(&ex->points.pt[b], &ex->points.pt[end]) <=
+                               ex->params.sved.radius_max * ex->params.sved.radius_max) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* A wall seen past an occluder: segment s goes on along the line of its
+ * last 5 to JOIN_END_RUN returns at end `end` (dir -1: its first beam, +1:
+ * its last), that run straight within the scan's noise (noise2 from LC; a
+ * corner or a curve is not); past that end lie one or more returns in
+ * front of that line (a chair leg, a post, a person), then 2 to
+ * min_segment_points - 1 returns SVED wasted (no segment, no mixed-pixel
+ * mark) that all lie on the line, within split_sigmas standard errors of a
+ * return one step past the run, the first within radius_max of s's end,
+ * and nothing else on the line after them. SVED's radius, which bounds a
+ * step from the last return only, cannot join them across the occluder's
+ * width; their line can. A gap with no return in front (a doorway, an
+ * opening, a wall seen nearly edge-on) is left as it is. They join s:
+ * labels, first or last, count. */
+static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segment_t *s,
+                                                   ptrdiff_t dir, const uint8_t *marks)
+{
+    const bsf_points_t *pts = &ex->points;
+    uint16_t *label = ex->scratch.seg.label;
+    const size_t first = s->first;
+    const size_t end = dir > 0 ? s->last : first;
+    bsf_point_t w[JOIN_END_RUN + 1u];
+    bsf_side_line_t l;
+    float bound2;
+    size_t b = end;
+    size_t j;
+    size_t k;
+    size_t at = 0u; /* the run's first position past the end, 0: none yet */
+#if !BSF_CONFIG_COMPACT
+    /* Speed only, first, cheaply (most ends have none; the compact build
+     * goes on to the line at every end): a candidate run past the end,
+     * 2 to min_segment_points - 1 wasted, unmarked returns (positions q ..
+     * k - 1, q > 1: one other return at least before them) before a
+     * return of a segment, an invalid one or max_gap_beams, all valid (an
+     * invalid beam has no segment), the first within radius_max of the end.
+     * at counts the valid returns in no segment before position k. */
+    j = dir > 0 ? pts->count - 1u - end : end;
+    j = j < (size_t)ex->params.sved.max_gap_beams ? j : (size_t)ex->params.sved.max_gap_beams;
+    b = end;
+    for (k = 1u;; ++k) {
+        /* the next four beams all in segments (no label BSF_SEG_NONE among
+         * them) reset the count, as one by one below; most ends have a
+         * long segment beside them */
+        while (at < 2u && k + 3u <= j) {
+            uint64_t v;
+            memcpy(&v, &label[dir > 0 ? b + 1u : b - 4u], sizeof v);
+            v = ~v; /* a zero lane: a beam in no segment */
+            if (((v - 0x0001000100010001u) & ~v & 0x8000800080008000u) != 0u) {
+                break;
+            }
+            k += 4u;
+            b = (size_t)((ptrdiff_t)b + 4 * dir);
+            at = 0u;
+        }
+        if (k <= j) {
+            b = (size_t)((ptrdiff_t)b + dir);
+            if (label[b] == (uint16_t)BSF_SEG_NONE && pts->valid[b]) {
+                ++at;
+                continue;
+            }
+        }
+        if (at >= 2u && run_within_radius(ex, marks, end, dir, k, at)) {
+            break;
+        }
+        if (k > j || label[b] == (uint16_t)BSF_SEG_NONE) {
+            return; /* the window's end, or an invalid beam */
+        }
+        at = 0u;
+    }
+    at = 0u;
+    b = end;
+#endif
+    /* s's returns from that end inwards (beams first .. last) */
+    for (l.n = 1; l.n <= (int)JOIN_END_RUN && b - first <= (size_t)s->last - first;
+         b = (size_t)((ptrdiff_t)b - dir)) {
+        if (label[b] == first) {
+            w[l.n++] = pts->pt[b];
+        }
+    }
+    w[0] = pts->pt[end];
+    bsf_side_fit(w, &l);
+    if (l.n <= (int)JOIN_MIN_END_RUN || !(l.var <= 4.0f * ex->noise2)) {
+        return; /* too short to judge, or not straight within the noise */
+    }
+    if (l.var < ex->noise2) {
+        l.var = ex->noise2;
+    }
+    bound2 = ex->params.lc.split_sigmas * ex->params.lc.split_sigmas * l.var * l.reach_i;
+    /* Returns in front of the line (positions 1 .. at - 1 past the end),
+     * then the run (at .. k - 1) up to a return of a segment, an invalid
+     * one or max_gap_beams (wasted returns off the line after it spoil
+     * it). */
+    for (k = 1u; k <= (size_t)ex->params.sved.max_gap_beams; ++k) {
+        float d;
+        int none;
+        j = (size_t)((ptrdiff_t)end + dir * (ptrdiff_t)k);
+        if (j >= pts->count || !pts->valid[j]) {
+            break;
+        }
+        d = bsf_side_distance(&l, &pts->pt[j]);
+        none = label[j] == (uint16_t)BSF_SEG_NONE;
+        if (none && !((marks[j / 8u] >> (j % 8u)) & 1u) && d * d <= bound2) {
+            at = at > 0u ? at : k;
+            continue;
+        }
+        /* the sensor's side of the line: -(nx cx + ny cy) > 0 */
+        if (at > 0u || !(d * -(l.nx * l.cx + l.ny * l.cy) > 0.0f && d * d > bound2)) {
+            at = none ? 0u : at; /* or behind the line, or on another surface */
+            break;
+        }
+    }
+    /* k - at returns in the run */
+    if (at < 2u || k < at + 2u || k - at >= (size_t)ex->params.sved.min_segment_points ||
+        !(sq_dist(&pts->pt[(size_t)((ptrdiff_t)end + dir * (ptrdiff_t)at)], &pts->pt[end]) <=
+          ex->params.sved.radius_max * ex->params.sved.radius_max)) {
+        return;
+    }
+    /* The run's beams j .. j + k - at - 1 join s, whose label is its
+     * first beam (the run's lowest, when it joins before s). */
+    j = dir > 0 ? end + at : end + 1u - k;
+    if (j < first) {
+        s->first = (uint16_t)j;
+    } else {
+        s->last = (uint16_t)(j + (k - at) - 1u);
+    }
+    s->n_points = (uint16_t)(s->n_points + (k - at));
+    for (b = s->first; b <= s->last; ++b) {
+        if (b - j < k - at || label[b] == first) {
+            label[b] = s->first;
+        }
+    }
+}
+
+/* join_occluded_run at each segment's first end, then its last, in the
+ * order of all[0..n); not through the seam of a full-circle scan. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline)) /* its frame (a line's points) stays off the fit's deepest call chain */
+#endif
+static void
+join_occluded_runs(bsf_extractor_t *ex, bsf_segment_t *all, size_t n)
+{
+    const uint8_t *marks = mixed_marks(ex);
+    size_t i;
+    for (i = 0u; marks != NULL && i < 2u * n; ++i) {
+        if (all[i / 2u].first <= all[i / 2u].last) {
+            join_occluded_run(ex, &all[i / 2u], (ptrdiff_t)(i % 2u) * 2 - 1, marks);
+        }
+    }
+}
+#endif
+
 static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     /* Every kept segment fits the scratch (one per valid point at most), so
@@ -449,6 +631,9 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
     if (st != BSF_OK) {
         return st;
     }
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+    join_occluded_runs(ex, all, n_all);
+#endif
     keep_segments_that_fit(ex, all, n_all, stats);
     if (USES_RPOS(ex)) {
         return BSF_OK;

@@ -930,6 +930,71 @@ static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(vo
 /* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
  * on dense scans whose fits climb near the target, and the curves it leaves
  * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
+/* A wall 3 m in front of a 0.5-degree LIDAR, seen past two boxes 1.5 m
+ * away that hide 12 beams each, with 3 beams of wall between them: more
+ * than SVED's radius (0.25 m at 3 m) from the wall's returns either side,
+ * so the paper's waste rule drops those 3 as a segment under 5 returns,
+ * though they lie on the wall's line. Ranges alternate by +-5 mm (noise).
+ * With wall_before 0 the beams before the first box read nothing, so only
+ * the wall after the boxes (its first end) can take the 3. Extracts it
+ * with the defaults; returns how many features reach from before beam
+ * from_beam to beam to_beam or past it, and checks every valid return lies
+ * in a feature. */
+static size_t extract_wall_between_two_occluders(int wall_before, size_t from_beam, size_t to_beam)
+{
+    const size_t n = 241u;
+    const float inc = 0.5f * 3.14159265f / 180.0f;
+    const float amin = 3.14159265f / 2.0f - 120.0f * inc;
+    bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    bsf_scan_t s;
+    size_t i;
+    size_t holding = 0u;
+    uint32_t in_features = 0u;
+    for (i = 0; i < n; ++i) {
+        const float a = amin + (float)i * inc;
+        const int box = (i >= 100u && i < 112u) || (i >= 115u && i < 127u);
+        const float depth = box ? 1.5f : 3.0f;
+        ranges[i] = depth / sinf(a) + ((i % 2u) != 0u ? 0.005f : -0.005f);
+        if (!wall_before && i < 100u) {
+            ranges[i] = 0.0f; /* below range_min: no return */
+        }
+    }
+    s.ranges = ranges;
+    s.count = n;
+    s.angle_min = amin;
+    s.angle_increment = inc;
+    s.range_min = 0.05f;
+    s.range_max = 30.0f;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+    for (i = 0; i < res.n_features; ++i) {
+        in_features += res.features[i].n_points;
+        if (res.features[i].first_beam < from_beam && res.features[i].last_beam >= to_beam &&
+            res.features[i].first_beam <= res.features[i].last_beam) {
+            ++holding;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(wall_before ? n : n - 100u, res.stats.n_valid);
+    TEST_ASSERT_EQUAL_UINT32(res.stats.n_valid, in_features);
+    return holding;
+}
+
+/* The 3 join the wall's feature before the boxes (its last end): one
+ * feature reaches from before the first box to past them. */
+static void test_a_wall_seen_between_two_occluders_keeps_its_short_piece(void)
+{
+    TEST_ASSERT_EQUAL_size_t(1u, extract_wall_between_two_occluders(1, 100u, 114u));
+}
+
+/* With nothing before the first box, the wall after the boxes takes the 3
+ * at its first end (the join relabels its returns with the run's first
+ * beam): one feature reaches from beam 112 to past the second box (the
+ * boxes, at one depth, make one feature of their own, beams 100-126). */
+static void test_a_wall_seen_past_two_occluders_takes_a_short_piece_at_its_first_end(void)
+{
+    TEST_ASSERT_EQUAL_size_t(1u, extract_wall_between_two_occluders(0, 113u, 127u));
+}
+
 static void test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls(void)
 {
     static const double pose[3][3] = {{2.0, 1.5, 0.4}, {6.5, 1.2, 2.0}, {1.5, 5.0, -0.8}};
@@ -1063,5 +1128,7 @@ int main(void)
     RUN_TEST(test_method_names_round_trip);
     RUN_TEST(test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls);
     RUN_TEST(test_fit_bins_cut_the_fit_work_on_dense_scans_and_keep_curves_on_the_walls);
+    RUN_TEST(test_a_wall_seen_between_two_occluders_keeps_its_short_piece);
+    RUN_TEST(test_a_wall_seen_past_two_occluders_takes_a_short_piece_at_its_first_end);
     return UNITY_END();
 }
