@@ -12,8 +12,12 @@
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
+/* The default method's fit_bin_length; 0 (no bins) unless a benchmark build
+ * sets another (bsf_params_check must accept the defaults it returns). */
 #ifndef BSF_FIT_BIN_LENGTH_DEFAULT
 #define BSF_FIT_BIN_LENGTH_DEFAULT 0.0f
+#elif !BSF_CONFIG_FIT_BINS
+#error "BSF_FIT_BIN_LENGTH_DEFAULT needs BSF_CONFIG_FIT_BINS 1"
 #endif
 #ifndef BSF_SPLIT_DIST_DEFAULT
 #define BSF_SPLIT_DIST_DEFAULT 0.25f
@@ -978,8 +982,10 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
 #define FIT_BIN_MIN_BINS 128u
 /* Walk the bins of points pts[0..n) of a fit (bsf_params_t.fit_bin_length):
  * the first and last point and each vertex pos[0..nv) alone, each run
- * between two of them cut into equal bins of about `len` (by the run's chord,
- * so noise only makes bins smaller). With ctrl NULL, bin means are written
+ * between two of them cut into equal bins of at most about `len` along the
+ * run (its length summed over about 32 strides, so a curved run's bins are
+ * not stretched by a short chord; noise only lengthens the sum, making bins
+ * smaller). With ctrl NULL, bin means are written
  * over pts[0..) (bin j starts at or after point j, so in place) and the
  * vertices' bin indices to bin_pos; otherwise pts holds the points again and
  * each point's squared distance from the curve ctrl[0..m) is measured at its
@@ -1061,12 +1067,20 @@ static BSF_COMPACT_NOINLINE size_t bin_walk(bsf_extractor_t *ex, bsf_point_t *pt
             const size_t next = v < nv ? pos[v] : n - 1u;
             size_t k = 1u;
             run_m = next - prev - 1u;
-            if (run_m >= 2u) {
-                const float dx = pts[next - 1u].x - pts[prev + 1u].x;
-                const float dy = pts[next - 1u].y - pts[prev + 1u].y;
-                const float chord = sqrtf(dx * dx + dy * dy);
+            if (run_m >= FIT_BIN_MIN_BINS) {
+                /* Read before this run's first bin overwrites anything of it. */
+                const size_t stride = run_m / 32u;
                 const float most = len * (float)(run_m - 1u);
-                k = most >= chord * (float)run_m ? run_m : (size_t)(most / chord);
+                float along = 0.0f;
+                size_t at = prev + 1u;
+                while (at < next - 1u) {
+                    const size_t to = at + stride < next - 1u ? at + stride : next - 1u;
+                    const float dx = pts[to].x - pts[at].x;
+                    const float dy = pts[to].y - pts[at].y;
+                    along += sqrtf(dx * dx + dy * dy);
+                    at = to;
+                }
+                k = most >= along * (float)run_m ? run_m : (size_t)(most / along);
                 k = k < run_m / FIT_BIN_MIN_BINS ? k : run_m / FIT_BIN_MIN_BINS;
                 k = k > 1u ? k : 1u;
             }

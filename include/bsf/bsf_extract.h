@@ -61,10 +61,22 @@ typedef uint32_t (*bsf_clock_fn)(void *user);
 /** Runtime parameters; start from bsf_params_default(method). */
 typedef struct {
     bsf_method_t method;
-    bsf_falko_params_t falko;         /**< used by FALKO-SVED-PDM */
-    bsf_lc_params_t lc;               /**< used by LC-SVED-PDM */
-    bsf_bid_params_t bid;             /**< used by BID-SVED-PDM */
-    bsf_sved_params_t sved;           /**< used by the three SVED methods */
+    bsf_falko_params_t falko; /**< used by FALKO-SVED-PDM */
+    bsf_lc_params_t lc;       /**< used by LC-SVED-PDM */
+    bsf_bid_params_t bid;     /**< used by BID-SVED-PDM */
+    /** Used by the three SVED methods. With LC-SVED-PDM and sved.reject_mixed
+     *  on, the extractor also gives a wall back the returns an occluder cut
+     *  off: a run of 2 to sved.min_segment_points - 1 returns that SVED
+     *  wasted just past a segment's end, beyond one or more returns in front
+     *  of the segment's line (a leg, a post), joins the segment when all of
+     *  it lies on the line of the segment's last 5-8 returns (straight within
+     *  the scan's noise) within 4 standard errors. The run must start within
+     *  sved.radius_max of the end (so radius_max 0, no cap in SVED, turns
+     *  this off) and end within sved.max_gap_beams beams; it needs the
+     *  mixed-pixel marks, which share the segments' storage and are kept
+     *  only when that array (BSF_MAX_SEGMENTS of bsf_segment_t) holds a
+     *  bit per beam, as with every default cap. */
+    bsf_sved_params_t sved;
     bsf_rpos_params_t rpos;           /**< used by RPOS-LSBA */
     bsf_pdm_params_t pdm;             /**< used by the three PDM methods */
     bsf_no_return_params_t no_return; /**< no-return codes, every method (bsf_scan.h) */
@@ -106,7 +118,10 @@ typedef struct {
      *  what a fit leaves unused goes to the later ones). A fragment still
      *  more than twice pdm.target_rms from its points grows past it. A fit
      *  stopped early keeps fewer control points and a larger E_curve;
-     *  stats.n_fit_visits counts the work. 0 (default): no bound. */
+     *  stats.n_fit_visits counts the work. With fit_bin_length, a binned
+     *  fit's passes visit bins but its share is per return, so what it
+     *  leaves goes to the fits after it (the scan's total still holds).
+     *  0 (default): no bound. */
     uint8_t fit_passes;
     /** The three PDM methods: on dense scans, PDM may fit the means of bins
      *  of consecutive returns instead of the returns themselves, for speed

@@ -927,9 +927,6 @@ static void test_a_short_segment_on_two_walls_gets_a_vertex_at_their_crossing(vo
     TEST_ASSERT_TRUE_MESSAGE(worst < 0.07, "a short segment's curve swings off two walls");
 }
 
-/* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
- * on dense scans whose fits climb near the target, and the curves it leaves
- * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
 /* A wall 3 m in front of a 0.5-degree LIDAR, seen past two boxes 1.5 m
  * away that hide 12 beams each, with 3 beams of wall between them: more
  * than SVED's radius (0.25 m at 3 m) from the wall's returns either side,
@@ -995,6 +992,9 @@ static void test_a_wall_seen_past_two_occluders_takes_a_short_piece_at_its_first
     TEST_ASSERT_EQUAL_size_t(1u, extract_wall_between_two_occluders(0, 113u, 127u));
 }
 
+/* bsf_params_t.fit_passes bounds the fit's work per scan (stats.n_fit_visits)
+ * on dense scans whose fits climb near the target, and the curves it leaves
+ * stay on the walls: an L-room seen by a 1081-beam LIDAR with 1 cm noise. */
 static void test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls(void)
 {
     static const double pose[3][3] = {{2.0, 1.5, 0.4}, {6.5, 1.2, 2.0}, {1.5, 5.0, -0.8}};

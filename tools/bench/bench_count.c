@@ -176,7 +176,11 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[a], "--fit-passes") == 0 && a + 1 < argc) {
             fit_passes = atol(argv[++a]);
         } else if (strcmp(argv[a], "--fit-bin-length") == 0 && a + 1 < argc) {
-            fit_bin_length = atof(argv[++a]);
+            char *end = NULL;
+            fit_bin_length = strtod(argv[++a], &end);
+            if (end == argv[a] || *end != '\0' || !(fit_bin_length >= 0.0)) {
+                fit_bin_length = 2.0; /* refused below, with the usage */
+            }
         } else if (strcmp(argv[a], "--kind") == 0 && a + 1 < argc) {
             ++a;
             for (kind = 0; kind < BENCH_ADV_COUNT; ++kind) {
