@@ -1105,6 +1105,41 @@ static void test_fit_bins_cut_the_fit_work_on_dense_scans_and_keep_curves_on_the
     TEST_ASSERT_TRUE(4u * visits[1] < visits[0]);
 }
 
+/* Bins follow the returns' path, not a run's chord: inside a round room 1 m
+ * across, a 270-degree scan of 1081 beams puts the returns 4.4 mm apart along
+ * a wall whose 1.41 m chord is a third of its length. Bins of 3 cm hold 6
+ * returns, bins of 1 m the most a run may (a 128th of it): so 3 cm must fit
+ * more bins, and visit more, than 1 m does (by the chord both took the cap). */
+static void test_fit_bins_follow_a_curved_run_not_its_chord(void)
+{
+    bsf_lidar_t l = bsf_lidar_default(0.0, 0.0, 0.0, 1081u, 4.71238898);
+    uint32_t visits[2];
+    int k;
+#if !BSF_CONFIG_FIT_BINS
+    TEST_IGNORE_MESSAGE("BSF_CONFIG_FIT_BINS is 0 in this build");
+#endif
+    bsf_scene_init(&scene);
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_circle(&scene, 0.0, 0.0, 1.0));
+    l.angle_increment = 4.71238898 / 1080.0;
+    l.noise_sigma = 0.005;
+    for (k = 0; k < 2; ++k) {
+        bsf_scene_rng_t rng;
+        bsf_scan_t s = scan_of(&l);
+        bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
+        p.fit_bin_length = k == 0 ? 0.03f : 1.0f;
+        bsf_scene_rng_seed(&rng, 91u);
+        TEST_ASSERT_EQUAL_INT(BSF_OK,
+                              bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        TEST_ASSERT_EQUAL_UINT32(1u, res.n_features);
+        visits[k] = res.stats.n_fit_visits;
+    }
+    printf("round room: fit visits with 3 cm bins %u, with 1 m bins %u\n", (unsigned)visits[0],
+           (unsigned)visits[1]);
+    TEST_ASSERT_TRUE(4u * visits[0] > 5u * visits[1]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -1128,6 +1163,7 @@ int main(void)
     RUN_TEST(test_method_names_round_trip);
     RUN_TEST(test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls);
     RUN_TEST(test_fit_bins_cut_the_fit_work_on_dense_scans_and_keep_curves_on_the_walls);
+    RUN_TEST(test_fit_bins_follow_a_curved_run_not_its_chord);
     RUN_TEST(test_a_wall_seen_between_two_occluders_keeps_its_short_piece);
     RUN_TEST(test_a_wall_seen_past_two_occluders_takes_a_short_piece_at_its_first_end);
     return UNITY_END();
