@@ -1462,25 +1462,34 @@ static void put_features_in_beam_order(bsf_result_t *res)
     }
 }
 
-/* The control points or the feature table ran out: start again, fitting
- * the segments that cover the most points first, so what is left out is
- * the small stuff. A segment that does not fit is cut; smaller ones may
- * still fit after it. */
-static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res, uint32_t points)
+/* Fit every segment in segment order. When the control points or the
+ * feature table run out, start again, fitting the segments that cover the
+ * most points first, so what is left out is the small stuff: a segment that
+ * does not fit then is cut; smaller ones may still fit after it. */
+static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
 {
-    size_t si = ex->n_segments;
-    /* The passes the first attempt spent stay spent. */
+    uint32_t points = 0u;
+    size_t si;
+    int largest_first = 0;
+    for (si = 0; si < ex->n_segments; ++si) {
+        points += ex->segments[si].n_points;
+    }
     ex->scratch.seg.use.fit.points_left = points;
-    res->n_features = 0u;
-    res->n_ctrl = 0u;
-    res->stats.n_in_features = 0u;
-    res->stats.n_ctrl = 0u;
-    res->stats.n_unfitted = 0u;
-    for (si = next_largest_segment(ex, si); si < ex->n_segments;
-         si = next_largest_segment(ex, si)) {
+    ex->scratch.seg.use.fit.passes_left = (uint32_t)ex->params.fit_passes * points;
+    for (si = 0; si < ex->n_segments; si = largest_first ? next_largest_segment(ex, si) : si + 1u) {
         const bsf_segment_t *s = &ex->segments[si];
         const bsf_status_t st = fit_segment(ex, s, res);
-        if (st == BSF_ERR_BUFFER) {
+        if (st == BSF_ERR_BUFFER && !largest_first) {
+            /* Start again; the passes the first attempt spent stay spent. */
+            largest_first = 1;
+            ex->scratch.seg.use.fit.points_left = points;
+            res->n_features = 0u;
+            res->n_ctrl = 0u;
+            res->stats.n_in_features = 0u;
+            res->stats.n_ctrl = 0u;
+            res->stats.n_unfitted = 0u;
+            si = ex->n_segments;
+        } else if (st == BSF_ERR_BUFFER) {
             res->stats.cut |=
                 (res->n_features >= BSF_MAX_SEGMENTS) ? BSF_CUT_SEGMENTS : BSF_CUT_CTRL;
             res->stats.n_cut_segments++;
@@ -1491,33 +1500,10 @@ static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res, uint32_t p
             res->stats.n_unfitted++;
         }
     }
-    put_features_in_beam_order(res);
-}
-
-static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
-{
-    uint32_t points = 0u;
-    size_t si;
-    for (si = 0; si < ex->n_segments; ++si) {
-        points += ex->segments[si].n_points;
-    }
-    ex->scratch.seg.use.fit.points_left = points;
-    ex->scratch.seg.use.fit.passes_left = (uint32_t)ex->params.fit_passes * points;
-    for (si = 0; si < ex->n_segments; ++si) {
-        const bsf_status_t st = fit_segment(ex, &ex->segments[si], res);
-        if (st == BSF_ERR_BUFFER) {
-            fit_largest_first(ex, res, points);
-            break;
-        }
-        if (st != BSF_OK) {
-            /* Not fitted: its points count as wasted (docs/DESIGN.md, "PDM and
-             * refinement"). */
-            res->stats.n_unfitted++;
-        }
-    }
-    /* A split segment's later pieces may start past a segment that lies
-     * inside its run (an occluder, SVED's look-back), or past the seam of a
-     * full-circle scan: then the features go back into beam order. */
+    /* Back into beam order when the fit went largest first, or when a split
+     * segment's later pieces start past a segment that lies inside its run
+     * (an occluder, SVED's look-back) or past the seam of a full-circle
+     * scan (features already in beam order stay as they are). */
     for (si = 1; si < res->n_features; ++si) {
         if (beam_order_key(&res->features[si]) <= beam_order_key(&res->features[si - 1u])) {
             put_features_in_beam_order(res);

@@ -635,6 +635,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     w->b = b;
 }
 
+#if !BSF_CONFIG_COMPACT
 static void frame_payload_write(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
                                 const bsf_result_t *res, uint32_t *table)
 {
@@ -646,6 +647,7 @@ static void frame_payload_cost(writer_t *w, plan_t *pl, const bsf_frame_info_t *
 {
     frame_payload_run(w, 1, pl, info, res, table);
 }
+#endif
 
 /* ---- The features frame as a job of bsf_stream_writer.h ----------------- */
 
@@ -660,11 +662,16 @@ typedef struct {
 static void features_job_payload(writer_t *w, int costing, bsf_enc_job_t *job)
 {
     features_job_t *fj = (features_job_t *)job;
+#if BSF_CONFIG_COMPACT
+    /* one copy of the run, which takes the kind from the bits (ENC_COSTING) */
+    frame_payload_run(w, costing, &fj->plan, fj->info, fj->res, fj->table);
+#else
     if (costing) {
         frame_payload_cost(w, &fj->plan, fj->info, fj->res, fj->table);
     } else {
         frame_payload_write(w, &fj->plan, fj->info, fj->res, fj->table);
     }
+#endif
 }
 
 static bsf_status_t features_job_plan(bsf_enc_job_t *job)
