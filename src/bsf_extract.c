@@ -12,11 +12,10 @@
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
-/* The default method's fit_bin_length; 0 (no bins) unless a benchmark build
- * sets another (bsf_params_check must accept the defaults it returns). */
-#ifndef BSF_FIT_BIN_LENGTH_DEFAULT
-#define BSF_FIT_BIN_LENGTH_DEFAULT 0.0f
-#elif !BSF_CONFIG_FIT_BINS
+/* The default method's fit_bin_length is 0 (no bins, memset) unless a
+ * benchmark build sets BSF_FIT_BIN_LENGTH_DEFAULT (bsf_params_check must
+ * accept the defaults it returns). */
+#if defined(BSF_FIT_BIN_LENGTH_DEFAULT) && !BSF_CONFIG_FIT_BINS
 #error "BSF_FIT_BIN_LENGTH_DEFAULT needs BSF_CONFIG_FIT_BINS 1"
 #endif
 #ifndef BSF_SPLIT_DIST_DEFAULT
@@ -88,7 +87,9 @@ bsf_params_t bsf_params_default(bsf_method_t method)
          * its segments may take that wall's first returns (bsf_grazing.h);
          * a detector that leaves no vertex there would round it off. */
         p.sved.join_grazing = 2u;
+#ifdef BSF_FIT_BIN_LENGTH_DEFAULT
         p.fit_bin_length = BSF_FIT_BIN_LENGTH_DEFAULT;
+#endif
     }
     p.no_return = bsf_no_return_params_default();
     p.split_dist = BSF_SPLIT_DIST_DEFAULT;
@@ -106,7 +107,9 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     p.no_return.min_run = 0u;
     p.split_dist = 0.0f;
     p.trim_tails = 0u;
+#ifdef BSF_FIT_BIN_LENGTH_DEFAULT
     p.fit_bin_length = 0.0f;
+#endif
     /* The first release's refinement target, so the paper-faithful rows of
      * bsf table1 are the numbers that release printed. */
     p.pdm.target_rms = 0.015f;
@@ -119,7 +122,9 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
 static const bsf_float_range_t extract_float_ranges[] = {
     {FLT_MAX, (uint16_t)offsetof(bsf_params_t, no_return.code), 0u},
     {BSF_FIT_MAX_COORD, (uint16_t)offsetof(bsf_params_t, split_dist), 0u},
+#if BSF_CONFIG_FIT_BINS /* else any value but 0 is BSF_ERR_UNSUPPORTED */
     {1.0f, (uint16_t)offsetof(bsf_params_t, fit_bin_length), 0u},
+#endif
 };
 
 bsf_status_t bsf_params_check(const bsf_params_t *p)
