@@ -7,10 +7,17 @@
 #include "bsf_segment_internal.h"
 
 #include <float.h>
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
 #define BSF_EXTRACTOR_READY 0x62736621u /* "bsf!" */
+/* The default method's fit_bin_length is 0 (no bins, memset) unless a
+ * benchmark build sets BSF_FIT_BIN_LENGTH_DEFAULT (bsf_params_check must
+ * accept the defaults it returns). */
+#if defined(BSF_FIT_BIN_LENGTH_DEFAULT) && !BSF_CONFIG_FIT_BINS
+#error "BSF_FIT_BIN_LENGTH_DEFAULT needs BSF_CONFIG_FIT_BINS 1"
+#endif
 #ifndef BSF_SPLIT_DIST_DEFAULT
 #define BSF_SPLIT_DIST_DEFAULT 0.25f
 #endif
@@ -80,6 +87,9 @@ bsf_params_t bsf_params_default(bsf_method_t method)
          * its segments may take that wall's first returns (bsf_grazing.h);
          * a detector that leaves no vertex there would round it off. */
         p.sved.join_grazing = 2u;
+#ifdef BSF_FIT_BIN_LENGTH_DEFAULT
+        p.fit_bin_length = BSF_FIT_BIN_LENGTH_DEFAULT;
+#endif
     }
     p.no_return = bsf_no_return_params_default();
     p.split_dist = BSF_SPLIT_DIST_DEFAULT;
@@ -97,6 +107,9 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
     p.no_return.min_run = 0u;
     p.split_dist = 0.0f;
     p.trim_tails = 0u;
+#ifdef BSF_FIT_BIN_LENGTH_DEFAULT
+    p.fit_bin_length = 0.0f;
+#endif
     /* The first release's refinement target, so the paper-faithful rows of
      * bsf table1 are the numbers that release printed. */
     p.pdm.target_rms = 0.015f;
@@ -109,6 +122,9 @@ bsf_params_t bsf_params_paper(bsf_method_t method)
 static const bsf_float_range_t extract_float_ranges[] = {
     {FLT_MAX, (uint16_t)offsetof(bsf_params_t, no_return.code), 0u},
     {BSF_FIT_MAX_COORD, (uint16_t)offsetof(bsf_params_t, split_dist), 0u},
+#if BSF_CONFIG_FIT_BINS /* else any value but 0 is BSF_ERR_UNSUPPORTED */
+    {1.0f, (uint16_t)offsetof(bsf_params_t, fit_bin_length), 0u},
+#endif
 };
 
 bsf_status_t bsf_params_check(const bsf_params_t *p)
@@ -123,8 +139,9 @@ bsf_status_t bsf_params_check(const bsf_params_t *p)
         p->trim_tails > 1u) {
         return BSF_ERR_PARAM;
     }
-    if ((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
-        ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) {
+    if (((unsigned)p->method < (unsigned)BSF_METHOD_COUNT &&
+         ((BSF_CONFIG_METHODS) & (1u << (unsigned)p->method)) == 0u) ||
+        (!(BSF_CONFIG_FIT_BINS) && p->fit_bin_length != 0.0f)) {
         return BSF_ERR_UNSUPPORTED; /* left out of this build (bsf_config.h) */
     }
     switch (p->method) {
@@ -359,8 +376,8 @@ static bsf_status_t detect_corners(bsf_extractor_t *ex, bsf_stats_t *stats)
 }
 
 /* Segments of at least min_points points among all[0..n). */
-static BSF_COMPACT_INLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
-                                                     uint32_t min_points)
+static BSF_COMPACT_NOINLINE size_t count_segments_from(const bsf_segment_t *all, size_t n,
+                                                       uint32_t min_points)
 {
     size_t c = 0u;
     size_t i;
@@ -409,6 +426,188 @@ keep_segments_that_fit(bsf_extractor_t *ex, const bsf_segment_t *all, size_t n, 
     stats->cut |= BSF_CUT_SEGMENTS;
 }
 
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+/* Returns of a segment's end that judge a short run past it
+ * (join_occluded_run): a line with a noise estimate of its own. */
+#define JOIN_END_RUN 8u
+/* Fewest of them: a noise estimate with two degrees of freedom at least. */
+#define JOIN_MIN_END_RUN 5u
+
+static float sq_dist(const bsf_point_t *a, const bsf_point_t *b);
+
+#if !BSF_CONFIG_COMPACT
+/* Of the `block` returns in no segment just before position k past beam
+ * end (direction dir), valid, a run of 2 to min_segment_points - 1 not
+ * marked mixed (marks) ends there, at position 2 or later, and starts
+ * within radius_max of beam end (join_occluded_run's first test). */
+static int run_within_radius(const bsf_extractor_t *ex, const uint8_t *marks, size_t end,
+                             ptrdiff_t dir, size_t k, size_t block)
+{
+    size_t q;
+    for (q = k - 1u; q + block >= k && q > 1u && q + ex->params.sved.min_segment_points > k; --q) {
+        const size_t b = (size_t)((ptrdiff_t)end + dir * (ptrdiff_t)q);
+        if ((marks[b / 8u] >> (b % 8u)) & 1u) {
+            return 0;
+        }
+        if (q + 2u <= k && sq_dist(&ex->points.pt[b], &ex->points.pt[end]) <=
+                               ex->params.sved.radius_max * ex->params.sved.radius_max) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#endif
+
+/* A wall seen past an occluder: segment s goes on along the line of its
+ * last 5 to JOIN_END_RUN returns at end `end` (dir -1: its first beam, +1:
+ * its last), that run straight within the scan's noise (noise2 from LC; a
+ * corner or a curve is not); past that end lie one or more returns in
+ * front of that line (a chair leg, a post, a person), then 2 to
+ * min_segment_points - 1 returns SVED wasted (no segment, no mixed-pixel
+ * mark) that all lie on the line, within split_sigmas standard errors of a
+ * return one step past the run, the first within radius_max of s's end,
+ * and nothing else on the line after them. SVED's radius, which bounds a
+ * step from the last return only, cannot join them across the occluder's
+ * width; their line can. A gap with no return in front (a doorway, an
+ * opening, a wall seen nearly edge-on) is left as it is. They join s:
+ * labels, first or last, count. */
+static BSF_COMPACT_NOINLINE void join_occluded_run(bsf_extractor_t *ex, bsf_segment_t *s,
+                                                   ptrdiff_t dir, const uint8_t *marks)
+{
+    const bsf_points_t *pts = &ex->points;
+    uint16_t *label = ex->scratch.seg.label;
+    const size_t first = s->first;
+    const size_t end = dir > 0 ? s->last : first;
+    bsf_point_t w[JOIN_END_RUN + 1u];
+    bsf_side_line_t l;
+    float bound2;
+    size_t b = end;
+    size_t j;
+    size_t k;
+    size_t at = 0u; /* the run's first position past the end, 0: none yet */
+#if !BSF_CONFIG_COMPACT
+    /* Speed only, first, cheaply (most ends have none; the compact build
+     * goes on to the line at every end): a candidate run past the end,
+     * 2 to min_segment_points - 1 wasted, unmarked returns (positions q ..
+     * k - 1, q > 1: one other return at least before them) before a
+     * return of a segment, an invalid one or max_gap_beams, all valid (an
+     * invalid beam has no segment), the first within radius_max of the end.
+     * at counts the valid returns in no segment before position k. */
+    j = dir > 0 ? pts->count - 1u - end : end;
+    j = j < (size_t)ex->params.sved.max_gap_beams ? j : (size_t)ex->params.sved.max_gap_beams;
+    b = end;
+    for (k = 1u;; ++k) {
+        /* the next four beams all in segments (no label BSF_SEG_NONE among
+         * them) reset the count, as one by one below; most ends have a
+         * long segment beside them */
+        while (at < 2u && k + 3u <= j) {
+            uint64_t v;
+            memcpy(&v, &label[dir > 0 ? b + 1u : b - 4u], sizeof v);
+            v = ~v; /* a zero lane: a beam in no segment */
+            if (((v - 0x0001000100010001u) & ~v & 0x8000800080008000u) != 0u) {
+                break;
+            }
+            k += 4u;
+            b = (size_t)((ptrdiff_t)b + 4 * dir);
+            at = 0u;
+        }
+        if (k <= j) {
+            b = (size_t)((ptrdiff_t)b + dir);
+            if (label[b] == (uint16_t)BSF_SEG_NONE && pts->valid[b]) {
+                ++at;
+                continue;
+            }
+        }
+        if (at >= 2u && run_within_radius(ex, marks, end, dir, k, at)) {
+            break;
+        }
+        if (k > j || label[b] == (uint16_t)BSF_SEG_NONE) {
+            return; /* the window's end, or an invalid beam */
+        }
+        at = 0u;
+    }
+    at = 0u;
+    b = end;
+#endif
+    /* s's returns from that end inwards (beams first .. last) */
+    for (l.n = 1; l.n <= (int)JOIN_END_RUN && b - first <= (size_t)s->last - first;
+         b = (size_t)((ptrdiff_t)b - dir)) {
+        if (label[b] == first) {
+            w[l.n++] = pts->pt[b];
+        }
+    }
+    w[0] = pts->pt[end];
+    bsf_side_fit(w, &l);
+    if (l.n <= (int)JOIN_MIN_END_RUN || !(l.var <= 4.0f * ex->noise2)) {
+        return; /* too short to judge, or not straight within the noise */
+    }
+    if (l.var < ex->noise2) {
+        l.var = ex->noise2;
+    }
+    bound2 = ex->params.lc.split_sigmas * ex->params.lc.split_sigmas * l.var * l.reach_i;
+    /* Returns in front of the line (positions 1 .. at - 1 past the end),
+     * then the run (at .. k - 1) up to a return of a segment, an invalid
+     * one or max_gap_beams (wasted returns off the line after it spoil
+     * it). */
+    for (k = 1u; k <= (size_t)ex->params.sved.max_gap_beams; ++k) {
+        float d;
+        int none;
+        j = (size_t)((ptrdiff_t)end + dir * (ptrdiff_t)k);
+        if (j >= pts->count || !pts->valid[j]) {
+            break;
+        }
+        d = bsf_side_distance(&l, &pts->pt[j]);
+        none = label[j] == (uint16_t)BSF_SEG_NONE;
+        if (none && !((marks[j / 8u] >> (j % 8u)) & 1u) && d * d <= bound2) {
+            at = at > 0u ? at : k;
+            continue;
+        }
+        /* the sensor's side of the line: -(nx cx + ny cy) > 0 */
+        if (at > 0u || !(d * -(l.nx * l.cx + l.ny * l.cy) > 0.0f && d * d > bound2)) {
+            at = none ? 0u : at; /* or behind the line, or on another surface */
+            break;
+        }
+    }
+    /* k - at returns in the run */
+    if (at < 2u || k < at + 2u || k - at >= (size_t)ex->params.sved.min_segment_points ||
+        !(sq_dist(&pts->pt[(size_t)((ptrdiff_t)end + dir * (ptrdiff_t)at)], &pts->pt[end]) <=
+          ex->params.sved.radius_max * ex->params.sved.radius_max)) {
+        return;
+    }
+    /* The run's beams j .. j + k - at - 1 join s, whose label is its
+     * first beam (the run's lowest, when it joins before s). */
+    j = dir > 0 ? end + at : end + 1u - k;
+    if (j < first) {
+        s->first = (uint16_t)j;
+    } else {
+        s->last = (uint16_t)(j + (k - at) - 1u);
+    }
+    s->n_points = (uint16_t)(s->n_points + (k - at));
+    for (b = s->first; b <= s->last; ++b) {
+        if (b - j < k - at || label[b] == first) {
+            label[b] = s->first;
+        }
+    }
+}
+
+/* join_occluded_run at each segment's first end, then its last, in the
+ * order of all[0..n); not through the seam of a full-circle scan. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline)) /* its frame (a line's points) stays off the fit's deepest call chain */
+#endif
+static void
+join_occluded_runs(bsf_extractor_t *ex, bsf_segment_t *all, size_t n)
+{
+    const uint8_t *marks = mixed_marks(ex);
+    size_t i;
+    for (i = 0u; marks != NULL && i < 2u * n; ++i) {
+        if (all[i / 2u].first <= all[i / 2u].last) {
+            join_occluded_run(ex, &all[i / 2u], (ptrdiff_t)(i % 2u) * 2 - 1, marks);
+        }
+    }
+}
+#endif
+
 static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
 {
     /* Every kept segment fits the scratch (one per valid point at most), so
@@ -441,6 +640,9 @@ static bsf_status_t segment(bsf_extractor_t *ex, bsf_stats_t *stats)
     if (st != BSF_OK) {
         return st;
     }
+#if (BSF_CONFIG_METHODS) & BSF_CONFIG_METHOD_LC
+    join_occluded_runs(ex, all, n_all);
+#endif
     keep_segments_that_fit(ex, all, n_all, stats);
     if (USES_RPOS(ex)) {
         return BSF_OK;
@@ -777,6 +979,171 @@ static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
     return worst;
 }
 
+#if BSF_CONFIG_FIT_BINS
+/* Fewest bins of a run between two pinned points: refinement may add one
+ * precision point per 4 points, so bins of a short run (or of one seen from
+ * close by) must not take the curve's room to bend (measured: with a floor of
+ * 64 bins, a 361-return segment wrapping the sensor kept 4 control points). */
+#define FIT_BIN_MIN_BINS 128u
+/* Walk the bins of points pts[0..n) of a fit (bsf_params_t.fit_bin_length):
+ * the first and last point and each vertex pos[0..nv) alone, each run
+ * between two of them cut into equal bins of at most about `len` along the
+ * run (its length summed over about 32 strides, so a curved run's bins are
+ * not stretched by a short chord; noise only lengthens the sum, making bins
+ * smaller). With ctrl NULL, bin means are written
+ * over pts[0..) (bin j starts at or after point j, so in place) and the
+ * vertices' bin indices to bin_pos; otherwise pts holds the points again and
+ * each point's squared distance from the curve ctrl[0..m) is measured at its
+ * bin's footpoint (t, one per bin): along the curve's normal for a bin of
+ * several points, whole for a single point (as PDM measures it). Returns the
+ * number of bins, or the sum of squared distances in *sum. */
+static BSF_COMPACT_NOINLINE size_t bin_walk(bsf_extractor_t *ex, bsf_point_t *pts, size_t n,
+                                            const uint16_t *pos, size_t nv, const bsf_point_t *ctrl,
+                                            size_t m, float *sum)
+{
+    const float len = ex->params.fit_bin_length;
+    const float *t = ex->scratch.seg.use.fit.pdm.t;
+    size_t j = 0u;
+    size_t v = 0u;
+    size_t prev = 0u;
+    size_t lo = 0u;
+    size_t hi = 1u;
+    size_t q = 0u;
+    size_t runs = 0u; /* bins of the current run still to walk, after this one */
+    size_t run_m = 0u;
+    size_t worst_at = 0u;
+    float worst = -1.0f;
+    float total = 0.0f;
+    for (;;) {
+        float mx = 0.0f;
+        float my = 0.0f;
+        size_t i;
+        if (ctrl == NULL) {
+            for (i = lo; i < hi; ++i) {
+                mx += pts[i].x;
+                my += pts[i].y;
+            }
+            pts[j].x = mx / (float)(hi - lo);
+            pts[j].y = my / (float)(hi - lo);
+        } else {
+            /* The span's basis and its derivative in u (farthest_point). */
+            const size_t last = m - 3u;
+            const float x = t[j] * (float)(m - 2u);
+            size_t s = x > 0.0f ? (size_t)x : 0u;
+            float u, k0, k2, b0, b2, ax, ay, bx, by, cx, cy, tx, ty, inv;
+            s = s > last ? last : s;
+            u = x - (float)s;
+            k0 = s == 0u ? 1.0f : 0.5f;
+            k2 = s == last ? 1.0f : 0.5f;
+            b0 = k0 * (1.0f - u) * (1.0f - u);
+            b2 = k2 * u * u;
+            ax = ctrl[s].x - ctrl[s + 1u].x;
+            ay = ctrl[s].y - ctrl[s + 1u].y;
+            bx = ctrl[s + 2u].x - ctrl[s + 1u].x;
+            by = ctrl[s + 2u].y - ctrl[s + 1u].y;
+            cx = ctrl[s + 1u].x + b0 * ax + b2 * bx;
+            cy = ctrl[s + 1u].y + b0 * ay + b2 * by;
+            tx = k2 * u * bx - k0 * (1.0f - u) * ax;
+            ty = k2 * u * by - k0 * (1.0f - u) * ay;
+            inv = tx * tx + ty * ty;
+            inv = hi - lo > 1u && inv > 0.0f ? 1.0f / inv : 0.0f;
+            for (i = lo; i < hi; ++i) {
+                const float dx = pts[i].x - cx;
+                const float dy = pts[i].y - cy;
+                const float along = tx * dx + ty * dy;
+                float d2 = dx * dx + dy * dy - along * along * inv;
+                d2 = d2 > 0.0f ? d2 : 0.0f;
+                total += d2;
+                if (d2 > worst) {
+                    worst = d2;
+                    worst_at = i;
+                }
+            }
+        }
+        ++j;
+        if (hi == n) {
+            ex->scratch.seg.use.fit.bin_worst = worst;
+            ex->scratch.seg.use.fit.bin_worst_at = (uint16_t)worst_at;
+            *sum = total;
+            return j;
+        }
+        if (runs == 0u && lo == prev) {
+            /* Past a pinned point: cut the run up to the next one. */
+            const size_t next = v < nv ? pos[v] : n - 1u;
+            size_t k = 1u;
+            run_m = next - prev - 1u;
+            if (run_m >= FIT_BIN_MIN_BINS) {
+                /* Read before this run's first bin overwrites anything of it. */
+                const size_t stride = run_m / 32u;
+                const float most = len * (float)(run_m - 1u);
+                float along = 0.0f;
+                size_t at = prev + 1u;
+                while (at < next - 1u) {
+                    const size_t to = at + stride < next - 1u ? at + stride : next - 1u;
+                    const float dx = pts[to].x - pts[at].x;
+                    const float dy = pts[to].y - pts[at].y;
+                    along += sqrtf(dx * dx + dy * dy);
+                    at = to;
+                }
+                k = most >= along * (float)run_m ? run_m : (size_t)(most / along);
+                k = k < run_m / FIT_BIN_MIN_BINS ? k : run_m / FIT_BIN_MIN_BINS;
+                k = k > 1u ? k : 1u;
+            }
+            runs = run_m > 0u ? (run_m + k - 1u) / k : 0u;
+            q = 0u;
+        }
+        if (runs > 0u) {
+            /* The run's next bin: points prev+1 .. next-1 in `runs` near-equal parts. */
+            const size_t of = q + runs;
+            lo = prev + 1u + run_m * q / of;
+            hi = prev + 1u + run_m * (q + 1u) / of;
+            ++q;
+            --runs;
+            continue;
+        }
+        /* The next pinned point. */
+        prev = v < nv ? pos[v] : n - 1u;
+        if (ctrl == NULL && v < nv) {
+            ex->scratch.seg.use.fit.bin_pos[v] = (uint16_t)j;
+        }
+        ++v;
+        lo = prev;
+        hi = prev + 1u;
+    }
+}
+
+/* After a fit of points a..a+n-1 of segment s on bin means: the points
+ * gathered again (as gather_segment does), and when the fit succeeded (ctrl,
+ * m control points) their E_curve, returned; the farthest one is left for
+ * split_point (bin_walk). */
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+__attribute__((noinline)) /* inlined, it slowed fit_segment's gather loop by 40 % */
+#endif
+static float
+fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t n,
+                  const uint16_t *pos, size_t nv, const bsf_point_t *ctrl, size_t m)
+{
+    bsf_point_t *pts = &ex->scratch.seg.use.fit.seg_points[a];
+    size_t beam;
+    size_t k = 0u;
+    float sum;
+    for (beam = s->first; k < a + n; beam = beam + 1u < ex->points.count ? beam + 1u : 0u) {
+        if (ex->scratch.seg.label[beam] == s->first) {
+            if (k >= a) {
+                pts[k - a] = ex->points.pt[beam];
+            }
+            ++k;
+        }
+    }
+    if (ctrl == NULL) {
+        return 0.0f;
+    }
+    (void)bin_walk(ex, pts, n, pos, nv, ctrl, m, &sum);
+    return sqrtf(sum / (float)n);
+}
+
+#endif /* BSF_CONFIG_FIT_BINS */
+
 /* Where the cut policy splits points a..b of a segment (docs/DESIGN.md, "Cut
  * policy"), or 0 when the fit in res->ctrl[res->n_ctrl..] stands: when some
  * point lies more than split_dist from the curve, just after that point,
@@ -794,10 +1161,20 @@ static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a
         e_curve * e_curve * (float)n <= bound * bound) {
         return 0u;
     }
+#if BSF_CONFIG_FIT_BINS
+    at = ex->scratch.seg.use.fit.bin_worst_at;
+    if ((at != 0xFFFFu ? ex->scratch.seg.use.fit.bin_worst
+                       : farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n,
+                                        ex->scratch.seg.use.fit.pdm.t, &res->ctrl[res->n_ctrl],
+                                        n_ctrl, &at)) <= bound * bound) {
+        return 0u;
+    }
+#else
     if (farthest_point(&ex->scratch.seg.use.fit.seg_points[a], n, ex->scratch.seg.use.fit.pdm.t,
                        &res->ctrl[res->n_ctrl], n_ctrl, &at) <= bound * bound) {
         return 0u;
     }
+#endif
     at = at < SPLIT_MIN_POINTS - 1u ? SPLIT_MIN_POINTS - 1u : at;
     at = at > n - SPLIT_MIN_POINTS - 1u ? n - SPLIT_MIN_POINTS - 1u : at;
     return a + at + 1u;
@@ -808,10 +1185,12 @@ static BSF_COMPACT_INLINE size_t split_point(const bsf_extractor_t *ex, size_t a
  * res->ctrl[res->n_ctrl..] without appending a feature. The vertex
  * positions, ascending, are shifted to the piece in place and back, so no
  * copy is made. *n_vertex_out receives the vertices used. */
-static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n_vertex,
-                               bsf_result_t *res, size_t *n_ctrl, float *e_curve,
+static bsf_status_t fit_points(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t b,
+                               size_t n_vertex, bsf_result_t *res, size_t *n_ctrl, float *e_curve,
                                size_t *n_vertex_out)
 {
+    bsf_point_t *pts = &ex->scratch.seg.use.fit.seg_points[a];
+    size_t nb;
     uint16_t *pos = ex->scratch.seg.use.fit.vertex_pos;
     /* LC's keypoint is the walls' intersection: the vertex stays there. */
     const int anchored = USES_LC(ex);
@@ -837,6 +1216,14 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] - a);
     }
+    nb = n;
+#if BSF_CONFIG_FIT_BINS
+    if (ex->params.fit_bin_length > 0.0f && n >= 2u * FIT_BIN_MIN_BINS) {
+        float sum;
+        nb = bin_walk(ex, pts, n, &pos[v0], v1 - v0, NULL, 0u, &sum);
+    }
+    ex->scratch.seg.use.fit.bin_worst_at = 0xFFFFu; /* split_point: farthest_point's */
+#endif
     *pdm = ex->params.pdm;
     if (ex->params.fit_passes != 0u) {
         /* The passes left per point left (fit_passes), at least one: the
@@ -848,18 +1235,29 @@ static bsf_status_t fit_points(bsf_extractor_t *ex, size_t a, size_t b, size_t n
         pdm->max_passes = (uint16_t)(share > 0xFFFFu ? 0xFFFFu : (share > 0u ? share : 1u));
     }
     info->iterations = 0u;
-    st = bsf_pdm_fit_anchored(&ex->scratch.seg.use.fit.seg_points[a], n, &pos[v0],
+    st = bsf_pdm_fit_anchored(pts, nb, nb < n ? ex->scratch.seg.use.fit.bin_pos : &pos[v0],
                               anchored ? &ex->scratch.seg.use.fit.vertex_anchor[v0] : NULL, v1 - v0,
                               pdm, &ex->scratch.seg.use.fit.pdm, &res->ctrl[res->n_ctrl],
                               &res->ctrl_is_vertex[res->n_ctrl],
                               (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl, n_ctrl, e_curve, info);
     {
         /* What this fit spent, failed or not, counts against the scan. */
-        const uint32_t spent = info->iterations * (uint32_t)n;
+        const uint32_t spent = info->iterations * (uint32_t)nb;
         uint32_t *left = &ex->scratch.seg.use.fit.passes_left;
         *left = spent < *left ? *left - spent : 0u;
         res->stats.n_fit_visits += spent;
     }
+#if BSF_CONFIG_FIT_BINS
+    if (nb < n) {
+        const float e = fit_returns_again(ex, s, a, n, &pos[v0], v1 - v0,
+                                          st == BSF_OK ? &res->ctrl[res->n_ctrl] : NULL, *n_ctrl);
+        if (st == BSF_OK) {
+            *e_curve = e;
+        }
+    }
+#else
+    (void)s;
+#endif
     for (i = v0; i < v1; ++i) {
         pos[i] = (uint16_t)(pos[i] + a);
     }
@@ -916,7 +1314,7 @@ static BSF_COMPACT_INLINE bsf_status_t fit_pieces(bsf_extractor_t *ex, const bsf
         bsf_status_t st = BSF_ERR_BUFFER;
         --depth;
         if (res->n_features < BSF_MAX_SEGMENTS && (size_t)BSF_MAX_CTRL_POINTS - res->n_ctrl >= 3u) {
-            st = fit_points(ex, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
+            st = fit_points(ex, s, a, b, n_vertex, res, &n_ctrl, &e_curve, &nv);
         }
         if (st != BSF_OK) {
             res->n_features = features0;
@@ -1027,7 +1425,7 @@ static void reverse_ctrl(bsf_result_t *res, size_t a, size_t b)
 
 /* Beam order of features: by first beam, one wrapping through the seam of a
  * full-circle scan (first_beam > last_beam) last, as segmentation emits them. */
-static BSF_COMPACT_INLINE uint32_t beam_order_key(const bsf_feature_t *f)
+static BSF_COMPACT_NOINLINE uint32_t beam_order_key(const bsf_feature_t *f)
 {
     return (f->first_beam > f->last_beam ? 0x10000u : 0u) + f->first_beam;
 }
@@ -1069,25 +1467,34 @@ static void put_features_in_beam_order(bsf_result_t *res)
     }
 }
 
-/* The control points or the feature table ran out: start again, fitting
- * the segments that cover the most points first, so what is left out is
- * the small stuff. A segment that does not fit is cut; smaller ones may
- * still fit after it. */
-static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res, uint32_t points)
+/* Fit every segment in segment order. When the control points or the
+ * feature table run out, start again, fitting the segments that cover the
+ * most points first, so what is left out is the small stuff: a segment that
+ * does not fit then is cut; smaller ones may still fit after it. */
+static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
 {
-    size_t si = ex->n_segments;
-    /* The passes the first attempt spent stay spent. */
+    uint32_t points = 0u;
+    size_t si;
+    int largest_first = 0;
+    for (si = 0; si < ex->n_segments; ++si) {
+        points += ex->segments[si].n_points;
+    }
     ex->scratch.seg.use.fit.points_left = points;
-    res->n_features = 0u;
-    res->n_ctrl = 0u;
-    res->stats.n_in_features = 0u;
-    res->stats.n_ctrl = 0u;
-    res->stats.n_unfitted = 0u;
-    for (si = next_largest_segment(ex, si); si < ex->n_segments;
-         si = next_largest_segment(ex, si)) {
+    ex->scratch.seg.use.fit.passes_left = (uint32_t)ex->params.fit_passes * points;
+    for (si = 0; si < ex->n_segments; si = largest_first ? next_largest_segment(ex, si) : si + 1u) {
         const bsf_segment_t *s = &ex->segments[si];
         const bsf_status_t st = fit_segment(ex, s, res);
-        if (st == BSF_ERR_BUFFER) {
+        if (st == BSF_ERR_BUFFER && !largest_first) {
+            /* Start again; the passes the first attempt spent stay spent. */
+            largest_first = 1;
+            ex->scratch.seg.use.fit.points_left = points;
+            res->n_features = 0u;
+            res->n_ctrl = 0u;
+            res->stats.n_in_features = 0u;
+            res->stats.n_ctrl = 0u;
+            res->stats.n_unfitted = 0u;
+            si = ex->n_segments;
+        } else if (st == BSF_ERR_BUFFER) {
             res->stats.cut |=
                 (res->n_features >= BSF_MAX_SEGMENTS) ? BSF_CUT_SEGMENTS : BSF_CUT_CTRL;
             res->stats.n_cut_segments++;
@@ -1098,33 +1505,10 @@ static void fit_largest_first(bsf_extractor_t *ex, bsf_result_t *res, uint32_t p
             res->stats.n_unfitted++;
         }
     }
-    put_features_in_beam_order(res);
-}
-
-static void fit_features(bsf_extractor_t *ex, bsf_result_t *res)
-{
-    uint32_t points = 0u;
-    size_t si;
-    for (si = 0; si < ex->n_segments; ++si) {
-        points += ex->segments[si].n_points;
-    }
-    ex->scratch.seg.use.fit.points_left = points;
-    ex->scratch.seg.use.fit.passes_left = (uint32_t)ex->params.fit_passes * points;
-    for (si = 0; si < ex->n_segments; ++si) {
-        const bsf_status_t st = fit_segment(ex, &ex->segments[si], res);
-        if (st == BSF_ERR_BUFFER) {
-            fit_largest_first(ex, res, points);
-            break;
-        }
-        if (st != BSF_OK) {
-            /* Not fitted: its points count as wasted (docs/DESIGN.md, "PDM and
-             * refinement"). */
-            res->stats.n_unfitted++;
-        }
-    }
-    /* A split segment's later pieces may start past a segment that lies
-     * inside its run (an occluder, SVED's look-back), or past the seam of a
-     * full-circle scan: then the features go back into beam order. */
+    /* Back into beam order when the fit went largest first, or when a split
+     * segment's later pieces start past a segment that lies inside its run
+     * (an occluder, SVED's look-back) or past the seam of a full-circle
+     * scan (features already in beam order stay as they are). */
     for (si = 1; si < res->n_features; ++si) {
         if (beam_order_key(&res->features[si]) <= beam_order_key(&res->features[si - 1u])) {
             put_features_in_beam_order(res);

@@ -342,7 +342,7 @@ static uint32_t feature_span(const bsf_feature_t *f, uint32_t n_beams)
 }
 
 /* A feature's own fields (not its points) within the result and the caps. */
-static BSF_COMPACT_INLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
+static BSF_COMPACT_NOINLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beams, size_t n_ctrl)
 {
     const size_t n = f->n_ctrl;
     const uint32_t beam_limit = n_beams != 0u ? n_beams : (uint32_t)BSF_MAX_POINTS;
@@ -353,13 +353,14 @@ static BSF_COMPACT_INLINE int feature_ok(const bsf_feature_t *f, uint32_t n_beam
              !(f->e_curve >= 0.0f && f->e_curve <= BSF_E_CURVE_MAX));
 }
 
+/* The frame's few header values (the step code, the pose) round through
+ * libm's floorf, not bsf_floorf: a few calls per frame, where a copy of
+ * bsf_floorf cost 68 bytes of the firmware, which links floorf anyway (PDM
+ * calls it); the same value for every float (test_math). */
 static bsf_status_t check_info(const bsf_frame_info_t *info, uint32_t *step_code)
 {
-    float code;
-    if (!is_finite_f(info->quant_step)) {
-        return BSF_ERR_ARG;
-    }
-    code = bsf_floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
+    /* a step that is NaN or infinite fails the code's range test */
+    const float code = floorf(info->quant_step / BSF_QUANT_STEP_UNIT + 0.5f);
     if (!(code >= 1.0f && code <= (float)BSF_WIRE_STEP_CODE_MAX)) {
         return BSF_ERR_ARG;
     }
@@ -398,9 +399,9 @@ static bsf_status_t check_stats(const bsf_stats_t *st)
     return BSF_OK;
 }
 
-static BSF_COMPACT_INLINE int32_t round_to_int(float v)
+static BSF_COMPACT_NOINLINE int32_t round_to_int(float v)
 {
-    return (int32_t)bsf_floorf(v + 0.5f);
+    return (int32_t)floorf(v + 0.5f);
 }
 
 /* The pose (checked): x and y in millimetres, theta in 2 pi / 65536 units
@@ -634,6 +635,7 @@ ENC_INLINE void frame_payload_run(writer_t *w, int costing, plan_t *pl,
     w->b = b;
 }
 
+#if !BSF_CONFIG_COMPACT
 static void frame_payload_write(writer_t *w, plan_t *pl, const bsf_frame_info_t *info,
                                 const bsf_result_t *res, uint32_t *table)
 {
@@ -645,6 +647,7 @@ static void frame_payload_cost(writer_t *w, plan_t *pl, const bsf_frame_info_t *
 {
     frame_payload_run(w, 1, pl, info, res, table);
 }
+#endif
 
 /* ---- The features frame as a job of bsf_stream_writer.h ----------------- */
 
@@ -659,11 +662,16 @@ typedef struct {
 static void features_job_payload(writer_t *w, int costing, bsf_enc_job_t *job)
 {
     features_job_t *fj = (features_job_t *)job;
+#if BSF_CONFIG_COMPACT
+    /* one copy of the run, which takes the kind from the bits (ENC_COSTING) */
+    frame_payload_run(w, costing, &fj->plan, fj->info, fj->res, fj->table);
+#else
     if (costing) {
         frame_payload_cost(w, &fj->plan, fj->info, fj->res, fj->table);
     } else {
         frame_payload_write(w, &fj->plan, fj->info, fj->res, fj->table);
     }
+#endif
 }
 
 static bsf_status_t features_job_plan(bsf_enc_job_t *job)

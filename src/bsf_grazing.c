@@ -62,13 +62,18 @@ static BSF_COMPACT_INLINE int bsf_grazing_ok(const bsf_points_t *pts, size_t i)
     return i < pts->count && pts->valid[i] != 0u;
 }
 
+/* Points i..i + 2 (valid beams) lie on one line. */
+static int bsf_grazing_run3(const bsf_points_t *pts, size_t i)
+{
+    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
+           bsf_grazing_triple(pts->pt, i, i + 1u, i + 2u);
+}
+
 /* Points i..i + 3 (valid beams) lie on one line: both triples collinear. */
 static int bsf_grazing_run4(const bsf_points_t *pts, size_t i)
 {
-    const bsf_point_t *p = pts->pt;
-    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
-           bsf_grazing_ok(pts, i + 3u) && bsf_grazing_triple(p, i, i + 1u, i + 2u) &&
-           bsf_grazing_triple(p, i + 1u, i + 2u, i + 3u);
+    return bsf_grazing_run3(pts, i) && bsf_grazing_ok(pts, i + 3u) &&
+           bsf_grazing_triple(pts->pt, i + 1u, i + 2u, i + 3u);
 }
 
 /* The middle return p1 lies where its ray crosses the chord p0-p2, to
@@ -90,9 +95,7 @@ static int bsf_grazing_on_ray(bsf_point_t p0, bsf_point_t p1, bsf_point_t p2)
 static int bsf_grazing_line3(const bsf_points_t *pts, size_t i)
 {
     const bsf_point_t *p = pts->pt;
-    return bsf_grazing_ok(pts, i) && bsf_grazing_ok(pts, i + 1u) && bsf_grazing_ok(pts, i + 2u) &&
-           bsf_grazing_triple(p, i, i + 1u, i + 2u) &&
-           bsf_grazing_on_ray(p[i], p[i + 1u], p[i + 2u]);
+    return bsf_grazing_run3(pts, i) && bsf_grazing_on_ray(p[i], p[i + 1u], p[i + 2u]);
 }
 
 /* Points s..s + 3 lie on one line (along the rays too) that starts at a
@@ -117,7 +120,7 @@ static int bsf_grazing_corner_run(const bsf_points_t *pts, size_t s, int dir)
  * in the scan, s - 1..s + 1 valid, s - 1 within cap of s + 1. The cheap
  * tests on the corner's return come first: most wide steps are depth
  * jumps, whose far return lies nowhere near the line. */
-static int bsf_grazing_run_room(const bsf_points_t *pts, size_t s, float cap)
+static BSF_COMPACT_INLINE int bsf_grazing_run_room(const bsf_points_t *pts, size_t s, float cap)
 {
     return s >= 3u && s + 3u < pts->count && pts->valid[s - 1u] && pts->valid[s] &&
            pts->valid[s + 1u] && bsf_grazing_within(pts->pt, s - 1u, s + 1u, cap);

@@ -289,7 +289,7 @@ static int fit_line_from(const lc_ctx_t *c, size_t a, size_t b, size_t from, flo
     return major_axis(sxx, sxy, syy, lmax, &l->dx, &l->dy);
 }
 
-static int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
+static BSF_COMPACT_NOINLINE int fit_line(const lc_ctx_t *c, size_t a, size_t b, lc_line_t *l)
 {
     return fit_line_from(c, a, b, a, 0.0f, 0.0f, l);
 }
@@ -1908,13 +1908,10 @@ static void keep(bsf_keypoint_t *out, size_t out_cap, size_t *n, size_t first, b
                  const bsf_keypoint_t *kp, const lc_ctx_t *c)
 {
     if (*n > first && too_close(last, kp, c)) {
-        if (kp->score > last->score) {
-            *last = *kp;
-            if (*n - 1u < out_cap) {
-                out[*n - 1u] = *kp;
-            }
+        if (!(kp->score > last->score)) {
+            return;
         }
-        return;
+        --*n; /* kp takes the previous keypoint's place */
     }
     if (*n < out_cap) {
         out[*n] = *kp;
@@ -2012,34 +2009,23 @@ static void detect_run(lc_ctx_t *c, bsf_lc_work_t *w, size_t m, bsf_keypoint_t *
             }
         }
     }
-    if (!changed) {
-        /* The last pass judged every survivor with its final neighbours:
-         * its keypoints stand. */
-        const size_t base = *n_found;
-        for (j = 0; j < nb; ++j) {
-            const size_t parked = base + j; /* never below the next slot written */
-            if (w->is_brk[w->brk[j]] == 2u) {
-                continue; /* a boundary, judged with these neighbours */
-            }
-            if (parked < out_cap) {
-                kp = out[parked];
-            } else {
-                const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
-                const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-                if (judge(c, lo, w->brk[j], hi, m, &kp) != LC_CORNER) {
-                    continue; /* cannot happen: same judgement as in the pass */
-                }
-            }
-            keep(out, out_cap, n_found, first, &last, &kp, c);
-        }
-        return;
-    }
+    /* Without a change, the last pass judged every survivor with its final
+     * neighbours: its boundaries stay and its parked keypoints stand (a
+     * keypoint beyond out_cap gets the same judgement again). Otherwise
+     * every survivor is judged again. */
     for (j = 0; j < nb; ++j) {
         const size_t lo = j == 0u ? 0u : w->brk[j - 1u];
         const size_t hi = j + 1u < nb ? w->brk[j + 1u] : m - 1u;
-        if (judge(c, lo, w->brk[j], hi, m, &kp) == LC_CORNER) {
-            keep(out, out_cap, n_found, first, &last, &kp, c);
+        const size_t parked = first + j; /* never below the next slot written */
+        if (!changed && w->is_brk[w->brk[j]] == 2u) {
+            continue;
         }
+        if (!changed && parked < out_cap) {
+            kp = out[parked];
+        } else if (judge(c, lo, w->brk[j], hi, m, &kp) != LC_CORNER) {
+            continue;
+        }
+        keep(out, out_cap, n_found, first, &last, &kp, c);
     }
 }
 

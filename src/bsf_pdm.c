@@ -668,7 +668,8 @@ static float systematic_error(const pdm_state_t *s, float rms, float window_max,
 /* Points per slot of fragment f's deviation window: 1 up to
  * PDM_BIAS_MAX_WINDOWS windows of bias_window points, then as many as keep
  * the fragment within that many windows. */
-static BSF_COMPACT_INLINE size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w, size_t f)
+static BSF_COMPACT_NOINLINE size_t bias_block(const pdm_state_t *s, const bsf_pdm_work_t *w,
+                                              size_t f)
 {
     const size_t count = (size_t)w->frag_last[f] - w->frag_first[f] + 1u;
     const size_t span = PDM_BIAS_MAX_WINDOWS * s->bias_window;

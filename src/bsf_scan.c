@@ -169,11 +169,11 @@ bsf_status_t bsf_scan_to_points(const bsf_scan_t *scan, bsf_points_t *out)
     if (scan->count > (size_t)BSF_MAX_POINTS) {
         return BSF_ERR_CAPACITY;
     }
-    if (!is_finite_f(scan->angle_min) || fabsf(scan->angle_min) > BSF_MAX_ABS_ANGLE_MIN ||
-        !is_finite_f(scan->angle_increment) || scan->angle_increment == 0.0f ||
-        fabsf(scan->angle_increment) > BSF_MAX_ABS_INCREMENT || !is_finite_f(scan->range_min) ||
+    if (!(fabsf(scan->angle_min) <= BSF_MAX_ABS_ANGLE_MIN) || scan->angle_increment == 0.0f ||
+        !(fabsf(scan->angle_increment) <= BSF_MAX_ABS_INCREMENT) || !is_finite_f(scan->range_min) ||
         scan->range_min < 0.0f || !(scan->range_max > scan->range_min)) {
-        /* range_max may be +inf ("no upper bound"); NaN fails the comparison. */
+        /* The angles within their bounds are finite (NaN and +-inf fail the
+         * tests); range_max may be +inf ("no upper bound"), NaN fails. */
         return BSF_ERR_ARG;
     }
 

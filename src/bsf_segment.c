@@ -107,7 +107,8 @@ typedef struct {
 } seg_sink_t;
 
 /* Returns 0 when the segment is kept but does not fit (capacity exceeded). */
-static int sink_close(seg_sink_t *sink, size_t first, size_t last, size_t n_points)
+static BSF_COMPACT_INLINE int sink_close(seg_sink_t *sink, size_t first, size_t last,
+                                         size_t n_points)
 {
     bsf_segment_t *s;
     if (n_points < (size_t)sink->min_points) {
@@ -127,8 +128,9 @@ static int sink_close(seg_sink_t *sink, size_t first, size_t last, size_t n_poin
 }
 
 /* Common argument checks of both segmenters; on success fills the sink. */
-static bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out, size_t cap, size_t *n_out,
-                          size_t *n_wasted_points, seg_sink_t *sink)
+static BSF_COMPACT_INLINE bsf_status_t begin(const bsf_points_t *pts, bsf_segment_t *out,
+                                             size_t cap, size_t *n_out, size_t *n_wasted_points,
+                                             seg_sink_t *sink)
 {
     if (n_out != NULL) {
         *n_out = 0;
@@ -407,22 +409,16 @@ void bsf_side_fit(const bsf_point_t *w, bsf_side_line_t *l)
 }
 
 /* The total least-squares line through the returns on side dir (-1: the
- * beams before i, +1: after) of beam i, all but the nearest; only l->n is
- * set when there are fewer than SEG_MIXED_MIN_SIDE returns. */
+ * beams before i, +1: after) of beam i, all but the nearest; only l->n and
+ * l->var (0) are set when there are fewer than SEG_MIXED_MIN_SIDE returns
+ * (side_judged looks at n first). */
 static void side_line(const bsf_points_t *pts, size_t i, int dir, int ring, beam_radius_t *rad,
                       bsf_side_line_t *l)
 {
     bsf_point_t w[SEG_MIXED_WINDOW];
     int k;
     l->n = 0;
-    l->cx = 0.0f;
-    l->cy = 0.0f;
-    l->nx = 0.0f;
-    l->ny = 1.0f;
     l->var = 0.0f;
-    l->reach_i = 1.0f;
-    l->reach_nr = 1.0f;
-    l->d_near = 0.0f;
 #if !BSF_CONFIG_COMPACT
     const int inside = i >= (size_t)SEG_MIXED_WINDOW && i + (size_t)SEG_MIXED_WINDOW < pts->count;
 #endif
@@ -745,18 +741,13 @@ static int is_mixed_pixel(const bsf_points_t *pts, size_t i, int ring, beam_radi
     return mixed_kind(pts, i, ring, rad, r, lo, hi, have_outer);
 }
 
-/* The radius test's constants for beam_within. */
+/* The radius test's constants for beam_within (the rest is each beam's,
+ * from beam_radius_start on). */
 static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float cap2)
 {
     rad->a2 = a2;
     rad->two_b = two_b;
     rad->cap2 = cap2;
-    rad->rho = 0.0f;
-    rad->lower = 0.0f;
-    rad->upper = 0.0f;
-    rad->limit = 0.0f;
-    rad->have_bounds = 0;
-    rad->have_limit = 0;
 }
 
 size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
@@ -1034,20 +1025,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             bsf_grazing_join(pts, b - 1u, p->radius_max, p->join_grazing == 2u, grazing_memo)) {
             best = 0u;
         }
-        if (best == 0u) {
-            open[0].last = (uint32_t)b; /* the current segment goes on (most beams) */
-            open[0].last_pos = (uint32_t)j;
-            open[0].n++;
-            open[0].end = q;
-        } else if (best < slots) {
-            open_seg_t s = open[best];
-            s.last = (uint32_t)b;
-            s.last_pos = (uint32_t)j;
-            s.n++;
-            s.end = q;
-            open_shift_up(open, best);
-            open[0] = s;
-        } else {
+        /* The segment beam b joins goes first (best == 0: the current one,
+         * most beams), or a new one starts there; then b extends it. */
+        if (best == slots) {
             if (n_open == slots) {
                 if (!close_open(&sink, &open[n_open - 1u], label, pts->count)) {
                     return BSF_ERR_CAPACITY;
@@ -1056,12 +1036,17 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
             }
             open_shift_up(open, n_open);
             open[0].first = (uint32_t)b;
-            open[0].last = (uint32_t)b;
-            open[0].last_pos = (uint32_t)j;
-            open[0].n = 1u;
-            open[0].end = q;
+            open[0].n = 0u;
             ++n_open;
+        } else if (best > 0u) {
+            const open_seg_t s = open[best];
+            open_shift_up(open, best);
+            open[0] = s;
         }
+        open[0].last = (uint32_t)b;
+        open[0].last_pos = (uint32_t)j;
+        open[0].n++;
+        open[0].end = q;
         if (label != NULL) {
             label[b] = (uint16_t)open[0].first;
         }

@@ -15,7 +15,7 @@ const char *bsf_status_str(bsf_status_t status)
     case BSF_ERR_FORMAT: return "malformed data";
     case BSF_ERR_CRC: return "checksum mismatch";
     case BSF_ERR_VERSION: return "unsupported version";
-    case BSF_ERR_UNSUPPORTED: return "method not compiled into this build";
+    case BSF_ERR_UNSUPPORTED: return "method or feature not compiled into this build";
     default: return "unknown status";
     }
 }

@@ -25,7 +25,7 @@ typedef struct bsf_cobs_out {
     int failed; /* the sink refused bytes */
 } stream_t;
 
-static void emit(stream_t *s, const uint8_t *data, size_t len)
+static BSF_COMPACT_NOINLINE void emit(stream_t *s, const uint8_t *data, size_t len)
 {
     if (!s->failed) {
         if (s->sink(s->ctx, data, len) != 0) {
@@ -54,7 +54,7 @@ static void block_end(stream_t *s)
     }
 }
 
-static void stream_init(stream_t *s)
+static BSF_COMPACT_NOINLINE void stream_init(stream_t *s)
 {
     memset(s, 0, sizeof *s);
     block_start(s);

@@ -296,17 +296,20 @@ static inline bits_t put_eg_wide(writer_t *w, bits_t b, ENC_COSTING_PARAM uint64
     return b;
 }
 
+/* EGk of v: the narrow fields as field_eg; the compact variant writes them
+ * too through put_eg_wide, which gives the same bits (v + 2^k is u followed
+ * by the k low bits of v) in one code path. */
 ENC_INLINE void field_eg64_(writer_t *w, bits_t *b, ENC_COSTING_PARAM uint64_t v, unsigned k)
 {
+#if BSF_CONFIG_COMPACT
+    *b = put_eg_wide(w, *b, v, k);
+#else
     if (v < ((uint64_t)1 << 30) && k <= 25u) {
         field_eg(w, b, costing, (uint32_t)v, k);
     } else {
-#if BSF_CONFIG_COMPACT
-        *b = put_eg_wide(w, *b, v, k);
-#else
         *b = put_eg_wide(w, *b, costing, v, k);
-#endif
     }
+#endif
 }
 
 ENC_INLINE void field_float_(writer_t *w, bits_t *b, ENC_COSTING_PARAM float v)

@@ -40,7 +40,7 @@ typedef enum {
     BSF_ERR_FORMAT = -7,      /**< malformed frame or field */
     BSF_ERR_CRC = -8,         /**< frame check sequence mismatch */
     BSF_ERR_VERSION = -9,     /**< unsupported frame version or type */
-    BSF_ERR_UNSUPPORTED = -10 /**< method compiled out of this build (BSF_CONFIG_METHODS) */
+    BSF_ERR_UNSUPPORTED = -10 /**< method or feature compiled out of this build (bsf_config.h) */
 } bsf_status_t;
 
 /** A point in the sensor (or world) plane, metres. */

@@ -28,6 +28,12 @@
  *       lists them for the caps guard).
  *   BSF_CONFIG_METHODS
  *       the extraction methods compiled in (below).
+ *   BSF_CONFIG_FIT_BINS (0 or 1)
+ *       1 (default): bsf_params_t.fit_bin_length, the opt-in fit on bin
+ *       means for dense scans, is compiled in; 0 leaves its code out (about
+ *       1.1 KiB at -Os) and bsf_params_check refuses a non-zero
+ *       fit_bin_length with BSF_ERR_UNSUPPORTED, as it refuses a method left
+ *       out. CMake: -DBSF_FIT_BINS=OFF.
  *   BSF_CONFIG_COMPACT (0 or 1)
  *       1: code kept only for speed is compiled in its short form (one
  *       general loop instead of written-out special cases, no fast paths
@@ -144,6 +150,11 @@
 #define BSF_CONFIG_METHODS 15
 #endif
 
+/** 1: the opt-in fit on bin means is compiled in (see the switches above). */
+#ifndef BSF_CONFIG_FIT_BINS
+#define BSF_CONFIG_FIT_BINS 1
+#endif
+
 /** 1: speed-only code in its short form (see the switches above). */
 #ifndef BSF_CONFIG_COMPACT
 #if defined(__OPTIMIZE_SIZE__)
@@ -182,6 +193,9 @@
 
 #if (BSF_CONFIG_COMPACT) != 0 && (BSF_CONFIG_COMPACT) != 1
 #error "BSF_CONFIG_COMPACT must be 0 or 1"
+#endif
+#if (BSF_CONFIG_FIT_BINS) != 0 && (BSF_CONFIG_FIT_BINS) != 1
+#error "BSF_CONFIG_FIT_BINS must be 0 or 1"
 #endif
 #if (BSF_CONFIG_SIMD) != 0 && (BSF_CONFIG_SIMD) != 1
 #error "BSF_CONFIG_SIMD must be 0 or 1"

@@ -61,10 +61,22 @@ typedef uint32_t (*bsf_clock_fn)(void *user);
 /** Runtime parameters; start from bsf_params_default(method). */
 typedef struct {
     bsf_method_t method;
-    bsf_falko_params_t falko;         /**< used by FALKO-SVED-PDM */
-    bsf_lc_params_t lc;               /**< used by LC-SVED-PDM */
-    bsf_bid_params_t bid;             /**< used by BID-SVED-PDM */
-    bsf_sved_params_t sved;           /**< used by the three SVED methods */
+    bsf_falko_params_t falko; /**< used by FALKO-SVED-PDM */
+    bsf_lc_params_t lc;       /**< used by LC-SVED-PDM */
+    bsf_bid_params_t bid;     /**< used by BID-SVED-PDM */
+    /** Used by the three SVED methods. With LC-SVED-PDM and sved.reject_mixed
+     *  on, the extractor also gives a wall back the returns an occluder cut
+     *  off: a run of 2 to sved.min_segment_points - 1 returns that SVED
+     *  wasted just past a segment's end, beyond one or more returns in front
+     *  of the segment's line (a leg, a post), joins the segment when all of
+     *  it lies on the line of the segment's last 5-8 returns (straight within
+     *  the scan's noise) within 4 standard errors. The run must start within
+     *  sved.radius_max of the end (so radius_max 0, no cap in SVED, turns
+     *  this off) and end within sved.max_gap_beams beams; it needs the
+     *  mixed-pixel marks, which share the segments' storage and are kept
+     *  only when that array (BSF_MAX_SEGMENTS of bsf_segment_t) holds a
+     *  bit per beam, as with every default cap. */
+    bsf_sved_params_t sved;
     bsf_rpos_params_t rpos;           /**< used by RPOS-LSBA */
     bsf_pdm_params_t pdm;             /**< used by the three PDM methods */
     bsf_no_return_params_t no_return; /**< no-return codes, every method (bsf_scan.h) */
@@ -106,8 +118,31 @@ typedef struct {
      *  what a fit leaves unused goes to the later ones). A fragment still
      *  more than twice pdm.target_rms from its points grows past it. A fit
      *  stopped early keeps fewer control points and a larger E_curve;
-     *  stats.n_fit_visits counts the work. 0 (default): no bound. */
+     *  stats.n_fit_visits counts the work. With fit_bin_length, a binned
+     *  fit's passes visit bins but its share is per return, so what it
+     *  leaves goes to the fits after it (the scan's total still holds).
+     *  0 (default): no bound. */
     uint8_t fit_passes;
+    /** The three PDM methods: on dense scans, PDM may fit the means of bins
+     *  of consecutive returns instead of the returns themselves, for speed
+     *  (docs/PERFORMANCE.md, "Fitting bin means"). Between two pinned
+     *  returns of a fit (its first and last, and each vertex, which stay
+     *  single), the returns are cut into equal bins of k, k the most returns
+     *  whose share of the run's chord is at most this length, and at most a
+     *  128th of the run (so runs under 256 returns never bin: a bin must not
+     *  take room the curve needs to bend). E_curve and the cut policy's
+     *  farthest point are over the returns, each return's distance taken
+     *  along the curve's normal at its bin's footpoint; stats.n_fit_visits
+     *  counts bin visits. PDM's refinement tests (target_rms, the windowed
+     *  mean of bias_window bins) see bin means: their noise share shrinks and
+     *  each window spans k times more wall, so refinement stops earlier
+     *  (measured: 3 cm bins make the 3200-beam office's fit 7x cheaper, with
+     *  curve p99 worse by 0.02 to 0.9 cm on most of the ground-truth
+     *  benchmark's 1081- and 3200-beam rows). Metres, 0..1; 0 (the default
+     *  for every method): every return is fitted. A build with
+     *  BSF_CONFIG_FIT_BINS 0 (bsf_config.h) refuses a non-zero value with
+     *  BSF_ERR_UNSUPPORTED. */
+    float fit_bin_length;
     bsf_clock_fn clock; /**< optional, see bsf_clock_fn */
     void *clock_user;   /**< passed to clock */
     uint32_t clock_hz;  /**< ticks per second of clock (> 0 when clock is set) */
@@ -139,7 +174,8 @@ bsf_params_t bsf_params_paper(bsf_method_t method);
 /** Check every parameter the method uses. @return BSF_OK, BSF_ERR_ARG for
  *  NULL, BSF_ERR_PARAM for an unknown method or a value out of range,
  *  BSF_ERR_UNSUPPORTED for a method left out of this build
- *  (BSF_CONFIG_METHODS, bsf_config.h). */
+ *  (BSF_CONFIG_METHODS, bsf_config.h) or a non-zero fit_bin_length in a
+ *  build without the fit on bin means (BSF_CONFIG_FIT_BINS). */
 BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
 
 /**
@@ -177,6 +213,9 @@ typedef struct {
                     bsf_pdm_info_t pdm_info;     /**< the fit's outcome */
                     uint32_t passes_left; /**< point visits the scan may still spend (fit_passes) */
                     uint32_t points_left; /**< points of the segments still to fit */
+                    uint16_t bin_pos[BSF_PDM_MAX_VERTICES]; /**< vertices' bins (fit_bin_length) */
+                    uint16_t bin_worst_at; /**< a binned fit's farthest return, or 0xFFFF */
+                    float bin_worst;       /**< its squared distance from the curve */
                 } fit;
             } use;
         } seg;

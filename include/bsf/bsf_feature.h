@@ -67,8 +67,10 @@ typedef struct {
     uint32_t n_cut_keypoints; /**< interest points dropped by the keypoint cap */
     uint32_t n_cut_segments;  /**< kept segments left out because of a cap */
     uint32_t n_cut_points;    /**< valid points of those segments (wasted in retrievability) */
-    uint32_t n_fit_visits;    /**< the fit's work: points visited by its footpoint passes, summed
-                                   over its fits (bsf_params_t.fit_passes bounds it); 0 for LSBA */
+    uint32_t n_fit_visits;    /**< the fit's work: points (bins, with fit_bin_length) visited by
+                                   its footpoint passes, summed over its fits
+                                   (bsf_params_t.fit_passes bounds it; a binned fit's one pass
+                                   over its returns after the fit is not counted); 0 for LSBA */
     uint32_t time_ns;         /**< whole extraction time, ns; 0 when no clock is set */
     uint32_t stage_ns[BSF_STAGE_COUNT]; /**< per-stage time, ns; 0 when no clock */
 } bsf_stats_t;

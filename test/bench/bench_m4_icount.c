@@ -29,7 +29,9 @@
  * On the office, the adversarial and the Intel scans the default method runs
  * a second time with the fit's work bounded (bsf_params_t.fit_passes
  * BENCH_FIT_PASSES, the row "lc-sved-pdm/fK"): what a firmware that must
- * keep up with a dense LIDAR in its worst scan pays.
+ * keep up with a dense LIDAR in its worst scan pays; and a third time with
+ * the fit also on bin means (bsf_params_t.fit_bin_length BENCH_FIT_BIN_CM
+ * centimetres, the row "lc-sved-pdm/fKbC", where the build has them).
  *
  * Prints numbers, judges none; fails only if an extraction fails or a pose
  * is not in free space. Run:
@@ -51,6 +53,7 @@
 #define MAX_SCANS 4096
 /* The bound on the fit's work of the extra default-method row. */
 #define BENCH_FIT_PASSES 4u
+#define BENCH_FIT_BIN_CM 3u
 #define N_SYNTH_SCENES 3
 #define N_SYNTH_POSES 2
 
@@ -89,8 +92,10 @@ typedef struct {
 #define NO_BID (ALL_METHODS & ~(1u << BSF_METHOD_BID_SVED_PDM))
 
 /* Measure every scan of a source with one method (its fit bounded by
- * fit_passes, 0: not); print one line. */
-static int run_method(const scan_source_t *src, bsf_method_t method, unsigned fit_passes)
+ * fit_passes, 0: not; on bins of bin_cm centimetres, 0: not); print one
+ * line. */
+static int run_method(const scan_source_t *src, bsf_method_t method, unsigned fit_passes,
+                      unsigned bin_cm)
 {
     bsf_params_t p = bsf_params_default(method);
     char label[32];
@@ -100,7 +105,10 @@ static int run_method(const scan_source_t *src, bsf_method_t method, unsigned fi
     uint32_t max_whole, med_whole, s;
 
     p.fit_passes = (uint8_t)fit_passes;
-    if (fit_passes != 0u) {
+    p.fit_bin_length = 0.01f * (float)bin_cm;
+    if (bin_cm != 0u) {
+        snprintf(label, sizeof label, "%s/f%ub%u", bsf_method_name(method), fit_passes, bin_cm);
+    } else if (fit_passes != 0u) {
         snprintf(label, sizeof label, "%s/f%u", bsf_method_name(method), fit_passes);
     } else {
         snprintf(label, sizeof label, "%s", bsf_method_name(method));
@@ -182,11 +190,12 @@ static int run_source(const scan_source_t *src)
            "median per stage (with clock hook)", "frame");
     for (m = 0; m < BSF_METHOD_COUNT; ++m) {
         if ((src->methods & (1u << m)) != 0u) {
-            rc |= run_method(src, (bsf_method_t)m, 0u);
+            rc |= run_method(src, (bsf_method_t)m, 0u, 0u);
         }
     }
     if (src->bounded && (src->methods & (1u << BSF_METHOD_DEFAULT)) != 0u) {
-        rc |= run_method(src, BSF_METHOD_DEFAULT, BENCH_FIT_PASSES);
+        rc |= run_method(src, BSF_METHOD_DEFAULT, BENCH_FIT_PASSES, 0u);
+        rc |= run_method(src, BSF_METHOD_DEFAULT, BENCH_FIT_PASSES, BENCH_FIT_BIN_CM);
     }
     return rc;
 }

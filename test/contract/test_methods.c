@@ -108,7 +108,7 @@ static void test_unknown_method_is_still_a_parameter_error(void)
 
 static void test_status_text_names_the_build(void)
 {
-    TEST_ASSERT_EQUAL_STRING("method not compiled into this build",
+    TEST_ASSERT_EQUAL_STRING("method or feature not compiled into this build",
                              bsf_status_str(BSF_ERR_UNSUPPORTED));
 }
 

@@ -230,6 +230,10 @@ static void edit_param(bsf_params_t *p, uint32_t field, uint32_t v)
         F(p->falko.neigh_b);
         F(p->bid.neigh_b);
         break;
+    case 35:
+        /* bins of 0 to 1.02 m (above 1 refused), or raw */
+        p->fit_bin_length = raw ? fv : 0.004f * (float)(v & 0xFFu);
+        break;
     case 36:
         /* a clock hook: v's low 16 bits are the ticks per call; clock_hz is
          * v itself when raw (0 must be refused), else 1 MHz */

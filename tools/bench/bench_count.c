@@ -10,7 +10,8 @@
  *   bench_count scaling --beams N [--method NAME]     (bench_scenes.h, 20 poses)
  *   bench_count adversarial --kind pillar|clutter|long-wall [--method NAME]
  *   bench_count office --beams N [--fov360] [--method NAME]   (demo office, 8 poses)
- *   any mode: --fit-passes K (bsf_params_t.fit_passes; default 0, no bound)
+ *   any mode: --fit-passes K (bsf_params_t.fit_passes; default 0, no bound),
+ *             --fit-bin-length M (bsf_params_t.fit_bin_length; default the method's)
  *
  * Prints what it ran (scans, frames, features) on one line; exit 1 on any
  * failure (a scan that does not extract, a pose that is not free).
@@ -127,12 +128,13 @@ static int ray_cast_poses(const bsf_scene_t *scene, const bsf_scene_pose_t *pose
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: bench_count intel LOG [--method NAME] [--encode] [--max-scans N]\n"
-                    "       bench_count scaling --beams N [--method NAME]\n"
-                    "       bench_count adversarial --kind pillar|clutter|long-wall [--method "
-                    "NAME]\n"
-                    "       bench_count office --beams N [--fov360] [--method NAME]\n"
-                    "       any mode: --fit-passes K (0..255, default 0: no bound)\n");
+    fprintf(stderr,
+            "usage: bench_count intel LOG [--method NAME] [--encode] [--max-scans N]\n"
+            "       bench_count scaling --beams N [--method NAME]\n"
+            "       bench_count adversarial --kind pillar|clutter|long-wall [--method "
+            "NAME]\n"
+            "       bench_count office --beams N [--fov360] [--method NAME]\n"
+            "       any mode: --fit-passes K (0..255, default 0: no bound), --fit-bin-length M\n");
 }
 
 int main(int argc, char **argv)
@@ -145,6 +147,7 @@ int main(int argc, char **argv)
     long beams = 0;
     long max_scans = 0;
     long fit_passes = 0;
+    double fit_bin_length = -1.0; /* < 0: the method's default */
     int encode = 0, fov360 = 0, kind = -1, a;
     size_t i;
     unsigned long features = 0, frames = 0, bytes = 0;
@@ -172,6 +175,12 @@ int main(int argc, char **argv)
             max_scans = atol(argv[++a]);
         } else if (strcmp(argv[a], "--fit-passes") == 0 && a + 1 < argc) {
             fit_passes = atol(argv[++a]);
+        } else if (strcmp(argv[a], "--fit-bin-length") == 0 && a + 1 < argc) {
+            char *end = NULL;
+            fit_bin_length = strtod(argv[++a], &end);
+            if (end == argv[a] || *end != '\0' || !(fit_bin_length >= 0.0)) {
+                fit_bin_length = 2.0; /* refused below, with the usage */
+            }
         } else if (strcmp(argv[a], "--kind") == 0 && a + 1 < argc) {
             ++a;
             for (kind = 0; kind < BENCH_ADV_COUNT; ++kind) {
@@ -190,7 +199,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (max_scans < 0 || beams < 0 || fit_passes < 0 || fit_passes > 255) {
+    if (max_scans < 0 || beams < 0 || fit_passes < 0 || fit_passes > 255 || fit_bin_length > 1.0) {
         usage();
         return 2;
     }
@@ -236,6 +245,9 @@ int main(int argc, char **argv)
 
     p = bsf_params_default(method);
     p.fit_passes = (uint8_t)fit_passes;
+    if (fit_bin_length >= 0.0) {
+        p.fit_bin_length = (float)fit_bin_length;
+    }
     if (bsf_extractor_init(&g_ex, &p) != BSF_OK) {
         fprintf(stderr, "bench_count: %s is not available in this build\n",
                 bsf_method_name(method));

@@ -14,7 +14,8 @@
  *            --evidence / --no-evidence (LC's corner evidence test,
  *            bsf_lc_params_t.corner_evidence; on by default), --tails / --no-tails
  *            (bsf_params_t.trim_tails; on by default), --fit-passes K
- *            (bsf_params_t.fit_passes: a bound on the fit's work; default 0, none), --datasets DIR
+ *            (bsf_params_t.fit_passes: a bound on the fit's work; default 0, none),
+ *            --fit-bin-length M (bsf_params_t.fit_bin_length; default the method's), --datasets DIR
  *            (also Gamma/eta/accuracy/bytes on the four logs in DIR/data),
  *            --scene NAME, --sensor N, --noise MM, --verbose (every missed corner,
  *            false vertex and stray curve), --oracle-reach M (how far from the vertex
@@ -89,6 +90,8 @@ static int evidence_mode = -1;
 static int tails_mode = -1;
 /* --fit-passes K: bsf_params_t.fit_passes (0, the default: no bound) */
 static long fit_passes = 0;
+/* --fit-bin-length M: bsf_params_t.fit_bin_length (< 0, the default: the method's) */
+static double fit_bin_length = -1.0;
 
 static bsf_params_t make_params(void)
 {
@@ -105,6 +108,9 @@ static bsf_params_t make_params(void)
         p.trim_tails = (uint8_t)tails_mode;
     }
     p.fit_passes = (uint8_t)fit_passes;
+    if (fit_bin_length >= 0.0) {
+        p.fit_bin_length = (float)fit_bin_length;
+    }
     return p;
 }
 
@@ -490,6 +496,14 @@ int main(int argc, char **argv)
                 fprintf(stderr, "bench_truth: --fit-passes needs a count in 0..255\n");
                 return 2;
             }
+        } else if (strcmp(argv[a], "--fit-bin-length") == 0 && a + 1 < argc) {
+            char *end = NULL;
+            fit_bin_length = strtod(argv[++a], &end);
+            if (end == argv[a] || *end != '\0' ||
+                !(fit_bin_length >= 0.0 && fit_bin_length <= 1.0)) {
+                fprintf(stderr, "bench_truth: --fit-bin-length needs metres in 0..1\n");
+                return 2;
+            }
         } else if (strcmp(argv[a], "--oracle-reach") == 0 && a + 1 < argc) {
             char *end = NULL;
             oracle_reach = strtod(argv[++a], &end);
@@ -511,7 +525,7 @@ int main(int argc, char **argv)
             fprintf(stderr,
                     "usage: %s [--quick] [--check] [--check-rows] [--verbose] [--paper] "
                     "[--[no-]grazing] "
-                    "[--[no-]evidence] [--[no-]tails] [--fit-passes K] "
+                    "[--[no-]evidence] [--[no-]tails] [--fit-passes K] [--fit-bin-length M] "
                     "[--poses N] [--oracle-reach M] "
                     "[--scene NAME] "
                     "[--sensor BEAMS] [--noise MM] [--datasets SHARED_DIR]\n",
@@ -547,6 +561,9 @@ int main(int argc, char **argv)
            tails_mode ? " with tail returns left off" : "", n_poses);
     if (fit_passes > 0) {
         printf(", at most %ld fit passes per point", fit_passes);
+    }
+    if (fit_bin_length > 0.0) {
+        printf(", fit on bins of at most %g m", fit_bin_length);
     }
     printf("\n");
     print_header();

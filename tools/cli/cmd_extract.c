@@ -25,6 +25,8 @@ static const char extract_help[] =
     "                   repeated\n"
     "  --fit-passes K   bound the fit's work per scan: at most K footpoint passes per\n"
     "                   fitted point on average (default 0: no bound; docs/PERFORMANCE.md)\n"
+    "  --fit-bin-length M  fit the means of bins of consecutive returns at most M metres\n"
+    "                   long on dense scans (0..1; default 0: every return)\n"
     "  --quant STEP     control point quantisation step in metres (default 0.005)\n"
     "  --meta-every K   repeat the metadata frame at least every K scans (default 64)\n"
     "  --reproducible   no measured extraction time: the same log gives the same bytes\n"
@@ -47,7 +49,9 @@ static const char extract_help[] =
     "                   (docs/TOOL.md): the odometry alone, the prior, the aligned pose;\n"
     "                   bsf map/render --prior draw the odometry path dashed\n"
     "  -o OUT           output stream file, '-' for stdout (default '-')\n"
-    "  -h, --help       this help\n"
+    "  -h, --help       this help\n";
+/* Split from the options: C99 compilers need only take 4095-character strings. */
+static const char extract_help_notes[] =
     "\n"
     "The stream starts with a metadata frame (method, parameters, caps, scan geometry,\n"
     "the log's absolute time of timestamp 0, the log's name), sent again whenever the\n"
@@ -96,10 +100,11 @@ typedef struct {
     bsf_method_t method;
     long first;
     long count;
-    double range_max;  /* <= 0: from the log */
-    double no_return;  /* > 0: the sensor's no-return code */
-    int no_return_off; /* 1: no recognition of undeclared codes */
-    long fit_passes;   /* bsf_params_t.fit_passes (0: no bound) */
+    double range_max;      /* <= 0: from the log */
+    double no_return;      /* > 0: the sensor's no-return code */
+    int no_return_off;     /* 1: no recognition of undeclared codes */
+    long fit_passes;       /* bsf_params_t.fit_passes (0: no bound) */
+    double fit_bin_length; /* bsf_params_t.fit_bin_length; < 0: the method's default */
     double quant;
     long meta_every;
     int reproducible;
@@ -324,6 +329,9 @@ static int run_extract(const extract_opts_t *o)
             p.no_return.min_run = 0u;
         }
         p.fit_passes = (uint8_t)o->fit_passes;
+        if (o->fit_bin_length >= 0.0) {
+            p.fit_bin_length = (float)o->fit_bin_length;
+        }
         if (init_extractor_params(&p, !o->reproducible) != 0) {
             return EXIT_FAIL;
         }
@@ -624,6 +632,7 @@ int cmd_extract(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.method = BSF_METHOD_DEFAULT;
     o.count = -1;
+    o.fit_bin_length = -1.0;
     o.quant = (double)BSF_QUANT_STEP_DEFAULT;
     o.meta_every = 64;
     o.pose_every = 1;
@@ -632,6 +641,7 @@ int cmd_extract(int argc, char **argv)
         const char *v;
         if (is_help(argv[i])) {
             fputs(extract_help, stdout);
+            fputs(extract_help_notes, stdout);
             return 0;
         } else if ((v = opt_value(argc, argv, &i, "--method", &err)) != NULL) {
             o.method = bsf_method_from_name(v);
@@ -661,6 +671,10 @@ int cmd_extract(int argc, char **argv)
         } else if ((v = opt_value(argc, argv, &i, "--fit-passes", &err)) != NULL) {
             if (parse_long(v, 0, 255, &o.fit_passes) != 0) {
                 return usage_error("--fit-passes needs a count in [0, 255], got '%s'", v);
+            }
+        } else if ((v = opt_value(argc, argv, &i, "--fit-bin-length", &err)) != NULL) {
+            if (parse_float(v, 0.0, 1.0, &o.fit_bin_length) != 0) {
+                return usage_error("--fit-bin-length needs metres in [0, 1], got '%s'", v);
             }
         } else if ((v = opt_value(argc, argv, &i, "--quant", &err)) != NULL) {
             if (parse_float(v, (double)BSF_QUANT_STEP_MIN, (double)BSF_QUANT_STEP_MAX, &o.quant) !=

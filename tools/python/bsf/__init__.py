@@ -125,7 +125,7 @@ class ScanStats:
     n_cut_segments: int = 0
     n_cut_points: int = 0
     time_ns: int = 0  #: extraction time, ns (0 without a clock)
-    n_fit_visits: int = 0  #: the fit's work: points visited by its footpoint passes (``fit_passes`` bounds it)
+    n_fit_visits: int = 0  #: the fit's work: points (bins, with ``fit_bin_length``) visited by its footpoint passes (``fit_passes`` bounds it)
     stage_ns: Tuple[int, ...] = (0, 0, 0, 0)  #: points, corners, segments, fit
 
     @classmethod

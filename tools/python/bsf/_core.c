@@ -163,6 +163,7 @@ static const param_desc_t g_params[] = {
     PARAM("split_dist", split_dist, PT_FLOAT),
     PARAM("trim_tails", trim_tails, PT_U8),
     PARAM("fit_passes", fit_passes, PT_U8),
+    PARAM("fit_bin_length", fit_bin_length, PT_FLOAT),
 };
 #define N_PARAMS (sizeof g_params / sizeof g_params[0])
 

@@ -97,6 +97,18 @@ def test_fit_passes_bounds_the_fit_work():
         bsf.extract(ranges, amin, inc, 0.05, 30.0, fit_passes=256)
 
 
+def test_fit_bin_length_fits_bin_means_on_dense_scans():
+    ranges, amin, inc = synthetic_scan(n=4096, fov=2 * np.pi)
+    assert bsf.default_params()["fit_bin_length"] == 0.0
+    every = bsf.extract(ranges, amin, inc, 0.05, 30.0)
+    binned = bsf.extract(ranges, amin, inc, 0.05, 30.0, fit_bin_length=0.03)
+    assert 0 < binned.stats.n_fit_visits < every.stats.n_fit_visits
+    assert binned.stats.n_in_features == every.stats.n_in_features
+    for bad in (-0.01, 1.5, float("nan")):
+        with pytest.raises((bsf.BsfError, ValueError)):
+            bsf.extract(ranges, amin, inc, 0.05, 30.0, fit_bin_length=bad)
+
+
 def test_timing_off_gives_zero_time():
     ranges, amin, inc = synthetic_scan()
     assert bsf.extract(ranges, amin, inc, 0.05, 30.0, timing=False).stats.time_ns == 0
