@@ -51,16 +51,22 @@ static void build_l_room(void)
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_add_l_room(&scene, 0.0, 0.0, 9.0, 7.0, 3.5, 3.0));
 }
 
-static void extract_with(bsf_method_t method, const bsf_lidar_t *l, uint64_t seed)
+/* Scan the scene through l (noise drawn from seed) and extract it with p. */
+static void extract_params(const bsf_params_t *p, const bsf_lidar_t *l, uint64_t seed)
 {
     bsf_scene_rng_t rng;
     bsf_scan_t s;
-    bsf_params_t p = bsf_params_default(method);
     bsf_scene_rng_seed(&rng, seed);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, l, &rng, ranges, NULL, BSF_MAX_POINTS));
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, p));
     s = scan_of(l);
     TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+}
+
+static void extract_with(bsf_method_t method, const bsf_lidar_t *l, uint64_t seed)
+{
+    const bsf_params_t p = bsf_params_default(method);
+    extract_params(&p, l, seed);
 }
 
 /* Corners over random poses in a rectangular and an L-shaped room: a
@@ -1016,17 +1022,11 @@ static void test_fit_passes_bounds_the_fit_work_and_keeps_curves_on_the_walls(vo
         l.angle_increment = 4.71238898 / 1080.0;
         l.noise_sigma = 0.01;
         for (bounded = 0; bounded <= 1; ++bounded) {
-            bsf_scene_rng_t rng;
-            bsf_scan_t s = scan_of(&l);
             bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
             double rms;
             TEST_ASSERT_EQUAL_UINT8(0u, p.fit_passes);
             p.fit_passes = bounded ? 3u : 0u;
-            bsf_scene_rng_seed(&rng, 60u + (uint64_t)k);
-            TEST_ASSERT_EQUAL_INT(BSF_OK,
-                                  bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
-            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+            extract_params(&p, &l, 60u + (uint64_t)k);
             curve_to_truth(&l, &rms, &max_d[bounded]);
             visits[bounded] = res.stats.n_fit_visits;
             in_features[bounded] = res.stats.n_in_features;
@@ -1076,18 +1076,12 @@ static void test_fit_bins_cut_the_fit_work_on_dense_scans_and_keep_curves_on_the
         l.angle_increment = 1.57079633 / 1080.0;
         l.noise_sigma = 0.01;
         for (binned = 0; binned <= 1; ++binned) {
-            bsf_scene_rng_t rng;
-            bsf_scan_t s = scan_of(&l);
             bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
             double rms;
             double sum = 0.0;
             size_t fi;
             p.fit_bin_length = binned ? 0.03f : 0.0f;
-            bsf_scene_rng_seed(&rng, 70u + (uint64_t)k);
-            TEST_ASSERT_EQUAL_INT(BSF_OK,
-                                  bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
-            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-            TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+            extract_params(&p, &l, 70u + (uint64_t)k);
             curve_to_truth(&l, &rms, &max_d[binned]);
             visits[binned] += res.stats.n_fit_visits;
             in_features[binned] = res.stats.n_in_features;
@@ -1128,15 +1122,9 @@ static void test_fit_bins_follow_a_curved_run_not_its_chord(void)
     l.angle_increment = 4.71238898 / 1080.0;
     l.noise_sigma = 0.005;
     for (k = 0; k < 2; ++k) {
-        bsf_scene_rng_t rng;
-        bsf_scan_t s = scan_of(&l);
         bsf_params_t p = bsf_params_default(BSF_METHOD_DEFAULT);
         p.fit_bin_length = k == 0 ? 0.03f : 1.0f;
-        bsf_scene_rng_seed(&rng, 91u);
-        TEST_ASSERT_EQUAL_INT(BSF_OK,
-                              bsf_scene_scan(&scene, &l, &rng, ranges, NULL, BSF_MAX_POINTS));
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
-        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        extract_params(&p, &l, 91u);
         TEST_ASSERT_EQUAL_UINT32(1u, res.n_features);
         visits[k] = res.stats.n_fit_visits;
     }
