@@ -947,29 +947,50 @@ static uint16_t beam_of_point(const bsf_extractor_t *ex, const bsf_segment_t *s,
     }
 }
 
+/* The point at parameter t (PDM's, 0..1) of the quadratic B-spline with
+ * control points ctrl[0..m), with what its derivative needs: the span's
+ * local u, its end factors k0 (1 on the first span, else 1/2) and k2 (1 on
+ * the last), and the differences a = ctrl[s] - ctrl[s+1], b = ctrl[s+2] -
+ * ctrl[s+1] (the span's basis in closed form, docs/DESIGN.md, appendix). */
+typedef struct {
+    float x, y, u, k0, k2, ax, ay, bx, by;
+} span_point_t;
+
+static BSF_COMPACT_INLINE void span_point(const bsf_point_t *ctrl, size_t m, float t,
+                                          span_point_t *c)
+{
+    const size_t last = m - 3u;
+    const float x = t * (float)(m - 2u);
+    size_t s = x > 0.0f ? (size_t)x : 0u;
+    float b0, b2;
+    s = s > last ? last : s;
+    c->u = x - (float)s;
+    c->k0 = s == 0u ? 1.0f : 0.5f;
+    c->k2 = s == last ? 1.0f : 0.5f;
+    b0 = c->k0 * (1.0f - c->u) * (1.0f - c->u);
+    b2 = c->k2 * c->u * c->u;
+    c->ax = ctrl[s].x - ctrl[s + 1u].x;
+    c->ay = ctrl[s].y - ctrl[s + 1u].y;
+    c->bx = ctrl[s + 2u].x - ctrl[s + 1u].x;
+    c->by = ctrl[s + 2u].y - ctrl[s + 1u].y;
+    c->x = ctrl[s + 1u].x + b0 * c->ax + b2 * c->bx;
+    c->y = ctrl[s + 1u].y + b0 * c->ay + b2 * c->by;
+}
+
 /* The point of pts[0..n) farthest from its footpoint on the curve ctrl[0..m)
- * (PDM's parameters t), as its squared distance; *at receives its index.
- * The span's basis in closed form (docs/DESIGN.md, appendix): k0 = 1 on the
- * first span, k2 = 1 on the last, 1/2 elsewhere. */
+ * (PDM's parameters t), as its squared distance; *at receives its index. */
 static float farthest_point(const bsf_point_t *pts, size_t n, const float *t,
                             const bsf_point_t *ctrl, size_t m, size_t *at)
 {
-    const size_t last = m - 3u;
     float worst = 0.0f;
     size_t i;
     *at = 0u;
     for (i = 0; i < n; ++i) {
-        const float x = t[i] * (float)(m - 2u);
-        size_t s = x > 0.0f ? (size_t)x : 0u;
-        float u, b0, b2, dx, dy, d2;
-        s = s > last ? last : s;
-        u = x - (float)s;
-        b0 = (s == 0u ? 1.0f : 0.5f) * (1.0f - u) * (1.0f - u);
-        b2 = (s == last ? 1.0f : 0.5f) * u * u;
-        dx = ctrl[s + 1u].x + b0 * (ctrl[s].x - ctrl[s + 1u].x) +
-             b2 * (ctrl[s + 2u].x - ctrl[s + 1u].x) - pts[i].x;
-        dy = ctrl[s + 1u].y + b0 * (ctrl[s].y - ctrl[s + 1u].y) +
-             b2 * (ctrl[s + 2u].y - ctrl[s + 1u].y) - pts[i].y;
+        span_point_t c;
+        float dx, dy, d2;
+        span_point(ctrl, m, t[i], &c);
+        dx = c.x - pts[i].x;
+        dy = c.y - pts[i].y;
         d2 = dx * dx + dy * dy;
         if (d2 > worst) {
             worst = d2;
@@ -1026,25 +1047,14 @@ static BSF_COMPACT_NOINLINE size_t bin_walk(bsf_extractor_t *ex, bsf_point_t *pt
             pts[j].x = mx / (float)(hi - lo);
             pts[j].y = my / (float)(hi - lo);
         } else {
-            /* The span's basis and its derivative in u (farthest_point). */
-            const size_t last = m - 3u;
-            const float x = t[j] * (float)(m - 2u);
-            size_t s = x > 0.0f ? (size_t)x : 0u;
-            float u, k0, k2, b0, b2, ax, ay, bx, by, cx, cy, tx, ty, inv;
-            s = s > last ? last : s;
-            u = x - (float)s;
-            k0 = s == 0u ? 1.0f : 0.5f;
-            k2 = s == last ? 1.0f : 0.5f;
-            b0 = k0 * (1.0f - u) * (1.0f - u);
-            b2 = k2 * u * u;
-            ax = ctrl[s].x - ctrl[s + 1u].x;
-            ay = ctrl[s].y - ctrl[s + 1u].y;
-            bx = ctrl[s + 2u].x - ctrl[s + 1u].x;
-            by = ctrl[s + 2u].y - ctrl[s + 1u].y;
-            cx = ctrl[s + 1u].x + b0 * ax + b2 * bx;
-            cy = ctrl[s + 1u].y + b0 * ay + b2 * by;
-            tx = k2 * u * bx - k0 * (1.0f - u) * ax;
-            ty = k2 * u * by - k0 * (1.0f - u) * ay;
+            /* The bin's footpoint and the curve's derivative in u there. */
+            span_point_t c;
+            float cx, cy, tx, ty, inv;
+            span_point(ctrl, m, t[j], &c);
+            cx = c.x;
+            cy = c.y;
+            tx = c.k2 * c.u * c.bx - c.k0 * (1.0f - c.u) * c.ax;
+            ty = c.k2 * c.u * c.by - c.k0 * (1.0f - c.u) * c.ay;
             inv = tx * tx + ty * ty;
             inv = hi - lo > 1u && inv > 0.0f ? 1.0f / inv : 0.0f;
             for (i = lo; i < hi; ++i) {
