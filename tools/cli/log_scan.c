@@ -18,6 +18,18 @@ int init_extractor_params(const bsf_params_t *params, int timed)
         p.clock_hz = 1000000000u;
     }
     st = bsf_extractor_init(&g_ex, &p);
+    if (st == BSF_ERR_UNSUPPORTED && !((BSF_CONFIG_METHODS >> (unsigned)p.method) & 1u)) {
+        /* Name what is missing and how to get it: the status alone cannot. */
+        fail_msg("cannot initialise the extractor: the method %s is not compiled into this build "
+                 "(configure with -DBSF_METHODS=all or a list that names it)",
+                 bsf_method_name(p.method));
+        return -1;
+    }
+    if (st == BSF_ERR_UNSUPPORTED && p.fit_bin_length != 0.0f && !BSF_CONFIG_FIT_BINS) {
+        fail_msg("cannot initialise the extractor: the fit on bin means (--fit-bin-length) is not "
+                 "compiled into this build (configure with -DBSF_FIT_BINS=ON)");
+        return -1;
+    }
     if (st != BSF_OK) {
         fail_msg("cannot initialise the extractor: %s", bsf_status_str(st));
         return -1;
