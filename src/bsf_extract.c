@@ -725,6 +725,13 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     float sy;
     float s;
     size_t k;
+    sx = p[0].x - p[step].x;
+    sy = p[0].y - p[step].y;
+    /* blend mode, first (cheap, most ends fail it): p[0] nearer the sensor
+     * than p[step] along p[step]'s beam */
+    if (apex != NULL && run > TAIL_MIN_RUN && !(sx * p[step].x + sy * p[step].y < 0.0f)) {
+        return 0;
+    }
     for (k = 0; k <= run; ++k) {
         w[k] = p[(ptrdiff_t)(k + gap) * step];
     }
@@ -744,8 +751,6 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
         d = bsf_side_distance(&l, &p[0]);
         l.reach_nr = l.reach_i;
     }
-    sx = p[0].x - p[step].x;
-    sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
     /* The turn: p[0] off the line by its own return, or off p[step]'s
      * offset (two returns) by min_turn or more. */
@@ -773,7 +778,7 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
                       0.0f &&
                   apex->x * p[step].x + apex->y * p[step].y > 0.0f &&
                   sq_dist(apex, &p[step]) <= 4.0f * sq_dist(&p[2 * step], &p[step]);
-        if (between || run <= TAIL_MIN_RUN || !(sx * p[step].x + sy * p[step].y < 0.0f)) {
+        if (between || run <= TAIL_MIN_RUN) {
             return between && run <= TAIL_MIN_RUN;
         }
         d = d1; /* blend mode: p[0] judged by its offset from p[step]'s */
