@@ -699,7 +699,16 @@ static float sq_dist(const bsf_point_t *a, const bsf_point_t *b)
  * p[0] at most half of it (a run at grazing incidence, the second surface
  * seen square-on). A smooth surface (a pillar's silhouette) bends by
  * degrees and keeps its spacing; a second surface starts where the returns
- * jump or their spacing changes at once. */
+ * jump or their spacing changes at once. With apex and a run longer than
+ * TAIL_MIN_RUN (blend mode) it asks whether p[step] is a blend of two
+ * ranges and p[0] a return of a nearer surface: p[step] off the run's line
+ * by the bound above, p[0] turning from it by min_turn, nearer the sensor
+ * than p[step] along p[step]'s beam and off the line further on the same
+ * side, the sensor's, by split_sigmas noise deviations (no line error:
+ * both share it) and split_min, and their line crossing the run's line
+ * anywhere but near and between the beams of p[2 step] and p[step], where
+ * two returns of a second wall at a concave corner meet it (no spacing
+ * test; apex is scratch). */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline)) /* its frame stays off the fit's deepest call chain */
 #endif
@@ -716,6 +725,13 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
     float sy;
     float s;
     size_t k;
+    sx = p[0].x - p[step].x;
+    sy = p[0].y - p[step].y;
+    /* blend mode, first (cheap, most ends fail it): p[0] nearer the sensor
+     * than p[step] along p[step]'s beam */
+    if (apex != NULL && run > TAIL_MIN_RUN && !(sx * p[step].x + sy * p[step].y < 0.0f)) {
+        return 0;
+    }
     for (k = 0; k <= run; ++k) {
         w[k] = p[(ptrdiff_t)(k + gap) * step];
     }
@@ -735,8 +751,6 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
         d = bsf_side_distance(&l, &p[0]);
         l.reach_nr = l.reach_i;
     }
-    sx = p[0].x - p[step].x;
-    sy = p[0].y - p[step].y;
     s = bsf_sinf(lc->min_turn);
     /* The turn: p[0] off the line by its own return, or off p[step]'s
      * offset (two returns) by min_turn or more. */
@@ -745,9 +759,11 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
         return 0;
     }
     if (apex != NULL) {
+        int between;
         d = d - d1; /* p[step]'s offset */
         if (!(d * d1 > 0.0f &&
-              (sq_dist(&p[2 * step], &p[step]) > 4.0f * sq_dist(&p[2 * step], &p[3 * step]) ||
+              (run > TAIL_MIN_RUN ||
+               sq_dist(&p[2 * step], &p[step]) > 4.0f * sq_dist(&p[2 * step], &p[3 * step]) ||
                4.0f * sq_dist(&p[step], &p[0]) < sq_dist(&p[2 * step], &p[3 * step])))) {
             return 0;
         }
@@ -757,11 +773,16 @@ tail_end(const bsf_point_t *p, ptrdiff_t step, size_t gap, size_t run, float noi
         /* Between the two beams, on the sensor's side (not in the
          * opposite wedge behind it), and near: lines that barely turn
          * (a small min_turn) cross far away, or not at all (NaN). */
-        return (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
-                       (apex->x * p[step].y - apex->y * p[step].x) >
-                   0.0f &&
-               apex->x * p[step].x + apex->y * p[step].y > 0.0f &&
-               sq_dist(apex, &p[step]) <= 4.0f * sq_dist(&p[2 * step], &p[step]);
+        between = (p[2 * step].x * apex->y - p[2 * step].y * apex->x) *
+                          (apex->x * p[step].y - apex->y * p[step].x) >
+                      0.0f &&
+                  apex->x * p[step].x + apex->y * p[step].y > 0.0f &&
+                  sq_dist(apex, &p[step]) <= 4.0f * sq_dist(&p[2 * step], &p[step]);
+        if (between || run <= TAIL_MIN_RUN) {
+            return between && run <= TAIL_MIN_RUN;
+        }
+        d = d1; /* blend mode: p[0] judged by its offset from p[step]'s */
+        l.reach_nr = 1.0f;
     }
     /* The sensor (the origin) lies on the side of the line where
      * -(nx cx + ny cy) is positive. */
@@ -804,7 +825,13 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
  * half a metre apart) and the next wall (3-4 returns a tenth of that
  * apart), the two returns of one wall nearest the corner judged against
  * the other wall's line; the shortest run that passes puts the vertex
- * between the last sparse and the first dense return. Returns the
+ * between the last sparse and the first dense return. Before the tail
+ * test, an end with no corner within 6 returns asks whether its second
+ * return is a blend (a mixed pixel) and the end a return of a nearer
+ * surface (tail_end's blend mode, judged by the tail rule's run one return
+ * further in, at least 6 returns): a side wall at grazing incidence or an
+ * occluder whose last return SVED joined through the blend. Both leave:
+ * a curve bent to reach them swings through free space. Returns the
  * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
  * wrote them, or that one vertex). */
 static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
@@ -837,6 +864,9 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
         size_t d1 = n;
         size_t d2 = n - 2u;
         size_t side;
+        size_t k;
+        const bsf_point_t *q = e ? &pts[n - 1u] : pts;
+        bsf_point_t a;
         if (n_vertex > 0u) {
             d1 = e ? n - 1u - pos[n_vertex - 1u] : pos[0];
         }
@@ -844,16 +874,21 @@ static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_seg
             d2 = e ? n - 1u - pos[n_vertex - 2u] : pos[1];
         }
         side = d1 == 2u ? d2 - 1u : (d1 <= run + 1u ? d1 - 1u : run);
-        if ((side >= TAIL_MIN_RUN ||
-             (side >= TAIL_FLOAT_RUN &&
-              floating_end(&ex->points, e ? s->last : s->first, e ? 1 : -1))) &&
-            tail_end(e ? &pts[n - 1u] : pts, e ? -1 : 1, d1 == 2u, side < run ? side : run,
-                     ex->noise2, &ex->params.lc, NULL)) {
-            if (e) {
-                *hi = n - 2u;
-            } else {
-                *lo = 1u;
+        /* k 2: the blend and the end leave; k 1: the end (a tail) */
+        for (k = 2u; k > 0u; --k) {
+            if ((k == 2u ? d1 != 2u && side > TAIL_MIN_RUN
+                         : side >= TAIL_MIN_RUN ||
+                               (side >= TAIL_FLOAT_RUN &&
+                                floating_end(&ex->points, e ? s->last : s->first, e ? 1 : -1))) &&
+                tail_end(q, e ? -1 : 1, d1 == 2u || k == 2u, side < run ? side : run, ex->noise2,
+                         &ex->params.lc, k == 2u ? &a : NULL)) {
+                break;
             }
+        }
+        if (e) {
+            *hi = n - 1u - k;
+        } else {
+            *lo = k;
         }
     }
     return n_vertex;

@@ -1133,6 +1133,67 @@ static void test_fit_bins_follow_a_curved_run_not_its_chord(void)
     TEST_ASSERT_TRUE(4u * visits[0] > 5u * visits[1]);
 }
 
+/* bench_truth's corridor at 361 beams (0.75 degrees), pose 23 of 40, 1 cm
+ * noise: the end wall 19 m away gives 6-7 returns (beams 155-161) and the
+ * side wall, at grazing incidence, one return 18.2 m away beside them
+ * (beam 154; the one before it is 2.4 m nearer). Beam 155 reads a blend of
+ * the two, 18.4 m (a quarter of the way from the side wall to the end
+ * wall, as bench_truth's mixed pixels put it): SVED joins the side-wall
+ * return through it to the end wall, and the end wall's curve, bent to
+ * reach both, lies 27 cm off the walls. Both leave the feature: it starts
+ * at beam 156 and its curve stays within 5 cm of the walls (3.3 cm), for
+ * every noise draw. */
+static void test_a_blend_second_from_the_end_leaves_the_feature_with_the_end(void)
+{
+    static float clean[BSF_MAX_POINTS];
+    static int16_t hits[BSF_MAX_POINTS];
+    const bsf_params_t p = bsf_params_default(BSF_METHOD_LC_SVED_PDM);
+    const bsf_scene_pose_t pose = bench_truth_corridor_pose(23, 40);
+    bsf_lidar_t l = bsf_lidar_default(pose.x, pose.y, pose.theta, 361u,
+                                      360.0 * 0.75 * 3.14159265358979 / 180.0);
+    double worst = 0.0;
+    uint64_t seed;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bench_truth_corridor(&scene));
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extractor_init(&ex, &p));
+    l.noise_sigma = 0.0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scene_scan(&scene, &l, NULL, clean, hits, BSF_MAX_POINTS));
+    /* the side wall's last return, then the end wall's 7 */
+    TEST_ASSERT_TRUE(hits[154] >= 0 && hits[155] >= 0 && hits[154] != hits[155]);
+    TEST_ASSERT_TRUE(hits[155] == hits[161] && clean[153] < clean[154] - 2.0f);
+    for (seed = 0u; seed < 10u; ++seed) {
+        bsf_scene_rng_t rng;
+        bsf_scan_t s;
+        size_t i;
+        size_t fi;
+        int found = 0;
+        double rms;
+        double max_d;
+        bsf_scene_rng_seed(&rng, 2700u + seed);
+        for (i = 0; i < l.n_beams; ++i) {
+            ranges[i] = clean[i];
+            if (hits[i] >= 0) {
+                ranges[i] = (float)((double)clean[i] + 0.01 * bsf_scene_rng_gauss(&rng));
+            }
+        }
+        ranges[155] = ranges[154] + 0.24f * (clean[155] - ranges[154]);
+        s = scan_of(&l);
+        TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_extract(&ex, &s, &res));
+        for (fi = 0; fi < res.n_features; ++fi) {
+            const bsf_feature_t *f = &res.features[fi];
+            if (f->first_beam <= 158u && f->last_beam >= 158u) {
+                TEST_ASSERT_EQUAL_UINT16_MESSAGE(156u, f->first_beam,
+                                                 "the blend or the side wall's return is fitted");
+                found = 1;
+            }
+        }
+        TEST_ASSERT_TRUE(found);
+        curve_to_truth(&l, &rms, &max_d);
+        worst = max_d > worst ? max_d : worst;
+    }
+    printf("blend second from the end: worst %.3f m\n", worst);
+    TEST_ASSERT_TRUE_MESSAGE(worst < 0.05, "a curve reaches out to a blend and a side wall");
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -1159,5 +1220,6 @@ int main(void)
     RUN_TEST(test_fit_bins_follow_a_curved_run_not_its_chord);
     RUN_TEST(test_a_wall_seen_between_two_occluders_keeps_its_short_piece);
     RUN_TEST(test_a_wall_seen_past_two_occluders_takes_a_short_piece_at_its_first_end);
+    RUN_TEST(test_a_blend_second_from_the_end_leaves_the_feature_with_the_end);
     return UNITY_END();
 }
