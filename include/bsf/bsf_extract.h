@@ -185,6 +185,13 @@ BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
  */
 typedef struct {
     bsf_params_t params;
+    /* The scalars before the arrays: Thumb-2 loads a field within 4 KB of a
+     * pointer (1 KB for a float) in one instruction, one farther away takes
+     * an address computation first (docs/PERFORMANCE.md, section 3). */
+    size_t n_keypoints;
+    size_t n_segments;
+    float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
+    uint32_t ready; /**< set by a successful init */
     bsf_points_t points;
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
@@ -220,10 +227,6 @@ typedef struct {
             } use;
         } seg;
     } scratch;
-    size_t n_keypoints;
-    size_t n_segments;
-    float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
-    uint32_t ready; /**< set by a successful init */
 } bsf_extractor_t;
 
 /**
