@@ -188,7 +188,7 @@ typedef struct {
     /* The scalars before the arrays: Thumb-2 loads a field within 4 KB of a
      * pointer (1 KB for a float) in one instruction, one farther away takes
      * an address computation first (docs/PERFORMANCE.md, section 3); the
-     * small arrays next, the points (14 KB) last before the scratch. */
+     * small arrays next, the points (14 KB) last. */
     size_t n_keypoints;
     size_t n_segments;
     float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
@@ -196,7 +196,6 @@ typedef struct {
     bsf_segment_t segments[BSF_MAX_SEGMENTS];
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
-    bsf_points_t points;
     /** Stage scratch. The corner stage runs before segmentation, and
      *  segmentation before fitting, so their working memory overlaps: the
      *  corner detectors' work, or the per-beam segment labels (written by
@@ -228,6 +227,7 @@ typedef struct {
             } use;
         } seg;
     } scratch;
+    bsf_points_t points;
 } bsf_extractor_t;
 
 /**
