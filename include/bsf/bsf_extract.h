@@ -212,9 +212,9 @@ typedef struct {
             union {
                 bsf_segment_t all[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
                 struct {
-                    bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
-                    uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
+                    uint16_t vertex_pos[BSF_MAX_KEYPOINTS];       /**< vertices, in seg_points */
                     bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
+                    bsf_point_t seg_points[BSF_MAX_POINTS];       /**< the segment's valid points */
                     bsf_pdm_work_t pdm;
                     bsf_pdm_params_t pdm_params; /**< the fit's: params.pdm, max_passes set */
                     bsf_pdm_info_t pdm_info;     /**< the fit's outcome */
