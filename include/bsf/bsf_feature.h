@@ -82,9 +82,9 @@ typedef struct {
     uint16_t n_features;
     uint16_t n_ctrl;
     bsf_stats_t stats;
-    bsf_feature_t features[BSF_MAX_SEGMENTS];
-    bsf_point_t ctrl[BSF_MAX_CTRL_POINTS];       /**< control points, sensor frame, metres */
     uint8_t ctrl_is_vertex[BSF_MAX_CTRL_POINTS]; /**< 1 for both copies of a vertex */
+    bsf_feature_t features[BSF_MAX_SEGMENTS];
+    bsf_point_t ctrl[BSF_MAX_CTRL_POINTS]; /**< control points, sensor frame, metres */
 } bsf_result_t;
 
 BSF_END_DECLS
