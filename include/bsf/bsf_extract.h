@@ -185,10 +185,17 @@ BSF_NODISCARD bsf_status_t bsf_params_check(const bsf_params_t *params);
  */
 typedef struct {
     bsf_params_t params;
-    bsf_points_t points;
+    /* The scalars before the arrays: Thumb-2 loads a field within 4 KB of a
+     * pointer (1 KB for a float) in one instruction, one farther away takes
+     * an address computation first (docs/PERFORMANCE.md, section 3); the
+     * small arrays next, the points (14 KB) last. */
+    size_t n_keypoints;
+    size_t n_segments;
+    float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
+    uint32_t ready; /**< set by a successful init */
+    bsf_segment_t segments[BSF_MAX_SEGMENTS];
     bsf_keypoint_t keypoints[BSF_MAX_KEYPOINTS];
     uint16_t interest[BSF_MAX_KEYPOINTS]; /**< keypoint beam indices, ascending */
-    bsf_segment_t segments[BSF_MAX_SEGMENTS];
     /** Stage scratch. The corner stage runs before segmentation, and
      *  segmentation before fitting, so their working memory overlaps: the
      *  corner detectors' work, or the per-beam segment labels (written by
@@ -205,9 +212,9 @@ typedef struct {
             union {
                 bsf_segment_t all[BSF_MAX_POINTS]; /**< every kept segment, before the cap */
                 struct {
-                    bsf_point_t seg_points[BSF_MAX_POINTS]; /**< one segment's valid points */
-                    uint16_t vertex_pos[BSF_MAX_KEYPOINTS]; /**< its vertices, in seg_points */
+                    uint16_t vertex_pos[BSF_MAX_KEYPOINTS];       /**< vertices, in seg_points */
                     bsf_point_t vertex_anchor[BSF_MAX_KEYPOINTS]; /**< their anchors (LC) */
+                    bsf_point_t seg_points[BSF_MAX_POINTS];       /**< the segment's valid points */
                     bsf_pdm_work_t pdm;
                     bsf_pdm_params_t pdm_params; /**< the fit's: params.pdm, max_passes set */
                     bsf_pdm_info_t pdm_info;     /**< the fit's outcome */
@@ -220,10 +227,7 @@ typedef struct {
             } use;
         } seg;
     } scratch;
-    size_t n_keypoints;
-    size_t n_segments;
-    float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
-    uint32_t ready; /**< set by a successful init */
+    bsf_points_t points;
 } bsf_extractor_t;
 
 /**

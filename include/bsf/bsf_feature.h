@@ -77,12 +77,14 @@ typedef struct {
 
 /** All features of one scan. Fixed size; lives in caller memory. */
 typedef struct {
-    bsf_feature_t features[BSF_MAX_SEGMENTS];
-    bsf_point_t ctrl[BSF_MAX_CTRL_POINTS];       /**< control points, sensor frame, metres */
-    uint8_t ctrl_is_vertex[BSF_MAX_CTRL_POINTS]; /**< 1 for both copies of a vertex */
+    /* The counts first: near the struct's start a load is one instruction
+     * on Thumb-2 (docs/PERFORMANCE.md, section 3). */
     uint16_t n_features;
     uint16_t n_ctrl;
     bsf_stats_t stats;
+    uint8_t ctrl_is_vertex[BSF_MAX_CTRL_POINTS]; /**< 1 for both copies of a vertex */
+    bsf_feature_t features[BSF_MAX_SEGMENTS];
+    bsf_point_t ctrl[BSF_MAX_CTRL_POINTS]; /**< control points, sensor frame, metres */
 } bsf_result_t;
 
 BSF_END_DECLS

@@ -135,9 +135,6 @@ BSF_NODISCARD bsf_status_t bsf_pdm_params_check(const bsf_pdm_params_t *p);
  * after a call describes the last fit (read-only for the caller).
  */
 typedef struct {
-    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
-    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
-    float arc[BSF_MAX_POINTS];    /**< arc length of each point from its fragment's first point */
     float band[BSF_MAX_CTRL_PER_FEATURE * 3];   /**< normal matrix, lower band (bw 2) */
     float factor[BSF_MAX_CTRL_PER_FEATURE * 3]; /**< its Cholesky factor */
     float rhs_x[BSF_MAX_CTRL_PER_FEATURE];      /**< right-hand sides, then solutions */
@@ -157,6 +154,11 @@ typedef struct {
     uint16_t n_history;                        /**< entries in rms_history */
     uint16_t n_fragments;
     uint16_t last_refined; /**< fragment that received the last refinement point, or 0xFFFF */
+    /* The per-point arrays last, so the small fields above stay within one
+     * load's reach of the struct's start (docs/PERFORMANCE.md, section 3). */
+    float t[BSF_MAX_POINTS];      /**< footpoint parameter of each point */
+    float t_prev[BSF_MAX_POINTS]; /**< parameters before the current iteration */
+    float arc[BSF_MAX_POINTS];    /**< arc length of each point from its fragment's first point */
 } bsf_pdm_work_t;
 
 /** Outcome details of one bsf_pdm_fit call. */

@@ -160,16 +160,18 @@ typedef struct {
      *  noise where the beams are dense) averaged over their points; 0 when
      *  no run was long enough to judge */
     float noise2;
-    uint16_t run[BSF_MAX_POINTS];     /**< beam index of each valid point of the current run */
-    uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
-    uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
-    uint16_t stack_b[BSF_MAX_POINTS];
+    /* Arrays in the order that measured smallest on the M4F (the byte
+     * array and the run first; docs/PERFORMANCE.md, section 3). */
+    uint8_t is_brk[BSF_MAX_POINTS];     /**< split marks, positions in run; then each split's
+                                             last verdict (1 corner, 2 boundary) */
+    uint16_t run[BSF_MAX_POINTS];       /**< beam index of each valid point of the current run */
     uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner or
                                              boundary verdict */
     uint16_t judged_hi[BSF_MAX_POINTS];
+    uint16_t brk[BSF_MAX_POINTS];     /**< split points, positions in run, ascending */
+    uint16_t stack_a[BSF_MAX_POINTS]; /**< pending pieces of the split */
+    uint16_t stack_b[BSF_MAX_POINTS];
     bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
-    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run; then each split's
-                                          last verdict (1 corner, 2 boundary) */
     /** summaries of the current run's points, block k holding positions
      *  k * BSF_LC_BLOCK on (long runs only) */
     bsf_lc_block_t block[(BSF_MAX_POINTS + BSF_LC_BLOCK - 1) / BSF_LC_BLOCK];
