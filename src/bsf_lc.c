@@ -2146,6 +2146,13 @@ static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_l
         if (!pts->valid[i]) {
             continue;
         }
+#if !BSF_CONFIG_COMPACT
+        /* lc_joins' first test here, as most beams pass it: no call */
+        if (i != prev && dist2(pts->pt[prev], pts->pt[i]) <= p->jump_a * p->jump_a) {
+            prev = i;
+            continue;
+        }
+#endif
         if (i != prev && !lc_joins(pts, p, grazing_memo, prev, i) &&
             past_occluder(pts, p, prev, i) == i) {
             return i;
@@ -2264,6 +2271,27 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
         }
         if (step < pts->count) {
             work->run[m++] = (uint16_t)i;
+#if !BSF_CONFIG_COMPACT && !defined(LC_SSE2)
+            {
+                /* Speed only, same runs: the beams after i (before the
+                 * pass's end and the scan's) that are valid and within
+                 * jump_a of the one before join here, as the steps above
+                 * would join them, with the last point in registers (the
+                 * SSE2 form takes four at a time above). */
+                const size_t left = pts->count - 1u - (step > i ? step : i);
+                const size_t stop = i + left;
+                const uint8_t *valid = pts->valid;
+                const bsf_point_t *pt = pts->pt;
+                uint16_t *run = work->run;
+                bsf_point_t last = pt[i];
+                size_t k = i;
+                while (k < stop && valid[k + 1u] && dist2(last, pt[k + 1u]) <= jump_a2) {
+                    last = pt[++k];
+                    run[m++] = (uint16_t)k;
+                }
+                step += k - i;
+            }
+#endif
         }
     }
     if (c.start > 0u) {
