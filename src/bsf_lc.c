@@ -1785,30 +1785,45 @@ static void keypoints_down(bsf_keypoint_t *out, size_t slot, size_t n)
 #endif
 
 /* Douglas-Peucker split of run positions 0..m-1 with an explicit stack;
- * returns the number of splits, ascending in w->brk. */
+ * returns the number of splits, ascending in w->brk. The left piece of a
+ * split is done first and its right piece is stacked with its ends swapped
+ * (a > b, never a piece's own order), so popping it emits the split in
+ * order: no marks to clear and gather. */
 
 static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, float tol)
 {
     size_t top = 0;
     size_t nb = 0;
     size_t i;
-    memset(w->is_brk, 0, m);
     w->stack_a[top] = 0u;
     w->stack_b[top] = (uint16_t)(m - 1u);
     ++top;
     while (top > 0u) {
-        const size_t a = w->stack_a[--top];
-        const size_t b = w->stack_b[top];
-        const bsf_point_t pa = pts->pt[w->run[a]];
-        const bsf_point_t pb = pts->pt[w->run[b]];
-        const float ex = pb.x - pa.x;
-        const float ey = pb.y - pa.y;
-        const float len = sqrtf(ex * ex + ey * ey);
+        size_t a = w->stack_a[--top];
+        size_t b = w->stack_b[top];
+        bsf_point_t pa;
+        bsf_point_t pb;
+        float ex;
+        float ey;
+        float len;
         float dmax = 0.0f;
-        size_t imax = a;
+        size_t imax;
+        if (a > b) {
+            /* the right piece of the split at b: everything left of b is done */
+            w->brk[nb++] = (uint16_t)b;
+            i = a;
+            a = b;
+            b = i;
+        }
         if (b < a + 2u) {
             continue;
         }
+        pa = pts->pt[w->run[a]];
+        pb = pts->pt[w->run[b]];
+        ex = pb.x - pa.x;
+        ey = pb.y - pa.y;
+        len = sqrtf(ex * ex + ey * ey);
+        imax = a;
         i = a + 1u;
 #ifdef LC_SSE2
         if (len > 0.0f) {
@@ -1848,35 +1863,14 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
             }
         }
         if (dmax > tol) {
-            w->is_brk[imax] = 1u;
             /* Each pushed piece is a strict sub-range with disjoint interior,
              * so the stack never holds more than m entries. */
+            w->stack_a[top] = (uint16_t)b;
+            w->stack_b[top] = (uint16_t)imax;
+            ++top;
             w->stack_a[top] = (uint16_t)a;
             w->stack_b[top] = (uint16_t)imax;
             ++top;
-            w->stack_a[top] = (uint16_t)imax;
-            w->stack_b[top] = (uint16_t)b;
-            ++top;
-        }
-    }
-    i = 0;
-#ifdef LC_SSE2
-    /* sixteen marks per step, most of them all clear */
-    for (; i + 16u <= m; i += 16u) {
-        unsigned set = 0xFFFFu ^ (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(
-                                     _mm_loadu_si128((const __m128i *)(const void *)&w->is_brk[i]),
-                                     _mm_setzero_si128()));
-        size_t k;
-        for (k = i; set != 0u; ++k, set >>= 1) {
-            if (set & 1u) {
-                w->brk[nb++] = (uint16_t)k;
-            }
-        }
-    }
-#endif
-    for (; i < m; ++i) {
-        if (w->is_brk[i]) {
-            w->brk[nb++] = (uint16_t)i;
         }
     }
     return nb;

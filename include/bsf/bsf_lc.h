@@ -168,7 +168,7 @@ typedef struct {
                                              boundary verdict */
     uint16_t judged_hi[BSF_MAX_POINTS];
     bsf_point_t rel[BSF_MAX_POINTS]; /**< run points relative to the apex being judged */
-    uint8_t is_brk[BSF_MAX_POINTS];  /**< split marks, positions in run; then each split's
+    uint8_t is_brk[BSF_MAX_POINTS];  /**< at each split's position in run, its
                                           last verdict (1 corner, 2 boundary) */
     /** summaries of the current run's points, block k holding positions
      *  k * BSF_LC_BLOCK on (long runs only) */
