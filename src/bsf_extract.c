@@ -890,6 +890,30 @@ static BSF_COMPACT_INLINE size_t gather_segment(bsf_extractor_t *ex, const bsf_s
         if (b == 0u && first > 0u) {
             k = 0u; /* wrapped through the seam */
         }
+#if !BSF_CONFIG_COMPACT
+        {
+            /* Speed only, the same points: the beams before the next
+             * interest beam, the last beam and the seam need no keypoint
+             * or end test (k skips the interest beams before b early, as
+             * the test below would on the next beam of the segment). */
+            const uint16_t *label = ex->scratch.seg.label;
+            const bsf_point_t *pt = ex->points.pt;
+            bsf_point_t *out = ex->scratch.seg.use.fit.seg_points;
+            const uint16_t want = (uint16_t)first;
+            size_t end = b <= last ? last : count - 1u;
+            while (k < n_keypoints && ex->interest[k] < b) {
+                ++k;
+            }
+            if (k < n_keypoints && ex->interest[k] < end) {
+                end = ex->interest[k];
+            }
+            for (; b < end; ++b) {
+                if (label[b] == want) {
+                    out[n++] = pt[b];
+                }
+            }
+        }
+#endif
         if (ex->scratch.seg.label[b] != first) {
             if (b == last) {
                 break;
