@@ -1161,6 +1161,34 @@ fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t 
     size_t beam;
     size_t k = 0u;
     float sum;
+#if !BSF_CONFIG_COMPACT
+    {
+        /* Speed only, the same points: the points before a counted in a
+         * loop of their own, the arrays in locals (the point stores made
+         * the compiler reload them at every beam). */
+        const uint16_t *label = ex->scratch.seg.label;
+        const bsf_point_t *pt = ex->points.pt;
+        const uint16_t want = s->first;
+        const size_t count = ex->points.count;
+        const size_t stop = a + n;
+        beam = s->first;
+        while (k < a) { /* the points before a: counted only */
+            k += label[beam] == want ? 1u : 0u;
+            if (++beam == count) {
+                beam = 0u;
+            }
+        }
+        while (k < stop) {
+            if (label[beam] == want) {
+                pts[k - a] = pt[beam];
+                ++k;
+            }
+            if (++beam == count) {
+                beam = 0u;
+            }
+        }
+    }
+#else
     for (beam = s->first; k < a + n; beam = beam + 1u < ex->points.count ? beam + 1u : 0u) {
         if (ex->scratch.seg.label[beam] == s->first) {
             if (k >= a) {
@@ -1169,6 +1197,7 @@ fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t 
             ++k;
         }
     }
+#endif
     if (ctrl == NULL) {
         return 0.0f;
     }
