@@ -1050,6 +1050,56 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         if (label != NULL) {
             label[b] = (uint16_t)open[0].first;
         }
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+        if (n_open == 1u && (!reject_mixed || marks != NULL)) {
+            /* Speed only, same segments: with one open segment (no end to
+             * search, none to expire), the next beams before the pass's
+             * end and the scan's, each valid, not marked mixed and within
+             * the radius's floor of the segment's end, continue it as the
+             * steps above would; an invalid beam is passed over as there. */
+            const size_t stop = pts->count - 1u - (j > b ? j : b); /* beams left */
+            const uint8_t *valid = pts->valid;
+            const bsf_point_t *pt = pts->pt;
+            const uint16_t first = (uint16_t)open[0].first;
+            bsf_point_t end = q;
+            size_t t = 0u;
+            size_t n_more = 0u;
+            size_t last = b;
+            while (t < stop) {
+                const size_t c = b + t + 1u;
+                float dx;
+                float dy;
+                if (!valid[c]) {
+                    ++t;
+                    continue;
+                }
+                if (reject_mixed && ((marks[c / 8u] >> (c % 8u)) & 1u) != 0u) {
+                    break;
+                }
+                dx = pt[c].x - end.x;
+                dy = pt[c].y - end.y;
+                if (!(dx * dx + dy * dy <= a2)) {
+                    break;
+                }
+                end = pt[c];
+                last = c;
+                ++n_more;
+                if (label != NULL) {
+                    label[c] = first;
+                }
+                ++t;
+            }
+            if (n_more > 0u) {
+                open[0].last = (uint32_t)last;
+                open[0].last_pos = (uint32_t)(j + (last - b));
+                open[0].n += (uint32_t)n_more;
+                open[0].end = end;
+            }
+            /* the beams passed over (invalid ones after the last joined
+             * included) are steps the loop would only skip */
+            j += last - b;
+        }
+#endif
     }
     /* Close the rest, oldest first. */
     while (n_open > 0u) {
