@@ -2132,21 +2132,38 @@ static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_l
                                             uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
+#if !BSF_CONFIG_COMPACT
+    const size_t end = prev;
+    const float jump_a2 = p->jump_a * p->jump_a;
+#endif
     size_t i;
     if (prev == pts->count) {
         return 0u;
     }
     for (i = 0; i < pts->count; ++i) {
+#if !BSF_CONFIG_COMPACT
+        {
+            /* Speed only: the valid beams before the last one within
+             * jump_a of the valid beam before them (lc_joins' first test)
+             * join in a loop, the last point in registers. */
+            const uint8_t *valid = pts->valid;
+            const bsf_point_t *pt = pts->pt;
+            bsf_point_t at = pt[prev];
+            while (i < end) {
+                if (valid[i]) {
+                    if (!(dist2(at, pt[i]) <= jump_a2)) {
+                        break;
+                    }
+                    at = pt[i];
+                    prev = i;
+                }
+                ++i;
+            }
+        }
+#endif
         if (!pts->valid[i]) {
             continue;
         }
-#if !BSF_CONFIG_COMPACT
-        /* lc_joins' first test here, as most beams pass it: no call */
-        if (i != prev && dist2(pts->pt[prev], pts->pt[i]) <= p->jump_a * p->jump_a) {
-            prev = i;
-            continue;
-        }
-#endif
         if (i != prev && !lc_joins(pts, p, grazing_memo, prev, i) &&
             past_occluder(pts, p, prev, i) == i) {
             return i;

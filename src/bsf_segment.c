@@ -856,6 +856,7 @@ static int close_open(seg_sink_t *sink, const open_seg_t *s, uint16_t *label, si
 static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float cap2)
 {
     size_t prev = bsf_last_valid_beam(pts);
+    const size_t end = prev;
     size_t i;
     if (prev == pts->count) {
         return 0u;
@@ -863,6 +864,28 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
     for (i = 0; i < pts->count; ++i) {
         float dx;
         float dy;
+#if !BSF_CONFIG_COMPACT
+        {
+            /* Speed only: the valid beams before the last one within the
+             * radius's floor of the valid beam before them (within_radius'
+             * first test) join in a loop, the last point in registers. */
+            const uint8_t *valid = pts->valid;
+            const bsf_point_t *pt = pts->pt;
+            bsf_point_t at = pt[prev];
+            while (i < end) {
+                if (valid[i]) {
+                    dx = pt[i].x - at.x;
+                    dy = pt[i].y - at.y;
+                    if (!(dx * dx + dy * dy <= a2)) {
+                        break;
+                    }
+                    at = pt[i];
+                    prev = i;
+                }
+                ++i;
+            }
+        }
+#endif
         if (!pts->valid[i]) {
             continue;
         }
