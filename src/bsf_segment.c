@@ -779,6 +779,25 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
             }
         }
 #endif
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+        if (b >= 2u && b + 3u < pts->count) {
+            /* Speed only, same marks: the first test below (on the ranges
+             * alone) on the beams it passes, in a loop of its own. */
+            const float *range = pts->range;
+            const uint8_t *valid = pts->valid;
+            const size_t stop = pts->count - 3u;
+            const float a2 = rad.a2;
+            while (b < stop) {
+                if (valid[b]) {
+                    const float step = range[b + 1u] - range[b - 1u];
+                    if (!(step * step <= a2)) {
+                        break;
+                    }
+                }
+                ++b;
+            }
+        }
+#endif
         if (!pts->valid[b]) {
             continue;
         }
@@ -1080,23 +1099,23 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
              * end and the scan's, each valid, not marked mixed and within
              * the radius's floor of the segment's end, continue it as the
              * steps above would; an invalid beam is passed over as there. */
-            const size_t stop = pts->count - 1u - (j > b ? j : b); /* beams left */
+            const size_t cend = b + (pts->count - 1u - (j > b ? j : b)); /* last beam */
             const uint8_t *valid = pts->valid;
             const bsf_point_t *pt = pts->pt;
+            const uint8_t *mk = reject_mixed ? marks : NULL;
+            uint16_t *lab = label;
             const uint16_t first = (uint16_t)open[0].first;
             bsf_point_t end = q;
-            size_t t = 0u;
             size_t n_more = 0u;
             size_t last = b;
-            while (t < stop) {
-                const size_t c = b + t + 1u;
+            size_t c;
+            for (c = b + 1u; c <= cend; ++c) {
                 float dx;
                 float dy;
                 if (!valid[c]) {
-                    ++t;
                     continue;
                 }
-                if (reject_mixed && ((marks[c / 8u] >> (c % 8u)) & 1u) != 0u) {
+                if (mk != NULL && ((mk[c / 8u] >> (c % 8u)) & 1u) != 0u) {
                     break;
                 }
                 dx = pt[c].x - end.x;
@@ -1107,10 +1126,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
                 end = pt[c];
                 last = c;
                 ++n_more;
-                if (label != NULL) {
-                    label[c] = first;
+                if (lab != NULL) {
+                    lab[c] = first;
                 }
-                ++t;
             }
             if (n_more > 0u) {
                 open[0].last = (uint32_t)last;
