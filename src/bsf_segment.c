@@ -875,7 +875,9 @@ static int close_open(seg_sink_t *sink, const open_seg_t *s, uint16_t *label, si
 static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float cap2)
 {
     size_t prev = bsf_last_valid_beam(pts);
+#if !BSF_CONFIG_COMPACT
     const size_t end = prev;
+#endif
     size_t i;
     if (prev == pts->count) {
         return 0u;
