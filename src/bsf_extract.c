@@ -980,8 +980,15 @@ typedef struct {
     float x, y, u, k0, k2, ax, ay, bx, by;
 } span_point_t;
 
-static BSF_COMPACT_INLINE void span_point(const bsf_point_t *ctrl, size_t m, float t,
-                                          span_point_t *c)
+/* Inlined in the speed builds too: out of line, its result went through the
+ * stack at every bin of bin_walk and every point of farthest_point. */
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+#define SPAN_POINT_INLINE inline __attribute__((always_inline))
+#else
+#define SPAN_POINT_INLINE BSF_COMPACT_INLINE
+#endif
+static SPAN_POINT_INLINE void span_point(const bsf_point_t *ctrl, size_t m, float t,
+                                         span_point_t *c)
 {
     const size_t last = m - 3u;
     const float x = t * (float)(m - 2u);
