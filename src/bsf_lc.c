@@ -2294,11 +2294,28 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
                 const uint8_t *valid = pts->valid;
                 const bsf_point_t *pt = pts->pt;
                 uint16_t *run = work->run;
-                bsf_point_t last = pt[i];
+                bsf_point_t p0 = pt[i];
+                bsf_point_t p1;
                 size_t k = i;
-                while (k < stop && valid[k + 1u] && dist2(last, pt[k + 1u]) <= jump_a2) {
-                    last = pt[++k];
-                    run[m++] = (uint16_t)k;
+                /* two beams per round, the last point alternating between
+                 * p0 and p1 (no copy) */
+                for (;;) {
+                    if (k >= stop || !valid[k + 1u]) {
+                        break;
+                    }
+                    p1 = pt[k + 1u];
+                    if (!(dist2(p0, p1) <= jump_a2)) {
+                        break;
+                    }
+                    run[m++] = (uint16_t)++k;
+                    if (k >= stop || !valid[k + 1u]) {
+                        break;
+                    }
+                    p0 = pt[k + 1u];
+                    if (!(dist2(p1, p0) <= jump_a2)) {
+                        break;
+                    }
+                    run[m++] = (uint16_t)++k;
                 }
                 step += k - i;
             }
