@@ -2283,7 +2283,9 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
         if (step < pts->count) {
             work->run[m++] = (uint16_t)i;
 #if !BSF_CONFIG_COMPACT && !defined(LC_SSE2)
-            {
+            /* (only once i continued a run: where runs are a beam or two
+             * long, as in clutter, the loop would only test beams twice) */
+            if (m >= 2u) {
                 /* Speed only, same runs: the beams after i (before the
                  * pass's end and the scan's) that are valid and within
                  * jump_a of the one before join here, as the steps above
