@@ -925,6 +925,30 @@ static BSF_COMPACT_INLINE size_t gather_segment(bsf_extractor_t *ex, const bsf_s
         if (b == 0u && first > 0u) {
             k = 0u; /* wrapped through the seam */
         }
+#if !BSF_CONFIG_COMPACT
+        {
+            /* Speed only, the same points: the beams before the next
+             * interest beam, the last beam and the seam need no keypoint
+             * or end test (k skips the interest beams before b early, as
+             * the test below would on the next beam of the segment). */
+            const uint16_t *label = ex->scratch.seg.label;
+            const bsf_point_t *pt = ex->points.pt;
+            bsf_point_t *out = ex->scratch.seg.use.fit.seg_points;
+            const uint16_t want = (uint16_t)first;
+            size_t end = b <= last ? last : count - 1u;
+            while (k < n_keypoints && ex->interest[k] < b) {
+                ++k;
+            }
+            if (k < n_keypoints && ex->interest[k] < end) {
+                end = ex->interest[k];
+            }
+            for (; b < end; ++b) {
+                if (label[b] == want) {
+                    out[n++] = pt[b];
+                }
+            }
+        }
+#endif
         if (ex->scratch.seg.label[b] != first) {
             if (b == last) {
                 break;
@@ -991,8 +1015,15 @@ typedef struct {
     float x, y, u, k0, k2, ax, ay, bx, by;
 } span_point_t;
 
-static BSF_COMPACT_INLINE void span_point(const bsf_point_t *ctrl, size_t m, float t,
-                                          span_point_t *c)
+/* Inlined in the speed builds too: out of line, its result went through the
+ * stack at every bin of bin_walk and every point of farthest_point. */
+#if !BSF_CONFIG_COMPACT && (defined(__GNUC__) || defined(__clang__))
+#define SPAN_POINT_INLINE inline __attribute__((always_inline))
+#else
+#define SPAN_POINT_INLINE BSF_COMPACT_INLINE
+#endif
+static SPAN_POINT_INLINE void span_point(const bsf_point_t *ctrl, size_t m, float t,
+                                         span_point_t *c)
 {
     const size_t last = m - 3u;
     const float x = t * (float)(m - 2u);
@@ -1172,6 +1203,34 @@ fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t 
     size_t beam;
     size_t k = 0u;
     float sum;
+#if !BSF_CONFIG_COMPACT
+    {
+        /* Speed only, the same points: the points before a counted in a
+         * loop of their own, the arrays in locals (the point stores made
+         * the compiler reload them at every beam). */
+        const uint16_t *label = ex->scratch.seg.label;
+        const bsf_point_t *pt = ex->points.pt;
+        const uint16_t want = s->first;
+        const size_t count = ex->points.count;
+        const size_t stop = a + n;
+        beam = s->first;
+        while (k < a) { /* the points before a: counted only */
+            k += label[beam] == want ? 1u : 0u;
+            if (++beam == count) {
+                beam = 0u;
+            }
+        }
+        while (k < stop) {
+            if (label[beam] == want) {
+                pts[k - a] = pt[beam];
+                ++k;
+            }
+            if (++beam == count) {
+                beam = 0u;
+            }
+        }
+    }
+#else
     for (beam = s->first; k < a + n; beam = beam + 1u < ex->points.count ? beam + 1u : 0u) {
         if (ex->scratch.seg.label[beam] == s->first) {
             if (k >= a) {
@@ -1180,6 +1239,7 @@ fit_returns_again(bsf_extractor_t *ex, const bsf_segment_t *s, size_t a, size_t 
             ++k;
         }
     }
+#endif
     if (ctrl == NULL) {
         return 0.0f;
     }

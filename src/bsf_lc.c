@@ -1785,30 +1785,45 @@ static void keypoints_down(bsf_keypoint_t *out, size_t slot, size_t n)
 #endif
 
 /* Douglas-Peucker split of run positions 0..m-1 with an explicit stack;
- * returns the number of splits, ascending in w->brk. */
+ * returns the number of splits, ascending in w->brk. The left piece of a
+ * split is done first and its right piece is stacked with its ends swapped
+ * (a > b, never a piece's own order), so popping it emits the split in
+ * order: no marks to clear and gather. */
 
 static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, float tol)
 {
     size_t top = 0;
     size_t nb = 0;
     size_t i;
-    memset(w->is_brk, 0, m);
     w->stack_a[top] = 0u;
     w->stack_b[top] = (uint16_t)(m - 1u);
     ++top;
     while (top > 0u) {
-        const size_t a = w->stack_a[--top];
-        const size_t b = w->stack_b[top];
-        const bsf_point_t pa = pts->pt[w->run[a]];
-        const bsf_point_t pb = pts->pt[w->run[b]];
-        const float ex = pb.x - pa.x;
-        const float ey = pb.y - pa.y;
-        const float len = sqrtf(ex * ex + ey * ey);
+        size_t a = w->stack_a[--top];
+        size_t b = w->stack_b[top];
+        bsf_point_t pa;
+        bsf_point_t pb;
+        float ex;
+        float ey;
+        float len;
         float dmax = 0.0f;
-        size_t imax = a;
+        size_t imax;
+        if (a > b) {
+            /* the right piece of the split at b: everything left of b is done */
+            w->brk[nb++] = (uint16_t)b;
+            i = a;
+            a = b;
+            b = i;
+        }
         if (b < a + 2u) {
             continue;
         }
+        pa = pts->pt[w->run[a]];
+        pb = pts->pt[w->run[b]];
+        ex = pb.x - pa.x;
+        ey = pb.y - pa.y;
+        len = sqrtf(ex * ex + ey * ey);
+        imax = a;
         i = a + 1u;
 #ifdef LC_SSE2
         if (len > 0.0f) {
@@ -1848,35 +1863,14 @@ static size_t split_run(const bsf_points_t *pts, bsf_lc_work_t *w, size_t m, flo
             }
         }
         if (dmax > tol) {
-            w->is_brk[imax] = 1u;
             /* Each pushed piece is a strict sub-range with disjoint interior,
              * so the stack never holds more than m entries. */
+            w->stack_a[top] = (uint16_t)b;
+            w->stack_b[top] = (uint16_t)imax;
+            ++top;
             w->stack_a[top] = (uint16_t)a;
             w->stack_b[top] = (uint16_t)imax;
             ++top;
-            w->stack_a[top] = (uint16_t)imax;
-            w->stack_b[top] = (uint16_t)b;
-            ++top;
-        }
-    }
-    i = 0;
-#ifdef LC_SSE2
-    /* sixteen marks per step, most of them all clear */
-    for (; i + 16u <= m; i += 16u) {
-        unsigned set = 0xFFFFu ^ (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(
-                                     _mm_loadu_si128((const __m128i *)(const void *)&w->is_brk[i]),
-                                     _mm_setzero_si128()));
-        size_t k;
-        for (k = i; set != 0u; ++k, set >>= 1) {
-            if (set & 1u) {
-                w->brk[nb++] = (uint16_t)k;
-            }
-        }
-    }
-#endif
-    for (; i < m; ++i) {
-        if (w->is_brk[i]) {
-            w->brk[nb++] = (uint16_t)i;
         }
     }
     return nb;
@@ -2138,11 +2132,35 @@ static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_l
                                             uint8_t *grazing_memo)
 {
     size_t prev = bsf_last_valid_beam(pts);
+#if !BSF_CONFIG_COMPACT
+    const size_t end = prev;
+    const float jump_a2 = p->jump_a * p->jump_a;
+#endif
     size_t i;
     if (prev == pts->count) {
         return 0u;
     }
     for (i = 0; i < pts->count; ++i) {
+#if !BSF_CONFIG_COMPACT
+        {
+            /* Speed only: the valid beams before the last one within
+             * jump_a of the valid beam before them (lc_joins' first test)
+             * join in a loop, the last point in registers. */
+            const uint8_t *valid = pts->valid;
+            const bsf_point_t *pt = pts->pt;
+            bsf_point_t at = pt[prev];
+            while (i < end) {
+                if (valid[i]) {
+                    if (!(dist2(at, pt[i]) <= jump_a2)) {
+                        break;
+                    }
+                    at = pt[i];
+                    prev = i;
+                }
+                ++i;
+            }
+        }
+#endif
         if (!pts->valid[i]) {
             continue;
         }
@@ -2264,6 +2282,46 @@ bsf_status_t bsf_lc_detect_memo(const bsf_points_t *pts, const bsf_lc_params_t *
         }
         if (step < pts->count) {
             work->run[m++] = (uint16_t)i;
+#if !BSF_CONFIG_COMPACT && !defined(LC_SSE2)
+            /* (only once i continued a run: where runs are a beam or two
+             * long, as in clutter, the loop would only test beams twice) */
+            if (m >= 2u) {
+                /* Speed only, same runs: the beams after i (before the
+                 * pass's end and the scan's) that are valid and within
+                 * jump_a of the one before join here, as the steps above
+                 * would join them, with the last point in registers (the
+                 * SSE2 form takes four at a time above). */
+                const size_t left = pts->count - 1u - (step > i ? step : i);
+                const size_t stop = i + left;
+                const uint8_t *valid = pts->valid;
+                const bsf_point_t *pt = pts->pt;
+                uint16_t *run = work->run;
+                bsf_point_t p0 = pt[i];
+                bsf_point_t p1;
+                size_t k = i;
+                /* two beams per round, the last point alternating between
+                 * p0 and p1 (no copy) */
+                for (;;) {
+                    if (k >= stop || !valid[k + 1u]) {
+                        break;
+                    }
+                    p1 = pt[k + 1u];
+                    if (!(dist2(p0, p1) <= jump_a2)) {
+                        break;
+                    }
+                    run[m++] = (uint16_t)++k;
+                    if (k >= stop || !valid[k + 1u]) {
+                        break;
+                    }
+                    p0 = pt[k + 1u];
+                    if (!(dist2(p1, p0) <= jump_a2)) {
+                        break;
+                    }
+                    run[m++] = (uint16_t)++k;
+                }
+                step += k - i;
+            }
+#endif
         }
     }
     if (c.start > 0u) {

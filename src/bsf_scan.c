@@ -266,11 +266,14 @@ bsf_status_t bsf_points_reject_no_return(bsf_points_t *pts, const bsf_no_return_
         for (i = 0; i < pts->count; ++i) {
             if (pts->valid[i]) {
                 const float r = pts->range[i];
-                if (r > top) {
-                    top = r;
-                    n_top = 1u;
-                } else if (r == top) {
-                    ++n_top;
+                /* one test for the usual r < top (a valid range is no NaN) */
+                if (r >= top) {
+                    if (r > top) {
+                        top = r;
+                        n_top = 1u;
+                    } else {
+                        ++n_top;
+                    }
                 }
             }
         }

@@ -750,6 +750,34 @@ static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float ca
     rad->cap2 = cap2;
 }
 
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+/* Speed only, same marks (bsf_sved_mixed_marks, after beam b - 1 passed its
+ * first test): the first beam from b on (2 <= b) that is valid and fails
+ * that test (its neighbours' ranges differ by more than the radius's floor),
+ * or count - 3; the beams before it, invalid or passing, the scan passes
+ * over. Out of line, so the scan's own loop keeps its registers. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+static size_t
+first_step_over(const bsf_points_t *pts, size_t b, float a2)
+{
+    const float *range = pts->range;
+    const uint8_t *valid = pts->valid;
+    const size_t stop = pts->count - 3u;
+    while (b < stop) {
+        if (valid[b]) {
+            const float step = range[b + 1u] - range[b - 1u];
+            if (!(step * step <= a2)) {
+                break;
+            }
+        }
+        ++b;
+    }
+    return b;
+}
+#endif
+
 size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p, uint8_t *marks,
                             uint16_t *off_line, size_t cap)
 {
@@ -796,6 +824,12 @@ size_t bsf_sved_mixed_marks(const bsf_points_t *pts, const bsf_sved_params_t *p,
             float lo;
             float hi;
             if (step * step <= rad.a2 || !between_neighbours(pts, b, &r[1], &lo, &hi)) {
+#ifndef SEG_SSE2
+                if (step * step <= rad.a2) {
+                    /* and on over the beams after it that pass too */
+                    b = first_step_over(pts, b + 1u, rad.a2) - 1u;
+                }
+#endif
                 continue;
             }
             /* and on with its other tests, where is_mixed_pixel goes on */
@@ -856,6 +890,9 @@ static int close_open(seg_sink_t *sink, const open_seg_t *s, uint16_t *label, si
 static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float cap2)
 {
     size_t prev = bsf_last_valid_beam(pts);
+#if !BSF_CONFIG_COMPACT
+    const size_t end = prev;
+#endif
     size_t i;
     if (prev == pts->count) {
         return 0u;
@@ -863,6 +900,28 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
     for (i = 0; i < pts->count; ++i) {
         float dx;
         float dy;
+#if !BSF_CONFIG_COMPACT
+        {
+            /* Speed only: the valid beams before the last one within the
+             * radius's floor of the valid beam before them (within_radius'
+             * first test) join in a loop, the last point in registers. */
+            const uint8_t *valid = pts->valid;
+            const bsf_point_t *pt = pts->pt;
+            bsf_point_t at = pt[prev];
+            while (i < end) {
+                if (valid[i]) {
+                    dx = pt[i].x - at.x;
+                    dy = pt[i].y - at.y;
+                    if (!(dx * dx + dy * dy <= a2)) {
+                        break;
+                    }
+                    at = pt[i];
+                    prev = i;
+                }
+                ++i;
+            }
+        }
+#endif
         if (!pts->valid[i]) {
             continue;
         }
@@ -875,6 +934,60 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
     }
     return 0u;
 }
+
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+/* Speed only, same segments (sved_run with one open segment o, which beam b,
+ * at pass position j, just extended: no end to search, none to expire): the
+ * beams after b up to beam cend (before the pass's end and the scan's), each
+ * valid, not marked mixed (marks NULL: none is) and within the radius's
+ * floor of the segment's end, continue it as sved_run's steps would; an
+ * invalid beam is passed over as there. Returns how many beams it took
+ * (up to the last one joined). Out of line, so sved_run's own loop keeps
+ * its registers. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+static size_t
+sved_continue(const bsf_points_t *pts, const uint8_t *marks, uint16_t *label, open_seg_t *o,
+              size_t b, size_t cend, float a2, size_t j)
+{
+    const uint8_t *valid = pts->valid;
+    const bsf_point_t *pt = pts->pt;
+    const uint16_t first = (uint16_t)o->first;
+    bsf_point_t end = o->end;
+    size_t n_more = 0u;
+    size_t last = b;
+    size_t c;
+    for (c = b + 1u; c <= cend; ++c) {
+        float dx;
+        float dy;
+        if (!valid[c]) {
+            continue;
+        }
+        if (marks != NULL && ((marks[c / 8u] >> (c % 8u)) & 1u) != 0u) {
+            break;
+        }
+        dx = pt[c].x - end.x;
+        dy = pt[c].y - end.y;
+        if (!(dx * dx + dy * dy <= a2)) {
+            break;
+        }
+        end = pt[c];
+        last = c;
+        ++n_more;
+        if (label != NULL) {
+            label[c] = first;
+        }
+    }
+    if (n_more > 0u) {
+        o->last = (uint32_t)last;
+        o->last_pos = (uint32_t)(j + (last - b));
+        o->n += (uint32_t)n_more;
+        o->end = end;
+    }
+    return last - b;
+}
+#endif
 
 /* Both SVED entry points: with extensions 0, the paper's rule whatever the
  * extension fields say (checked, then ignored), and no full-circle pass. */
@@ -900,6 +1013,9 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     int reject_mixed;
     int grazing;
     int ring;
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+    size_t one_open;
+#endif
 
     st = begin(pts, out, cap, n_out, n_wasted_points, &sink);
     if (st != BSF_OK) {
@@ -926,6 +1042,11 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
     if (ring) {
         start = ring_start(pts, a2, two_b, cap2);
     }
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+    /* sved_continue serves one open segment, and mixed pixels only marked
+     * (else 0: n_open is never 0 there) */
+    one_open = !reject_mixed || marks != NULL ? 1u : 0u;
+#endif
 
     for (j = 0; j < pts->count; ++j) {
         size_t b = start + j;
@@ -1050,6 +1171,14 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         if (label != NULL) {
             label[b] = (uint16_t)open[0].first;
         }
+#if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
+        if (n_open == one_open) {
+            /* the beams passed over (invalid ones after the last joined
+             * included) are steps the loop would only skip */
+            j += sved_continue(pts, reject_mixed ? marks : NULL, label, &open[0], b,
+                               b + (pts->count - 1u - (j > b ? j : b)), a2, j);
+        }
+#endif
     }
     /* Close the rest, oldest first. */
     while (n_open > 0u) {

@@ -162,8 +162,8 @@ typedef struct {
     float noise2;
     /* Arrays in the order that measured smallest on the M4F (the byte
      * array and the run first; docs/PERFORMANCE.md, section 3). */
-    uint8_t is_brk[BSF_MAX_POINTS];     /**< split marks, positions in run; then each split's
-                                             last verdict (1 corner, 2 boundary) */
+    uint8_t is_brk[BSF_MAX_POINTS];     /**< at each split's position in run, its last
+                                             verdict (1 corner, 2 boundary) */
     uint16_t run[BSF_MAX_POINTS];       /**< beam index of each valid point of the current run */
     uint16_t judged_lo[BSF_MAX_POINTS]; /**< per split: neighbours of its last corner or
                                              boundary verdict */
