@@ -177,6 +177,21 @@ static void test_a_corner_behind_a_thin_post_is_found(void)
     TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
 }
 
+/* At 0.25 deg beams a post 16 cm wide 4 m away is 9 beams wide, more than
+ * the 2 * min_side_points beams a run skips for any occluder, within the 16
+ * (LC_OCCLUDER_BEAMS, SVED's max_gap_beams) it skips for one that starts
+ * nearer than the run's end: the corner it hides 6 m away is found. */
+static void test_a_corner_behind_a_post_nine_beams_wide_is_found_at_fine_beams(void)
+{
+    size_t n;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 6.0, 0.0, 0.75 * PI, 3.0, 1.25 * PI, 3.0));
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 4.0, 0.0, 0.08) >= 0);
+    n = detect(0.0, 0.0, 0.0, 1081u, 1.5 * PI, 0.01);
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+    TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
+}
+
 /* A room corner 7 m away whose second wall is seen at 77 deg incidence:
  * its returns near the corner are 0.4 m apart at 0.75 deg beams, wider
  * than the jump radius there (0.33 m), so without grazing joins the run
@@ -752,6 +767,7 @@ int main(void)
     RUN_TEST(test_a_lone_far_corner_is_found_at_one_degree_beams);
     RUN_TEST(test_a_corner_beyond_30_m_is_found);
     RUN_TEST(test_a_corner_behind_a_thin_post_is_found);
+    RUN_TEST(test_a_corner_behind_a_post_nine_beams_wide_is_found_at_fine_beams);
     RUN_TEST(test_a_corner_onto_a_wall_seen_at_grazing_incidence_is_found_with_grazing_joins);
     RUN_TEST(test_grazing_joins_add_no_corner_on_straight_walls_or_at_depth_jumps);
     RUN_TEST(test_a_corner_onto_a_wall_seen_nearly_edge_on_is_found_with_corner_joins);
