@@ -2079,7 +2079,8 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
  * look-back keeps such a wall one segment too). When i is nearer than a
  * (a step towards the sensor: an occluder, not a recess behind a's
  * surface), within LC_OCCLUDER_BEAMS: at fine beams an occluder is wider
- * than 2 * min_side_points beams, and its own run then goes unjudged. Else
+ * than 2 * min_side_points beams, and its own run then goes unjudged;
+ * past those the return after the resumed one must continue it too. Else
  * returns i. One exponential per jump: the radius is taken at a's range. */
 static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
 {
@@ -2088,8 +2089,13 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
                             ? i + LC_OCCLUDER_BEAMS
                             : narrow;
     const float x = p->jump_b * pts->range[a];
+#if BSF_CONFIG_COMPACT
+    /* x >= 0, so bsf_expf(x) >= 1 and r >= jump_a: d2 <= r2 alone decides
+     * as the fast path's tests do, for one exponential per jump anyway. */
+    const float r = p->jump_a * bsf_expf(x);
+    const float r2 = r * r;
+#else
     float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
-#if !BSF_CONFIG_COMPACT
     /* Bounds on r2 that spare the exponential, as in within_jump; computed
      * once, when a point is beyond jump_a. */
     float r2_lo = -1.0f;
@@ -2100,30 +2106,38 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
     for (j = i + 1u; j <= span && j < pts->count; ++j) {
         if (pts->valid[j]) {
             const float d2 = dist2(pts->pt[a], pts->pt[j]);
-            if (d2 <= p->jump_a * p->jump_a) {
-                return j;
+#if BSF_CONFIG_COMPACT
+            const int near = d2 <= r2;
+#else
+            int near = d2 <= p->jump_a * p->jump_a;
+            if (!near) {
+                if (!have_bounds && x >= 0.0f && x <= 1.0f) {
+                    float lo;
+                    float hi;
+                    bsf_exp_bounds01(x, &lo, &hi);
+                    r2_lo = (p->jump_a * lo) * (p->jump_a * lo);
+                    r2_hi = (p->jump_a * hi) * (p->jump_a * hi);
+                }
+                have_bounds = 1;
+                near = d2 <= r2_lo;
+                if (!near && d2 > r2_hi) {
+                    continue;
+                }
             }
-#if !BSF_CONFIG_COMPACT
-            if (!have_bounds && x >= 0.0f && x <= 1.0f) {
-                float lo;
-                float hi;
-                bsf_exp_bounds01(x, &lo, &hi);
-                r2_lo = (p->jump_a * lo) * (p->jump_a * lo);
-                r2_hi = (p->jump_a * hi) * (p->jump_a * hi);
-            }
-            have_bounds = 1;
-            if (d2 <= r2_lo) {
-                return j;
-            }
-            if (d2 > r2_hi) {
-                continue;
+            if (!near) {
+                if (r2 < 0.0f) {
+                    const float r = p->jump_a * bsf_expf(x);
+                    r2 = r * r;
+                }
+                near = d2 <= r2;
             }
 #endif
-            if (r2 < 0.0f) {
-                const float r = p->jump_a * bsf_expf(x);
-                r2 = r * r;
-            }
-            if (d2 <= r2) {
+            /* Past 2 * min_side_points beams the return after j must
+             * continue it too (range within jump_a; an invalid one is at
+             * range 0): a blend at the occluder's far edge, between it and
+             * the surface behind, may lie within the radius of a. */
+            if (near && (j <= narrow || (j + 1u < pts->count &&
+                                         fabsf(pts->range[j + 1u] - pts->range[j]) <= p->jump_a))) {
                 return j;
             }
         }
