@@ -53,6 +53,12 @@ static inline __m128 lc_pair(const bsf_point_t *p, const bsf_point_t *q)
 #define LC_EVIDENCE_SIGMAS 5.0f
 /* Gauss-Newton steps of the geometric circle fit in the evidence route. */
 #define LC_CIRCLE_STEPS 3u
+/* Widest occluder, in beams, that a run goes on past when its first return
+ * is nearer than the run's end (past_occluder): SVED's default
+ * max_gap_beams, so LC judges the corner hidden behind an occluder that
+ * SVED's look-back keeps in one segment (a post 16 cm wide 4 m away is 9
+ * beams at 0.25 deg). */
+#define LC_OCCLUDER_BEAMS 16u
 
 bsf_lc_params_t bsf_lc_params_default(void)
 {
@@ -2064,14 +2070,26 @@ static int within_jump(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t
  * leg) too narrow to hold a corner of its own (LC judges no run shorter
  * than 2 * min_side_points + 1): returns the beam where the run resumes, so
  * a corner hidden behind it is still judged from both walls (SVED's
- * look-back keeps such a wall one segment too). Else returns i. One
- * exponential per jump: the radius is taken at a's range. */
+ * look-back keeps such a wall one segment too). When i is nearer than a
+ * (a step towards the sensor: an occluder, not a recess behind a's
+ * surface), within LC_OCCLUDER_BEAMS: at fine beams an occluder is wider
+ * than 2 * min_side_points beams, and its own run then goes unjudged;
+ * past those the return after the resumed one must continue it too. Else
+ * returns i. One exponential per jump: the radius is taken at a's range. */
 static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, size_t a, size_t i)
 {
-    const size_t span = 2u * (size_t)p->min_side_points;
+    const size_t narrow = i + 2u * (size_t)p->min_side_points;
+    const size_t span = pts->range[i] < pts->range[a] && narrow < i + LC_OCCLUDER_BEAMS
+                            ? i + LC_OCCLUDER_BEAMS
+                            : narrow;
     const float x = p->jump_b * pts->range[a];
+#if BSF_CONFIG_COMPACT
+    /* x >= 0, so bsf_expf(x) >= 1 and r >= jump_a: d2 <= r2 alone decides
+     * as the fast path's tests do, for one exponential per jump anyway. */
+    const float r = p->jump_a * bsf_expf(x);
+    const float r2 = r * r;
+#else
     float r2 = -1.0f; /* computed once, when a point is beyond jump_a */
-#if !BSF_CONFIG_COMPACT
     /* Bounds on r2 that spare the exponential, as in within_jump; computed
      * once, when a point is beyond jump_a. */
     float r2_lo = -1.0f;
@@ -2079,33 +2097,41 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
     int have_bounds = 0;
 #endif
     size_t j;
-    for (j = i + 1u; j <= i + span && j < pts->count; ++j) {
+    for (j = i + 1u; j <= span && j < pts->count; ++j) {
         if (pts->valid[j]) {
             const float d2 = dist2(pts->pt[a], pts->pt[j]);
-            if (d2 <= p->jump_a * p->jump_a) {
-                return j;
+#if BSF_CONFIG_COMPACT
+            const int near = d2 <= r2;
+#else
+            int near = d2 <= p->jump_a * p->jump_a;
+            if (!near) {
+                if (!have_bounds && x >= 0.0f && x <= 1.0f) {
+                    float lo;
+                    float hi;
+                    bsf_exp_bounds01(x, &lo, &hi);
+                    r2_lo = (p->jump_a * lo) * (p->jump_a * lo);
+                    r2_hi = (p->jump_a * hi) * (p->jump_a * hi);
+                }
+                have_bounds = 1;
+                near = d2 <= r2_lo;
+                if (!near && d2 > r2_hi) {
+                    continue;
+                }
             }
-#if !BSF_CONFIG_COMPACT
-            if (!have_bounds && x >= 0.0f && x <= 1.0f) {
-                float lo;
-                float hi;
-                bsf_exp_bounds01(x, &lo, &hi);
-                r2_lo = (p->jump_a * lo) * (p->jump_a * lo);
-                r2_hi = (p->jump_a * hi) * (p->jump_a * hi);
-            }
-            have_bounds = 1;
-            if (d2 <= r2_lo) {
-                return j;
-            }
-            if (d2 > r2_hi) {
-                continue;
+            if (!near) {
+                if (r2 < 0.0f) {
+                    const float r = p->jump_a * bsf_expf(x);
+                    r2 = r * r;
+                }
+                near = d2 <= r2;
             }
 #endif
-            if (r2 < 0.0f) {
-                const float r = p->jump_a * bsf_expf(x);
-                r2 = r * r;
-            }
-            if (d2 <= r2) {
+            /* Past 2 * min_side_points beams the return after j must
+             * continue it too (range within jump_a; an invalid one is at
+             * range 0): a blend at the occluder's far edge, between it and
+             * the surface behind, may lie within the radius of a. */
+            if (near && (j <= narrow || (j + 1u < pts->count &&
+                                         fabsf(pts->range[j + 1u] - pts->range[j]) <= p->jump_a))) {
                 return j;
             }
         }

@@ -78,6 +78,19 @@ static size_t detect_ring(double x, double y, double heading, size_t n, double s
     return n_out;
 }
 
+/* LC with its defaults on the ranges[] of lidar lid as they are (no new
+ * scan); returns the keypoint count. */
+static size_t detect_ranges(const bsf_lidar_t *lid)
+{
+    const bsf_lc_params_t p = bsf_lc_params_default();
+    const bsf_scan_t scan = bsf_scene_lidar_scan(lid, ranges);
+    size_t n_out = 0;
+    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
+    return n_out;
+}
+
 /* Distance from keypoint k to the world point (wx, wy) seen from the pose. */
 static double dist_to(size_t k, double x, double y, double heading, double wx, double wy)
 {
@@ -175,6 +188,58 @@ static void test_a_corner_behind_a_thin_post_is_found(void)
     n = detect(0.0, 0.0, 0.0, 541u, 1.5 * PI, 0.01);
     TEST_ASSERT_EQUAL_size_t(1u, n);
     TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
+}
+
+/* At 0.25 deg beams a post 16 cm wide 4 m away is 9 beams wide, more than
+ * the 2 * min_side_points beams a run skips for any occluder, within the 16
+ * (LC_OCCLUDER_BEAMS, SVED's max_gap_beams) it skips for one that starts
+ * nearer than the run's end: the corner it hides 6 m away is found. */
+static void test_a_corner_behind_a_post_nine_beams_wide_is_found_at_fine_beams(void)
+{
+    size_t n;
+    TEST_ASSERT_EQUAL_INT(BSF_OK,
+                          bsf_scene_add_corner(&scene, 6.0, 0.0, 0.75 * PI, 3.0, 1.25 * PI, 3.0));
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 4.0, 0.0, 0.08) >= 0);
+    n = detect(0.0, 0.0, 0.0, 1081u, 1.5 * PI, 0.01);
+    TEST_ASSERT_EQUAL_size_t(1u, n);
+    TEST_ASSERT_TRUE(dist_to(0, 0.0, 0.0, 0.0, 6.0, 0.0) < 0.03);
+}
+
+/* The cluttered room's pose 15 at 1081 beams with mixed pixels, reduced: a
+ * wall 4.5 m away, a post 3 m away 7 beams wide (more than 2 *
+ * min_side_points) and just past it a box 1 m away. The one beam between
+ * them sees the wall, blended 12 cm towards the post: within the jump
+ * radius of the wall's last return before the post, but the return after
+ * it (the box) does not continue it, so the run does not resume there. It
+ * did (the return after was not checked), and the run ending with the
+ * blend put a corner on the wall beside the post. */
+static void test_a_blend_at_an_occluders_far_edge_does_not_resume_the_run(void)
+{
+    bsf_lidar_t lid = bsf_lidar_default(0.0, 0.0, 0.0, 1081u, 1.5 * PI);
+    size_t n;
+    size_t k;
+    size_t b = 0;
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 4.5, -3.0, 4.5, 3.0) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_circle(&scene, 3.0, 0.0, 0.05) >= 0);
+    TEST_ASSERT_TRUE(bsf_scene_add_segment(&scene, 1.0, 0.018, 1.0, 0.6) >= 0);
+    n = detect_lidar(&lid, 0.01);
+    for (k = 0; k < n; ++k) {
+        TEST_ASSERT_TRUE(hypot((double)kps[k].point.x - 4.5, (double)kps[k].point.y) > 0.5);
+    }
+    /* b: the beam past the post's far edge */
+    for (k = 1; k < lid.n_beams; ++k) {
+        if (ranges[k - 1u] < 3.5f && ranges[k - 1u] > 2.5f && ranges[k] > 3.5f) {
+            b = k;
+        }
+    }
+    TEST_ASSERT_TRUE(b > 7u && ranges[b] > 4.4f && ranges[b + 1u] < 1.1f);
+    TEST_ASSERT_TRUE(ranges[b - 7u] > 2.5f && ranges[b - 8u] > 4.4f); /* 7 beams */
+    ranges[b] -= 0.12f;
+    n = detect_ranges(&lid);
+    for (k = 0; k < n; ++k) {
+        TEST_ASSERT_TRUE_MESSAGE(hypot((double)kps[k].point.x - 4.5, (double)kps[k].point.y) > 0.5,
+                                 "a corner on the wall beside the post");
+    }
 }
 
 /* A room corner 7 m away whose second wall is seen at 77 deg incidence:
@@ -640,19 +705,6 @@ static void test_the_scans_noise_follows_the_range_noise(void)
     TEST_ASSERT_TRUE(work.noise2 == 0.0f);
 }
 
-/* LC with its defaults on the ranges[] of lidar lid as they are (no new
- * scan); returns the keypoint count. */
-static size_t detect_ranges(const bsf_lidar_t *lid)
-{
-    const bsf_lc_params_t p = bsf_lc_params_default();
-    const bsf_scan_t scan = bsf_scene_lidar_scan(lid, ranges);
-    size_t n_out = 0;
-    TEST_ASSERT_EQUAL_INT(BSF_OK, bsf_scan_to_points(&scan, &points));
-    TEST_ASSERT_EQUAL_INT(BSF_OK,
-                          bsf_lc_detect(&points, &p, &work, kps, BSF_MAX_KEYPOINTS, &n_out));
-    return n_out;
-}
-
 /* A room corner 11.5 m away (the demo office's, 1 deg beams, no noise)
  * whose first wall is seen at grazing incidence, its returns 0.4-0.5 m
  * apart, and whose second wall faces the sensor. Mixed pixels on the first
@@ -752,6 +804,8 @@ int main(void)
     RUN_TEST(test_a_lone_far_corner_is_found_at_one_degree_beams);
     RUN_TEST(test_a_corner_beyond_30_m_is_found);
     RUN_TEST(test_a_corner_behind_a_thin_post_is_found);
+    RUN_TEST(test_a_corner_behind_a_post_nine_beams_wide_is_found_at_fine_beams);
+    RUN_TEST(test_a_blend_at_an_occluders_far_edge_does_not_resume_the_run);
     RUN_TEST(test_a_corner_onto_a_wall_seen_at_grazing_incidence_is_found_with_grazing_joins);
     RUN_TEST(test_grazing_joins_add_no_corner_on_straight_walls_or_at_depth_jumps);
     RUN_TEST(test_a_corner_onto_a_wall_seen_nearly_edge_on_is_found_with_corner_joins);
