@@ -806,7 +806,8 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
 
 /* The first and last of the n gathered points to fit (LC with trim_tails):
  * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
- * that leaves the other end out) is left off. With an LC corner within
+ * that leaves the other end out; the blend mode's run, one return further
+ * in, reaches the other end on a segment of 9 or 10 returns) is left off. With an LC corner within
  * that run the run is the corner's side: the returns between the end and
  * the corner, its apex left out; with the corner two returns from the end,
  * up to TAIL_RUN returns from the vertex, not past the next one nor to the

@@ -57,7 +57,8 @@ static inline __m128 lc_pair(const bsf_point_t *p, const bsf_point_t *q)
  * is nearer than the run's end (past_occluder): SVED's default
  * max_gap_beams, so LC judges the corner hidden behind an occluder that
  * SVED's look-back keeps in one segment (a post 16 cm wide 4 m away is 9
- * beams at 0.25 deg). */
+ * beams at 0.25 deg). A fixed number: LC does not see the SVED parameters,
+ * so it stays 16 whatever sved.max_gap_beams a caller sets. */
 #define LC_OCCLUDER_BEAMS 16u
 
 bsf_lc_params_t bsf_lc_params_default(void)
@@ -2129,7 +2130,9 @@ static size_t past_occluder(const bsf_points_t *pts, const bsf_lc_params_t *p, s
             /* Past 2 * min_side_points beams the return after j must
              * continue it too (range within jump_a; an invalid one is at
              * range 0): a blend at the occluder's far edge, between it and
-             * the surface behind, may lie within the radius of a. */
+             * the surface behind, may lie within the radius of a. So a
+             * dropout or the scan's last beam right after j keeps the run
+             * from resuming at j (the next candidate may still). */
             if (near && (j <= narrow || (j + 1u < pts->count &&
                                          fabsf(pts->range[j + 1u] - pts->range[j]) <= p->jump_a))) {
                 return j;

@@ -754,7 +754,7 @@ static void beam_radius_init(beam_radius_t *rad, float a2, float two_b, float ca
 /* Speed only, same marks (bsf_sved_mixed_marks, after beam b - 1 passed its
  * first test): the first beam from b on (2 <= b) that is valid and fails
  * that test (its neighbours' ranges differ by more than the radius's floor),
- * or count - 3; the beams before it, invalid or passing, the scan passes
+ * or max(b, count - 3); the beams before it, invalid or passing, the scan passes
  * over. Out of line, so the scan's own loop keeps its registers. */
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((noinline))
@@ -1173,8 +1173,8 @@ static bsf_status_t sved_run(const bsf_points_t *pts, const bsf_sved_params_t *p
         }
 #if !BSF_CONFIG_COMPACT && !defined(SEG_SSE2)
         if (n_open == one_open) {
-            /* the beams passed over (invalid ones after the last joined
-             * included) are steps the loop would only skip */
+            /* the beams passed over are steps the loop would only skip
+             * (invalid ones after the last joined are left to the loop) */
             j += sved_continue(pts, reject_mixed ? marks : NULL, label, &open[0], b,
                                b + (pts->count - 1u - (j > b ? j : b)), a2, j);
         }

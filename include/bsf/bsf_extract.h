@@ -188,7 +188,8 @@ typedef struct {
     /* The scalars before the arrays: Thumb-2 loads a field within 4 KB of a
      * pointer (1 KB for a float) in one instruction, one farther away takes
      * an address computation first (docs/PERFORMANCE.md, section 3); the
-     * small arrays next, the points (14 KB) last. */
+     * small arrays next, then the stages' scratch, the points (14 KB)
+     * last. */
     size_t n_keypoints;
     size_t n_segments;
     float noise2;   /**< the scan's noise variance by LC (bsf_lc_work_t), for the tail rule */
