@@ -804,37 +804,36 @@ static int floating_end(const bsf_points_t *pts, size_t b, int dir)
     return o < pts->count && pts->valid[o] && pts->range[o] < pts->range[b];
 }
 
-/* The first and last of the n gathered points to fit (LC with trim_tails):
- * a tail (tail_end, judged by the run of up to TAIL_RUN returns beside it
- * that leaves the other end out; the blend mode's run, one return further
- * in, reaches the other end on a segment of 9 or 10 returns) is left off. With an LC corner within
- * that run the run is the corner's side: the returns between the end and
- * the corner, its apex left out; with the corner two returns from the end,
- * up to TAIL_RUN returns from the vertex, not past the next one nor to the
- * other end. A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1 returns judges
- * only a floating end (floating_end): a far surface seen over a few
- * returns through a gap, whose end beam blends with the surface in
- * front. A segment too short for TAIL_MIN_RUN and without a corner gets
- * one, a vertex at its third return from that end anchored at the
- * crossing, when its last two returns at one end are a second surface
- * (tail_end with an apex, judged by the other returns): its one quadratic
- * span cannot turn there and would swing off both surfaces, and leaving
- * the two returns out would waste a third of the segment. A segment of 6
- * to 8 returns without a corner is judged the same way through views of 5
- * or 6 returns that leave 1 to 3 returns out at one end (shortest view
- * first): a corner between a wall seen at grazing incidence (3-4 returns
- * half a metre apart) and the next wall (3-4 returns a tenth of that
- * apart), the two returns of one wall nearest the corner judged against
- * the other wall's line; the shortest run that passes puts the vertex
- * between the last sparse and the first dense return. Before the tail
- * test, an end with no corner within 6 returns asks whether its second
- * return is a blend (a mixed pixel) and the end a return of a nearer
- * surface (tail_end's blend mode, judged by the tail rule's run one return
- * further in, at least 6 returns): a side wall at grazing incidence or an
- * occluder whose last return SVED joined through the blend. Both leave:
- * a curve bent to reach them swings through free space. Returns the
- * segment's vertex count (vertex_pos and vertex_anchor, as gather_segment
- * wrote them, or that one vertex). */
+/* The first and last of the n gathered points to fit (LC with trim_tails): a
+ * tail (tail_end, judged by the run of up to TAIL_RUN returns beside it that
+ * leaves the other end out; the blend mode's run, one return further in,
+ * reaches the other end on a segment of 9 or 10 returns) is left off. With
+ * an LC corner within that run the run is the corner's side: the returns
+ * between the end and the corner, its apex left out; with the corner two
+ * returns from the end, up to TAIL_RUN returns from the vertex, not past the
+ * next one nor to the other end. A run of TAIL_FLOAT_RUN to TAIL_MIN_RUN - 1
+ * returns judges only a floating end (floating_end): a far surface seen over
+ * a few returns through a gap, whose end beam blends with the surface in
+ * front. A segment too short for TAIL_MIN_RUN and without a corner gets one,
+ * a vertex at its third return from that end anchored at the crossing, when
+ * its last two returns at one end are a second surface (tail_end with an
+ * apex, judged by the other returns): its one quadratic span cannot turn
+ * there and would swing off both surfaces, and leaving the two returns out
+ * would waste a third of the segment. A segment of 6 to 8 returns without a
+ * corner is judged the same way through views of 5 or 6 returns that leave 1
+ * to 3 returns out at one end (shortest view first): a corner between a wall
+ * seen at grazing incidence (3-4 returns half a metre apart) and the next
+ * wall (3-4 returns a tenth of that apart), the two returns of one wall
+ * nearest the corner judged against the other wall's line; the shortest run
+ * that passes puts the vertex between the last sparse and the first dense
+ * return. Before the tail test, an end with no corner within 6 returns asks
+ * whether its second return is a blend (a mixed pixel) and the end a return
+ * of a nearer surface (tail_end's blend mode, judged by the tail rule's run
+ * one return further in, at least 6 returns): a side wall at grazing
+ * incidence or an occluder whose last return SVED joined through the blend.
+ * Both leave: a curve bent to reach them swings through free space. Returns
+ * the segment's vertex count (vertex_pos and vertex_anchor, as
+ * gather_segment wrote them, or that one vertex). */
 static BSF_COMPACT_NOINLINE size_t trim_tails(bsf_extractor_t *ex, const bsf_segment_t *s, size_t n,
                                               size_t n_vertex, size_t *lo, size_t *hi)
 {

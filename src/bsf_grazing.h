@@ -57,6 +57,34 @@ static inline size_t bsf_last_valid_beam(const bsf_points_t *pts)
     return pts->count;
 }
 
+#if !BSF_CONFIG_COMPACT
+/* Speed only, for SVED's and LC's ring_start: from beam i on, the valid
+ * beams before beam end within sqrt(r2) of the valid beam before them
+ * (*prev the first) join in a loop, the last point in registers. Returns
+ * the first beam that does not join (or end), with *prev the last that
+ * did: each caller's own test then judges that beam as before. */
+static inline size_t bsf_join_near_beams(const bsf_points_t *pts, size_t i, size_t end, float r2,
+                                         size_t *prev)
+{
+    const uint8_t *valid = pts->valid;
+    const bsf_point_t *pt = pts->pt;
+    bsf_point_t at = pt[*prev];
+    while (i < end) {
+        if (valid[i]) {
+            const float dx = pt[i].x - at.x;
+            const float dy = pt[i].y - at.y;
+            if (!(dx * dx + dy * dy <= r2)) {
+                break;
+            }
+            at = pt[i];
+            *prev = i;
+        }
+        ++i;
+    }
+    return i;
+}
+#endif
+
 #if BSF_CONFIG_SIMD && defined(__SSE2__)
 #include <emmintrin.h>
 #include <string.h>

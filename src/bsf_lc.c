@@ -2171,24 +2171,9 @@ static BSF_COMPACT_INLINE size_t ring_start(const bsf_points_t *pts, const bsf_l
     }
     for (i = 0; i < pts->count; ++i) {
 #if !BSF_CONFIG_COMPACT
-        {
-            /* Speed only: the valid beams before the last one within
-             * jump_a of the valid beam before them (lc_joins' first test)
-             * join in a loop, the last point in registers. */
-            const uint8_t *valid = pts->valid;
-            const bsf_point_t *pt = pts->pt;
-            bsf_point_t at = pt[prev];
-            while (i < end) {
-                if (valid[i]) {
-                    if (!(dist2(at, pt[i]) <= jump_a2)) {
-                        break;
-                    }
-                    at = pt[i];
-                    prev = i;
-                }
-                ++i;
-            }
-        }
+        /* the beams before the last one within jump_a of the one before
+         * (lc_joins' first test) join without a call */
+        i = bsf_join_near_beams(pts, i, end, jump_a2, &prev);
 #endif
         if (!pts->valid[i]) {
             continue;

@@ -901,26 +901,9 @@ static size_t ring_start(const bsf_points_t *pts, float a2, float two_b, float c
         float dx;
         float dy;
 #if !BSF_CONFIG_COMPACT
-        {
-            /* Speed only: the valid beams before the last one within the
-             * radius's floor of the valid beam before them (within_radius'
-             * first test) join in a loop, the last point in registers. */
-            const uint8_t *valid = pts->valid;
-            const bsf_point_t *pt = pts->pt;
-            bsf_point_t at = pt[prev];
-            while (i < end) {
-                if (valid[i]) {
-                    dx = pt[i].x - at.x;
-                    dy = pt[i].y - at.y;
-                    if (!(dx * dx + dy * dy <= a2)) {
-                        break;
-                    }
-                    at = pt[i];
-                    prev = i;
-                }
-                ++i;
-            }
-        }
+        /* the beams before the last one within the radius's floor of the
+         * one before (within_radius' first test) join without the test */
+        i = bsf_join_near_beams(pts, i, end, a2, &prev);
 #endif
         if (!pts->valid[i]) {
             continue;
